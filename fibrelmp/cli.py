@@ -1,0 +1,167 @@
+"""Command-line interface: thin adapters; heavy modules are imported inside commands.
+
+Exit codes: 0 success, 2 bad input (InputError), 1 run failure (RunError / LAMMPS).
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+from . import __version__
+
+app = typer.Typer(add_completion=True, no_args_is_help=True, rich_markup_mode=None,
+                  help="Run FibreNet inputs on LAMMPS and write FibreNet's own outputs.")
+
+_state = {"quiet": False, "verbose": False}
+
+
+def _say(msg: str) -> None:
+    if not _state["quiet"]:
+        typer.echo(msg, err=True)
+
+
+def _report_warnings(warnings: list[tuple[str, str]]) -> None:
+    groups: dict[str, list[str]] = {}
+    for kind, text in warnings:
+        groups.setdefault(kind, []).append(text)
+    for kind, texts in groups.items():
+        count = f" ({len(texts)})" if len(texts) > 1 else ""
+        typer.secho(f"warning [{kind}]{count}: {texts[0]}", err=True, fg=typer.colors.YELLOW)
+        if _state["verbose"]:
+            for t in texts[1:]:
+                typer.secho(f"  {t}", err=True, fg=typer.colors.YELLOW)
+
+
+def _guard(func):
+    """Turn fibrelmp's exceptions into messages and exit codes (no traceback)."""
+    import functools
+
+    @functools.wraps(func)
+    def wrapper(*args, **kwargs):
+        from .errors import InputError, RunError
+
+        try:
+            return func(*args, **kwargs)
+        except InputError as exc:
+            typer.secho(f"error: {exc}", err=True, fg=typer.colors.RED)
+            raise typer.Exit(2)
+        except RunError as exc:
+            typer.secho(f"run failed: {exc}", err=True, fg=typer.colors.RED)
+            raise typer.Exit(1)
+        except KeyboardInterrupt:
+            typer.secho("interrupted", err=True, fg=typer.colors.RED)
+            raise typer.Exit(130)
+    return wrapper
+
+
+def _version(value: bool) -> None:
+    if value:
+        typer.echo(f"fibrelmp {__version__}")
+        try:
+            from ._lammps import load_lammps_module
+
+            lmp = load_lammps_module().lammps(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
+            typer.echo(f"LAMMPS {lmp.version()} (MPI support: {bool(lmp.has_mpi_support)})")
+            lmp.close()
+        except Exception as exc:  # version output must never crash
+            typer.echo(f"LAMMPS unavailable: {exc}")
+        raise typer.Exit()
+
+
+@app.callback()
+def main_options(
+    quiet: bool = typer.Option(False, "--quiet", "-q", help="Only warnings and errors."),
+    verbose: bool = typer.Option(False, "--verbose", "-v", help="Show every warning and more detail."),
+    version: Optional[bool] = typer.Option(None, "--version", callback=_version, is_eager=True,
+                                           help="Print fibrelmp and LAMMPS versions."),
+) -> None:
+    _state["quiet"], _state["verbose"] = quiet, verbose
+
+
+@app.command()
+@_guard
+def check(input: Path = typer.Argument(..., help="FibreNet input file.")) -> None:
+    """Parse and validate INPUT without running; print a summary.
+
+    Example: fibrelmp check examples/fibre_network/input.txt
+    """
+    from .api import read_input
+
+    model = read_input(input)
+    p = model.particles
+    lines = [f"input        {model.source}",
+             f"units        {model.units}",
+             f"beads        {p.count}",
+             f"springs      {model.bonds.count}",
+             f"angles       {model.angles.count}",
+             f"types        {', '.join(p.type_names)}",
+             f"pairs        " + "; ".join(f"{law.kind} {p.type_names[law.type_i]}-{p.type_names[law.type_j]}"
+                                         for law in model.pairs),
+             f"box          {' x '.join(f'{x:g}' for x in model.box.lengths)} "
+             f"({'periodic' if all(model.box.periodic) else 'finite, wall k = %g' % model.box.wall_stiffness})",
+             f"time step    {model.dynamics.dt:g}   lambda {model.dynamics.lambda_:g}   damping {model.dynamics.damping:g}"]
+    for st in model.plan.stages:
+        extra = f" in chunks of {st.chunk}" + (", velocities reset" if st.reset else "") if st.name == "relax" else \
+            f", output every {model.plan.output.every}"
+        lines.append(f"stage        {st.name}: {st.steps} steps{extra}")
+    if p.count and model.bonds.count:
+        k_over_m = model.bonds.k / np.maximum(np.minimum(p.masses[model.bonds.atoms[:, 0]],
+                                                         p.masses[model.bonds.atoms[:, 1]]), 1e-300)
+        period = 2 * np.pi / np.sqrt(k_over_m.max())
+        lines.append(f"spring period {period:.4g} (shortest) = {period / model.dynamics.dt:.1f} time steps")
+    typer.echo("\n".join(lines))
+    _report_warnings(model.warnings)
+    typer.echo(f"warnings     {len(model.warnings)}")
+
+
+@app.command()
+@_guard
+def translate(input: Path = typer.Argument(..., help="FibreNet input file."),
+              out: Path = typer.Option(..., "-o", "--out", help="Folder for in.lammps and the data file.")) -> None:
+    """Write a stock-LAMMPS job (in.lammps + data file) for INPUT into a folder.
+
+    Example: fibrelmp translate input.txt -o job/ && cd job && lmp -in in.lammps
+    """
+    from .api import read_input, translate as do_translate
+
+    model = read_input(input)
+    _report_warnings(model.warnings)
+    job = do_translate(model, out)
+    _say(f"wrote {job.script} and {job.data}")
+
+
+@app.command()
+@_guard
+def run(input: Path = typer.Argument(..., help="FibreNet input file."),
+        out: Optional[Path] = typer.Option(None, "--out", help="Folder for the outputs (default: next to the input)."),
+        work: Optional[Path] = typer.Option(None, "--work", help="Folder for the rendered LAMMPS job "
+                                            "(default: <out>/<output_file>_work).")) -> None:
+    """Translate INPUT, run it on LAMMPS and write the outputs in FibreNet's formats.
+
+    Example: fibrelmp run examples/fibre_network/input.txt
+    """
+    import time
+
+    from .api import read_input, run as do_run
+
+    model = read_input(input)
+    _report_warnings(model.warnings)
+    start = time.monotonic()
+    result = do_run(model, out=out, work=work, progress=not _state["quiet"])
+    for path in result.outputs:
+        _say(f"wrote {path}")
+    _say(f"done in {time.monotonic() - start:.1f} s (LAMMPS job: {result.job.script})")
+
+
+def main() -> None:
+    app()
+
+
+import numpy as np  # noqa: E402  (used by check; cheap compared with lammps)
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,123 @@
+"""FibreNet output formats: ``_coord/_vel/_force.xyz`` frames and ``_restart.res``.
+
+Formats as FibreNet's DumpData / DumpRestartData write them (std::fixed 5 decimals for the
+xyz files, default ostream precision -- 6 significant digits -- for the restart file).
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from ..textio import atomic_write, parse_table, read_text
+
+XYZ_SUFFIX = {"position": "_coord.xyz", "velocity": "_vel.xyz", "force": "_force.xyz"}
+RESTART_SUFFIX = "_restart.res"
+
+
+def _rows(fmt_row: str, names: np.ndarray, values: np.ndarray) -> str:
+    n = len(names)
+    if n == 0:
+        return ""
+    flat = np.empty((n, 1 + values.shape[1]), dtype=object)
+    flat[:, 0] = names
+    flat[:, 1:] = values
+    return (fmt_row * n) % tuple(flat.ravel().tolist())
+
+
+def xyz_frame(step: int, dt: float, lengths: np.ndarray, names: np.ndarray, values: np.ndarray) -> str:
+    head = f"{len(names)}\nFRAME\t{step}\t{dt:.5f}\t{lengths[0]:.5f}\t{lengths[1]:.5f}\t{lengths[2]:.5f}\n"
+    return head + _rows("%s\t%.5f\t%.5f\t%.5f\n", names, values)
+
+
+class XyzWriter:
+    """Append frames to a temp file; ``close`` renames it into place (no half outputs)."""
+
+    def __init__(self, path: str | Path):
+        self.path = Path(path)
+        self.tmp = self.path.with_name(f".{self.path.name}.tmp{os.getpid()}")
+        try:
+            self.fh = open(self.tmp, "w")
+        except OSError as exc:
+            raise InputError(self.path, None, f"cannot write output: {exc.strerror or exc}") from None
+
+    def write(self, step: int, dt: float, lengths: np.ndarray, names: np.ndarray, values: np.ndarray) -> None:
+        self.fh.write(xyz_frame(step, dt, lengths, names, values))
+
+    def close(self) -> None:
+        self.fh.close()
+        os.replace(self.tmp, self.path)
+
+    def abort(self) -> None:
+        self.fh.close()
+        self.tmp.unlink(missing_ok=True)
+
+
+def _g(x: float) -> str:
+    return f"{x:g}"
+
+
+def restart_text(step: int, dt: float, lengths: np.ndarray, names: np.ndarray, x: np.ndarray,
+                 unwrapped: np.ndarray, v_tilde: np.ndarray, force: np.ndarray) -> str:
+    head = (f"{len(names)}\nFRAME\t{step}\t{_g(dt)}\t{_g(lengths[0])}\t{_g(lengths[1])}\t"
+            f"{_g(lengths[2])}\n")
+    values = np.hstack([x, unwrapped, v_tilde, force])
+    return head + _rows("\t%s" + "\t%g" * 12 + "\n", names, values)
+
+
+def write_restart(path: str | Path, *args) -> None:
+    atomic_write(path, restart_text(*args))
+
+
+@dataclass
+class XyzFrame:
+    step: int
+    dt: float
+    lengths: np.ndarray
+    names: list[str]
+    values: np.ndarray
+
+
+def read_xyz(path: str | Path) -> list[XyzFrame]:
+    """Read every frame of a FibreNet xyz file."""
+    path = Path(path)
+    lines = read_text(path, "FibreNet xyz file").splitlines()
+    frames, i = [], 0
+    while i < len(lines):
+        if not lines[i].strip():
+            i += 1
+            continue
+        try:
+            n = int(lines[i])
+        except ValueError:
+            raise InputError(path, i + 1, f"expected a bead count, got {lines[i]!r}") from None
+        head = lines[i + 1].split() if i + 1 < len(lines) else []
+        if len(head) != 6 or head[0] != "FRAME":
+            raise InputError(path, i + 2, "expected 'FRAME step dt Lx Ly Lz'")
+        body = lines[i + 2:i + 2 + n]
+        if len(body) < n:
+            raise InputError(path, i + 3 + len(body), f"frame has {len(body)} of {n} rows")
+        table, val = parse_table(body, list(range(i + 3, i + 3 + n)), 4, path, "xyz", text_cols=(0,))
+        frames.append(XyzFrame(int(head[1]), float(head[2]), np.array(head[3:], float),
+                               list(table[:, 0]), val[:, 1:4]))
+        i += 2 + n
+    return frames
+
+
+def read_restart(path: str | Path) -> tuple[list[str], np.ndarray]:
+    """Bead rows of a FibreNet restart file: types and (n,12) x, ix, v~, F.
+
+    As FibreNet does, only lines of exactly 13 tokens count as bead rows.
+    """
+    path = Path(path)
+    raw = read_text(path, "FibreNet restart file").splitlines()
+    keep = [(k + 1, ln) for k, ln in enumerate(raw) if len(ln.split()) == 13]
+    if not keep:
+        raise InputError(path, None, "no bead rows (lines of 13 tokens: type x y z ix iy iz vx vy vz fx fy fz)")
+    numbers, lines = [k for k, _ in keep], [ln for _, ln in keep]
+    table, val = parse_table(lines, numbers, 13, path, "restart row", text_cols=(0,))
+    return list(table[:, 0]), val[:, 1:]

@@ -1,0 +1,615 @@
+"""Read FibreNet input + model (+ restart) files into the neutral Model.
+
+Semantics follow FibreNet's SimulationManager.cpp (commit fe11bbcc), not its README,
+where the two disagree; see docs/fibrenet.md for every quirk and deviation.
+"""
+
+from __future__ import annotations
+
+import difflib
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from ..model import (Angles, Bonds, Box, Dynamics, Model, OutputSpec, PairLaw, Particles,
+                     RunPlan, Stage)
+from ..textio import integer_column, parse_table, read_text, to_float, to_int
+
+EXTENSIONS = (".txt", ".in", ".inp")
+
+# keyword -> (number of value tokens or None for "checked elsewhere", repeatable)
+KEYWORDS: dict[str, tuple[int | None, bool]] = {
+    "model_file": (1, False), "output_file": (1, False), "output_freq": (1, False),
+    "output_data": (1, True), "output_type": (1, True), "restart_file": (1, True),
+    "restart_data": (1, True), "run": (1, False), "minimize_steps": (1, False),
+    "minimize_substeps": (1, False), "minimize_reset": (1, False), "step": (1, False),
+    "cutoff": (1, False), "lambda": (1, False), "damping": (1, False), "gravity": (3, False),
+    "type": (1, True), "pair": (None, True), "grid_update_freq": (1, False),
+    "box_unit_cell": (1, False), "box_size": (3, False), "box_type": (1, False),
+    "box_wall_rep": (1, False), "modif_bead": (None, True), "modif_spring": (None, True),
+}
+REQUIRED = ("model_file", "step", "lambda", "run", "cutoff", "box_unit_cell", "box_size",
+            "box_type", "output_file", "output_freq", "output_type", "output_data")
+_COMMENT = re.compile(r"^\s*(#|//|%|!)")
+_STOI = re.compile(r"^\s*[+-]?\d+")
+
+
+@dataclass
+class _Line:
+    number: int
+    tokens: list[str]
+
+
+class _InputFile:
+    """FibreNet input: first token is the keyword; single keywords keep the first line."""
+
+    def __init__(self, path: Path, model: list[tuple[str, str]]):
+        self.path = path
+        self.lines: dict[str, list[_Line]] = {}
+        for number, raw in enumerate(read_text(path, "FibreNet input file").splitlines(), 1):
+            tokens = raw.split()
+            if not tokens or _COMMENT.match(raw):
+                continue
+            key = tokens[0]
+            if key == "box_wall_re":
+                model.append(("keyword alias", f"{path}:{number}: 'box_wall_re' (as in FibreNet's "
+                              "README) is read as 'box_wall_rep'; real FibreNet ignores it and "
+                              "leaves the wall stiffness uninitialised"))
+                key = "box_wall_rep"
+            if key not in KEYWORDS:
+                hint = difflib.get_close_matches(key, KEYWORDS, n=1)
+                extra = f" (did you mean '{hint[0]}'?)" if hint else ""
+                raise InputError(path, number, f"unknown keyword '{key}'{extra}")
+            nvalues, _ = KEYWORDS[key]
+            if nvalues is not None and len(tokens) != nvalues + 1:
+                raise InputError(path, number, f"'{key}' takes {nvalues} value(s), "
+                                 f"found {len(tokens) - 1}")
+            self.lines.setdefault(key, []).append(_Line(number, tokens))
+        for key, found in self.lines.items():
+            if not KEYWORDS[key][1] and len(found) > 1:
+                model.append(("repeated keyword", f"{path}:{found[1].number}: '{key}' repeated; "
+                              f"FibreNet uses the first one (line {found[0].number})"))
+
+    def first(self, key: str) -> _Line | None:
+        found = self.lines.get(key)
+        return found[0] if found else None
+
+    def all(self, key: str) -> list[_Line]:
+        return self.lines.get(key, [])
+
+    def require(self, key: str) -> _Line:
+        line = self.first(key)
+        if line is None:
+            raise InputError(self.path, None, f"required keyword '{key}' is missing")
+        return line
+
+    def number(self, key: str, default: float | None = None, positive: bool = False,
+               nonnegative: bool = False) -> float:
+        line = self.first(key)
+        if line is None:
+            if default is None:
+                raise InputError(self.path, None, f"required keyword '{key}' is missing")
+            return default
+        value = to_float(line.tokens[1], self.path, line.number, key)
+        if positive and value <= 0:
+            raise InputError(self.path, line.number, f"'{key}' must be > 0, got {line.tokens[1]}")
+        if nonnegative and value < 0:
+            raise InputError(self.path, line.number, f"'{key}' must be >= 0, got {line.tokens[1]}")
+        return value
+
+    def integer(self, key: str, default: int | None = None, minimum: int = 0) -> int:
+        line = self.first(key)
+        if line is None:
+            if default is None:
+                raise InputError(self.path, None, f"required keyword '{key}' is missing")
+            return default
+        value = to_int(line.tokens[1], self.path, line.number, key)
+        if value < minimum:
+            raise InputError(self.path, line.number, f"'{key}' must be >= {minimum}, got {value}")
+        return value
+
+
+def _model_sections(path: Path) -> dict[str, tuple[list[str], list[int]]]:
+    """Lines of the model file grouped by their first token (BEAD, SPRING, ANGLE)."""
+    text = read_text(path, "FibreNet model file")
+    sections: dict[str, tuple[list[str], list[int]]] = {k: ([], []) for k in ("BEAD", "SPRING", "ANGLE")}
+    for number, raw in enumerate(text.splitlines(), 1):
+        head = raw.lstrip()[:6]
+        for key in sections:
+            if head.startswith(key) and (len(raw.split(None, 1)[0]) == len(key)):
+                sections[key][0].append(raw)
+                sections[key][1].append(number)
+                break
+    return sections
+
+
+def _stoi(token: str) -> int | None:
+    m = _STOI.match(token)
+    return int(m.group()) if m else None
+
+
+def read(path: str | Path) -> Model:
+    """Read a FibreNet input file (and the files it names) into a Model."""
+    path = Path(path)
+    notes: list[tuple[str, str]] = []
+    inp = _InputFile(path, notes)
+    for key in REQUIRED:
+        if key != "box_wall_rep":
+            inp.require(key)
+    folder = path.parent
+
+    # ---- types and pairs -------------------------------------------------------------
+    type_names: list[str] = []
+    for line in inp.all("type"):
+        if line.tokens[1] in type_names:
+            raise InputError(path, line.number, f"type '{line.tokens[1]}' defined twice")
+        type_names.append(line.tokens[1])
+    if not type_names:
+        raise InputError(path, None, "no 'type' lines: at least one bead type is needed")
+    type_index = {name: i for i, name in enumerate(type_names)}
+    cutoff = inp.number("cutoff", positive=True)
+    pair_lines: dict[tuple[int, int], _Line] = {}
+    for line in inp.all("pair"):
+        t = line.tokens
+        if len(t) < 5:
+            raise InputError(path, line.number, "'pair' needs: pair hs|st|lj TYPE TYPE values...")
+        for name in t[2:4]:
+            if name not in type_index:
+                raise InputError(path, line.number, f"pair refers to undefined type '{name}'")
+        i, j = sorted((type_index[t[2]], type_index[t[3]]))
+        pair_lines[(i, j)] = line        # later lines override earlier ones, as in FibreNet
+    pairs = [_pair_law(path, line, i, j, cutoff) for (i, j), line in sorted(pair_lines.items())]
+    for i in range(len(type_names)):
+        for j in range(i, len(type_names)):
+            if (i, j) not in pair_lines:
+                raise InputError(path, None, f"no 'pair' line for types {type_names[i]} "
+                                 f"{type_names[j]}: FibreNet needs every type pair defined")
+
+    # ---- box -----------------------------------------------------------------------------
+    size_line = inp.require("box_size")
+    size = np.array([to_float(v, path, size_line.number, "box_size") for v in size_line.tokens[1:]])
+    if (size <= 0).any():
+        raise InputError(path, size_line.number, "box_size values must be > 0")
+    box_type = inp.require("box_type")
+    if box_type.tokens[1] not in ("pbc", "finite"):
+        raise InputError(path, box_type.number, f"box_type must be 'pbc' or 'finite', got "
+                         f"'{box_type.tokens[1]}'")
+    if inp.first("box_wall_rep") is None:
+        raise InputError(path, None, "'box_wall_rep' is missing: without it FibreNet silently "
+                         "uses a finite box with an uninitialised wall stiffness")
+    wall_k = inp.number("box_wall_rep", nonnegative=True)
+    periodic = box_type.tokens[1] == "pbc"
+    unit_cell = inp.number("box_unit_cell", positive=True)
+    if (np.floor(size / unit_cell) < 3).any():
+        notes.append(("neighbour grid", f"{path}:{inp.first('box_unit_cell').number}: FibreNet "
+                      "needs at least 3 grid cells per axis (box_size / box_unit_cell); LAMMPS "
+                      "does not, so this input runs here but not in FibreNet"))
+    if inp.first("grid_update_freq") is not None:
+        inp.integer("grid_update_freq", minimum=1)
+    box = Box(np.zeros(3), size, (periodic,) * 3, None if periodic else wall_k)
+
+    # ---- dynamics ------------------------------------------------------------------------
+    dt = inp.number("step", positive=True)
+    lam = inp.number("lambda", positive=True)
+    damping = inp.number("damping", default=0.0)
+    gravity = np.zeros(3)
+    if (g := inp.first("gravity")) is not None:
+        gravity = np.array([to_float(v, path, g.number, "gravity") for v in g.tokens[1:]])
+    run_steps = inp.integer("run", minimum=0)
+    min_steps = inp.integer("minimize_steps", default=0)
+    sub_default = min_steps if min_steps > 0 else 0
+    min_sub = inp.integer("minimize_substeps", default=sub_default)
+    if min_sub > min_steps:
+        raise InputError(path, inp.first("minimize_substeps").number,
+                         "minimize_substeps must not exceed minimize_steps")
+    if min_steps > 0 and min_sub == 0:
+        raise InputError(path, inp.first("minimize_substeps").number,
+                         "minimize_substeps 0 with minimize_steps > 0 (FibreNet divides by zero)")
+    reset = False
+    if (r := inp.first("minimize_reset")) is not None:
+        if r.tokens[1] not in ("yes", "no"):
+            raise InputError(path, r.number, f"minimize_reset must be yes or no, got '{r.tokens[1]}'")
+        reset = r.tokens[1] == "yes"
+    out_freq = inp.integer("output_freq", minimum=1)
+    if out_freq > run_steps:
+        raise InputError(path, inp.first("output_freq").number,
+                         f"output_freq ({out_freq}) must not exceed run ({run_steps})")
+
+    # ---- model file ----------------------------------------------------------------------
+    model_line = inp.require("model_file")
+    model_path = folder / model_line.tokens[1]
+    if not model_path.exists():
+        raise InputError(path, model_line.number, f"model file '{model_line.tokens[1]}' not found "
+                         f"(looked in {folder})")
+    particles, springs, angles = _read_model(model_path, type_index, type_names, size, notes)
+    n = particles.count
+
+    # ---- restart, modif_bead, modif_spring (FibreNet's order) ------------------------------
+    restart_lines = inp.all("restart_file")
+    restart_fields: set[str] = set()
+    for line in inp.all("restart_data"):
+        value = line.tokens[1]
+        if value not in ("position", "velocity", "force", "all"):
+            raise InputError(path, line.number, f"restart_data must be position, velocity, force "
+                             f"or all, got '{value}'")
+        restart_fields |= {"position", "velocity", "force"} if value == "all" else {value}
+    if restart_lines:
+        rline = restart_lines[-1]           # the last restart_file line wins
+        rpath = folder / rline.tokens[1]
+        if not rpath.exists():
+            raise InputError(path, rline.number, f"restart file '{rline.tokens[1]}' not found")
+        from ..post.fibrenet_out import read_restart
+
+        rtypes, rdata = read_restart(rpath)
+        if len(rtypes) != n:
+            raise InputError(rpath, None, f"restart file has {len(rtypes)} bead rows, the model has {n}")
+        mismatch = np.flatnonzero(np.asarray(rtypes, dtype=object) !=
+                                  np.asarray(type_names, dtype=object)[particles.types])
+        if mismatch.size:
+            b = int(mismatch[0])
+            raise InputError(rpath, None, f"bead {b}: restart type '{rtypes[b]}' differs from the "
+                             f"model type '{type_names[particles.types[b]]}'")
+        if "position" in restart_fields:
+            particles.positions = rdata[:, 0:3].copy()
+            particles.unwrapped = rdata[:, 3:6].copy()
+        if "velocity" in restart_fields:
+            particles.velocities = rdata[:, 6:9].copy()
+            particles.display_velocities = rdata[:, 6:9].copy()
+        if "force" in restart_fields:
+            particles.initial_forces = rdata[:, 9:12].copy()
+        if not restart_fields:
+            notes.append(("restart ignored", f"{path}:{rline.number}: restart_file without "
+                          "restart_data: FibreNet only validates the file and applies nothing"))
+    _apply_modif_bead(inp, particles, type_index, notes)
+    _apply_modif_spring(inp, springs, notes)
+    bonds = springs.to_bonds()
+    _check_positions(particles, box, periodic, model_path, notes)
+
+    # ---- exclusion rule ------------------------------------------------------------------
+    exclusion = _exclusion_rule(particles, bonds, model_path)
+
+    # ---- outputs ---------------------------------------------------------------------------
+    fields: set[str] = set()
+    for line in inp.all("output_data"):
+        value = line.tokens[1]
+        if value not in ("position", "velocity", "force", "all"):
+            raise InputError(path, line.number, f"output_data must be position, velocity, force "
+                             f"or all, got '{value}'")
+        fields |= {"position", "velocity", "force"} if value == "all" else {value}
+    out_types: set[int] | None = set()
+    for line in inp.all("output_type"):
+        if line.tokens[1] == "all":
+            out_types = None
+            break
+        if line.tokens[1] not in type_index:
+            raise InputError(path, line.number, f"output_type refers to undefined type "
+                             f"'{line.tokens[1]}'")
+        out_types.add(type_index[line.tokens[1]])
+    output = OutputSpec("fibrenet", inp.require("output_file").tokens[1], folder,
+                        tuple(f for f in ("position", "velocity", "force") if f in fields),
+                        None if out_types is None else tuple(sorted(out_types)), out_freq)
+
+    stages: list[Stage] = []
+    if min_steps > 0:
+        chunks = min_steps // min_sub
+        if chunks * min_sub != min_steps:
+            notes.append(("minimize remainder", f"{path}: minimize_steps {min_steps} is not a "
+                          f"multiple of minimize_substeps {min_sub}; FibreNet drops the last "
+                          f"{min_steps - chunks * min_sub} steps, so does fibrelmp"))
+        stages.append(Stage("relax", chunks * min_sub, min_sub, reset=reset))
+    stages.append(Stage("production", run_steps, out_freq, output=True))
+
+    dyn = Dynamics(dt=dt, damping=damping, lambda_=lam, gravity=gravity, pair_cutoff=cutoff,
+                   exclusion=exclusion)
+    _note_quirks(particles, bonds, angles, pairs, dyn, notes, model_path)
+    model = Model(path, particles, bonds, angles, pairs, box, dyn, RunPlan(stages, output))
+    model.warnings.extend(notes)
+    return model
+
+
+def _pair_law(path: Path, line: _Line, i: int, j: int, cutoff: float) -> PairLaw:
+    t = line.tokens
+    kind = t[1]
+    need = {"hs": 5, "st": 8, "lj": 7}
+    if kind not in need:
+        raise InputError(path, line.number, f"unknown pair kind '{kind}' (hs, st or lj)")
+    if len(t) != need[kind]:
+        raise InputError(path, line.number, f"pair {kind} takes {need[kind] - 4} values, "
+                         f"found {len(t) - 4}")
+    v = [to_float(x, path, line.number, f"pair {kind}") for x in t[4:]]
+    if kind == "hs":
+        return PairLaw("hs", i, j, {"K": v[0]})
+    if kind == "st":
+        krep, katt, l0, rc = v
+        if rc <= 0:
+            raise InputError(path, line.number, "pair st cutoff must be > 0")
+        b = katt + krep
+        # What FibreNet actually runs: F = Katt(l0-r) + Krep(2 l0 - rc - r) for r < rc.
+        rstar = (katt * l0 + krep * (2 * l0 - rc)) / b if b != 0 else 0.0
+        return PairLaw("st", i, j, {"Krep": krep, "Katt": katt, "l0": l0, "rc": rc, "B": b,
+                                    "rstar": rstar, "cutoff": min(rc, cutoff)})
+    sigma, eps, shift = v
+    if shift <= 0:
+        raise InputError(path, line.number, "pair lj cutoff (third value) must be > 0")
+    return PairLaw("lj", i, j, {"sigma": sigma, "epsilon": eps, "shift": shift,
+                                "cutoff": min(shift, cutoff)})
+
+
+def _read_model(path: Path, type_index: dict[str, int], type_names: list[str], size: np.ndarray,
+                notes: list) -> tuple[Particles, "_Springs", Angles]:
+    sections = _model_sections(path)
+    lines, numbers = sections["BEAD"]
+    if not lines:
+        raise InputError(path, None, "no BEAD lines in the model file")
+    table, val = parse_table(lines, numbers, 18, path, "BEAD", text_cols=(0, 1))
+    names = table[:, 1]
+    unknown = [k for k, name in enumerate(names) if name not in type_index]
+    if unknown:
+        raise InputError(path, numbers[unknown[0]], f"bead type '{names[unknown[0]]}' is not "
+                         f"defined by a 'type' line (defined: {', '.join(type_names)})")
+    types = np.array([type_index[name] for name in names], dtype=np.int64)
+    tags = integer_column(val, table, 2, path, numbers, "BEAD")
+    loc = integer_column(val, table, 3, path, numbers, "BEAD")
+    radius, mass = val[:, 4], val[:, 5]
+    for col, arr, what in ((5, radius, "radius"), (6, mass, "mass")):
+        if (arr < 0).any():
+            row = int(np.flatnonzero(arr < 0)[0])
+            raise InputError(path, numbers[row], f"BEAD {what} must be >= 0, got {table[row, col - 1]}")
+    pos, vel, force, image = val[:, 6:9], val[:, 9:12], val[:, 12:15], val[:, 15:18]
+    outside = ((pos < 0) | (pos > size)).any(axis=1)
+    if outside.any():
+        row = int(np.flatnonzero(outside)[0])
+        raise InputError(path, numbers[row], f"bead {row} at ({pos[row, 0]:g}, {pos[row, 1]:g}, "
+                         f"{pos[row, 2]:g}) lies outside the box [0, L] (box_size "
+                         f"{size[0]:g} {size[1]:g} {size[2]:g})")
+    # FibreNet bug (S:1404): the integrator starts from v_old = (vx, vx, vx)
+    v_old = np.repeat(vel[:, :1], 3, axis=1)
+    if (v_old != vel).any():
+        row = int(np.flatnonzero((v_old != vel).any(axis=1))[0])
+        notes.append(("velocity quirk", f"{path}:{numbers[row]}: FibreNet starts beads from "
+                      "v = (vx, vx, vx) (a bug in its model reader); fibrelmp reproduces it. "
+                      "Use 'modif_bead ... velocity' to set other velocities"))
+    particles = Particles(list(type_names), types, pos.copy(), image.copy(), v_old, mass.copy(),
+                          radius.copy(), tags, loc, force.copy(), vel.copy())
+    springs = _read_springs(path, sections["SPRING"], len(types), notes)
+    angles = _read_angles(path, sections["ANGLE"], len(types))
+    return particles, springs, angles
+
+
+def _check_index(idx: np.ndarray, n: int, path: Path, numbers: list[int], what: str) -> None:
+    bad = (idx < 0) | (idx >= n)
+    if bad.any():
+        row, col = np.argwhere(bad)[0]
+        raise InputError(path, numbers[row], f"{what} refers to bead {idx[row, col]}, but the "
+                         f"model has beads 0..{n - 1}")
+
+
+class _Springs:
+    """Spring data as read, before HR_FL parameters become break lengths."""
+
+    def __init__(self, m: int):
+        self.atoms = np.zeros((m, 2), np.int64)
+        self.r0, self.k = np.zeros(m), np.zeros(m)
+        self.tags = np.zeros(m, np.int64)
+        self.fl = np.zeros(m, bool)
+        self.c1, self.c2 = np.zeros(m), np.zeros(m)
+
+    def to_bonds(self) -> Bonds:
+        brk = np.full(len(self.r0), np.nan)
+        for r in np.flatnonzero(self.fl):
+            brk[r] = _break_length(self.r0[r], self.c1[r], self.c2[r])
+        return Bonds(self.atoms, self.k, self.r0, brk)
+
+
+def _read_springs(path: Path, section: tuple[list[str], list[int]], n: int, notes: list) -> _Springs:
+    lines, numbers = section
+    s = _Springs(len(lines))
+    if not lines:
+        return s
+    rows: list[list[str]] = [ln.split() for ln in lines]
+    if all(len(r) == 7 and r[1] == "HR" for r in rows):      # fast path: all plain HR
+        table, val = parse_table(lines, numbers, 7, path, "SPRING", text_cols=(0, 1))
+        s.tags = integer_column(val, table, 2, path, numbers, "SPRING")
+        s.atoms[:] = np.stack([integer_column(val, table, c, path, numbers, "SPRING") for c in (3, 4)], 1)
+        s.r0[:], s.k[:] = val[:, 5], val[:, 6]
+    else:
+        truncated = []
+        for r, tok in enumerate(rows):
+            ln = numbers[r]
+            kind = tok[1] if len(tok) > 1 else ""
+            if kind not in ("HR", "HR_FL"):
+                raise InputError(path, ln, f"unknown spring kind '{kind}' (HR or HR_FL)")
+            if kind == "HR" and len(tok) < 7:
+                raise InputError(path, ln, f"SPRING HR needs at least 7 tokens, found {len(tok)}")
+            if kind == "HR_FL" and len(tok) != 9:
+                raise InputError(path, ln, f"SPRING HR_FL needs 9 tokens, found {len(tok)}")
+            s.tags[r] = to_int(tok[2], path, ln, "SPRING tag")
+            s.atoms[r] = (to_int(tok[3], path, ln, "SPRING bead"), to_int(tok[4], path, ln, "SPRING bead"))
+            s.r0[r] = to_float(tok[5], path, ln, "SPRING rest length")
+            s.k[r] = to_float(tok[6], path, ln, "SPRING stiffness")
+            if kind == "HR_FL":
+                c1, c2 = _stoi(tok[7]), _stoi(tok[8])
+                if c1 is None or c2 is None:
+                    raise InputError(path, ln, "SPRING HR_FL c1/c2 must start with an integer "
+                                     "(FibreNet reads them with std::stoi)")
+                if str(c1) != tok[7].strip() or str(c2) != tok[8].strip():
+                    truncated.append(ln)
+                s.fl[r], s.c1[r], s.c2[r] = True, c1, c2
+        if truncated:
+            notes.append(("HR_FL integer truncation", f"{path}:{truncated[0]}: FibreNet reads "
+                          f"HR_FL c1 and c2 with std::stoi, truncating them to integers "
+                          f"({len(truncated)} spring(s)); fibrelmp reproduces this"))
+    _check_index(s.atoms, n, path, numbers, "SPRING")
+    for arr, what in ((s.r0, "rest length"), (s.k, "stiffness")):
+        if (arr < 0).any():
+            row = int(np.flatnonzero(arr < 0)[0])
+            raise InputError(path, numbers[row], f"SPRING {what} must be >= 0")
+    same = s.atoms[:, 0] == s.atoms[:, 1]
+    if same.any():
+        raise InputError(path, numbers[int(np.flatnonzero(same)[0])], "SPRING connects a bead to itself")
+    return s
+
+
+def _break_length(r0: float, c1: float, c2: float) -> float:
+    """Tension break length of HR_FL: |c1 (r - r0) / r| > c2  <=>  r > r0 c1 / (c1 - c2)."""
+    if c1 > c2:
+        return r0 * c1 / (c1 - c2)
+    return np.inf
+
+
+def _read_angles(path: Path, section: tuple[list[str], list[int]], n: int) -> Angles:
+    lines, numbers = section
+    if not lines:
+        return Angles.empty()
+    table, val = parse_table(lines, numbers, 10, path, "ANGLE", text_cols=(0, 1))
+    bad = [r for r in range(len(lines)) if table[r, 1] not in ("HR", "HR_FL")]
+    if bad:
+        raise InputError(path, numbers[bad[0]], f"unknown angle kind '{table[bad[0], 1]}' (HR or HR_FL)")
+    atoms = np.stack([integer_column(val, table, c, path, numbers, "ANGLE") for c in (3, 4, 5)], 1)
+    _check_index(atoms, n, path, numbers, "ANGLE")
+    # FibreNet reads theta0 with std::stof: float precision
+    theta0 = val[:, 8].astype(np.float32).astype(np.float64)
+    return Angles(atoms, val[:, 9].copy(), theta0)
+
+
+def _select(tokens: list[str], particles: Particles, type_index: dict[str, int], path: Path,
+            number: int) -> np.ndarray:
+    how, what = tokens[1], tokens[2]
+    if how == "type":
+        if what not in type_index:
+            raise InputError(path, number, f"modif_bead: undefined type '{what}'")
+        return particles.types == type_index[what]
+    value = to_int(what, path, number, f"modif_bead {how}")
+    if how == "tag":
+        return particles.molecules == value
+    if how == "id":
+        if not 0 <= value < particles.count:
+            raise InputError(path, number, f"modif_bead id {value} out of range 0..{particles.count - 1}")
+        mask = np.zeros(particles.count, bool)
+        mask[value] = True
+        return mask
+    raise InputError(path, number, f"modif_bead selects by type, tag or id, got '{how}'")
+
+
+def _apply_modif_bead(inp: _InputFile, p: Particles, type_index: dict[str, int], notes: list) -> None:
+    for line in inp.all("modif_bead"):
+        t, ln = line.tokens, line.number
+        if len(t) < 5:
+            raise InputError(inp.path, ln, "modif_bead needs: modif_bead type|tag|id X mass|velocity|skin_radius values")
+        mask = _select(t, p, type_index, inp.path, ln)
+        prop = t[3]
+        if prop == "mass":
+            if len(t) != 5:
+                raise InputError(inp.path, ln, "modif_bead ... mass takes 1 value")
+            m = to_float(t[4], inp.path, ln, "mass")
+            if m < 0:
+                raise InputError(inp.path, ln, "mass must be >= 0")
+            p.masses[mask] = m
+        elif prop == "velocity":
+            if len(t) != 7:
+                raise InputError(inp.path, ln, "modif_bead ... velocity takes 3 values")
+            v = np.array([to_float(x, inp.path, ln, "velocity") for x in t[4:7]])
+            p.velocities[mask] = v
+            p.display_velocities[mask] = v
+        elif prop == "skin_radius":
+            if len(t) != 5:
+                raise InputError(inp.path, ln, "modif_bead ... skin_radius takes 1 value")
+            skin = to_float(t[4], inp.path, ln, "skin_radius")
+            notes.append(("skin radius", f"{inp.path}:{ln}: skin_radius only tunes FibreNet's hs "
+                          f"contact list; LAMMPS lists neighbours with its own skin, so contacts "
+                          f"are never detected late (skin {skin:g} has no effect)"))
+        else:
+            raise InputError(inp.path, ln, f"modif_bead property must be mass, velocity or "
+                             f"skin_radius, got '{prop}'")
+
+
+def _apply_modif_spring(inp: _InputFile, springs: _Springs, notes: list) -> None:
+    for line in inp.all("modif_spring"):
+        t, ln = line.tokens, line.number
+        if len(t) != 5:
+            raise InputError(inp.path, ln, "modif_spring needs: modif_spring id|tag N "
+                             "rest_length|stiffness|c1|c2|damping value")
+        how = t[1]
+        sel = to_int(t[2], inp.path, ln, f"modif_spring {how}")
+        if how == "id":
+            if not 0 <= sel < len(springs.r0):
+                raise InputError(inp.path, ln, f"modif_spring id {sel} out of range 0..{len(springs.r0) - 1}")
+            mask = np.arange(len(springs.r0)) == sel
+        elif how == "tag":
+            mask = springs.tags == sel
+        else:
+            raise InputError(inp.path, ln, f"modif_spring selects by id or tag, got '{how}'")
+        value = to_float(t[4], inp.path, ln, f"modif_spring {t[3]}")
+        if t[3] == "rest_length":
+            springs.r0[mask] = value
+        elif t[3] == "stiffness":
+            springs.k[mask] = value
+        elif t[3] == "c1":      # read with std::stod here, unlike the model file
+            springs.c1[mask] = value
+        elif t[3] == "c2":
+            springs.c2[mask] = value
+        elif t[3] == "damping":
+            notes.append(("spring damping unused", f"{inp.path}:{ln}: FibreNet stores a spring "
+                          "damping value but its kernel never uses it; ignored"))
+        else:
+            raise InputError(inp.path, ln, f"modif_spring property must be rest_length, "
+                             f"stiffness, c1, c2 or damping, got '{t[3]}'")
+
+
+def _check_positions(p: Particles, box: Box, periodic: bool, path: Path, notes: list) -> None:
+    diff = p.unwrapped - p.positions
+    if periodic:
+        shift = diff / box.lengths
+        off = np.abs(shift - np.round(shift)) * box.lengths > 1e-6 * box.lengths.max()
+        if off.any():
+            row = int(np.flatnonzero(off.any(axis=1))[0])
+            notes.append(("wrapped/unwrapped mismatch", f"{path}: bead {row}: unwrapped position "
+                          "is not the wrapped one plus whole box lengths; fibrelmp uses the "
+                          "unwrapped position (bonds follow it) and wraps it"))
+    elif (np.abs(diff) > 0).any():
+        row = int(np.flatnonzero((np.abs(diff) > 0).any(axis=1))[0])
+        notes.append(("wrapped/unwrapped mismatch", f"{path}: bead {row}: in a finite box the "
+                      "unwrapped (ix iy iz) and wrapped positions differ; fibrelmp uses px py pz "
+                      "for everything (FibreNet uses ix for springs/angles)"))
+        p.unwrapped = p.positions.copy()
+
+
+def _exclusion_rule(p: Particles, bonds: Bonds, path: Path) -> str:
+    """FibreNet skips non-bonded pairs with the same tag and |loc_id_i - loc_id_j| <= 1."""
+    order = np.lexsort((p.loc_ids, p.molecules))
+    tag, loc = p.molecules[order], p.loc_ids[order]
+    starts = np.r_[0, np.flatnonzero(np.diff(tag)) + 1]
+    span = np.maximum.reduceat(loc, starts) - np.minimum.reduceat(loc, starts)
+    if (span <= 1).all():
+        return "molecule"       # every pair inside a tag is excluded
+    raise InputError(path, None, "beads of one tag have loc_id values more than 1 apart: "
+                     "FibreNet's partial exclusion (|loc_id_i - loc_id_j| <= 1) has no exact "
+                     "LAMMPS equivalent; give every bead of a fibre the same loc_id")
+
+
+def _note_quirks(p: Particles, bonds: Bonds, angles: Angles, pairs: list[PairLaw], dyn: Dynamics,
+                 notes: list, path: Path) -> None:
+    for law in pairs:
+        if law.kind == "st" and law.params["B"] * (law.params["rstar"] - law.params["cutoff"]) != 0:
+            jump = law.params["B"] * (law.params["rstar"] - law.params["cutoff"])
+            notes.append(("st force jump", f"pair st {p.type_names[law.type_i]} "
+                          f"{p.type_names[law.type_j]}: as FibreNet runs it the force is one linear "
+                          f"spring B={law.params['B']:g}, r*={law.params['rstar']:.6g}, cut at "
+                          f"{law.params['cutoff']:g} where it jumps by {jump:.6g}; reproduced"))
+    if (~np.isnan(bonds.break_length)).any():
+        notes.append(("HR_FL breaking", f"{path}: HR_FL springs break only in tension here "
+                      "(fix bond/break); FibreNet also breaks them in compression and keeps HR "
+                      "angles that contain them"))
+    if angles.count:
+        a, b, c = (p.unwrapped[angles.atoms[:, k]] for k in range(3))
+        u, v = a - b, c - b
+        cos = (u * v).sum(1) / np.sqrt((u * u).sum(1) * (v * v).sum(1))
+        if (cos <= -1.0 + 1e-14).any():
+            notes.append(("straight triple", f"{path}: some angle triples are exactly straight; "
+                          "FibreNet clamps cos to -0.999999 there and applies a spurious force, "
+                          "fibrelmp does not"))
+    if p.count and (p.masses == 0).any():
+        pass  # mass-0 beads move at constant velocity in both codes: not a quirk

@@ -1,0 +1,269 @@
+"""Turn a bead-spring Model into a LAMMPS data file and input script (rendered to disk).
+
+The script is self-contained stock LAMMPS (no Python hooks): ``lmp -in in.lammps`` inside the
+job folder replays exactly what ``fibrelmp run`` executes line by line.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from jinja2 import Environment, PackageLoader, StrictUndefined
+
+from ..errors import InputError
+from ..model import Model
+from ..textio import atomic_write
+
+SCRIPT_NAME = "in.lammps"
+DATA_NAME = "data.lammps"
+FRAMES_NAME = "frames.dump"
+STATE_SECTION = "FibreNetState"
+
+
+@dataclass
+class Job:
+    folder: Path
+    script: Path
+    data: Path
+    frames: Path
+    total_steps: int
+    type_of_ltype: np.ndarray            # LAMMPS type (1-based, index 0 unused) -> user type
+    output_steps: list[int] = field(default_factory=list)
+
+
+def _fmt(x: float) -> str:
+    return repr(float(x))
+
+
+def _unique_rows(*cols: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    table = np.column_stack(cols) if cols[0].size else np.zeros((0, len(cols)))
+    if not table.size:
+        return table, np.zeros(0, np.int64)
+    uniq, inverse = np.unique(table, axis=0, return_inverse=True)
+    return uniq, inverse.reshape(-1)
+
+
+def _pair_coeffs(model: Model, ltypes: np.ndarray) -> tuple[list[str], list[str], float]:
+    """pair_coeff lines per LAMMPS type pair, the sub-styles used, and the largest cutoff."""
+    laws = {(law.type_i, law.type_j): law for law in model.pairs}
+    lines, styles, max_cut = [], set(), 0.0
+    nl = len(ltypes)
+    for a in range(nl):
+        for b in range(a, nl):
+            ti, tj = int(ltypes[a, 0]), int(ltypes[b, 0])
+            law = laws[(min(ti, tj), max(ti, tj))]
+            p = law.params
+            if law.kind == "hs":
+                rc = ltypes[a, 2] + ltypes[b, 2]
+                if p["K"] == 0 or rc <= 0:
+                    lines.append(f"pair_coeff {a + 1} {b + 1} none")
+                    continue
+                # harmonic/cut: E = k (rc - r)^2, so k = K/2 gives F = K (Ri + Rj - r)
+                lines.append(f"pair_coeff {a + 1} {b + 1} harmonic/cut {_fmt(p['K'] / 2)} {_fmt(rc)}")
+                styles.add("harmonic/cut")
+                max_cut = max(max_cut, rc)
+            elif law.kind == "st":
+                expr = f"0.5*{_fmt(p['B'])}*(r-{_fmt(p['rstar'])})^2"
+                lines.append(f'pair_coeff {a + 1} {b + 1} lepton "{expr}" {_fmt(p["cutoff"])}')
+                styles.add("lepton")
+                max_cut = max(max_cut, p["cutoff"])
+            else:  # FibreNet lj: F = 48 eps (s/r)^6 ((s/r)^6 - 1/2) / r^2 - Fc, shifted to 0 at c3
+                s, e, c3 = p["sigma"], p["epsilon"], p["shift"]
+                fc = 48 * e * (s / c3) ** 6 * ((s / c3) ** 6 - 0.5) / c3 ** 2
+                expr = (f"{_fmt(48 * e * s ** 12 / 13)}/r^13-{_fmt(24 * e * s ** 6 / 7)}/r^7"
+                        f"+{_fmt(fc)}*r")
+                lines.append(f'pair_coeff {a + 1} {b + 1} lepton "{expr}" {_fmt(p["cutoff"])}')
+                styles.add("lepton")
+                max_cut = max(max_cut, p["cutoff"])
+    return lines, sorted(styles), max_cut
+
+
+ANGLE_CLAMP = 0.001     # LAMMPS angle styles use max(sin(theta), 0.001) when spreading forces
+
+
+def angle_expression(c: float, theta0: float) -> str:
+    """Lepton energy for E = c (theta - theta0)^2 whose forces are exact near straight triples.
+
+    LAMMPS divides dE/dtheta by max(sin(theta), 0.001).  Inside that clamp the expression adds
+    a term D with dD/dtheta = dE/dtheta * (0.001/sin(theta) - 1), so the clamped division gives
+    the exact force (FibreNet's).  Its energy is cancelled by subtracting a derivative-free copy
+    (floor() has zero derivative in Lepton) quantised to 2^-60, so E stays c (theta - theta0)^2.
+    With phi = pi - theta:  integral of (phi - u)/sin(phi) = phi + phi^3/18 - u ln tan(phi/2)
+    (u = pi - theta0; the phi^5 term is below 1e-17 inside the clamp).
+    """
+    u = math.pi - theta0
+    q = 2.0 ** 60
+    s = ANGLE_CLAMP
+    return (f"{_fmt(c)}*theta^2+select(step({_fmt(s)}-sin(phi)),D-floor(D*{_fmt(q)})/{_fmt(q)},0);"
+            f"D={_fmt(2 * c * s)}*(phi+phi^3/18-{_fmt(u)}*log(tan(max(abs(phi),1e-300)/2)))"
+            f"-{_fmt(c)}*theta^2;phi={_fmt(u)}-theta")
+
+
+def _schedule(model: Model, general_lambda: bool) -> tuple[list[tuple], list[int], int]:
+    """The sequence of actions the script performs (see the template for each action).
+
+    FibreNet's first step of a fresh start (or after a velocity reset) uses a stored force
+    instead of F(x): the "kick" action reproduces that step exactly.
+    """
+    acts: list[tuple] = []
+    total = sum(st.steps for st in model.plan.stages)
+    piece = max(1, math.ceil(total / 50))          # progress granularity
+    out_steps: list[int] = []
+    fresh = True                                   # next step starts from the stored state
+
+    def advance(n: int, store_before_last: bool) -> None:
+        nonlocal fresh
+        if n <= 0:
+            return
+        if fresh:
+            acts.append(("kick",))
+            fresh = False
+            n -= 1
+            if n == 0:
+                return
+        body = n - 1 if store_before_last else n
+        while body > 0:
+            k = min(piece, body)
+            acts.append(("run", k))
+            body -= k
+        if store_before_last:
+            acts.append(("store_force",))
+            acts.append(("run", 1))
+
+    relax = [st for st in model.plan.stages if st.name == "relax"]
+    production = [st for st in model.plan.stages if st.name == "production"][0]
+    frame0 = "state"
+    if relax:
+        st = relax[0]
+        if st.reset:        # FibreNet zeroes v and F before and after every chunk
+            for _ in range(st.steps // st.chunk):
+                acts.append(("reset",))
+                fresh = True
+                advance(st.chunk, False)
+            acts.append(("reset",))
+            fresh = True
+        else:               # without resets the chunks are one continuous damped run
+            advance(st.steps, general_lambda)
+            frame0 = "dynamic"
+        acts.append(("reset_timestep",))
+    acts.append(("frame", frame0, 0))
+    out_steps.append(0)
+    step = 0
+    while step < production.steps:
+        n = min(production.chunk, production.steps - step)
+        advance(n, general_lambda and not (fresh and n == 1))
+        step += n
+        acts.append(("frame", "dynamic", step))
+        out_steps.append(step)
+    return acts, out_steps, total
+
+
+def write_job(model: Model, folder: str | Path) -> Job:
+    """Write data file + input script for ``model`` into ``folder``."""
+    folder = Path(folder)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InputError(folder, None, f"cannot create job folder: {exc.strerror or exc}") from None
+    p, dyn, box = model.particles, model.dynamics, model.box
+    if dyn.damping < 0:
+        raise InputError(model.source, None, "damping must be >= 0")
+
+    # LAMMPS types: one per (user type, mass, radius) so masses and hs radii are per type
+    ltypes, atype = _unique_rows(p.types.astype(float), p.masses, p.radii)
+    frozen_types = [i + 1 for i in range(len(ltypes)) if ltypes[i, 1] == 0]
+    mobile_types = [i + 1 for i in range(len(ltypes)) if ltypes[i, 1] > 0]
+    btypes, btype = _unique_rows(model.bonds.k, model.bonds.r0,
+                                 np.nan_to_num(model.bonds.break_length, nan=-1.0))
+    atypes, antype = _unique_rows(model.angles.c, model.angles.theta0)
+    pair_lines, pair_styles, max_cut = _pair_coeffs(model, ltypes)
+
+    general_lambda = dyn.lambda_ != 0.5
+    use_mvv = general_lambda and dyn.damping != 0 and bool(mobile_types)
+    needs_state = True
+
+    # communication must reach across bonds and angles (1-3 pairs) as well as pair cutoffs
+    bond_len = 0.0
+    if model.bonds.count:
+        d = p.unwrapped[model.bonds.atoms[:, 0]] - p.unwrapped[model.bonds.atoms[:, 1]]
+        bond_len = float(np.sqrt((d * d).sum(1)).max())
+    skin = max(0.05, 0.25 * max(max_cut, 1e-12)) if max_cut > 0 else 0.3
+    comm_cut = max(max_cut + skin, 2.0 * max(bond_len, float(np.max(model.bonds.r0, initial=0.0))) + skin)
+
+    acts, out_steps, total = _schedule(model, general_lambda)
+
+    data_path = folder / DATA_NAME
+    _write_data(model, data_path, ltypes, atype, btypes, btype, atypes, antype, use_mvv)
+    env = Environment(loader=PackageLoader("fibrelmp", "templates"), undefined=StrictUndefined,
+                      trim_blocks=True, lstrip_blocks=True, keep_trailing_newline=True)
+    script = env.get_template("bead_spring.lammps.j2").render(
+        model=model, dyn=dyn, box=box, fmt=_fmt, use_mvv=use_mvv,
+        frozen_types=frozen_types, mobile_types=mobile_types,
+        bond_types=btypes, angle_types=atypes, pair_lines=pair_lines, pair_styles=pair_styles,
+        max_cut=max(max_cut, 1e-6), skin=skin, comm_cut=comm_cut, acts=acts,
+        general_lambda=general_lambda, data_name=DATA_NAME, frames_name=FRAMES_NAME,
+        state_section=STATE_SECTION, wall_pad=float(box.lengths.max()),
+        type_names=[p.type_names[int(t)] for t in ltypes[:, 0]], needs_state=needs_state,
+        rad2deg=180.0 / math.pi, inf=float("inf"), angle_expression=angle_expression,
+    )
+    script_path = folder / SCRIPT_NAME
+    atomic_write(script_path, script)
+    type_of_ltype = np.r_[-1, ltypes[:, 0].astype(np.int64)]
+    return Job(folder, script_path, data_path, folder / FRAMES_NAME, total, type_of_ltype, out_steps)
+
+
+def _block(fmt_row: str, columns: list[np.ndarray]) -> str:
+    """Format rows with one C-level % operation (no per-row Python loop)."""
+    n = len(columns[0])
+    if n == 0:
+        return ""
+    flat = np.empty((n, len(columns)), dtype=object)
+    for c, col in enumerate(columns):
+        flat[:, c] = col.tolist() if isinstance(col, np.ndarray) else col
+    return (fmt_row * n) % tuple(flat.ravel().tolist())
+
+
+def _write_data(model: Model, path: Path, ltypes, atype, btypes, btype, atypes, antype,
+                use_mvv: bool) -> None:
+    p, box = model.particles, model.box
+    n = p.count
+    ids = np.arange(1, n + 1)
+    parts = [f"LAMMPS data file written by fibrelmp from {model.source.name}\n\n",
+             f"{n} atoms\n{model.bonds.count} bonds\n{model.angles.count} angles\n",
+             f"{len(ltypes)} atom types\n{max(len(btypes), 1) if model.bonds.count else 0} bond types\n",
+             f"{len(atypes) if model.angles.count else 0} angle types\n\n"]
+    for axis, name in enumerate("xyz"):
+        parts.append(f"{_fmt(box.lo[axis])} {_fmt(box.hi[axis])} {name}lo {name}hi\n")
+    parts.append("\nMasses\n\n")
+    for i, row in enumerate(ltypes):
+        mass = row[1] if row[1] > 0 else 1.0      # mass-0 beads are not integrated: placeholder
+        parts.append(f"{i + 1} {_fmt(mass)}  # {p.type_names[int(row[0])]} m={row[1]:g} R={row[2]:g}\n")
+    # unwrapped coordinates: read_data wraps them into periodic boxes and sets image flags
+    x = p.unwrapped if any(box.periodic) else p.positions
+    cols = [ids, p.molecules, atype + 1, x[:, 0], x[:, 1], x[:, 2]]
+    if use_mvv:
+        parts.append("\nAtoms # hybrid\n\n")
+        parts.append(_block("%d %d %.17g %.17g %.17g %d 0\n", [ids, atype + 1, x[:, 0], x[:, 1], x[:, 2], p.molecules]))
+    else:
+        parts.append("\nAtoms # angle\n\n")
+        parts.append(_block("%d %d %d %.17g %.17g %.17g\n", cols))
+    v = p.velocities
+    parts.append("\nVelocities\n\n")
+    parts.append(_block("%d %.17g %.17g %.17g\n", [ids, v[:, 0], v[:, 1], v[:, 2]]))
+    if model.bonds.count:
+        b = model.bonds.atoms + 1
+        parts.append("\nBonds\n\n")
+        parts.append(_block("%d %d %d %d\n", [np.arange(1, len(b) + 1), btype + 1, b[:, 0], b[:, 1]]))
+    if model.angles.count:
+        a = model.angles.atoms + 1
+        parts.append("\nAngles\n\n")
+        parts.append(_block("%d %d %d %d %d\n", [np.arange(1, len(a) + 1), antype + 1, a[:, 0], a[:, 1], a[:, 2]]))
+    f0 = p.initial_forces if p.initial_forces is not None else np.zeros((n, 3))
+    vt = p.display_velocities if p.display_velocities is not None else p.velocities
+    parts.append(f"\n{STATE_SECTION}\n\n")
+    parts.append(_block("%d %.17g %.17g %.17g %.17g %.17g %.17g\n",
+                        [ids, f0[:, 0], f0[:, 1], f0[:, 2], vt[:, 0], vt[:, 1], vt[:, 2]]))
+    atomic_write(path, "".join(parts))

@@ -264,6 +264,12 @@ def read(path: str | Path) -> Model:
             notes.append(("restart ignored", f"{path}:{rline.number}: restart_file without "
                           "restart_data: FibreNet only validates the file and applies nothing"))
     _apply_modif_bead(inp, particles, type_index, notes)
+    quirk = (particles.velocities != particles.display_velocities).any(axis=1)
+    if quirk.any():
+        row = int(np.flatnonzero(quirk)[0])
+        notes.append(("velocity quirk", f"{model_path}: bead {row}: FibreNet starts beads from "
+                      "v = (vx, vx, vx) (a bug in its model reader); fibrelmp reproduces it. "
+                      "Use 'modif_bead ... velocity' to set other velocities"))
     _apply_modif_spring(inp, springs, notes)
     bonds = springs.to_bonds()
     _check_positions(particles, box, periodic, model_path, notes)
@@ -367,11 +373,6 @@ def _read_model(path: Path, type_index: dict[str, int], type_names: list[str], s
                          f"{size[0]:g} {size[1]:g} {size[2]:g})")
     # FibreNet bug (S:1404): the integrator starts from v_old = (vx, vx, vx)
     v_old = np.repeat(vel[:, :1], 3, axis=1)
-    if (v_old != vel).any():
-        row = int(np.flatnonzero((v_old != vel).any(axis=1))[0])
-        notes.append(("velocity quirk", f"{path}:{numbers[row]}: FibreNet starts beads from "
-                      "v = (vx, vx, vx) (a bug in its model reader); fibrelmp reproduces it. "
-                      "Use 'modif_bead ... velocity' to set other velocities"))
     particles = Particles(list(type_names), types, pos.copy(), image.copy(), v_old, mass.copy(),
                           radius.copy(), tags, loc, force.copy(), vel.copy())
     springs = _read_springs(path, sections["SPRING"], len(types), notes)

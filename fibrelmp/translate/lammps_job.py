@@ -176,8 +176,8 @@ def write_job(model: Model, folder: str | Path) -> Job:
     ltypes, atype = _unique_rows(p.types.astype(float), p.masses, p.radii)
     frozen_types = [i + 1 for i in range(len(ltypes)) if ltypes[i, 1] == 0]
     mobile_types = [i + 1 for i in range(len(ltypes)) if ltypes[i, 1] > 0]
-    btypes, btype = _unique_rows(model.bonds.k, model.bonds.r0,
-                                 np.nan_to_num(model.bonds.break_length, nan=-1.0))
+    bonds = _bonds_alive_at_first_step(model)
+    btypes, btype = _unique_rows(bonds.k, bonds.r0, np.nan_to_num(bonds.break_length, nan=-1.0))
     atypes, antype = _unique_rows(model.angles.c, model.angles.theta0)
     pair_lines, pair_styles, max_cut = _pair_coeffs(model, ltypes)
 
@@ -186,17 +186,21 @@ def write_job(model: Model, folder: str | Path) -> Job:
     needs_state = True
 
     # communication must reach across bonds and angles (1-3 pairs) as well as pair cutoffs
-    bond_len = 0.0
-    if model.bonds.count:
-        d = p.unwrapped[model.bonds.atoms[:, 0]] - p.unwrapped[model.bonds.atoms[:, 1]]
-        bond_len = float(np.sqrt((d * d).sum(1)).max())
+    # ghosts must reach both legs of every angle and every bond, as well as the pair cutoffs
+    legs = [bonds.atoms] + [model.angles.atoms[:, [0, 1]], model.angles.atoms[:, [2, 1]]]
+    leg_len = 0.0
+    for pairs_ in legs:
+        if len(pairs_):
+            d = p.unwrapped[pairs_[:, 0]] - p.unwrapped[pairs_[:, 1]]
+            leg_len = max(leg_len, float(np.sqrt((d * d).sum(1)).max()))
+    leg_len = max(leg_len, float(np.max(bonds.r0, initial=0.0)))
     skin = max(0.05, 0.25 * max(max_cut, 1e-12)) if max_cut > 0 else 0.3
-    comm_cut = max(max_cut + skin, 2.0 * max(bond_len, float(np.max(model.bonds.r0, initial=0.0))) + skin)
+    comm_cut = max(max_cut + skin, 2.0 * leg_len + skin)
 
     acts, out_steps, total = _schedule(model, general_lambda)
 
     data_path = folder / DATA_NAME
-    _write_data(model, data_path, ltypes, atype, btypes, btype, atypes, antype, use_mvv)
+    _write_data(model, bonds, data_path, ltypes, atype, btypes, btype, atypes, antype, use_mvv)
     env = Environment(loader=PackageLoader("fibrelmp", "templates"), undefined=StrictUndefined,
                       trim_blocks=True, lstrip_blocks=True, keep_trailing_newline=True)
     script = env.get_template("bead_spring.lammps.j2").render(
@@ -226,23 +230,61 @@ def _block(fmt_row: str, columns: list[np.ndarray]) -> str:
     return (fmt_row * n) % tuple(flat.ravel().tolist())
 
 
-def _write_data(model: Model, path: Path, ltypes, atype, btypes, btype, atypes, antype,
+def _bonds_alive_at_first_step(model: Model):
+    """Drop HR_FL springs already beyond their break length where the first step checks them.
+
+    FibreNet tests the stress before the first force; fix bond/break acts only after the
+    first integration, so such springs are left out of the data file instead.
+    """
+    from ..model import Bonds
+
+    b, p = model.bonds, model.particles
+    breakable = np.isfinite(b.break_length)
+    if not breakable.any():
+        return b
+    first = model.plan.stages[0]
+    x = p.unwrapped.copy()
+    if not (first.name == "relax" and first.reset):
+        dt = model.dynamics.dt
+        f0 = p.initial_forces if p.initial_forces is not None else np.zeros_like(x)
+        mobile = p.masses > 0
+        x += p.velocities * dt
+        x[mobile] += 0.5 * dt * dt * f0[mobile] / p.masses[mobile, None]
+    d = x[b.atoms[:, 0]] - x[b.atoms[:, 1]]
+    broken = breakable & (np.sqrt((d * d).sum(1)) > b.break_length)
+    if not broken.any():
+        return b
+    model.warn("HR_FL broken at start", f"{int(broken.sum())} HR_FL spring(s) exceed their break "
+               "length at the first step; FibreNet breaks them before any force acts, so they are "
+               "left out of the LAMMPS data file")
+    keep = ~broken
+    return Bonds(b.atoms[keep], b.k[keep], b.r0[keep], b.break_length[keep])
+
+
+def _write_data(model: Model, bonds, path: Path, ltypes, atype, btypes, btype, atypes, antype,
                 use_mvv: bool) -> None:
     p, box = model.particles, model.box
     n = p.count
     ids = np.arange(1, n + 1)
     parts = [f"LAMMPS data file written by fibrelmp from {model.source.name}\n\n",
-             f"{n} atoms\n{model.bonds.count} bonds\n{model.angles.count} angles\n",
-             f"{len(ltypes)} atom types\n{max(len(btypes), 1) if model.bonds.count else 0} bond types\n",
+             f"{n} atoms\n{bonds.count} bonds\n{model.angles.count} angles\n",
+             f"{len(ltypes)} atom types\n{len(btypes) if bonds.count else 0} bond types\n",
              f"{len(atypes) if model.angles.count else 0} angle types\n\n"]
+    # finite axes: the data-file box must hold beads already pushed into a wall (restarts);
+    # the walls themselves sit at box.lo / box.hi in the script
+    x = p.unwrapped if any(box.periodic) else p.positions
     for axis, name in enumerate("xyz"):
-        parts.append(f"{_fmt(box.lo[axis])} {_fmt(box.hi[axis])} {name}lo {name}hi\n")
+        lo, hi = box.lo[axis], box.hi[axis]
+        if not box.periodic[axis] and n:
+            margin = 1e-6 * (hi - lo)
+            lo = min(lo, float(x[:, axis].min()) - margin)
+            hi = max(hi, float(x[:, axis].max()) + margin)
+        parts.append(f"{_fmt(lo)} {_fmt(hi)} {name}lo {name}hi\n")
     parts.append("\nMasses\n\n")
     for i, row in enumerate(ltypes):
         mass = row[1] if row[1] > 0 else 1.0      # mass-0 beads are not integrated: placeholder
         parts.append(f"{i + 1} {_fmt(mass)}  # {p.type_names[int(row[0])]} m={row[1]:g} R={row[2]:g}\n")
     # unwrapped coordinates: read_data wraps them into periodic boxes and sets image flags
-    x = p.unwrapped if any(box.periodic) else p.positions
     cols = [ids, p.molecules, atype + 1, x[:, 0], x[:, 1], x[:, 2]]
     if use_mvv:
         parts.append("\nAtoms # hybrid\n\n")
@@ -253,8 +295,8 @@ def _write_data(model: Model, path: Path, ltypes, atype, btypes, btype, atypes, 
     v = p.velocities
     parts.append("\nVelocities\n\n")
     parts.append(_block("%d %.17g %.17g %.17g\n", [ids, v[:, 0], v[:, 1], v[:, 2]]))
-    if model.bonds.count:
-        b = model.bonds.atoms + 1
+    if bonds.count:
+        b = bonds.atoms + 1
         parts.append("\nBonds\n\n")
         parts.append(_block("%d %d %d %d\n", [np.arange(1, len(b) + 1), btype + 1, b[:, 0], b[:, 1]]))
     if model.angles.count:

@@ -1,0 +1,140 @@
+#!/usr/bin/env python3
+"""Translation speed: fibrelmp's read_input + translate versus LAMMPS's own read_data.
+
+Generates a random ~260,000-bead FibreNet network (examples/generate_network.py) in a
+temporary folder, then in the same process measures, best of --repeat:
+
+  (a) translate = fibrelmp.api.read_input(input.txt) + fibrelmp.api.translate(model, job)
+      (parse the FibreNet input and model, write data.lammps and in.lammps);
+  (b) read_data = LAMMPS executing the ``read_data`` line of that in.lammps (the set-up
+      commands before it are issued first, untimed, in a fresh instance).
+
+Goal: translate / read_data <= 1.0, i.e. fibrelmp's whole translation costs no more than
+LAMMPS reading the file it produces.
+
+    python benchmarks/translate.py [--beads 260000] [--repeat 3] [--profile]
+"""
+
+from __future__ import annotations
+
+import argparse
+import gc
+import importlib.util
+import os
+import shutil
+import tempfile
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+
+
+def load_generator():
+    spec = importlib.util.spec_from_file_location(
+        "generate_network", HERE.parent / "examples" / "generate_network.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def setup_and_read_data(script: Path) -> tuple[list[str], str]:
+    """The commands of in.lammps before ``read_data`` and the read_data line itself."""
+    lines = [ln.strip() for ln in script.read_text().splitlines()]
+    lines = [ln for ln in lines if ln and not ln.startswith("#")]
+    k = next(i for i, ln in enumerate(lines) if ln.split()[0] == "read_data")
+    return lines[:k], lines[k]
+
+
+def time_translate(input_path: Path, job_dir: Path) -> tuple[float, float, object]:
+    from fibrelmp.api import read_input, translate
+
+    shutil.rmtree(job_dir, ignore_errors=True)     # a fresh folder, as in a real first translate
+    gc.collect()
+    t0 = time.perf_counter()
+    model = read_input(input_path)
+    t1 = time.perf_counter()
+    job = translate(model, job_dir)
+    t2 = time.perf_counter()
+    return t1 - t0, t2 - t1, job
+
+
+def time_read_data(job_dir: Path, setup: list[str], read_data: str) -> float:
+    from fibrelmp._lammps import new_lammps
+
+    cwd = os.getcwd()
+    lmp = new_lammps(["-log", "none", "-screen", "none", "-nocite"])
+    try:
+        os.chdir(job_dir)
+        for ln in setup:
+            lmp.command(ln)
+        gc.collect()
+        t0 = time.perf_counter()
+        lmp.command(read_data)
+        return time.perf_counter() - t0
+    finally:
+        os.chdir(cwd)
+        lmp.close()
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--beads", type=int, default=260000)
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--profile", action="store_true",
+                    help="also cProfile one read_input + translate and print the top functions")
+    args = ap.parse_args()
+
+    gen = load_generator()
+    with tempfile.TemporaryDirectory(prefix="fibrelmp-bench-") as tmp:
+        tmp = Path(tmp)
+        net_dir, job_dir = tmp / "network", tmp / "job"
+        t0 = time.perf_counter()
+        net = gen.generate(gen.parse_args(["--beads", str(args.beads), "--seed", str(args.seed),
+                                           "--out", str(net_dir)]))
+        t_gen = time.perf_counter() - t0
+        input_path = net_dir / "input.txt"
+        print(f"network: {net['n']} beads, {len(net['springs'])} springs, {len(net['angles'])} "
+              f"angles, box {net['L']:.4g} (generated in {t_gen:.2f} s)")
+
+        # warm-up (imports, jinja template compilation, LAMMPS library load), untimed
+        _, _, job = time_translate(input_path, job_dir)
+        setup, read_data = setup_and_read_data(job.script)
+        print(f"model.txt {(net_dir / 'model.txt').stat().st_size / 1e6:.1f} MB, "
+              f"data.lammps {job.data.stat().st_size / 1e6:.1f} MB")
+
+        parse, write, rd = [], [], []
+        for _ in range(args.repeat):       # interleaved, so machine-load drift hits both alike
+            a, b, _ = time_translate(input_path, job_dir)
+            parse.append(a)
+            write.append(b)
+            rd.append(time_read_data(job_dir, setup, read_data))
+        total = [a + b for a, b in zip(parse, write)]
+        best = min(range(args.repeat), key=lambda i: total[i])
+        t_tr, t_rd = total[best], min(rd)
+        print(f"translate (read_input + translate), best of {args.repeat}: {t_tr:.3f} s "
+              f"(read_input {parse[best]:.3f} s + translate {write[best]:.3f} s); "
+              f"all: {', '.join(f'{t:.3f}' for t in total)}")
+        print(f"LAMMPS read_data, best of {args.repeat}: {t_rd:.3f} s; "
+              f"all: {', '.join(f'{t:.3f}' for t in rd)}")
+
+        if args.profile:
+            import cProfile
+            import pstats
+
+            from fibrelmp.api import read_input, translate
+
+            prof = cProfile.Profile()
+            prof.enable()
+            translate(read_input(input_path), job_dir)
+            prof.disable()
+            pstats.Stats(prof).sort_stats("tottime").print_stats(25)
+
+        ratio = t_tr / t_rd
+        verdict = "OK" if ratio <= 1.0 else "ABOVE GOAL 1.0"
+        print(f"translate/read_data ratio: {ratio:.2f} ({verdict})")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

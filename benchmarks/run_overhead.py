@@ -115,7 +115,7 @@ def main() -> int:
     ap.add_argument("--beads", type=int, default=50000)
     ap.add_argument("--steps", type=int, default=1000)
     ap.add_argument("--output-freq", type=int, default=250)
-    ap.add_argument("--repeat", type=int, default=1,
+    ap.add_argument("--repeat", type=int, default=3,
                     help="pairs of (fibrelmp, bare) runs; the best of each is compared")
     ap.add_argument("--seed", type=int, default=1)
     args = ap.parse_args()

@@ -346,6 +346,12 @@ def _pair_law(path: Path, line: _Line, i: int, j: int, cutoff: float) -> PairLaw
 
 def _read_model(path: Path, type_index: dict[str, int], type_names: list[str], size: np.ndarray,
                 notes: list) -> tuple[Particles, "_Springs", Angles]:
+    from .fibrenet_fast import fast_read_model
+
+    read_text(path, "FibreNet model file")      # encoding / binary checks with clear messages
+    fast = fast_read_model(path.read_bytes(), type_index, type_names, size, _Springs)
+    if fast is not None:
+        return fast
     sections = _model_sections(path)
     lines, numbers = sections["BEAD"]
     if not lines:

@@ -14,6 +14,7 @@ import numpy as np
 from jinja2 import Environment, PackageLoader, StrictUndefined
 
 from ..errors import InputError
+from ..fastfmt import rows_text
 from ..model import Model
 from ..textio import atomic_write
 
@@ -39,11 +40,16 @@ def _fmt(x: float) -> str:
 
 
 def _unique_rows(*cols: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    table = np.column_stack(cols) if cols[0].size else np.zeros((0, len(cols)))
-    if not table.size:
-        return table, np.zeros(0, np.int64)
-    uniq, inverse = np.unique(table, axis=0, return_inverse=True)
-    return uniq, inverse.reshape(-1)
+    """np.unique(rows, axis=0) via per-column integer codes (sorting ints, not byte rows)."""
+    if not cols[0].size:
+        return np.zeros((0, len(cols))), np.zeros(0, np.int64)
+    key = np.zeros(len(cols[0]), np.int64)
+    for col in cols:
+        u, inv = np.unique(col, return_inverse=True)
+        key = key * len(u) + inv.reshape(-1)
+        key = np.unique(key, return_inverse=True)[1].reshape(-1)   # re-compress: no overflow
+    _, first, inverse = np.unique(key, return_index=True, return_inverse=True)
+    return np.column_stack([np.asarray(c)[first] for c in cols]), inverse.reshape(-1)
 
 
 def _pair_coeffs(model: Model, ltypes: np.ndarray) -> tuple[list[str], list[str], float]:
@@ -224,6 +230,12 @@ def _block(fmt_row: str, columns: list[np.ndarray]) -> str:
     n = len(columns[0])
     if n == 0:
         return ""
+    # fast path: "%d"/"%.17g" columns and literal tokens, formatted digit-column-wise
+    tokens, it = fmt_row.split(), iter(columns)
+    if fmt_row.endswith("\n") and fmt_row.count("%") == len(columns):
+        text = rows_text([next(it) if tok.startswith("%") else tok for tok in tokens])
+        if text is not None:
+            return text.decode("ascii")
     flat = np.empty((n, len(columns)), dtype=object)
     for c, col in enumerate(columns):
         flat[:, c] = col.tolist() if isinstance(col, np.ndarray) else col

@@ -1,0 +1,73 @@
+"""Vectorised ASCII formatting of numeric columns (no per-value Python code).
+
+Floats are written in the shortest fixed-point form (<= 9 decimals) that reads back to the
+identical double; columns that need more digits return None so callers fall back to %.17g.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+_POW10 = 10 ** np.arange(19, dtype=np.int64)
+
+
+def _fixed(s: np.ndarray, k: int) -> np.ndarray:
+    """Text of s / 10^k (s int64) with exactly k decimals, right-aligned: (n, w) uint8."""
+    neg = s < 0
+    mag = np.abs(s)
+    ndig = np.maximum(np.searchsorted(_POW10, mag, side="right"), k + 1)   # digits printed
+    w = int(ndig.max(initial=1))
+    d = np.empty((len(s), w), np.uint8)
+    r = mag.copy()
+    for j in range(w - 1, -1, -1):          # w vectorised passes, one per digit position
+        r, digit = np.divmod(r, 10)
+        d[:, j] = digit
+    d += 48
+    first = w - ndig                        # column of the first printed digit
+    d[np.arange(w)[None, :] < first[:, None]] = 32
+    if neg.any():
+        d = np.hstack([np.full((len(s), 1), 32, np.uint8), d])
+        rows = np.flatnonzero(neg)
+        d[rows, first[rows]] = 45           # '-' just before the first digit
+    if k:
+        d = np.hstack([d[:, :-k], np.full((len(s), 1), 46, np.uint8), d[:, -k:]])
+    return d
+
+
+def float_text(x: np.ndarray, max_decimals: int = 9) -> np.ndarray | None:
+    """Fixed-point text that parses back to exactly x, or None (caller falls back to repr).
+
+    round(x 10^k) / 10^k == x means the k-decimal string is the correctly rounded decimal
+    of x (integer / power of ten is correctly rounded in IEEE arithmetic), so float() or
+    LAMMPS's strtod reads back the very same double.
+    """
+    x = np.asarray(x, np.float64)
+    if not np.isfinite(x).all():
+        return None
+    big = float(np.abs(x).max(initial=0.0))
+    for k in range(max_decimals + 1):
+        scale = 10.0 ** k
+        if big * scale >= 2.0 ** 53:
+            return None
+        s = np.round(x * scale)
+        if (s / scale == x).all():
+            return _fixed(s.astype(np.int64), k)
+    return None
+
+
+def rows_text(columns: list) -> bytes | None:
+    """Space-separated rows of int/float columns, or None if a float column needs repr."""
+    n = len(columns[0])
+    parts = []
+    for col in columns:
+        if isinstance(col, str):                    # literal text in every row
+            parts += [np.frombuffer(col.encode() * n, np.uint8).reshape(n, -1),
+                      np.full((n, 1), 32, np.uint8)]
+            continue
+        col = np.asarray(col)
+        f = _fixed(col.astype(np.int64), 0) if col.dtype.kind in "iub" else float_text(col)
+        if f is None:
+            return None
+        parts += [f, np.full((n, 1), 32, np.uint8)]
+    parts[-1] = np.full((n, 1), 10, np.uint8)
+    return np.hstack(parts).tobytes()

@@ -1,0 +1,115 @@
+"""Fast path for FibreNet model files in the usual FibreGen layout (BEAD, SPRING, ANGLE blocks).
+
+Each block is parsed by one np.loadtxt call.  Anything unusual (other layouts, HR_FL springs,
+extra tokens, bad values) returns None and the line-by-line reader in fibrenet.py runs instead,
+so error messages keep their exact line numbers.
+"""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+
+import numpy as np
+
+from ..model import Angles, Particles
+
+_NCOLS = {"BEAD": 18, "SPRING": 7, "ANGLE": 10}
+# bytes that str.splitlines()/str.split() treat as line breaks / whitespace but loadtxt may not
+_ODD = (b"\x0b", b"\x0c", b"\x1c", b"\x1d", b"\x1e", b"\x1f")
+
+
+def model_blocks(raw: bytes) -> dict[str, tuple[str, int]] | None:
+    """FibreGen layout (all BEAD lines, then SPRING lines, then ANGLE lines): {kind: (text,
+    first line number)}; None for any other layout or unusual bytes (use the slow path)."""
+    if not raw.isascii() or any(c in raw for c in _ODD):
+        return None
+    if b"\r" in raw and raw.count(b"\r") != raw.count(b"\r\n"):
+        return None
+    at = {}
+    for key in _NCOLS:
+        k = key.encode()
+        at[key] = 0 if raw.startswith(k) else (lambda i: -1 if i < 0 else i + 1)(raw.find(b"\n" + k))
+    if at["BEAD"] != 0:
+        return None
+    order = [k for k in _NCOLS if at[k] >= 0]
+    if [at[k] for k in order] != sorted(at[k] for k in order):
+        return None
+    out = {k: ("", 0) for k in _NCOLS}
+    bounds = [at[k] for k in order] + [len(raw)]
+    for k, a, b in zip(order, bounds[:-1], bounds[1:]):
+        out[k] = (raw[a:b].decode("ascii"), raw.count(b"\n", 0, a) + 1)
+    return out
+
+
+def table(text: str, kind: str, col1: dict) -> np.ndarray | None:
+    """(n, ncols) floats of one block; column 0 must be the keyword on every non-blank line,
+    column 1 (type name / spring kind) is mapped through col1."""
+    if not text:
+        return np.zeros((0, _NCOLS[kind]))
+    try:
+        val = np.loadtxt(io.StringIO(text), converters={0: {kind: 0.0}.__getitem__,
+                                                        1: col1.__getitem__},
+                         comments=None, ndmin=2, dtype=np.float64)
+    except Exception:        # other lines, wrong column count, unknown name, bad number
+        return None
+    if val.shape[1] != _NCOLS[kind] or not np.isfinite(val).all():
+        return None
+    return val
+
+
+def ints(col: np.ndarray) -> np.ndarray | None:
+    return col.astype(np.int64) if (col == np.round(col)).all() else None
+
+
+
+def fast_read_model(raw: bytes, type_index: dict[str, int], type_names: list[str],
+                    size: np.ndarray, springs_factory):
+    """(particles, springs, angles) or None when the slow reader must handle the file."""
+    blocks = model_blocks(raw[3:] if raw.startswith(b"\xef\xbb\xbf") else raw)
+    if blocks is None:
+        return None
+    btext, _ = blocks["BEAD"]
+    if not btext:
+        return None
+    val = table(btext, "BEAD", {k: float(v) for k, v in type_index.items()})
+    if val is None:
+        return None
+    n = len(val)
+    types, tags, loc = ints(val[:, 1]), ints(val[:, 2]), ints(val[:, 3])
+    if tags is None or loc is None:
+        return None
+    radius, mass = val[:, 4], val[:, 5]
+    pos, vel, force, image = val[:, 6:9], val[:, 9:12], val[:, 12:15], val[:, 15:18]
+    if (radius < 0).any() or (mass < 0).any() or ((pos < 0) | (pos > size)).any():
+        return None
+    v_old = np.repeat(vel[:, :1], 3, axis=1)       # FibreNet's (vx, vx, vx) quirk
+    particles = Particles(list(type_names), types, pos.copy(), image.copy(), v_old, mass.copy(),
+                          radius.copy(), tags, loc, force.copy(), vel.copy())
+    stext, _ = blocks["SPRING"]
+    sval = table(stext, "SPRING", {"HR": 0.0})
+    if sval is None:
+        return None
+    s = springs_factory(len(sval))
+    st, a0, a1 = ints(sval[:, 2]), ints(sval[:, 3]), ints(sval[:, 4])
+    if st is None or a0 is None or a1 is None:
+        return None
+    s.tags, s.atoms = st, np.column_stack([a0, a1]).reshape(-1, 2)
+    s.r0, s.k = sval[:, 5].copy(), sval[:, 6].copy()
+    if ((s.atoms < 0) | (s.atoms >= n)).any() or (s.r0 < 0).any() or (s.k < 0).any() \
+            or (s.atoms[:, 0] == s.atoms[:, 1]).any():
+        return None
+    atext, _ = blocks["ANGLE"]
+    if not atext:
+        return particles, s, Angles.empty()
+    aval = table(atext, "ANGLE", {"HR": 0.0, "HR_FL": 1.0})
+    if aval is None:
+        return None
+    cols = [ints(aval[:, c]) for c in (3, 4, 5)]
+    if any(c is None for c in cols):
+        return None
+    atoms = np.column_stack(cols)
+    if ((atoms < 0) | (atoms >= n)).any():
+        return None
+    # theta0 is read with std::stof in FibreNet: float precision
+    return particles, s, Angles(atoms, aval[:, 9].copy(), aval[:, 8].astype(np.float32).astype(np.float64))

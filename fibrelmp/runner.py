@@ -11,6 +11,7 @@ import os
 import sys
 import time
 from pathlib import Path
+from typing import Callable
 
 from ._lammps import new_lammps
 from .errors import RunError
@@ -47,8 +48,12 @@ class Progress:
             sys.stderr.write("\n")
 
 
-def run_script(script: Path, total_steps: int, progress: bool = True, log: bool = False) -> None:
-    """Execute ``script`` inside its folder with the lammps module."""
+def run_script(script: Path, total_steps: int, progress: bool = True, log: bool = False,
+               on_command: Callable[[list[str]], None] | None = None) -> None:
+    """Execute ``script`` inside its folder with the lammps module.
+
+    ``on_command`` is called with the words of every command after LAMMPS finished it.
+    """
     script = Path(script)
     rank, _ = mpi_rank_size()
     args = ["-nocite", "-log", "log.lammps" if log else "none", "-screen", "none"]
@@ -70,6 +75,8 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
             words = text.split()
             if words[0] == "run" and len(words) > 1:
                 bar.advance(int(words[1]))
+            if on_command is not None:
+                on_command(words)
     finally:
         bar.close()
         os.chdir(cwd)

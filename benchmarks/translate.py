@@ -19,22 +19,18 @@ from __future__ import annotations
 
 import argparse
 import gc
-import importlib.util
 import os
 import shutil
+import sys
 import tempfile
 import time
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+from _common import load_generator  # noqa: E402
 
 
-def load_generator():
-    spec = importlib.util.spec_from_file_location(
-        "generate_network", HERE.parent / "examples" / "generate_network.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
 
 
 def setup_and_read_data(script: Path) -> tuple[list[str], str]:

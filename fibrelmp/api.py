@@ -36,8 +36,9 @@ def run(model: Model, out: str | Path | None = None, work: str | Path | None = N
     from .runner import mpi_rank_size, run_script
 
     spec = model.plan.output
-    out_folder = Path(out) if out is not None else spec.folder
-    work_folder = Path(work) if work is not None else out_folder / f"{spec.basename}_work"
+    # absolute paths: the runner changes directory while the converter thread writes
+    out_folder = (Path(out) if out is not None else spec.folder).resolve()
+    work_folder = (Path(work) if work is not None else out_folder / f"{spec.basename}_work").resolve()
     rank, size = mpi_rank_size()
     job = translate(model, work_folder)
     if job.frames.exists():

@@ -52,6 +52,9 @@ def _guard(func):
         except RunError as exc:
             typer.secho(f"run failed: {exc}", err=True, fg=typer.colors.RED)
             raise typer.Exit(1)
+        except OSError as exc:
+            typer.secho(f"run failed: {exc}", err=True, fg=typer.colors.RED)
+            raise typer.Exit(1)
         except KeyboardInterrupt:
             typer.secho("interrupted", err=True, fg=typer.colors.RED)
             raise typer.Exit(130)

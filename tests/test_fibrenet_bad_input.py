@@ -125,3 +125,13 @@ def test_cli_lammps_failure_exit_1(tmp_path):
 def test_version():
     proc = subprocess.run([sys.executable, "-m", "fibrelmp.cli", "--version"], capture_output=True, text=True)
     assert proc.returncode == 0 and "fibrelmp" in proc.stdout and "LAMMPS 2025" in proc.stdout
+
+
+def test_cli_run_with_relative_paths(tmp_path):
+    """Outputs land next to a relative input path even though LAMMPS runs in the work folder."""
+    (tmp_path / "case").mkdir()
+    write_case(tmp_path / "case")
+    proc = _cli("--quiet", "run", "case/input.txt", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert (tmp_path / "case" / "out_coord.xyz").exists()
+    assert (tmp_path / "case" / "out_work" / "in.lammps").exists()

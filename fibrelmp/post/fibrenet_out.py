@@ -13,20 +13,14 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from ..textio import atomic_write, parse_table, read_text
+from ..textio import atomic_write, format_rows, parse_table, read_text
 
 XYZ_SUFFIX = {"position": "_coord.xyz", "velocity": "_vel.xyz", "force": "_force.xyz"}
 RESTART_SUFFIX = "_restart.res"
 
 
 def _rows(fmt_row: str, names: np.ndarray, values: np.ndarray) -> str:
-    n = len(names)
-    if n == 0:
-        return ""
-    flat = np.empty((n, 1 + values.shape[1]), dtype=object)
-    flat[:, 0] = names
-    flat[:, 1:] = values
-    return (fmt_row * n) % tuple(flat.ravel().tolist())
+    return format_rows(fmt_row, [names] + [values[:, c] for c in range(values.shape[1])])
 
 
 def xyz_frame(step: int, dt: float, lengths: np.ndarray, names: np.ndarray, values: np.ndarray) -> str:

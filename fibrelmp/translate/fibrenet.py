@@ -618,5 +618,3 @@ def _note_quirks(p: Particles, bonds: Bonds, angles: Angles, pairs: list[PairLaw
             notes.append(("straight triple", f"{path}: some angle triples are exactly straight; "
                           "FibreNet clamps cos to -0.999999 there and applies a spurious force, "
                           "fibrelmp does not"))
-    if p.count and (p.masses == 0).any():
-        pass  # mass-0 beads move at constant velocity in both codes: not a quirk

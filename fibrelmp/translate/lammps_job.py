@@ -16,7 +16,7 @@ from jinja2 import Environment, PackageLoader, StrictUndefined
 from ..errors import InputError
 from ..fastfmt import rows_text
 from ..model import Model
-from ..textio import atomic_write
+from ..textio import atomic_write, format_rows
 
 SCRIPT_NAME = "in.lammps"
 DATA_NAME = "data.lammps"
@@ -189,7 +189,6 @@ def write_job(model: Model, folder: str | Path) -> Job:
 
     general_lambda = dyn.lambda_ != 0.5
     use_mvv = general_lambda and dyn.damping != 0 and bool(mobile_types)
-    needs_state = True
 
     # communication must reach across bonds and angles (1-3 pairs) as well as pair cutoffs
     # ghosts must reach both legs of every angle and every bond, as well as the pair cutoffs
@@ -216,7 +215,7 @@ def write_job(model: Model, folder: str | Path) -> Job:
         max_cut=max(max_cut, 1e-6), skin=skin, comm_cut=comm_cut, acts=acts,
         general_lambda=general_lambda, data_name=DATA_NAME, frames_name=FRAMES_NAME,
         state_section=STATE_SECTION, wall_pad=float(box.lengths.max()),
-        type_names=[p.type_names[int(t)] for t in ltypes[:, 0]], needs_state=needs_state,
+        type_names=[p.type_names[int(t)] for t in ltypes[:, 0]],
         rad2deg=180.0 / math.pi, inf=float("inf"), angle_expression=angle_expression,
     )
     script_path = folder / SCRIPT_NAME
@@ -226,7 +225,7 @@ def write_job(model: Model, folder: str | Path) -> Job:
 
 
 def _block(fmt_row: str, columns: list[np.ndarray]) -> str:
-    """Format rows with one C-level % operation (no per-row Python loop)."""
+    """Data-file rows: digit-wise numpy formatting when possible, else one % operation."""
     n = len(columns[0])
     if n == 0:
         return ""
@@ -236,10 +235,7 @@ def _block(fmt_row: str, columns: list[np.ndarray]) -> str:
         text = rows_text([next(it) if tok.startswith("%") else tok for tok in tokens])
         if text is not None:
             return text.decode("ascii")
-    flat = np.empty((n, len(columns)), dtype=object)
-    for c, col in enumerate(columns):
-        flat[:, c] = col.tolist() if isinstance(col, np.ndarray) else col
-    return (fmt_row * n) % tuple(flat.ravel().tolist())
+    return format_rows(fmt_row, columns)
 
 
 def _bonds_alive_at_first_step(model: Model):

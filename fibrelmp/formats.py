@@ -1,4 +1,8 @@
-"""Input-format registry: detection by content ("magic") first, then by extension."""
+"""Input-format registry: detection by content ("magic") first, then by extension.
+
+Each entry names the reader module; readers are imported lazily so ``fibrelmp check`` on a
+FibreNet file never imports the DEM code (and vice versa).
+"""
 
 from __future__ import annotations
 
@@ -8,10 +12,19 @@ from types import ModuleType
 
 from .errors import InputError
 
-# name -> (module path, content test)
-_READERS: dict[str, tuple[str, re.Pattern]] = {
-    "fibrenet": ("fibrelmp.translate.fibrenet", re.compile(rb"^\s*model_file\s", re.M)),
+# name -> (module path, content test, extensions)
+_READERS: dict[str, tuple[str, re.Pattern, tuple[str, ...]]] = {
+    "fibrenet": ("fibrelmp.translate.fibrenet", re.compile(rb"^[ \t]*model_file\s", re.M), ()),
+    "musen-script": ("fibrelmp.translate.musen_script",
+                     re.compile(rb"^[ \t]*(JOB|SOURCE_FILE|COMPONENT)\b", re.M), ()),
+    # an object line "0 ID 1 TYPE 5 ...", or a scene line (22 domain / 32 material) of an object-less scene
+    "musen": ("fibrelmp.translate.musen",
+              re.compile(rb"\A\s*(0\s+\d+\s+1\s+\d+\s+5\b|(22|32)\s+\S)"), (".txt",)),
+    "demdf": ("fibrelmp.translate.demdf", re.compile(rb"\A(\xef\xbb\xbf)?\s*\{"), (".json",)),
 }
+
+_HINT = ("expected a FibreNet input (with a 'model_file' line), a MUSEN text scene, a cmusen job "
+         "script or a DEMDF JSON file")
 
 
 def detect(path: str | Path) -> str:
@@ -24,11 +37,18 @@ def detect(path: str | Path) -> str:
         head = path.read_bytes()[:1 << 20]
     except OSError as exc:
         raise InputError(path, None, f"cannot read input: {exc.strerror or exc}") from None
-    for name, (_, magic) in _READERS.items():
+    if path.suffix.lower() == ".mdem" or (b"\0" in head[:4096] and not head.startswith((b"\xff\xfe", b"\xfe\xff"))):
+        if path.suffix.lower() == ".mdem":
+            raise InputError(path, None, "binary MUSEN .mdem files cannot be read: export the scene "
+                             "as text (MUSEN: File > Export > Text, or a cmusen job with "
+                             "'COMPONENT EXPORT_TO_TEXT') and run that file")
+    for name, (_, magic, _) in _READERS.items():
         if magic.search(head):
             return name
-    raise InputError(path, None, "cannot tell the input format: expected a FibreNet input "
-                     "(with a 'model_file' line)")
+    for name, (_, _, exts) in _READERS.items():
+        if path.suffix.lower() in exts and name != "musen":
+            return name                 # let the reader explain what is wrong inside
+    raise InputError(path, None, f"cannot tell the input format: {_HINT}")
 
 
 def reader(name: str) -> ModuleType:

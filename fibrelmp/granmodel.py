@@ -1,0 +1,224 @@
+"""The neutral model for granular (DEM) inputs: MUSEN scenes and DEMDF documents.
+
+Readers fill a ``GranularModel``; ``translate.granular_job`` turns it into a LAMMPS job
+(``units si``-style consistent units, ``pair_style granular``); the writers in ``post/``
+turn LAMMPS frames back into MUSEN time points or DEMDF snapshots.  No format-to-format
+shortcuts: everything a writer needs that LAMMPS does not compute (names, keys, the
+original document) travels in this model.
+
+Conventions: arrays are numpy, rows are objects in the order the reader met them;
+LAMMPS atom id = sphere row + 1.  ``inf`` is "never" for activity ends.  Units are whatever
+the input uses consistently (MUSEN: SI; DEMDF: dimensionless) - the translator never
+converts, it only has to be self-consistent.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+
+@dataclass
+class Material:
+    """A material / object type.  ``props`` keeps every numbered property the input had
+    (MUSEN property ids: 0 density, 2 viscosity, 7 E, 8 normal strength, 9 tangential
+    strength, 10 Poisson ratio, ...), so writers can copy it through unchanged."""
+
+    key: str
+    name: str
+    density: float = float("nan")
+    youngs: float = float("nan")           # E [Pa]
+    poisson: float = float("nan")          # nu
+    normal_strength: float = float("nan")  # sigma_n [Pa] (bond breakage)
+    shear_strength: float = float("nan")   # tau_s [Pa]
+    props: dict[int, float] = field(default_factory=dict)
+
+    @property
+    def shear_modulus(self) -> float:
+        return self.youngs / (2.0 * (1.0 + self.poisson))
+
+
+@dataclass
+class ContactLaw:
+    """One unordered material pair's contact parameters, in the *effective* (already
+    mixed) form the source code uses:  F_n = 4/3 E* sqrt(R*) d^1.5 (Hertz) with damping
+    from ``restitution``; tangential stiffness 8 G* a, Coulomb limit ``friction``·|F_n|;
+    rolling torque ``rolling_friction``·|F_n|·R_i (MUSEN's constant-torque rolling)."""
+
+    youngs_eff: float          # E*
+    shear_eff: float           # G*  (0 = frictionless, no tangential spring)
+    restitution: float         # e in (0, 1]
+    friction: float = 0.0      # mu sliding
+    rolling_friction: float = 0.0
+
+
+@dataclass
+class Spheres:
+    ids: np.ndarray            # (n,) int64 source ids (MUSEN object ids / DEMDF array index)
+    material: np.ndarray       # (n,) int index into GranularModel.materials
+    radius: np.ndarray         # (n,)
+    contact_radius: np.ndarray # (n,) (MUSEN flag 30; equal to radius elsewhere)
+    mass: np.ndarray           # (n,)
+    position: np.ndarray       # (n,3)
+    velocity: np.ndarray       # (n,3)
+    omega: np.ndarray          # (n,3)
+    quaternion: np.ndarray     # (n,4) w x y z
+    active_start: np.ndarray   # (n,)
+    active_end: np.ndarray     # (n,) inf = active for ever
+    compound_key: list[str] | None = None   # per-sphere key as written (MUSEN 23)
+
+    @property
+    def count(self) -> int:
+        return int(self.ids.shape[0])
+
+
+@dataclass
+class SolidBonds:
+    """Cylindrical solid bonds between two spheres (MUSEN type 9)."""
+
+    ids: np.ndarray            # (m,) int64 source ids
+    pair: np.ndarray           # (m,2) sphere *rows* (not ids)
+    material: np.ndarray       # (m,) material index
+    diameter: np.ndarray       # (m,)
+    length0: np.ndarray        # (m,) stored initial length L0
+    active_start: np.ndarray
+    active_end: np.ndarray
+    compound_key: list[str] | None = None
+    # state carried over from a later time point of a result file (optional)
+    force: np.ndarray | None = None             # (m,3)
+    tangential_overlap: np.ndarray | None = None
+
+    @property
+    def count(self) -> int:
+        return int(self.ids.shape[0])
+
+
+@dataclass
+class Triangles:
+    """Triangular wall elements (MUSEN type 14)."""
+
+    ids: np.ndarray            # (k,) int64
+    material: np.ndarray       # (k,) material index
+    vertices: np.ndarray       # (k,3,3) V1 V2 V3
+    velocity: np.ndarray       # (k,3)
+    active_start: np.ndarray
+    active_end: np.ndarray
+    compound_key: list[str] | None = None
+
+    @property
+    def count(self) -> int:
+        return int(self.ids.shape[0])
+
+
+@dataclass
+class MotionInterval:
+    """Time-dependent rigid motion (MUSEN 26 type 1): in [t_begin, t_end) the geometry
+    translates with ``velocity`` and rotates with ``angular_velocity`` about ``centre``."""
+
+    t_begin: float
+    t_end: float
+    velocity: np.ndarray           # (3,)
+    centre: np.ndarray             # (3,)
+    angular_velocity: np.ndarray   # (3,)
+
+
+@dataclass
+class Geometry:
+    """A named group of triangles that moves as one body (MUSEN 25/26/27)."""
+
+    name: str
+    key: str
+    mass: float
+    free: tuple[bool, bool, bool]
+    rotate_around_centre: bool | None       # None: old 6-field line without the flag
+    motion_type: int                         # 0 none, 1 time, 2 force, 3 constant force
+    motion: list[MotionInterval]
+    triangle_rows: np.ndarray                # (k,) rows into GranularModel.triangles
+    raw_lines: list[str] = field(default_factory=list)  # 25/26/27 lines as read, for write-back
+
+
+@dataclass
+class Plane:
+    """An infinite wall plane; ``normal`` points into the domain (DEMDF walls)."""
+
+    normal: np.ndarray     # (3,) unit
+    point: np.ndarray      # (3,)
+    material: int          # material / object-type index of the wall
+
+
+@dataclass
+class GranularPlan:
+    dt: float
+    t_start: float
+    t_end: float
+    save_every_steps: int | None = None     # one of these two says when frames are saved
+    save_every_time: float | None = None
+    gravity: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    domain: tuple[np.ndarray, np.ndarray] | None = None   # (lo, hi): particles leaving are removed
+    periodic: tuple[bool, bool, bool] = (False, False, False)
+    periodic_box: tuple[np.ndarray, np.ndarray] | None = None
+    bond_breakage: int = 1                  # MUSEN CONSIDER_BREAKAGE: 0 none, 1 combined, 2 separate
+    contacts_between_bonded: bool = True    # MUSEN default
+    dimension: int = 3
+
+
+@dataclass
+class GranularModel:
+    source: Path
+    kind: str                              # "musen" | "demdf"
+    materials: list[Material]
+    contacts: dict[tuple[int, int], ContactLaw]   # key (a, b) with a <= b, material indices
+    spheres: Spheres
+    plan: GranularPlan
+    bonds: SolidBonds | None = None
+    triangles: Triangles | None = None
+    geometries: list[Geometry] = field(default_factory=list)
+    planes: list[Plane] = field(default_factory=list)
+    # Everything a writer copies through untouched (MUSEN scene lines 22..41, DEMDF document).
+    passthrough: dict[str, Any] = field(default_factory=dict)
+    warnings: list[tuple[str, str]] = field(default_factory=list)
+    units: str = "si"
+
+    def warn(self, kind: str, message: str) -> None:
+        self.warnings.append((kind, message))
+
+    def contact(self, a: int, b: int) -> ContactLaw:
+        return self.contacts[(min(a, b), max(a, b))]
+
+
+def hertz_effective(m1: Material, m2: Material) -> tuple[float, float]:
+    """MUSEN's mixing (SimplifiedScene::CalculateInteractionProperty): E*, G*."""
+    e_star = 1.0 / ((1 - m1.poisson ** 2) / m1.youngs + (1 - m2.poisson ** 2) / m2.youngs)
+    g_star = 1.0 / ((2 - m1.poisson) / m1.shear_modulus + (2 - m2.poisson) / m2.shear_modulus)
+    return e_star, g_star
+
+
+@dataclass
+class GranularFrame:
+    """One saved time point as LAMMPS computed it, in model terms.
+
+    Sphere arrays are aligned with ``sphere_rows`` (spheres still in the simulation; removed
+    ones are absent).  Bond arrays are aligned with the model's bond rows; ``bond_alive``
+    False means broken or removed (its activity end is then ``bond_end_time``).  Triangle
+    arrays are aligned with the model's triangle rows (vertices where the wall is now).
+    """
+
+    time: float
+    step: int
+    sphere_rows: np.ndarray          # (n',) int rows into GranularModel.spheres
+    position: np.ndarray             # (n',3)
+    velocity: np.ndarray             # (n',3) at the same time as position
+    omega: np.ndarray                # (n',3)
+    force: np.ndarray                # (n',3) total force
+    quaternion: np.ndarray           # (n',4)
+    bond_alive: np.ndarray | None = None       # (m,) bool
+    bond_end_time: np.ndarray | None = None    # (m,) break / removal time, inf if alive
+    bond_force: np.ndarray | None = None       # (m,3) force on the bond's first sphere
+    bond_torque: np.ndarray | None = None      # (m,) |total torque| if known
+    bond_tangential_overlap: np.ndarray | None = None   # (m,3) if known
+    triangle_vertices: np.ndarray | None = None # (k,3,3)
+    triangle_velocity: np.ndarray | None = None # (k,3)
+    triangle_force: np.ndarray | None = None    # (k,3) force the particles exert on each triangle

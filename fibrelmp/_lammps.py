@@ -59,3 +59,20 @@ def lmp_executable_env() -> dict[str, str]:
     if libdirs:
         env["LD_LIBRARY_PATH"] = os.pathsep.join([libdirs[0], env.get("LD_LIBRARY_PATH", "")]).rstrip(os.pathsep)
     return env
+
+
+def mpi_abort(code: int) -> None:
+    """Abort every MPI rank (LAMMPS exceptions do not cross ranks: without this a failure
+    on one rank leaves the others waiting in a collective for ever).  Does nothing when MPI
+    was never initialised (serial runs, errors before LAMMPS started)."""
+    try:
+        lib = ctypes.CDLL("libmpi.so.12", mode=ctypes.RTLD_NOLOAD | ctypes.RTLD_GLOBAL)
+    except OSError:
+        return
+    flag = ctypes.c_int(0)
+    if lib.MPI_Initialized(ctypes.byref(flag)) != 0 or not flag.value:
+        return
+    comm_world = ctypes.c_int(0x44000000)   # MPICH ABI handle (libmpi.so.12 is MPICH-ABI)
+    sys.stderr.flush()
+    sys.stdout.flush()
+    lib.MPI_Abort(comm_world, ctypes.c_int(code))

@@ -36,6 +36,21 @@ def _report_warnings(warnings: list[tuple[str, str]]) -> None:
                 typer.secho(f"  {t}", err=True, fg=typer.colors.YELLOW)
 
 
+def _fail(message: str, code: int) -> None:
+    """Report and exit; under MPI a failure on any rank aborts all ranks (never a hang)."""
+    from ._lammps import mpi_abort
+    from .runner import mpi_rank_size
+
+    rank, size = mpi_rank_size()
+    # input errors are found identically on every rank (all ranks parse): say them once
+    if code != 2 or rank == 0:
+        prefix = f"[rank {rank}] " if size > 1 and code != 2 else ""
+        typer.secho(prefix + message, err=True, fg=typer.colors.RED)
+    if size > 1:
+        mpi_abort(code)
+    raise typer.Exit(code)
+
+
 def _guard(func):
     """Turn fibrelmp's exceptions into messages and exit codes (no traceback)."""
     import functools
@@ -47,17 +62,11 @@ def _guard(func):
         try:
             return func(*args, **kwargs)
         except InputError as exc:
-            typer.secho(f"error: {exc}", err=True, fg=typer.colors.RED)
-            raise typer.Exit(2)
-        except RunError as exc:
-            typer.secho(f"run failed: {exc}", err=True, fg=typer.colors.RED)
-            raise typer.Exit(1)
-        except OSError as exc:
-            typer.secho(f"run failed: {exc}", err=True, fg=typer.colors.RED)
-            raise typer.Exit(1)
+            _fail(f"error: {exc}", 2)
+        except (RunError, OSError) as exc:
+            _fail(f"run failed: {exc}", 1)
         except KeyboardInterrupt:
-            typer.secho("interrupted", err=True, fg=typer.colors.RED)
-            raise typer.Exit(130)
+            _fail("interrupted", 130)
     return wrapper
 
 

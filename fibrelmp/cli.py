@@ -96,11 +96,23 @@ def main_options(
 
 @app.command()
 @_guard
-def check(input: Path = typer.Argument(..., help="FibreNet input file.")) -> None:
+def check(input: Path = typer.Argument(..., help="Any supported input file.")) -> None:
     """Parse and validate INPUT without running; print a summary.
 
     Example: fibrelmp check examples/fibre_network/input.txt
     """
+    from .formats import detect
+
+    kind = detect(input)
+    if kind != "fibrenet":
+        from .granular_api import model_for_check
+        from .granular_check import summary
+
+        model = model_for_check(input, kind)
+        typer.echo("\n".join(summary(model)))
+        _report_warnings(model.warnings)
+        typer.echo(f"warnings     {len(model.warnings)}")
+        return
     from .api import read_input
 
     model = read_input(input)
@@ -132,12 +144,24 @@ def check(input: Path = typer.Argument(..., help="FibreNet input file.")) -> Non
 
 @app.command()
 @_guard
-def translate(input: Path = typer.Argument(..., help="FibreNet input file."),
+def translate(input: Path = typer.Argument(..., help="Any supported input file."),
               out: Path = typer.Option(..., "-o", "--out", help="Folder for in.lammps and the data file.")) -> None:
     """Write a stock-LAMMPS job (in.lammps + data file) for INPUT into a folder.
 
     Example: fibrelmp translate input.txt -o job/ && cd job && lmp -in in.lammps
     """
+    from .formats import detect
+
+    kind = detect(input)
+    if kind != "fibrenet":
+        from .granular_api import model_for_check
+        from .translate.granular_job import write_granular_job
+
+        model = model_for_check(input, kind)
+        _report_warnings(model.warnings)
+        job = write_granular_job(model, out)
+        _say(f"wrote {job.script} and {job.data}")
+        return
     from .api import read_input, translate as do_translate
 
     model = read_input(input)
@@ -148,25 +172,114 @@ def translate(input: Path = typer.Argument(..., help="FibreNet input file."),
 
 @app.command()
 @_guard
-def run(input: Path = typer.Argument(..., help="FibreNet input file."),
-        out: Optional[Path] = typer.Option(None, "--out", help="Folder for the outputs (default: next to the input)."),
-        work: Optional[Path] = typer.Option(None, "--work", help="Folder for the rendered LAMMPS job "
-                                            "(default: <out>/<output_file>_work).")) -> None:
-    """Translate INPUT, run it on LAMMPS and write the outputs in FibreNet's formats.
+def run(input: Path = typer.Argument(..., help="FibreNet input, MUSEN text scene, cmusen job script "
+                                     "or DEMDF JSON file."),
+        out: Optional[Path] = typer.Option(None, "--out", "-o", help="Where results go: a folder "
+                                           "(FibreNet, DEMDF) or the result file (MUSEN scene). "
+                                           "Default: next to the input."),
+        work: Optional[Path] = typer.Option(None, "--work", help="Folder for the rendered LAMMPS job."),
+        end_time: Optional[float] = typer.Option(None, "--end-time", "--time-end",
+                                                 help="MUSEN scene / DEMDF: simulated end time."),
+        step: Optional[float] = typer.Option(None, "--step", help="MUSEN scene: simulation time step."),
+        save_step: Optional[float] = typer.Option(None, "--save-step", "--save-every",
+                                                  help="MUSEN scene / DEMDF: time between saved states."),
+        steps: Optional[int] = typer.Option(None, "--steps", help="DEMDF: number of time steps to run."),
+        precision: int = typer.Option(6, "--precision", help="MUSEN result: significant digits "
+                                      "(6 as MUSEN; 17 for exact round trips)."),
+        ) -> None:
+    """Translate INPUT, run it on LAMMPS and write the results in the input's own format.
 
-    Example: fibrelmp run examples/fibre_network/input.txt
+    \b
+    Examples:
+      fibrelmp run examples/fibre_network/input.txt
+      fibrelmp run examples/musen/single_particle_job.txt
+      fibrelmp run scene.txt --end-time 0.1 --step 1e-6 --save-step 1e-3 -o result.txt
+      fibrelmp run examples/demdf/head_on.json --time-end 2
     """
     import time
 
-    from .api import read_input, run as do_run
+    from .formats import detect
 
-    model = read_input(input)
-    _report_warnings(model.warnings)
+    kind = detect(input)
     start = time.monotonic()
-    result = do_run(model, out=out, work=work, progress=not _state["quiet"])
-    for path in result.outputs:
+    if kind == "fibrenet":
+        from .api import read_input, run as do_run
+
+        if any(v is not None for v in (end_time, step, save_step, steps)):
+            raise _bad_option(input, "--end-time/--step/--save-step/--steps are for MUSEN and DEMDF "
+                              "inputs; FibreNet inputs set their own steps")
+        model = read_input(input)
+        _report_warnings(model.warnings)
+        result = do_run(model, out=out, work=work, progress=not _state["quiet"])
+        outputs, script = result.outputs, result.job.script
+    elif kind == "musen-script":
+        from .granular_api import run_musen_script
+
+        if any(v is not None for v in (end_time, step, save_step, steps)):
+            raise _bad_option(input, "a cmusen job script sets END_TIME, SIMULATION_STEP and "
+                              "SAVING_STEP itself; edit the script instead")
+        res = run_musen_script(input, work=work, progress=not _state["quiet"], say=_say,
+                               warn=_report_warnings)
+        outputs, script = res.outputs, (res.jobs[-1].script if res.jobs else None)
+        for note in res.notes:
+            _say(note)
+    else:
+        from .granular_api import read_granular, run_demdf, run_musen_scene
+
+        if kind == "demdf":
+            res = run_demdf(input, out=out, work=work, progress=not _state["quiet"], time_end=end_time,
+                            steps=steps, save_every=save_step, warn=_report_warnings, say=_say)
+        else:
+            model, overrides = read_granular(input, kind, end_time, step, save_step, steps)
+            for text in overrides:
+                _say(f"override: {text}")
+            _report_warnings(model.warnings)
+            target = out if out is not None else input.with_name(f"{input.stem}_result.txt")
+            res = run_musen_scene(model, target, work=work, progress=not _state["quiet"],
+                                  precision=precision)
+        for note in res.notes:
+            _say(note)
+        outputs, script = res.outputs, (res.jobs[-1].script if res.jobs else None)
+    for path in outputs:
         _say(f"wrote {path}")
-    _say(f"done in {time.monotonic() - start:.1f} s (LAMMPS job: {result.job.script})")
+    _say(f"done in {time.monotonic() - start:.1f} s (LAMMPS job: {script})")
+
+
+def _bad_option(path: Path, message: str):
+    from .errors import InputError
+
+    return InputError(path, None, message)
+
+
+@app.command("post")
+@_guard
+def post(dump: Path = typer.Argument(..., help="LAMMPS text dump (.gz too), or any MDAnalysis trajectory."),
+         to: Optional[str] = typer.Option(None, "--to", help="xyz, res, mercury, vtk, musen or demdf."),
+         out: Optional[Path] = typer.Option(None, "-o", "--out", help="Output base name (folder/name)."),
+         info: bool = typer.Option(False, "--info", help="Describe the dump (frames, atoms, columns, box)."),
+         frames: Optional[str] = typer.Option(None, "--frames", help="Frames to convert: i, start:stop:step, "
+                                              "or a comma list (default all; res: the last)."),
+         types: Optional[list[str]] = typer.Option(None, "--types", help="Only these atom types (numbers "
+                                                   "or names; repeat or comma-separate)."),
+         data: Optional[Path] = typer.Option(None, "--data", help="LAMMPS data file: type names, radii, "
+                                             "masses, bonds the dump lacks."),
+         local: Optional[Path] = typer.Option(None, "--local", help="dump local file with per-contact data "
+                                              "(mercury .fstat and elastic energy)."),
+         gravity: Optional[tuple[float, float, float]] = typer.Option(None, "--gravity", help="gx gy gz for "
+                                                                      "the gravitational energy."),
+         force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
+         topology: Optional[Path] = typer.Option(None, "--topology", help="Topology for MDAnalysis "
+                                                 "trajectory formats.")) -> None:
+    """Convert an existing dump into FibreNet, MercuryDPM, ParaView, MUSEN or DEMDF files.
+
+    Example: fibrelmp post dump.lammpstrj --to vtk -o run --data data.lammps
+    """
+    from .post.cli_post import post_command
+
+    written = post_command(dump, to, out, info, frames, types, data, local, gravity, force, topology,
+                           typer.echo if info else _say)
+    for path in written:
+        _say(f"wrote {path}")
 
 
 def main() -> None:

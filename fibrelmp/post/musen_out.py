@@ -1,0 +1,435 @@
+"""Write GranularFrames as a MUSEN text result (what cmusen's EXPORT_TO_TEXT writes).
+
+Layout (``ExportAsText.cpp``): one line per object in ascending id with ALL saved time points
+on it, then the scene lines 22/28/29/30, geometries 25/26/27, 38, materials 32/33/34 and
+generators 39/40/41.  Time-point values get ``precision`` significant digits like a C++
+ostream (``%g``); activity intervals and scene lines always get 6, sphere radii 16 and bond
+diameters/lengths 25, as in MUSEN.
+
+Memory stays bounded: ``add`` appends each frame's per-type value block to one raw float64
+file per object type in a temporary folder beside the output (laid out saves x objects x
+columns); ``close`` reads back chunks of objects for all saves and formats them (one C-level
+``%`` per chunk and object type), a chunk holding about a million numbers whatever the number
+of saves, writes a temp file and renames it.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError, RunError
+from ..granmodel import GranularFrame, GranularModel
+from ..translate.musen import (ACTIVE_INTERACTIONS, ACTIVE_PROPERTIES, DEFAULT_ACTIVITY_END,
+                               PROPERTY_DEFAULTS)
+
+# MUSEN's export selector groups and flags, in ExportAsText.h order (cmusen TEXT_EXPORT_*).
+EXPORT_FLAGS: dict[str, tuple[str, ...]] = {
+    "objectTypes": ("particles", "bonds", "walls"),
+    "constProps": ("id", "type", "geometry", "material", "activityInterval"),
+    "tdPropsPart": ("angVel", "coord", "force", "forceAmpl", "orient", "princStress",
+                    "stressTensor", "temperature", "velocity"),
+    "tdPropsBond": ("coord", "force", "forceAmpl", "tangOverlap", "temperature", "totTorque",
+                    "velocity"),
+    "tdPropsWall": ("coord", "force", "forceAmpl", "velocity"),
+    "sceneInfo": ("domain", "pbc", "anisotropy", "contactRadius"),
+    "geometries": ("baseInfo", "tdProperties", "wallsList", "analysisVolumes"),
+    "materials": ("compounds", "interactions", "mixtures"),
+    "generators": ("packageGenerator", "bondsGenerator"),
+}
+# per type: (flag, tag, width) in the exporter's order, and the spooled column block.
+# Spheres: principal stresses (42) and the stress tensor (36) are never written (fibrelmp
+# does not compute them); temperature (37) is 0, as MUSEN writes without a thermal model.
+_SPHERE = (("angVel", 16, 3), ("coord", 12, 3), ("force", 20, 3), ("forceAmpl", 18, 1),
+           ("orient", 31, 4), ("temperature", 37, 1), ("velocity", 15, 3))
+_BOND = (("coord", 12, 3), ("force", 20, 3), ("forceAmpl", 18, 1), ("tangOverlap", 45, 3),
+         ("temperature", 37, 1), ("totTorque", 43, 1), ("velocity", 15, 3))
+_WALL = (("coord", 44, 9), ("force", 20, 3), ("forceAmpl", 18, 1), ("velocity", 15, 3))
+_CHUNK = 4096
+_VALUES_PER_CHUNK = 1_000_000         # ~8 MB of floats (+ their text) per formatting chunk
+
+
+def _gather(path: Path, count: int, width: int, nt: int, rows: np.ndarray) -> np.ndarray:
+    """(len(rows), nt, width) from the spool file laid out (nt, count, width): one read of
+    the row span per save (rows of one type come in id order, so the span is tight)."""
+    lo, hi = int(rows.min()), int(rows.max()) + 1
+    out = np.empty((len(rows), nt, width))
+    with open(path, "rb") as fh:
+        for k in range(nt):
+            fh.seek(((k * count) + lo) * width * 8)
+            block = np.fromfile(fh, np.float64, (hi - lo) * width).reshape(hi - lo, width)
+            out[:, k] = block[rows - lo]
+    return out
+
+
+def all_on() -> dict[str, dict[str, bool]]:
+    return {g: {f: True for f in flags} for g, flags in EXPORT_FLAGS.items()}
+
+
+def _property(mat, pid: int) -> float:
+    """A material property as simulated: the Material fields win over ``props``."""
+    fields = {0: mat.density, 7: mat.youngs, 8: mat.normal_strength, 9: mat.shear_strength,
+              10: mat.poisson}
+    if pid in fields and fields[pid] == fields[pid]:          # not nan
+        return fields[pid]
+    return mat.props.get(pid, PROPERTY_DEFAULTS[pid])
+
+
+def _g(x: float) -> str:
+    return "%g" % (DEFAULT_ACTIVITY_END if x == np.inf else x)
+
+
+class MusenResultWriter:
+    """``add`` every frame, then ``close`` (or ``abort`` on failure)."""
+
+    def __init__(self, model: GranularModel, path: str | os.PathLike, precision: int = 6,
+                 time_interval: tuple[float, float] | None = None,
+                 selectors: dict[str, dict[str, bool]] | None = None):
+        self.model = model
+        self.path = Path(path)
+        self.precision = int(precision)
+        self.time_interval = time_interval
+        self.sel = all_on()
+        for group, flags in (selectors or {}).items():
+            self.sel[group].update(flags)
+        self.times: list[float] = []
+        sp = model.spheres
+        self.sphere_end = sp.active_end.copy()
+        self.bond_end = model.bonds.active_end.copy() if model.bonds is not None else None
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            self.spool = Path(tempfile.mkdtemp(prefix=f".{self.path.name}.spool.",
+                                               dir=self.path.parent))
+        except OSError as exc:
+            raise InputError(self.path, None, f"cannot write output: {exc.strerror or exc}") from None
+        self.tmp = self.path.with_name(f".{self.path.name}.tmp{os.getpid()}")
+
+    # ------------------------------------------------------------------ frames
+    def add(self, frame: GranularFrame) -> None:
+        m = self.model
+        sp = m.spheres
+        t = float(frame.time)
+        rows = np.asarray(frame.sphere_rows, np.int64)
+        n = sp.count
+        present = np.zeros(n, bool)
+        present[rows] = True
+        # a sphere active by its interval but missing from the frame was removed at this save
+        gone = ~present & (sp.active_start <= t) & (self.sphere_end > t)
+        self.sphere_end[gone] = t
+        if self.bond_end is not None and frame.bond_alive is not None:
+            dead = ~np.asarray(frame.bond_alive, bool)
+            when = (np.asarray(frame.bond_end_time, np.float64) if frame.bond_end_time is not None
+                    else np.full(len(dead), t))
+            when = np.where(np.isfinite(when), when, t)
+            self.bond_end[dead] = np.minimum(self.bond_end[dead], when[dead])
+        if self.time_interval is not None and not (
+                self.time_interval[0] <= t <= self.time_interval[1]):
+            return
+        blocks = {"s": self._sphere_block(frame, rows)}
+        if m.bonds is not None:
+            blocks["b"] = self._bond_block(frame, blocks["s"])
+        if m.triangles is not None:
+            blocks["w"] = self._wall_block(frame)
+        try:
+            for name, block in blocks.items():        # one growing (T, n, K) file per type
+                with open(self.spool / f"{name}.bin", "ab") as fh:
+                    fh.write(np.ascontiguousarray(block, np.float64).tobytes())
+        except OSError as exc:
+            raise RunError(f"cannot spool MUSEN result frame to {self.spool}: "
+                           f"{exc.strerror or exc}") from None
+        self.times.append(t)
+
+    def _sphere_block(self, f: GranularFrame, rows: np.ndarray) -> np.ndarray:
+        # spheres not in the frame are written as zeros, as MUSEN stores nothing for them
+        n = self.model.spheres.count
+        b = np.zeros((n, 18))
+        force = np.asarray(f.force, np.float64).reshape(-1, 3)
+        b[rows, 0:3] = f.omega
+        b[rows, 3:6] = f.position
+        b[rows, 6:9] = force
+        b[rows, 9] = np.linalg.norm(force, axis=1)
+        b[rows, 10:14] = f.quaternion
+        b[rows, 15:18] = f.velocity          # column 14: temperature 0
+        return b
+
+    def _bond_block(self, f: GranularFrame, s: np.ndarray) -> np.ndarray:
+        bonds = self.model.bonds
+        pair = bonds.pair
+        b = np.zeros((bonds.count, 15))
+        # midpoint / mean velocity of the two spheres as the frame has them (0 when absent)
+        b[:, 0:3] = 0.5 * (s[pair[:, 0], 3:6] + s[pair[:, 1], 3:6])
+        b[:, 12:15] = 0.5 * (s[pair[:, 0], 15:18] + s[pair[:, 1], 15:18])
+        alive = (np.ones(bonds.count, bool) if f.bond_alive is None
+                 else np.asarray(f.bond_alive, bool))
+        if f.bond_force is not None:
+            force = np.where(alive[:, None], np.asarray(f.bond_force, np.float64), 0.0)
+            b[:, 3:6] = force
+            b[:, 6] = np.linalg.norm(force, axis=1)
+        if f.bond_tangential_overlap is not None:
+            b[:, 7:10] = np.where(alive[:, None], f.bond_tangential_overlap, 0.0)
+        if f.bond_torque is not None:                 # column 10: temperature 0
+            b[:, 11] = np.where(alive, f.bond_torque, 0.0)
+        return b
+
+    def _wall_block(self, f: GranularFrame) -> np.ndarray:
+        tri = self.model.triangles
+        b = np.zeros((tri.count, 16))
+        vert = tri.vertices if f.triangle_vertices is None else f.triangle_vertices
+        b[:, 0:9] = np.asarray(vert, np.float64).reshape(-1, 9)
+        if f.triangle_force is not None:
+            b[:, 9:12] = f.triangle_force
+            b[:, 12] = np.linalg.norm(np.asarray(f.triangle_force, np.float64), axis=1)
+        b[:, 13:16] = tri.velocity if f.triangle_velocity is None else f.triangle_velocity
+        return b
+
+    # ------------------------------------------------------------------ output
+    def close(self) -> Path:
+        try:
+            with open(self.tmp, "w", newline="\n") as out:
+                self._write_objects(out)
+                out.write(self._scene_text())
+            os.replace(self.tmp, self.path)
+        except OSError as exc:
+            self.abort()
+            raise InputError(self.path, None, f"cannot write output: {exc.strerror or exc}") from None
+        except BaseException:
+            self.abort()
+            raise
+        shutil.rmtree(self.spool, ignore_errors=True)
+        return self.path
+
+    def abort(self) -> None:
+        shutil.rmtree(self.spool, ignore_errors=True)
+        try:
+            self.tmp.unlink()
+        except OSError:
+            pass
+
+    def _objects(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(ids, type, row) of every object to write, ascending id."""
+        m = self.model
+        parts = [(m.spheres.ids, 1)]
+        if m.bonds is not None:
+            parts.append((m.bonds.ids, 9))
+        if m.triangles is not None:
+            parts.append((m.triangles.ids, 14))
+        liquid = m.passthrough.get("liquid_bonds") or []
+        if liquid:
+            parts.append((np.array([lb["id"] for lb in liquid], np.int64), 13))
+        ids = np.concatenate([np.asarray(p[0], np.int64) for p in parts])
+        types = np.concatenate([np.full(len(p[0]), p[1]) for p in parts])
+        rows = np.concatenate([np.arange(len(p[0])) for p in parts])
+        keep = self._filter(types, rows)
+        order = np.argsort(ids[keep], kind="stable")
+        return ids[keep][order], types[keep][order], rows[keep][order]
+
+    def _filter(self, types: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        """CExportAsText::FilterObjects: only when some selector is off."""
+        if all(all(g.values()) for g in self.sel.values()):
+            return np.ones(len(types), bool)
+        ot = self.sel["objectTypes"]
+        keep = (((types == 1) & ot["particles"]) | ((types == 9) & ot["bonds"])
+                | ((types == 14) & ot["walls"]))
+        if self.times and any(any(self.sel[g].values())
+                              for g in ("tdPropsPart", "tdPropsBond", "tdPropsWall")):
+            start, end = self._activity(types, rows)
+            keep &= ~((self.times[-1] < start) | (self.times[0] > end))
+        return keep
+
+    def _activity(self, types, rows) -> tuple[np.ndarray, np.ndarray]:
+        m = self.model
+        start = np.zeros(len(types))
+        end = np.zeros(len(types))
+        for t, s, e in ((1, m.spheres.active_start, self.sphere_end),
+                        (9, None if m.bonds is None else m.bonds.active_start, self.bond_end),
+                        (14, None if m.triangles is None else m.triangles.active_start,
+                         None if m.triangles is None else m.triangles.active_end)):
+            sel = types == t
+            if sel.any():
+                start[sel], end[sel] = s[rows[sel]], e[rows[sel]]
+        sel = types == 13
+        if sel.any():
+            liquid = m.passthrough["liquid_bonds"]
+            start[sel] = [liquid[r]["active_start"] for r in rows[sel]]
+            end[sel] = [liquid[r]["active_end"] for r in rows[sel]]
+        return start, end
+
+    def _write_objects(self, out) -> None:
+        ids, types, rows = self._objects()
+        nt = len(self.times)
+        maps = {}
+        m = self.model
+        for name, count, width in (("s", m.spheres.count, 18),
+                                   ("b", 0 if m.bonds is None else m.bonds.count, 15),
+                                   ("w", 0 if m.triangles is None else m.triangles.count, 16)):
+            if nt and count:
+                maps[name] = (self.spool / f"{name}.bin", count, width)
+        # objects per chunk: about _VALUES_PER_CHUNK numbers in memory whatever the saves
+        chunk = max(16, min(_CHUNK, _VALUES_PER_CHUNK // max(1, nt * 19)))
+        for lo in range(0, len(ids), chunk):
+            cid, ctype, crow = ids[lo:lo + chunk], types[lo:lo + chunk], rows[lo:lo + chunk]
+            lines = np.empty(len(cid), dtype=object)
+            for t in (1, 9, 13, 14):
+                sel = np.flatnonzero(ctype == t)
+                if len(sel):
+                    lines[sel] = self._lines(t, cid[sel], crow[sel], maps)
+            out.write("".join(lines.tolist()))
+
+    def _lines(self, otype: int, ids: np.ndarray, rows: np.ndarray, maps) -> list[str]:
+        heads = self._headers(otype, ids, rows)
+        nt = len(self.times)
+        p = self.precision
+        spec, group, name = {1: (_SPHERE, "tdPropsPart", "s"), 9: (_BOND, "tdPropsBond", "b"),
+                             14: (_WALL, "tdPropsWall", "w"), 13: ((), "", "")}[otype]
+        cols, tpl = [], f"2 %.{p}g "
+        start = 0
+        for flag, tag, width in spec:
+            if self.sel[group][flag]:
+                cols.extend(range(start, start + width))
+                tpl += f"{tag} " + f"%.{p}g " * width
+            start += width
+        if nt == 0:
+            return [h + "\n" for h in heads]
+        values = np.empty((len(rows), nt, 1 + len(cols)))
+        values[:, :, 0] = self.times
+        if cols:
+            values[:, :, 1:] = _gather(*maps[name], nt, rows)[:, :, cols]
+        text = ((tpl * nt + "\n") * len(rows)) % tuple(values.ravel().tolist())
+        return [h + body + "\n" for h, body in zip(heads, text.split("\n"))]
+
+    def _headers(self, otype: int, ids: np.ndarray, rows: np.ndarray) -> list[str]:
+        m = self.model
+        c = self.sel["constProps"]
+        if otype == 1:
+            obj = m.spheres
+            geom = ["%.16g %.16g" % (obj.radius[r], obj.contact_radius[r]) for r in rows]
+        elif otype == 9:
+            obj = m.bonds
+            sid = m.spheres.ids
+            geom = ["%d %d %.25g %.25g" % (sid[obj.pair[r, 0]], sid[obj.pair[r, 1]],
+                                          obj.diameter[r], obj.length0[r]) for r in rows]
+        elif otype == 14:
+            obj = m.triangles
+            geom = [""] * len(rows)
+        else:
+            obj = None
+            liquid = m.passthrough["liquid_bonds"]
+            geom = ["%d %d %.25g %.25g" % (liquid[r]["left"], liquid[r]["right"],
+                                          liquid[r]["diameter"], liquid[r]["length0"])
+                    for r in rows]
+        start, end = self._activity(np.full(len(rows), otype), rows)
+        heads = []
+        for j, r in enumerate(rows):
+            h = []
+            if c["id"]:
+                h.append(f"0 {ids[j]} ")
+            if c["type"]:
+                h.append(f"1 {otype} ")
+            if c["geometry"]:
+                h.append(f"5 {geom[j]} ")
+            if c["material"]:
+                h.append(f"23 {self._key(obj, otype, r)} ")
+            if c["activityInterval"]:
+                h.append(f"24 {_g(start[j])} {_g(end[j])} ")
+            heads.append("".join(h))
+        return heads
+
+    def _key(self, obj, otype: int, r: int) -> str:
+        if otype == 13:
+            key = self.model.passthrough["liquid_bonds"][r]["key"]
+        elif obj.compound_key is not None:
+            key = obj.compound_key[r]
+        else:
+            key = self.model.materials[int(obj.material[r])].key
+        return key or "Undefined"
+
+    def _scene_text(self) -> str:
+        m = self.model
+        pt = m.passthrough
+        raw = pt.get("raw", {})
+        lines: list[str] = []
+
+        def line(*values) -> None:
+            lines.append("".join(f"{v} " for v in values) + "\n")
+
+        sc = self.sel["sceneInfo"]
+        if sc["domain"] and m.plan.domain is not None:
+            line(22, *[_g(v) for v in np.concatenate(m.plan.domain)])
+        if sc["pbc"]:
+            flags, box = pt.get("pbc", ([False] * 4, [-5e-3] * 3 + [5e-3] * 3))
+            periodic = tuple(bool(x) for x in m.plan.periodic)
+            if periodic != tuple(flags[0] and f for f in flags[1:]):
+                flags = [any(periodic), *periodic]
+            if m.plan.periodic_box is not None:
+                box = list(np.concatenate(m.plan.periodic_box))
+            line(28, *[int(f) for f in flags], *[_g(v) for v in box])
+        if sc["anisotropy"]:
+            line(29, int(bool(pt.get("anisotropy", False))))
+        if sc["contactRadius"]:
+            line(30, int(bool(pt.get("contact_radius_flag", False))))
+        ge = self.sel["geometries"]
+        tri_ids = m.triangles.ids if m.triangles is not None else np.zeros(0, np.int64)
+        for g in m.geometries:
+            if ge["baseInfo"]:
+                line(25, g.name.replace(" ", "_"), g.key, _g(g.mass), *[int(f) for f in g.free],
+                     int(bool(g.rotate_around_centre)))
+            if ge["tdProperties"]:
+                line(26, self._motion_text(g) + " ")
+            if ge["wallsList"]:
+                line(27, len(g.triangle_rows), *[int(i) for i in tri_ids[g.triangle_rows]])
+        if ge["analysisVolumes"]:
+            for tok in raw.get(38, []):
+                line(38, *tok)
+        ma = self.sel["materials"]
+        if ma["compounds"]:
+            for mat in m.materials:
+                props = [x for p in ACTIVE_PROPERTIES for x in (p, _g(_property(mat, p)))]
+                line(32, mat.key, mat.name, *props)
+        if ma["interactions"]:
+            inter = pt.get("interactions", {})
+            for b in range(len(m.materials)):
+                for a in range(b + 1):
+                    props = inter.get((a, b))
+                    law = m.contacts.get((a, b))
+                    if props is None and law is None:
+                        continue
+                    values = (dict(props) if props is not None else {})
+                    if law is not None:        # the model's contact law is what was simulated
+                        values.update({200: law.restitution, 201: law.friction,
+                                       202: law.rolling_friction})
+                    line(33, m.materials[b].key, m.materials[a].key,
+                         *[x for p in ACTIVE_INTERACTIONS for x in (p, _g(values[p]))])
+        if ma["mixtures"]:
+            for tok in raw.get(34, []):
+                line(34, *tok)
+        gen = self.sel["generators"]
+        if gen["packageGenerator"]:
+            for tok in raw.get(39, []):
+                line(39, *tok)
+            for tok in raw.get(40, [["1", "2"]])[-1:]:   # MUSEN always writes its config line
+                line(40, *tok)
+        if gen["bondsGenerator"]:
+            for tok in raw.get(41, []):
+                line(41, *tok)
+        return "".join(lines)
+
+    @staticmethod
+    def _motion_text(g) -> str:
+        """GeometryMotion.cpp operator<<: `type n intervals`, "0 0" for none."""
+        if g.motion_type == 0:
+            return "0 0"
+        if g.motion_type == 1:
+            parts = [f"1 {len(g.motion)}"]
+            for iv in g.motion:
+                parts.append(" ".join(_g(v) for v in (iv.t_begin, iv.t_end, *iv.velocity,
+                                                      *iv.centre, *iv.angular_velocity)))
+            return " ".join(parts)
+        for raw in g.raw_lines:                     # force-driven motion: as read
+            tok = raw.split()
+            if tok[0] == "26":
+                return " ".join(tok[1:])
+        return f"{g.motion_type} 0"

@@ -1,0 +1,73 @@
+"""Soft-sphere contact parameters for DEMDF's hard-sphere (BOS) descriptions.
+
+BOS treats collisions as instantaneous.  fibrelmp replaces them with frictionless Hertz
+contacts (``pair_style granular hertz/material ... damping coeff_restitution``) stiff enough
+that the peak overlap stays below a small fraction of the radius:
+
+* peak overlap of a Hertz contact hit at normal speed v:
+  ``delta = (15 m* v^2 / (16 E* sqrt(R*)))^(2/5)``  (Johnson 1985)
+* so the smallest modulus keeping ``delta <= f * R_min`` is
+  ``E* = 15 m* v^2 / (16 sqrt(R*) (f R_min)^(5/2))``
+* elastic contact duration ``t_c = 2.9432 delta / v`` (slower impacts last longer, so the
+  fastest one sets the time step).
+
+The approach speed bound of a particle is ``sqrt(|v|^2 + 2 |g| L)``: its own speed plus what
+the body force can add over the domain's extent ``L`` along it.  A particle pair's bound is
+the sum of the two fastest bounds of the two types; a particle-wall bound is the particle's.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+# 2 * integral_0^1 dx / sqrt(1 - x^(5/2)): Hertz contact duration in units of delta_max / v
+HERTZ_DURATION = 2.943
+
+
+def peak_overlap(m_eff: float, r_eff: float, e_star: float, speed: float) -> float:
+    return (15.0 * m_eff * speed ** 2 / (16.0 * e_star * math.sqrt(r_eff))) ** 0.4
+
+
+def modulus_for_overlap(m_eff: float, r_eff: float, speed: float, overlap: float) -> float:
+    return 15.0 * m_eff * speed ** 2 / (16.0 * math.sqrt(r_eff) * overlap ** 2.5)
+
+
+def contact_time(m_eff: float, r_eff: float, e_star: float, speed: float) -> float:
+    return HERTZ_DURATION * peak_overlap(m_eff, r_eff, e_star, speed) / speed
+
+
+def speed_bounds(velocity: np.ndarray, gravity: np.ndarray, extent: np.ndarray) -> np.ndarray:
+    """Per particle: the fastest it can move, |v| plus the fall over the domain along g."""
+    g = float(np.linalg.norm(gravity))
+    fall = 0.0
+    if g > 0:
+        fall = float(np.sum(np.abs(gravity) / g * extent))   # extent of the box along g
+    return np.sqrt(np.einsum("ij,ij->i", velocity, velocity) + 2.0 * g * fall)
+
+
+@dataclass
+class Partner:
+    """One contact kind: a particle type against a particle type or a wall material."""
+
+    key: tuple[int, int]          # material indices (a <= b)
+    m_eff: float
+    r_eff: float
+    r_min: float                  # the overlap limit is a fraction of this radius
+    speed: float                  # approach speed bound (> 0)
+    restitution: float
+    label: str
+
+
+def pair_speed(bounds_a: np.ndarray, bounds_b: np.ndarray | None) -> float:
+    """Largest possible approach speed: same type -> two fastest; else fastest of each;
+    ``bounds_b`` None -> a wall (the particle's own bound).  0 when no such pair exists."""
+    if bounds_b is None:
+        return float(bounds_a.max()) if bounds_a.size else 0.0
+    if bounds_a is bounds_b:
+        return float(np.sort(bounds_a)[-2:].sum()) if bounds_a.size >= 2 else 0.0
+    if not bounds_a.size or not bounds_b.size:
+        return 0.0
+    return float(bounds_a.max() + bounds_b.max())

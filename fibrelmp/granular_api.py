@@ -118,28 +118,6 @@ def check_musen_runnable(model: GranularModel) -> None:
                          "or --save-step")
 
 
-def apply_scene_options(model: GranularModel, end_time: float | None, step: float | None,
-                        save_step: float | None) -> list[str]:
-    """Command-line run settings for a bare MUSEN scene (which carries none of its own).
-
-    Returns the overrides to print.  Models are MUSEN's defaults for a bare scene:
-    Hertz-Mindlin particle-particle and particle-wall, elastic solid bonds."""
-    said = []
-    for name, value in (("end time", end_time), ("step", step), ("save step", save_step)):
-        if value is not None and not value > 0:
-            raise InputError(None, None, f"--{name.replace(' ', '-')} must be positive, got {value}")
-    if end_time is not None:
-        model.plan.t_end = end_time
-        said.append(f"end time {end_time:g} s")
-    if step is not None:
-        model.plan.dt = step
-        said.append(f"simulation step {step:g} s")
-    if save_step is not None:
-        model.plan.save_every_time, model.plan.save_every_steps = save_step, None
-        said.append(f"saving step {save_step:g} s")
-    return said
-
-
 def read_granular(path: str | Path, kind: str, end_time: float | None = None,
                   step: float | None = None, save_step: float | None = None,
                   steps: int | None = None) -> tuple[GranularModel, list[str]]:
@@ -150,10 +128,44 @@ def read_granular(path: str | Path, kind: str, end_time: float | None = None,
         return demdf.read(path, time_end=end_time, steps=steps, save_every=save_step), []
     from .translate import musen
 
-    model = musen.read(path)
     if steps is not None:
         raise InputError(path, None, "--steps is for DEMDF inputs; a MUSEN scene takes --end-time")
-    return model, apply_scene_options(model, end_time, step, save_step)
+    model = musen.read(path)
+    return model, bare_scene_settings(model, end_time, step, save_step)
+
+
+def bare_scene_settings(model: GranularModel, end_time: float | None, step: float | None,
+                        save_step: float | None) -> list[str]:
+    """Settings for a bare MUSEN scene, as cmusen would simulate it after IMPORT_FROM_TEXT:
+    Hertz-Mindlin particle-particle and particle-wall, elastic solid bonds (breakage on),
+    gravity (0, 0, -9.81); step, saving step and end time from the command line (MUSEN's
+    defaults 1e-6 s, 1e-3 s and 1 s, with a warning, when not given)."""
+    from .translate.musen_script import (MUSEN_DEFAULTS, SUPPORTED_MODELS, MusenJob,
+                                         MusenModelSpec, apply_simulator_settings)
+
+    for name, value in (("end-time", end_time), ("step", step), ("save-step", save_step)):
+        if value is not None and not value > 0:
+            raise InputError(model.source, None, f"--{name} must be positive, got {value:g}")
+    job = MusenJob(path=model.source, index=0, line=0, component="SIMULATOR",
+                   simulation_step=step or 0.0, saving_step=save_step or 0.0,
+                   end_time=end_time or 0.0, ext_accel=tuple(MUSEN_DEFAULTS["gravity"]))
+    job.models = [MusenModelSpec(name=SUPPORTED_MODELS["PP"], params="", kind="PP", line=0)]
+    if model.triangles is not None and model.triangles.count:
+        job.models.append(MusenModelSpec(name=SUPPORTED_MODELS["PW"], params="", kind="PW", line=0))
+    if model.bonds is not None and model.bonds.count:
+        job.models.append(MusenModelSpec(name=SUPPORTED_MODELS["SB"], params="", kind="SB", line=0))
+    apply_simulator_settings(model, job)
+    plan = model.plan
+    model.warnings = [(kind, f"no --step/--save-step/--end-time given: MUSEN's defaults are used "
+                              f"(step {plan.dt:g} s, saving step {plan.save_every_time:g} s, end "
+                              f"{plan.t_end:g} s)") if kind == "musen-default-settings" else (kind, text)
+                      for kind, text in model.warnings]
+    said = [f"models {', '.join(spec.name for spec in job.models)} (MUSEN's for a bare scene)",
+            "gravity 0 0 -9.81 m/s^2 (MUSEN's default)"]
+    for name, value in (("end time", end_time), ("simulation step", step), ("saving step", save_step)):
+        if value is not None:
+            said.append(f"{name} {value:g} s")
+    return said
 
 
 def _initial_frame(model: GranularModel):

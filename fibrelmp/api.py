@@ -40,8 +40,9 @@ def run(model: Model, out: str | Path | None = None, work: str | Path | None = N
     out_folder = (Path(out) if out is not None else spec.folder).resolve()
     work_folder = (Path(work) if work is not None else out_folder / f"{spec.basename}_work").resolve()
     rank, size = mpi_rank_size()
-    job = translate(model, work_folder)
-    if job.frames.exists():
+    # every rank parses and renders identically; only rank 0 writes the job files
+    job = write_job(model, work_folder, write_files=rank == 0)
+    if rank == 0 and job.frames.exists():
         job.frames.unlink()
     names = {lt: model.particles.type_names[t] for lt, t in enumerate(job.type_of_ltype) if lt > 0}
     types = None if spec.types is None else {model.particles.type_names[t] for t in spec.types}
@@ -57,7 +58,7 @@ def run(model: Model, out: str | Path | None = None, work: str | Path | None = N
         # module releases the GIL inside the library)
         outputs = _run_with_converter(job, progress, convert)
     else:
-        run_script(job.script, job.total_steps, progress=progress)
+        run_script(job.script, job.total_steps, progress=progress, text=job.text)
         if rank == 0:
             outputs = convert(iter_frames(job.frames))
     if rank == 0 and not keep_work:

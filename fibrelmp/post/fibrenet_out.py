@@ -14,6 +14,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..textio import atomic_write, format_rows, parse_table, read_text
+from .textfmt import fixed_chars, join_fields, name_chars
 
 XYZ_SUFFIX = {"position": "_coord.xyz", "velocity": "_vel.xyz", "force": "_force.xyz"}
 RESTART_SUFFIX = "_restart.res"
@@ -23,9 +24,31 @@ def _rows(fmt_row: str, names: np.ndarray, values: np.ndarray) -> str:
     return format_rows(fmt_row, [names] + [values[:, c] for c in range(values.shape[1])])
 
 
+def _xyz_head(n: int, step: int, dt: float, lengths: np.ndarray) -> str:
+    return f"{n}\nFRAME\t{step}\t{dt:.5f}\t{lengths[0]:.5f}\t{lengths[1]:.5f}\t{lengths[2]:.5f}\n"
+
+
+def xyz_frame_bytes(step: int, dt: float, lengths: np.ndarray, codes: np.ndarray, table: list[str],
+                    values: np.ndarray) -> bytes:
+    """One xyz frame; row i is ``table[codes[i]]`` and values[i] ("%s\t%.5f\t%.5f\t%.5f").
+
+    Formatted with array operations (textfmt, byte-identical to ``%.5f``); values that
+    need it (nan, inf, huge) take the ``%`` path.
+    """
+    n = len(codes)
+    head = _xyz_head(n, step, dt, lengths).encode()
+    chars = fixed_chars(values.ravel(), 5) if n else None
+    if chars is None:
+        names = np.array(table, dtype=object)[codes] if n else np.zeros(0, object)
+        return head + _rows("%s\t%.5f\t%.5f\t%.5f\n", names, values).encode()
+    chars = chars.reshape(n, 3, -1)
+    return head + join_fields([name_chars(codes, table), b"\t", chars[:, 0], b"\t", chars[:, 1],
+                               b"\t", chars[:, 2], b"\n"], n)
+
+
 def xyz_frame(step: int, dt: float, lengths: np.ndarray, names: np.ndarray, values: np.ndarray) -> str:
-    head = f"{len(names)}\nFRAME\t{step}\t{dt:.5f}\t{lengths[0]:.5f}\t{lengths[1]:.5f}\t{lengths[2]:.5f}\n"
-    return head + _rows("%s\t%.5f\t%.5f\t%.5f\n", names, values)
+    table, codes = np.unique(np.asarray(names, dtype=str), return_inverse=True)
+    return xyz_frame_bytes(step, dt, lengths, codes.ravel(), list(table), values).decode()
 
 
 class XyzWriter:
@@ -35,12 +58,16 @@ class XyzWriter:
         self.path = Path(path)
         self.tmp = self.path.with_name(f".{self.path.name}.tmp{os.getpid()}")
         try:
-            self.fh = open(self.tmp, "w")
+            self.fh = open(self.tmp, "wb")
         except OSError as exc:
             raise InputError(self.path, None, f"cannot write output: {exc.strerror or exc}") from None
 
     def write(self, step: int, dt: float, lengths: np.ndarray, names: np.ndarray, values: np.ndarray) -> None:
-        self.fh.write(xyz_frame(step, dt, lengths, names, values))
+        self.fh.write(xyz_frame(step, dt, lengths, names, values).encode())
+
+    def write_codes(self, step: int, dt: float, lengths: np.ndarray, codes: np.ndarray, table: list[str],
+                    values: np.ndarray) -> None:
+        self.fh.write(xyz_frame_bytes(step, dt, lengths, codes, table, values))
 
     def close(self) -> None:
         self.fh.close()

@@ -1,29 +1,46 @@
-"""Streaming reader for LAMMPS text dumps (``dump custom`` / ``write_dump``).
+"""Streaming reader for LAMMPS text dumps (``dump custom`` / ``dump local`` / ``write_dump``).
 
-Frames are found from the ``ITEM: TIMESTEP`` markers; each atom block is parsed in one
-vectorised call.  Memory holds one frame at a time.
+A frame is the items from ``ITEM: UNITS`` / ``ITEM: TIME`` / ``ITEM: TIMESTEP`` to the end
+of its ``ITEM: ATOMS`` (or ``ITEM: ENTRIES``) block; the block's length is the frame's own
+``NUMBER OF ATOMS`` (so the atom count may change between frames).  Each block is parsed
+by one C-level call (``np.loadtxt``); memory holds one frame at a time, read in chunks, so
+a 10 GB dump converts frame by frame.  ``.gz`` dumps are read through gzip.
+
+A truncated last frame is dropped with a warning; every other defect is an InputError
+``path:line: message``.
 """
 
 from __future__ import annotations
 
 import gzip
-from dataclasses import dataclass
-from itertools import islice
+import io
+import warnings as _warnings
+import zlib
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Iterator
+from typing import Callable, Iterator
 
 import numpy as np
 
 from ..errors import InputError
 
+# columns that may hold text (type labels with ``dump_modify types labels``, element names)
+TEXT_COLUMNS = {"type", "element"}
+CHUNK = 1 << 24
+
 
 @dataclass
 class Frame:
     step: int
-    lo: np.ndarray              # (3,)
-    hi: np.ndarray              # (3,)
+    lo: np.ndarray              # (3,) box origin (for triclinic boxes: xlo ylo zlo, not the bounds)
+    hi: np.ndarray              # (3,) lo + edge lengths
     boundary: tuple[str, ...]   # e.g. ("pp", "mm", "mm")
     columns: dict[str, np.ndarray]
+    tilt: np.ndarray | None = None      # (xy, xz, yz) for triclinic boxes
+    time: float | None = None           # ITEM: TIME (dump_modify time yes)
+    line: int | None = None             # line of the frame's first ITEM in the file
+    units: str | None = None            # ITEM: UNITS (dump_modify units yes)
+    source: str | None = None           # file the frame came from (error messages)
 
     @property
     def count(self) -> int:
@@ -33,57 +50,400 @@ class Frame:
     def periodic(self) -> np.ndarray:
         return np.array([b == "pp" for b in self.boundary])
 
+    @property
+    def lengths(self) -> np.ndarray:
+        return self.hi - self.lo
+
+    @property
+    def triclinic(self) -> bool:
+        return self.tilt is not None
+
+    def has(self, *names: str) -> bool:
+        return all(n in self.columns for n in names)
+
     def column(self, name: str) -> np.ndarray:
-        return self.columns[name]
+        try:
+            return self.columns[name]
+        except KeyError:
+            where = f" (frame at line {self.line})" if self.line else ""
+            raise InputError(self.source, None, f"the dump has no column {name!r}{where}; "
+                             f"columns: {' '.join(self.columns) or '(none)'}") from None
+
+    def vector(self, *names: str) -> np.ndarray:
+        """(n, k) float array of the named columns."""
+        return np.column_stack([np.asarray(self.column(c), np.float64) for c in names])
+
+    # -- coordinates -------------------------------------------------------------------
+    @property
+    def cell(self) -> np.ndarray:
+        """Edge vectors as columns: x = lo + cell @ s for scaled coordinates s."""
+        lx, ly, lz = self.lengths
+        xy, xz, yz = self.tilt if self.tilt is not None else (0.0, 0.0, 0.0)
+        return np.array([[lx, xy, xz], [0.0, ly, yz], [0.0, 0.0, lz]])
+
+    def _cartesian(self, names: tuple[str, str, str]) -> np.ndarray:
+        s = self.vector(*names)
+        return self.lo + s @ self.cell.T
+
+    def positions(self) -> np.ndarray | None:
+        """Positions as dumped (``x y z``, else scaled ``xs ys zs``), or None."""
+        if self.has("x", "y", "z"):
+            return self.vector("x", "y", "z")
+        if self.has("xs", "ys", "zs"):
+            return self._cartesian(("xs", "ys", "zs"))
+        return None
+
+    def unwrapped(self) -> np.ndarray | None:
+        """Unwrapped positions when derivable (xu/xsu, or x/xs plus image flags)."""
+        if self.has("xu", "yu", "zu"):
+            return self.vector("xu", "yu", "zu")
+        if self.has("xsu", "ysu", "zsu"):
+            return self._cartesian(("xsu", "ysu", "zsu"))
+        x = self.positions()
+        if x is not None and self.has("ix", "iy", "iz"):
+            return x + self.vector("ix", "iy", "iz") @ self.cell.T
+        return None
+
+    def wrapped(self) -> np.ndarray:
+        """Positions inside the box on periodic axes (x y z as dumped are already so)."""
+        x = self.positions()
+        if x is not None:
+            return x
+        xu = self.unwrapped()
+        if xu is None:
+            raise InputError(self.source, self.line, "the dump has no positions: needs x y z, xs ys zs, "
+                             f"xu yu zu or xsu ysu zsu; columns: {' '.join(self.columns)}")
+        per = self.periodic
+        s = np.linalg.solve(self.cell, (xu - self.lo).T).T
+        s[:, per] -= np.floor(s[:, per])
+        return self.lo + s @ self.cell.T
+
+    def select(self, rows: np.ndarray | slice) -> "Frame":
+        """A frame with only the given atom rows (a mask, index array or slice)."""
+        cols = {k: v[rows] for k, v in self.columns.items()}
+        return Frame(self.step, self.lo, self.hi, self.boundary, cols, self.tilt, self.time,
+                     self.line, self.units, self.source)
+
+
+@dataclass
+class Header:
+    """What a frame's ITEM lines say, before its atom block is parsed."""
+
+    step: int
+    count: int
+    lo: np.ndarray
+    hi: np.ndarray
+    boundary: tuple[str, ...]
+    names: list[str]
+    line: int
+    time: float | None = None
+    units: str | None = None
+    tilt: np.ndarray | None = None
+    kind: str = "ATOMS"          # "ATOMS" or "ENTRIES" (dump local)
+    extra: dict = field(default_factory=dict)
 
 
 def _open(path: Path):
-    if path.suffix == ".gz":
+    with open(path, "rb") as fh:
+        magic = fh.read(2)
+    if magic == b"\x1f\x8b":
         return gzip.open(path, "rb")
     return open(path, "rb")
 
 
-def iter_frames(path: str | Path, warnings: list[tuple[str, str]] | None = None) -> Iterator[Frame]:
-    """Yield frames of a text dump; a truncated last frame is dropped with a warning."""
+class _Stream:
+    """Line and block access over a file read in large chunks (no per-line objects)."""
+
+    def __init__(self, fh, path: Path):
+        self.fh = fh
+        self.path = path
+        self.buf = bytearray()
+        self.pos = 0
+        self.line = 0              # lines consumed so far
+        self.line_bytes = 100.0    # mean atom-line length of the last block
+
+    def _more(self) -> bool:
+        # no latch on EOF: a dump LAMMPS is still writing may grow (fibrelmp run)
+        try:
+            data = self.fh.read(CHUNK)
+        except (OSError, EOFError, zlib.error) as exc:     # gzip.BadGzipFile is an OSError
+            raise InputError(self.path, self.line + 1,
+                             f"cannot read the dump: {exc}") from None
+        if not data:
+            return False
+        self.buf += data
+        return True
+
+    def _compact(self) -> None:
+        # drop consumed bytes (only between lines, so no caller holds an offset)
+        if self.pos > CHUNK:
+            del self.buf[:self.pos]
+            self.pos = 0
+
+    def readline(self, limit: int = 1 << 20) -> bytes | None:
+        """Next line without its newline; None at the end of the file."""
+        self._compact()
+        scan = self.pos
+        while True:
+            k = self.buf.find(b"\n", scan)
+            if k < 0 and len(self.buf) - self.pos > limit:
+                # header lines are short: do not pull a whole binary file into memory
+                raise InputError(self.path, self.line + 1, "line longer than 1 MB where a dump "
+                                 "header line was expected (not a LAMMPS text dump?)")
+            if k < 0:
+                scan = len(self.buf)
+            if k >= 0:
+                out = bytes(self.buf[self.pos:k])
+                self.pos = k + 1
+                self.line += 1
+                return out
+            if not self._more():
+                if self.pos < len(self.buf):
+                    out = bytes(self.buf[self.pos:])
+                    self.pos = len(self.buf)
+                    self.line += 1
+                    return out
+                return None
+
+    def lines(self, n: int) -> tuple[bytes, int]:
+        """The next ``n`` lines as one bytes object, and how many there were (< n at EOF)."""
+        if n <= 0:
+            return b"", 0
+        self._compact()
+        start = scan = self.pos
+        need = n
+        while True:
+            end = len(self.buf)
+            # search a window sized from the line length seen so far, not the whole buffer
+            # (many small frames would otherwise rescan a 16 MB buffer each)
+            stop = min(end, scan + max(1 << 16, int(need * self.line_bytes * 1.25)))
+            if stop > scan:
+                view = np.frombuffer(self.buf, np.uint8, count=stop - scan, offset=scan)
+                nl = np.flatnonzero(view == 10)
+                del view                  # release the export before the buffer grows
+            else:
+                nl = np.zeros(0, np.int64)
+            c = len(nl)
+            if c >= need:
+                k = scan + int(nl[need - 1])
+                out = bytes(self.buf[start:k + 1])
+                self.pos = k + 1
+                self.line += n
+                self.line_bytes = max(1.0, len(out) / n)
+                return out, n
+            need -= c
+            scan = stop
+            if stop < end:
+                continue
+            if not self._more():
+                out = bytes(self.buf[start:])
+                self.pos = len(self.buf)
+                got = n - need + (1 if out and not out.endswith(b"\n") else 0)
+                self.line += got
+                return out, got
+
+
+def _decode(raw: bytes) -> str:
+    return raw.decode("utf-8", "replace").strip()
+
+
+def _read_header(st: _Stream, path: Path, first: bytes,
+                 warnings: list | None) -> Header | None:
+    """Parse the ITEM lines of one frame, ``first`` being its first (already read) line."""
+    start = st.line
+    step = count = None
+    time = units = tilt = None
+    box = None
+    line = first
+    while True:
+        text = _decode(line)
+        if not text.startswith("ITEM:"):
+            if line is not first:
+                msg = f"expected an 'ITEM:' line, got {text[:60]!r}"
+            elif start == 1:
+                msg = f"not a LAMMPS text dump: expected 'ITEM: TIMESTEP', got {text[:60]!r}"
+            else:
+                msg = (f"expected 'ITEM: TIMESTEP' starting the next frame, got {text[:60]!r} "
+                       "(more atom lines than the previous frame's NUMBER OF ATOMS?)")
+            raise InputError(path, st.line, msg)
+        item = text[5:].strip()
+        if item.startswith(("ATOMS", "ENTRIES")):
+            kind = "ATOMS" if item.startswith("ATOMS") else "ENTRIES"
+            missing = [w for w, v in (("TIMESTEP", step), ("NUMBER OF " + kind, count)) if v is None]
+            if missing:
+                raise InputError(path, st.line, f"frame has no ITEM: {missing[0]} before ITEM: {kind}")
+            names = item.split()[1:]
+            if len(set(names)) != len(names):
+                raise InputError(path, st.line, f"repeated column name in ITEM: {kind}")
+            if box is None:
+                box = (np.zeros(3), np.zeros(3), ("pp", "pp", "pp"))
+            lo, hi, bnd = box
+            return Header(step, count, lo, hi, bnd, names, start, time, units, tilt, kind)
+        values = []
+        nvalues = 3 if item.startswith("BOX BOUNDS") else 1
+        for _ in range(nvalues):
+            raw = st.readline()
+            if raw is None:
+                if warnings is not None:
+                    warnings.append(("truncated dump", f"{path}:{start}: last frame is incomplete "
+                                     f"(ends inside ITEM: {item}); ignored"))
+                return None
+            values.append(_decode(raw))
+        try:
+            if item == "TIMESTEP":
+                step = int(values[0])
+            elif item == "TIME":
+                time = float(values[0])
+            elif item == "UNITS":
+                units = values[0]
+            elif item.startswith("NUMBER OF"):
+                count = int(values[0])
+                if count < 0:
+                    raise ValueError
+            elif item.startswith("BOX BOUNDS"):
+                words = item.split()[2:]
+                if "abc" in words or "origin" in words:
+                    raise InputError(path, st.line - 3, "general triclinic boxes (BOX BOUNDS abc origin) "
+                                     "are not supported; dump with dump_modify triclinic/general no")
+                nums = np.array([v.split()[:3] for v in values], dtype=float) if "xy" in words else \
+                    np.array([v.split()[:2] for v in values], dtype=float)
+                bnd = tuple(w for w in words if w not in ("xy", "xz", "yz"))[-3:]
+                if len(bnd) != 3:
+                    bnd = ("pp", "pp", "pp")
+                if "xy" in words:
+                    xy, xz, yz = nums[:, 2]
+                    tilt = np.array([xy, xz, yz])
+                    # the dump holds the bounding box; the box itself is inside it
+                    lo = nums[:, 0] - np.array([min(0.0, xy, xz, xy + xz), min(0.0, yz), 0.0])
+                    hi = nums[:, 1] - np.array([max(0.0, xy, xz, xy + xz), max(0.0, yz), 0.0])
+                else:
+                    lo, hi = nums[:, 0].copy(), nums[:, 1].copy()
+                box = (lo, hi, bnd)
+            else:
+                raise InputError(path, st.line - nvalues, f"unknown dump item 'ITEM: {item}'")
+        except (ValueError, IndexError):
+            raise InputError(path, st.line - nvalues + 1,
+                             f"ITEM: {item}: malformed value {' / '.join(values)[:80]!r}") from None
+        line = st.readline()
+        if line is None:
+            if warnings is not None:
+                warnings.append(("truncated dump", f"{path}:{start}: last frame is incomplete "
+                                 "(no ITEM: ATOMS block); ignored"))
+            return None
+
+
+def parse_block(block: bytes, head: Header, path: Path | str | None) -> dict[str, np.ndarray]:
+    """Columns of an atom block: one C-level parse; a slow path finds and names any defect."""
+    names, n = head.names, head.count
+    if n == 0:
+        return {c: np.zeros(0) for c in names}
+    try:
+        with _warnings.catch_warnings():
+            _warnings.simplefilter("ignore")
+            data = np.loadtxt(io.BytesIO(block), dtype=np.float64, comments=None, ndmin=2)
+        if data.shape == (n, len(names)):
+            return {c: data[:, k] for k, c in enumerate(names)}
+    except ValueError:
+        pass
+    return _parse_slow(block, head, path)
+
+
+def _parse_slow(block: bytes, head: Header, path) -> dict[str, np.ndarray]:
+    first = head.line + (head.extra.get("header_lines") or 0)
+    rows = block.decode("utf-8", "replace").split("\n")[:head.count]
+    ncol = len(head.names)
+    for k, row in enumerate(rows):
+        got = len(row.split())
+        if got != ncol:
+            if row.startswith("ITEM:"):
+                raise InputError(path, first + k, f"frame has {k} atom lines but NUMBER OF "
+                                 f"{head.kind} says {head.count}")
+            raise InputError(path, first + k, f"atom line has {got} values; ITEM: {head.kind} "
+                             f"names {ncol} columns ({' '.join(head.names)})")
+    table = np.array(" ".join(rows).split(), dtype=object).reshape(len(rows), ncol)
+    cols: dict[str, np.ndarray] = {}
+    for c, name in enumerate(head.names):
+        try:
+            cols[name] = table[:, c].astype(np.float64)
+        except ValueError:
+            if name in TEXT_COLUMNS:
+                cols[name] = table[:, c].astype(str)
+                continue
+            for k, tok in enumerate(table[:, c]):
+                try:
+                    float(tok)
+                except ValueError:
+                    raise InputError(path, first + k, f"column {name!r}: expected a number, "
+                                     f"got {tok[:40]!r}") from None
+    return cols
+
+
+Selector = Callable[[int, "Header"], bool]
+
+
+def iter_headers(path: str | Path, warnings: list[tuple[str, str]] | None = None,
+                 want: Selector | None = None) -> Iterator[tuple[Header, bytes | None]]:
+    """Yield (header, atom block bytes or None if ``want(index, header)`` is False)."""
     path = Path(path)
     if not path.exists():
         raise InputError(path, None, "dump file not found")
-    line_no = 0
-    with _open(path) as fh:
+    if path.is_dir():
+        raise InputError(path, None, "is a directory, expected a LAMMPS dump file")
+    try:
+        fh = _open(path)
+    except OSError as exc:
+        raise InputError(path, None, f"cannot read the dump: {exc.strerror or exc}") from None
+    with fh:
+        st = _Stream(fh, path)
+        index = 0
+        seen_any = False
         while True:
-            line = fh.readline()
-            line_no += 1
-            if not line:
+            line = st.readline()
+            if line is None:
+                if not seen_any:
+                    raise InputError(path, None, "empty dump file (no frames)")
                 return
+            if b"\0" in line:
+                raise InputError(path, st.line, "binary data where a LAMMPS text dump line was "
+                                 "expected (binary dumps are not supported)")
             if not line.strip():
                 continue
-            if not line.startswith(b"ITEM: TIMESTEP"):
-                raise InputError(path, line_no, "expected 'ITEM: TIMESTEP' (is this a LAMMPS text dump?)")
-            header = list(islice(fh, 8))
-            if len(header) < 8 or not header[7].startswith(b"ITEM: ATOMS"):
-                if warnings is not None:
-                    warnings.append(("truncated dump", f"{path}:{line_no}: last frame is incomplete; ignored"))
+            head = _read_header(st, path, line, warnings)
+            if head is None:
                 return
-            try:
-                step = int(header[0])
-                natoms = int(header[2])
-                box_words = header[3].split()[3:]
-                bounds = np.array([np.array(header[4 + k].split()[:2], dtype=float) for k in range(3)])
-            except (ValueError, IndexError):
-                raise InputError(path, line_no + 1, "malformed dump header") from None
-            names = [w.decode() for w in header[7].split()[2:]]
-            rows = list(islice(fh, natoms))
-            if len(rows) < natoms:
+            seen_any = True
+            head.extra["header_lines"] = st.line - head.line + 1
+            block, got = st.lines(head.count)
+            if got < head.count:
                 if warnings is not None:
-                    warnings.append(("truncated dump", f"{path}:{line_no}: last frame has {len(rows)} "
-                                     f"of {natoms} atom lines; ignored"))
+                    warnings.append(("truncated dump", f"{path}:{head.line}: last frame has {got} "
+                                     f"of {head.count} atom lines; ignored"))
                 return
-            try:
-                data = np.array(b" ".join(rows).split(), dtype=np.float64)
-                data = data.reshape(natoms, len(names))
-            except ValueError:
-                raise InputError(path, line_no + 9, "atom block does not match its column header") from None
-            line_no += 8 + natoms
-            cols = {name: data[:, k] for k, name in enumerate(names)}
-            yield Frame(step, bounds[:, 0].copy(), bounds[:, 1].copy(),
-                        tuple(w.decode() for w in box_words), cols)
+            if not block.endswith(b"\n") and head.count:
+                # at the end of the file without a newline: a cut last line is truncation
+                tail = block[block.rfind(b"\n") + 1:]
+                if len(tail.split()) != len(head.names):
+                    if warnings is not None:
+                        warnings.append(("truncated dump", f"{path}:{head.line}: last frame ends "
+                                         "inside an atom line; ignored"))
+                    return
+            yield head, (block if want is None or want(index, head) else None)
+            index += 1
+
+
+def frame_from(head: Header, block: bytes, path: Path | str | None) -> Frame:
+    cols = parse_block(block, head, path)
+    return Frame(head.step, head.lo, head.hi, head.boundary, cols, head.tilt, head.time,
+                 head.line, head.units, None if path is None else str(path))
+
+
+def iter_frames(path: str | Path, warnings: list[tuple[str, str]] | None = None,
+                want: Selector | None = None) -> Iterator[Frame]:
+    """Yield frames of a text dump; a truncated last frame is dropped with a warning.
+
+    ``want(index, header)`` (optional) skips frames without parsing their atom blocks.
+    """
+    for head, block in iter_headers(path, warnings, want):
+        if block is not None:
+            yield frame_from(head, block, path)
+

@@ -39,28 +39,53 @@ def wrapped_and_unwrapped(frame: Frame) -> tuple[np.ndarray, np.ndarray]:
     return wrapped, unwrapped
 
 
+def type_codes(types: np.ndarray, names_of_type: dict[int, str]) -> tuple[np.ndarray, list[str]]:
+    """Per-atom index into a small table of type names (no per-atom Python code)."""
+    t = np.asarray(types).astype(np.int64)
+    if t.size == 0:
+        return np.zeros(0, np.int64), []
+    uniq, codes = np.unique(t, return_inverse=True) if int(t.max()) - int(t.min()) > 1 << 20 else \
+        _small_unique(t)
+    return codes.ravel(), [names_of_type[int(u)] for u in uniq]
+
+
+def _small_unique(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    lo = int(t.min())
+    present = np.zeros(int(t.max()) - lo + 1, bool)
+    present[t - lo] = True
+    remap = np.cumsum(present) - 1
+    return np.flatnonzero(present) + lo, remap[t - lo]
+
+
 def write_fibrenet(frames: Iterable[Frame], basename: str, folder: Path, fields: Sequence[str],
-                   names_of_type: dict[int, str], dt: float, box_lengths: np.ndarray,
+                   names_of_type: dict[int, str], dt: float, box_lengths: np.ndarray | None,
                    output_types: set[str] | None, restart: bool = True) -> list[Path]:
-    """Write ``<basename>_coord/_vel/_force.xyz`` (every frame) and ``_restart.res`` (last)."""
+    """Write ``<basename>_coord/_vel/_force.xyz`` (every frame) and ``_restart.res`` (last).
+
+    ``box_lengths`` None: each frame's own box (post-processing of dumps whose box changes).
+    """
     folder = Path(folder)
     writers = {f: XyzWriter(folder / f"{basename}{XYZ_SUFFIX[f]}") for f in fields}
     last = None
     try:
         for frame in frames:
-            order = np.argsort(frame.column("id"), kind="stable")
-            names = np.array([names_of_type[int(t)] for t in frame.column("type")[order]], dtype=object)
-            keep = np.ones(len(order), bool) if output_types is None else np.isin(names, list(output_types))
+            ids = frame.column("id")
+            # dumps written with "modify sort id" need no reordering (saves a sort per frame)
+            order = slice(None) if bool(np.all(ids[1:] > ids[:-1])) else np.argsort(ids, kind="stable")
+            codes, table = type_codes(frame.column("type")[order], names_of_type)
+            keep = slice(None) if output_types is None else \
+                np.isin(codes, [k for k, name in enumerate(table) if name in output_types])
             wrapped, unwrapped = wrapped_and_unwrapped(frame)
             data = {"position": wrapped[order]}
             if "velocity" in fields or restart:
                 data["velocity"] = _pick(frame, VEL_COLUMNS, ("vx", "vy", "vz"))[order]
             if "force" in fields or restart:
                 data["force"] = _pick(frame, FORCE_COLUMNS, ("fx", "fy", "fz"))[order]
+            lengths = box_lengths if box_lengths is not None else frame.hi - frame.lo
             for f, w in writers.items():
-                w.write(frame.step, dt, box_lengths, names[keep], data[f][keep])
-            last = (frame.step, names, data["position"], unwrapped[order], data.get("velocity"),
-                    data.get("force"))
+                w.write_codes(frame.step, dt, lengths, codes[keep], table, data[f][keep])
+            last = (frame.step, (codes, table), data["position"], unwrapped[order], data.get("velocity"),
+                    data.get("force"), lengths)
     except BaseException:
         for w in writers.values():
             w.abort()
@@ -70,7 +95,8 @@ def write_fibrenet(frames: Iterable[Frame], basename: str, folder: Path, fields:
     written = [w.path for w in writers.values()]
     if restart and last is not None:
         path = folder / f"{basename}{RESTART_SUFFIX}"
-        step, names, x, xu, v, f = last
-        write_restart(path, step, dt, box_lengths, names, x, xu, v, f)
+        step, (codes, table), x, xu, v, f, lengths = last
+        names = np.array(table, dtype=object)[codes]
+        write_restart(path, step, dt, lengths, names, x, xu, v, f)
         written.append(path)
     return written

@@ -33,6 +33,7 @@ class Job:
     total_steps: int
     type_of_ltype: np.ndarray            # LAMMPS type (1-based, index 0 unused) -> user type
     output_steps: list[int] = field(default_factory=list)
+    text: str = ""                        # the script, also when only rank 0 wrote files
 
 
 def _fmt(x: float) -> str:
@@ -167,11 +168,15 @@ def _schedule(model: Model, general_lambda: bool) -> tuple[list[tuple], list[int
     return acts, out_steps, total
 
 
-def write_job(model: Model, folder: str | Path) -> Job:
-    """Write data file + input script for ``model`` into ``folder``."""
+def write_job(model: Model, folder: str | Path, write_files: bool = True) -> Job:
+    """Write data file + input script for ``model`` into ``folder``.
+
+    ``write_files=False`` (MPI ranks other than 0) renders the script in memory only: LAMMPS
+    reads the data file on rank 0 and broadcasts it."""
     folder = Path(folder)
     try:
-        folder.mkdir(parents=True, exist_ok=True)
+        if write_files:
+            folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise InputError(folder, None, f"cannot create job folder: {exc.strerror or exc}") from None
     p, dyn, box = model.particles, model.dynamics, model.box
@@ -205,7 +210,8 @@ def write_job(model: Model, folder: str | Path) -> Job:
     acts, out_steps, total = _schedule(model, general_lambda)
 
     data_path = folder / DATA_NAME
-    _write_data(model, bonds, data_path, ltypes, atype, btypes, btype, atypes, antype, use_mvv)
+    if write_files:
+        _write_data(model, bonds, data_path, ltypes, atype, btypes, btype, atypes, antype, use_mvv)
     env = Environment(loader=PackageLoader("fibrelmp", "templates"), undefined=StrictUndefined,
                       trim_blocks=True, lstrip_blocks=True, keep_trailing_newline=True)
     script = env.get_template("bead_spring.lammps.j2").render(
@@ -219,9 +225,11 @@ def write_job(model: Model, folder: str | Path) -> Job:
         rad2deg=180.0 / math.pi, inf=float("inf"), angle_expression=angle_expression,
     )
     script_path = folder / SCRIPT_NAME
-    atomic_write(script_path, script)
+    if write_files:
+        atomic_write(script_path, script)
     type_of_ltype = np.r_[-1, ltypes[:, 0].astype(np.int64)]
-    return Job(folder, script_path, data_path, folder / FRAMES_NAME, total, type_of_ltype, out_steps)
+    return Job(folder, script_path, data_path, folder / FRAMES_NAME, total, type_of_ltype, out_steps,
+               text=script)
 
 
 def _block(fmt_row: str, columns: list[np.ndarray]) -> str:

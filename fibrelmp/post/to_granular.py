@@ -1,0 +1,109 @@
+"""LAMMPS dump frames -> the neutral GranularModel/GranularFrame, for the MUSEN and DEMDF
+writers (``fibrelmp post --to musen|demdf``).
+
+The model is built from the first frame (plus ``--data`` facts): one sphere per atom id,
+one material per atom type.  A dump says nothing about materials or contact laws, so the
+MUSEN result carries materials with only a density (from mass and radius when both are
+known) and the DEMDF document only object types with radius and mass.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Iterable, Iterator
+
+import numpy as np
+
+from ..errors import InputError
+from ..granmodel import GranularFrame, GranularModel, GranularPlan, Material, Spheres
+from .lammps_dump import Frame
+
+
+def _vector(frame: Frame, names: tuple[str, str, str], n: int) -> np.ndarray:
+    return frame.vector(*names) if frame.has(*names) else np.zeros((n, 3))
+
+
+def model_from_frame(first: Frame, source: Path, names: dict[int, str], kind: str,
+                     time: float, dt: float) -> GranularModel:
+    n = first.count
+    if not first.has("radius"):
+        raise InputError(source, first.line, f"--to {kind} needs sphere radii: the dump has no "
+                         "'radius' (or 'diameter') column; add it to the dump or give --data")
+    ids = first.column("id").astype(np.int64)
+    types = first.column("type").astype(np.int64)
+    radius = first.column("radius").astype(np.float64)
+    mass = first.column("mass").astype(np.float64) if first.has("mass") else np.full(n, np.nan)
+    tlist = sorted(set(types.tolist()))
+    mat_of_type = {t: k for k, t in enumerate(tlist)}
+    materials = []
+    for t in tlist:
+        rows = types == t
+        vol = 4.0 / 3.0 * math.pi * radius[rows] ** 3
+        rho = float(np.mean(mass[rows] / vol)) if np.isfinite(mass[rows]).all() else float("nan")
+        name = names.get(t, f"type{t}")
+        mat = Material(key=f"LAMMPS_TYPE_{t}", name=name.replace(" ", "_"), density=rho)
+        if math.isfinite(rho):
+            mat.props[0] = rho
+        materials.append(mat)
+    x = first.wrapped()
+    spheres = Spheres(ids=ids if kind == "musen" else np.arange(n), material=np.array([mat_of_type[t] for t in types]),
+                      radius=radius, contact_radius=radius.copy(), mass=mass, position=x,
+                      velocity=_vector(first, ("vx", "vy", "vz"), n),
+                      omega=_vector(first, ("omegax", "omegay", "omegaz"), n),
+                      quaternion=first.vector("quatw", "quati", "quatj", "quatk") if first.has("quatw", "quati", "quatj", "quatk")
+                      else np.tile([1.0, 0.0, 0.0, 0.0], (n, 1)),
+                      active_start=np.full(n, time), active_end=np.full(n, np.inf))
+    plan = GranularPlan(dt=dt, t_start=time, t_end=time,
+                        domain=(first.lo.copy(), first.hi.copy()),
+                        periodic=tuple(bool(p) for p in first.periodic))
+    model = GranularModel(source=source, kind=kind, materials=materials, contacts={},
+                          spheres=spheres, plan=plan)
+    model.passthrough["atom_ids"] = ids
+    return model
+
+
+def granular_frames(frames: Iterable[tuple[Frame, float]], model: GranularModel) -> Iterator[GranularFrame]:
+    """Each dump frame as a GranularFrame; atoms missing from a frame count as removed,
+    atoms the first frame did not have are an error (a model cannot grow)."""
+    ids = model.passthrough["atom_ids"]
+    order = np.argsort(ids)
+    for frame, time in frames:
+        fid = frame.column("id").astype(np.int64)
+        pos = np.searchsorted(ids, fid, sorter=order)
+        pos = np.minimum(pos, len(ids) - 1)
+        rows = order[pos]
+        if len(fid) and not np.array_equal(ids[rows], fid):
+            new = fid[ids[rows] != fid][0]
+            raise InputError(frame.source, frame.line, f"atom {new} appears after the first frame: "
+                             "MUSEN/DEMDF results need every object present from the start")
+        n = frame.count
+        quat = (frame.vector("quatw", "quati", "quatj", "quatk") if frame.has("quatw", "quati", "quatj", "quatk")
+                else np.tile([1.0, 0.0, 0.0, 0.0], (n, 1)))
+        yield GranularFrame(time=time, step=frame.step, sphere_rows=rows, position=frame.wrapped(),
+                            velocity=_vector(frame, ("vx", "vy", "vz"), n),
+                            omega=_vector(frame, ("omegax", "omegay", "omegaz"), n),
+                            force=_vector(frame, ("fx", "fy", "fz"), n), quaternion=quat)
+
+
+def demdf_document(model: GranularModel, filename: str) -> dict:
+    """A minimal DEMDF document describing the dump's particles (object type = LAMMPS type)."""
+    s = model.spheres
+    object_types = []
+    for k, mat in enumerate(model.materials):
+        rows = s.material == k
+        entry = {"id": k, "type": "particle", "name": mat.name, "radius": float(s.radius[rows][0])}
+        if np.isfinite(s.mass[rows]).all():
+            entry["mass"] = float(s.mass[rows][0])
+        object_types.append(entry)
+        if not (np.allclose(s.radius[rows], s.radius[rows][0])):
+            raise InputError(model.source, None, f"DEMDF object types carry one radius; LAMMPS type "
+                             f"{mat.key.rsplit('_', 1)[-1]} has several")
+    lo, hi = model.plan.domain
+    particles = [[*map(float, x), *map(float, v), int(t)]
+                 for x, v, t in zip(s.position, s.velocity, s.material)]
+    return {"fileFormat": "demdf", "fileFormatVersion": 0.01, "name": f"from {model.source.name}",
+            "dimensionality": 3, "time": model.plan.t_start, "timeStep": model.plan.dt,
+            "domain": [lo.tolist(), hi.tolist()], "objectTypes": object_types,
+            "objects": {"particles": particles},
+            "output": {"snapshot": {"filename": filename, "saveCount": 0}}}

@@ -7,6 +7,7 @@ import shutil
 from dataclasses import dataclass
 from pathlib import Path
 
+from .errors import InputError
 from .formats import detect, reader
 from .model import Model
 from .translate.lammps_job import Job, write_job
@@ -29,8 +30,12 @@ class RunResult:
 
 
 def run(model: Model, out: str | Path | None = None, work: str | Path | None = None,
-        progress: bool = True, keep_work: bool = True) -> RunResult:
-    """Translate, run in-process and write the results in the input's own format."""
+        progress: bool = True, keep_work: bool = True, checkpoint_every: int | None = None,
+        resume: bool = False) -> RunResult:
+    """Translate, run in-process and write the results in the input's own format.
+
+    ``checkpoint_every`` writes a checkpoint every that many steps (and one on SIGTERM or
+    Ctrl-C in any case); ``resume`` continues from the checkpoint in the work folder."""
     from .post.lammps_dump import iter_frames
     from .post.to_fibrenet import write_fibrenet
     from .runner import mpi_rank_size, run_script
@@ -42,7 +47,9 @@ def run(model: Model, out: str | Path | None = None, work: str | Path | None = N
     rank, size = mpi_rank_size()
     # every rank parses and renders identically; only rank 0 writes the job files
     job = write_job(model, work_folder, write_files=rank == 0)
-    if rank == 0 and job.frames.exists():
+    checkpoints = prepare_checkpoints(job.folder, job.text, checkpoint_every, resume,
+                                      [job.frames.name], rank)
+    if rank == 0 and job.frames.exists() and not resume:
         job.frames.unlink()
     names = {lt: model.particles.type_names[t] for lt, t in enumerate(job.type_of_ltype) if lt > 0}
     types = None if spec.types is None else {model.particles.type_names[t] for t in spec.types}
@@ -56,9 +63,10 @@ def run(model: Model, out: str | Path | None = None, work: str | Path | None = N
     if rank == 0 and size == 1 and (os.cpu_count() or 1) > 1:
         # convert each frame on a second core while LAMMPS computes the next one (the lammps
         # module releases the GIL inside the library)
-        outputs = _run_with_converter(job, progress, convert)
+        outputs = _run_with_converter(job, progress, convert, checkpoints)
     else:
-        run_script(job.script, job.total_steps, progress=progress, text=job.text)
+        run_script(job.script, job.total_steps, progress=progress, text=job.text,
+                   checkpoints=checkpoints)
         if rank == 0:
             outputs = convert(iter_frames(job.frames))
     if rank == 0 and not keep_work:
@@ -70,7 +78,21 @@ class _RunAborted(Exception):
     """Tells the converter thread that LAMMPS failed: discard partial outputs."""
 
 
-def _run_with_converter(job: Job, progress: bool, convert) -> list[Path]:
+def prepare_checkpoints(folder: Path, text: str, every: int | None, resume: bool,
+                        appended: list[str], rank: int):
+    """Checkpointing for a job (always on: a SIGTERM/Ctrl-C leaves a checkpoint behind);
+    when resuming, load the state and cut the dumps back to the checkpoint."""
+    from .checkpoint import Checkpointing, load, truncate_outputs
+
+    if every is not None and every <= 0:
+        raise InputError(None, None, f"--checkpoint-every must be a positive number of steps, got {every}")
+    state = load(folder, text) if resume else None
+    if state is not None and rank == 0:
+        truncate_outputs(folder, state)
+    return Checkpointing(Path(folder), every, state, list(appended))
+
+
+def _run_with_converter(job: Job, progress: bool, convert, checkpoints=None) -> list[Path]:
     import queue
     import threading
 
@@ -99,7 +121,7 @@ def _run_with_converter(job: Job, progress: bool, convert) -> list[Path]:
     worker = threading.Thread(target=work, daemon=True)
     worker.start()
     try:
-        run_script(job.script, job.total_steps, progress=progress,
+        run_script(job.script, job.total_steps, progress=progress, checkpoints=checkpoints,
                    on_command=lambda w: ready.put(True) if w[0] == "write_dump" else None)
     except BaseException:
         ready.put("abort")

@@ -67,6 +67,12 @@ def _guard(func):
             _fail(f"run failed: {exc}", 1)
         except KeyboardInterrupt:
             _fail("interrupted", 130)
+        except Exception as exc:
+            from .checkpoint import CheckpointStop
+
+            if isinstance(exc, CheckpointStop):
+                _fail(str(exc), 128 + exc.signum)
+            raise
     return wrapper
 
 
@@ -186,6 +192,11 @@ def run(input: Path = typer.Argument(..., help="FibreNet input, MUSEN text scene
         steps: Optional[int] = typer.Option(None, "--steps", help="DEMDF: number of time steps to run."),
         precision: int = typer.Option(6, "--precision", help="MUSEN result: significant digits "
                                       "(6 as MUSEN; 17 for exact round trips)."),
+        checkpoint_every: Optional[int] = typer.Option(None, "--checkpoint-every", help="Write a "
+                                                       "checkpoint every N steps (one is always "
+                                                       "written on SIGTERM/Ctrl-C)."),
+        resume: bool = typer.Option(False, "--resume", help="Continue an interrupted run from the "
+                                    "checkpoint in its work folder."),
         ) -> None:
     """Translate INPUT, run it on LAMMPS and write the results in the input's own format.
 
@@ -210,7 +221,8 @@ def run(input: Path = typer.Argument(..., help="FibreNet input, MUSEN text scene
                               "inputs; FibreNet inputs set their own steps")
         model = read_input(input)
         _report_warnings(model.warnings)
-        result = do_run(model, out=out, work=work, progress=not _state["quiet"])
+        result = do_run(model, out=out, work=work, progress=not _state["quiet"],
+                        checkpoint_every=checkpoint_every, resume=resume)
         outputs, script = result.outputs, result.job.script
     elif kind == "musen-script":
         from .granular_api import run_musen_script

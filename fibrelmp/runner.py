@@ -16,6 +16,11 @@ from typing import Callable
 from ._lammps import new_lammps
 from .errors import RunError
 
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from .checkpoint import Checkpointing  # noqa: F401
+
 
 def mpi_rank_size() -> tuple[int, int]:
     for rank_var, size_var in (("PMI_RANK", "PMI_SIZE"), ("OMPI_COMM_WORLD_RANK", "OMPI_COMM_WORLD_SIZE")):
@@ -49,37 +54,82 @@ class Progress:
 
 
 def run_script(script: Path, total_steps: int, progress: bool = True, log: bool = False,
-               on_command: Callable[[list[str]], None] | None = None, text: str | None = None) -> None:
+               on_command: Callable[[list[str]], None] | None = None, text: str | None = None,
+               checkpoints: "Checkpointing | None" = None) -> None:
     """Execute ``script`` inside its folder with the lammps module.
 
     ``text`` is the script's content when this rank did not write the file (MPI ranks > 0:
     LAMMPS opens data files and writes dumps on rank 0 only).  ``on_command`` is called with
-    the words of every command after LAMMPS finished it.
+    the words of every command after LAMMPS finished it (also for the ``write_dump`` lines a
+    resumed run skips: their frames are in the dump already).  ``checkpoints`` enables
+    checkpoints and resuming (see fibrelmp.checkpoint).
     """
+    from .checkpoint import ACTIONS, CheckpointStop
+
     script = Path(script)
-    rank, _ = mpi_rank_size()
+    rank, size = mpi_rank_size()
     args = ["-nocite", "-log", "log.lammps" if log and rank == 0 else "none", "-screen", "none"]
-    lines = (text if text is not None else script.read_text()).splitlines()
+    script_text = text if text is not None else script.read_text()
+    lines = script_text.splitlines()
     cwd = os.getcwd()
     bar = Progress(total_steps, progress and rank == 0)
+    resume = checkpoints.resume if checkpoints is not None else None
+    skip_to = resume["line"] if resume else 0
+    steps = resume["steps"] if resume else 0
+    frames = 0
+    since = 0
+    deferred: list[str] = []         # per-atom fixes: defined after read_restart to get their data
     lmp = None
+    if resume:
+        bar.advance(steps)
     try:
         if rank == 0 or script.parent.is_dir():
             os.chdir(script.parent)
         lmp = new_lammps(args)
+        if checkpoints is not None:
+            checkpoints.install()
         for number, line in enumerate(lines, 1):
             text = line.strip()
             if not text or text.startswith("#"):
                 continue
+            words = text.split()
+            if number <= skip_to:
+                if words[0] in ACTIONS:
+                    if words[0] == "write_dump":
+                        frames += 1
+                        if on_command is not None:
+                            on_command(words)
+                    continue
+                if words[0] == "fix" and len(words) > 3 and words[3] == "property/atom":
+                    deferred.append(text)
+                    continue
+                if words[0] == "read_data":
+                    text = "read_restart checkpoint.restart"
             try:
                 lmp.command(text)
+                if number <= skip_to and words[0] == "read_data":
+                    for fix in deferred:
+                        lmp.command(fix)
             except Exception as exc:       # LAMMPS raises plain Exception subclasses
                 raise RunError(f"{script}:{number}: LAMMPS error: {str(exc).strip()}") from None
-            words = text.split()
+            if words[0] == "write_dump":
+                frames += 1
             if words[0] == "run" and len(words) > 1:
-                bar.advance(int(words[1]))
+                n = int(words[1])
+                bar.advance(n)
+                steps += n
+                since += n
             if on_command is not None:
                 on_command(words)
+            if checkpoints is not None and words[0] == "run":
+                signum = checkpoints.stop_requested(size)
+                if signum or (checkpoints.every and since >= checkpoints.every):
+                    checkpoints.write(lmp, rank, number, steps, frames, script_text)
+                    since = 0
+                    if signum:
+                        raise CheckpointStop(script.parent, signum)
+        if checkpoints is not None:
+            checkpoints.clear(rank)
     finally:
         bar.close()
         os.chdir(cwd)

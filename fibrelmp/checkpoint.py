@@ -1,0 +1,127 @@
+"""Checkpoints: stop a run cleanly (every N steps, or on SIGTERM/Ctrl-C) and resume it.
+
+A checkpoint sits in the job folder: ``checkpoint.restart`` (LAMMPS ``write_restart``: atoms,
+velocities, bonds, contact and bond history, per-atom fix data) and ``checkpoint.json``
+(fibrelmp's own state: the script line to continue from, steps done, and the byte size of
+every dump the script appends to, so frames written after the checkpoint are dropped).
+
+Resuming replays the same rendered script: set-up commands run again (styles, fixes,
+variables must exist), ``read_data`` becomes ``read_restart``, and commands that change the
+state or write output (run, velocity, displace_atoms, write_dump, ...) are skipped up to the
+checkpoint line.  Checkpoints are taken only between ``run`` commands of the script, so every
+MPI rank stops at the same command (the stop request is agreed with an MPI all-reduce).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import hashlib
+import json
+import os
+import signal
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .errors import InputError
+
+RESTART = "checkpoint.restart"
+STATE = "checkpoint.json"
+# commands that change the state or write output: done already when resuming
+ACTIONS = frozenset({"run", "minimize", "velocity", "displace_atoms", "reset_timestep", "write_dump",
+                     "write_restart", "write_data", "set", "delete_atoms", "create_atoms",
+                     "delete_bonds", "displace_box", "change_box"})
+
+
+class CheckpointStop(Exception):
+    """The run stopped after writing a checkpoint (signal received)."""
+
+    def __init__(self, folder: Path, signum: int):
+        self.folder, self.signum = folder, signum
+        super().__init__(f"stopped by {signal.Signals(signum).name}; checkpoint written in {folder}: "
+                         "continue with --resume")
+
+
+@dataclass
+class Checkpointing:
+    folder: Path                         # the job folder
+    every: int | None = None             # steps between checkpoints (None: only on signals)
+    resume: dict | None = None           # state of the checkpoint to continue from
+    appended: list[str] = field(default_factory=list)   # dumps the script appends to
+    _stop: int = 0
+
+    # -- signals --------------------------------------------------------------------------
+    def install(self) -> None:
+        for sig in (signal.SIGTERM, signal.SIGINT):
+            try:
+                signal.signal(sig, self._request)
+            except ValueError:           # not the main thread: no signal handling
+                return
+
+    def _request(self, signum, frame) -> None:
+        self._stop = signum
+
+    def stop_requested(self, size: int) -> int:
+        """The signal to stop for, agreed by every MPI rank (0 = go on)."""
+        if size == 1:
+            return self._stop
+        return _allreduce_max(self._stop)
+
+    # -- files -----------------------------------------------------------------------------
+    def write(self, lmp, rank: int, line: int, steps: int, frames: int, script_text: str) -> None:
+        tmp = self.folder / (RESTART + ".tmp")
+        lmp.command(f"write_restart {tmp.name}")
+        if rank != 0:
+            return
+        os.replace(tmp, self.folder / RESTART)
+        state = {"line": line, "steps": steps, "frames": frames, "script_sha256": _sha(script_text),
+                 "sizes": {name: (self.folder / name).stat().st_size
+                           for name in self.appended if (self.folder / name).exists()}}
+        part = self.folder / (STATE + ".tmp")
+        part.write_text(json.dumps(state, indent=1))
+        os.replace(part, self.folder / STATE)
+
+    def clear(self, rank: int) -> None:
+        if rank == 0:
+            for name in (RESTART, STATE, RESTART + ".tmp", STATE + ".tmp"):
+                (self.folder / name).unlink(missing_ok=True)
+
+
+def load(folder: Path, script_text: str) -> dict:
+    """The checkpoint state in ``folder``; an InputError when there is none or the input
+    changed since it was written."""
+    path = Path(folder) / STATE
+    if not path.exists() or not (Path(folder) / RESTART).exists():
+        raise InputError(path, None, "no checkpoint to resume from (run without --resume, or "
+                         "give the same --work folder as the interrupted run)")
+    try:
+        state = json.loads(path.read_text())
+        line, steps = int(state["line"]), int(state["steps"])
+    except (ValueError, KeyError, TypeError):
+        raise InputError(path, None, "the checkpoint state is damaged; run again without --resume") from None
+    if state.get("script_sha256") != _sha(script_text):
+        raise InputError(path, None, "the input changed since this checkpoint was written: the "
+                         "translated job differs; run again without --resume")
+    state["line"], state["steps"] = line, steps
+    return state
+
+
+def truncate_outputs(folder: Path, state: dict) -> None:
+    """Drop what the interrupted run appended after its checkpoint."""
+    for name, size in state.get("sizes", {}).items():
+        path = Path(folder) / name
+        if path.exists() and path.stat().st_size > size:
+            with open(path, "r+b") as fh:
+                fh.truncate(size)
+
+
+def _sha(text: str) -> str:
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def _allreduce_max(value: int) -> int:
+    lib = ctypes.CDLL("libmpi.so.12", mode=ctypes.RTLD_NOLOAD | ctypes.RTLD_GLOBAL)
+    send, recv = ctypes.c_int(value), ctypes.c_int(0)
+    # MPICH ABI handles: MPI_INT, MPI_MAX, MPI_COMM_WORLD
+    lib.MPI_Allreduce(ctypes.byref(send), ctypes.byref(recv), 1, ctypes.c_int(0x4c000405),
+                      ctypes.c_int(0x58000001), ctypes.c_int(0x44000000))
+    return recv.value

@@ -66,7 +66,7 @@ def mpi_abort(code: int) -> None:
     on one rank leaves the others waiting in a collective for ever).  Does nothing when MPI
     was never initialised (serial runs, errors before LAMMPS started)."""
     try:
-        lib = ctypes.CDLL("libmpi.so.12", mode=ctypes.RTLD_NOLOAD | ctypes.RTLD_GLOBAL)
+        lib = ctypes.CDLL("libmpi.so.12", mode=os.RTLD_NOLOAD | ctypes.RTLD_GLOBAL)  # ctypes has no RTLD_NOLOAD
     except OSError:
         return
     flag = ctypes.c_int(0)

@@ -119,7 +119,7 @@ def _sha(text: str) -> str:
 
 
 def _allreduce_max(value: int) -> int:
-    lib = ctypes.CDLL("libmpi.so.12", mode=ctypes.RTLD_NOLOAD | ctypes.RTLD_GLOBAL)
+    lib = ctypes.CDLL("libmpi.so.12", mode=os.RTLD_NOLOAD | ctypes.RTLD_GLOBAL)  # ctypes has no RTLD_NOLOAD
     send, recv = ctypes.c_int(value), ctypes.c_int(0)
     # MPICH ABI handles: MPI_INT, MPI_MAX, MPI_COMM_WORLD
     lib.MPI_Allreduce(ctypes.byref(send), ctypes.byref(recv), 1, ctypes.c_int(0x4c000405),

@@ -14,7 +14,21 @@ import typer
 from . import __version__
 
 app = typer.Typer(add_completion=True, no_args_is_help=True, rich_markup_mode=None,
-                  help="Run FibreNet inputs on LAMMPS and write FibreNet's own outputs.")
+                  help="""Run FibreNet, MUSEN and DEMDF inputs on LAMMPS and write the results in
+each code's own format; convert LAMMPS dumps into those formats.
+
+\b
+Examples:
+  fibrelmp check examples/fibre_network/input.txt      # validate, list every error
+  fibrelmp run examples/musen/single_particle_job.txt
+  fibrelmp translate examples/demdf/head_on.json -o job/
+  fibrelmp post frames.dump --to vtk -o run/frames
+  fibrelmp --install-completion                        # tab completion for your shell
+
+\b
+Exit codes: 0 success, 1 the run failed (LAMMPS error), 2 bad input or
+output path (error: path:line: message), 130 interrupted, 128+N stopped by
+signal N after writing a checkpoint (resume with run --resume).""")
 
 _state = {"quiet": False, "verbose": False}
 
@@ -76,6 +90,21 @@ def _guard(func):
     return wrapper
 
 
+def _mpi_library_version() -> str:
+    """MPI_Get_library_version of the MPI library LAMMPS loaded (callable before MPI_Init)."""
+    import ctypes
+    import os
+
+    lib = ctypes.CDLL("libmpi.so.12", mode=os.RTLD_NOLOAD | ctypes.RTLD_GLOBAL)
+    buf, length = ctypes.create_string_buffer(8192), ctypes.c_int(0)   # MPI_MAX_LIBRARY_VERSION_STRING
+    if lib.MPI_Get_library_version(buf, ctypes.byref(length)) != 0:
+        raise OSError("MPI_Get_library_version failed")
+    major, minor = ctypes.c_int(0), ctypes.c_int(0)
+    lib.MPI_Get_version(ctypes.byref(major), ctypes.byref(minor))
+    first = buf.value.decode(errors="replace").strip().splitlines()[0]
+    return f"{' '.join(first.split())} (MPI standard {major.value}.{minor.value})"
+
+
 def _version(value: bool) -> None:
     if value:
         typer.echo(f"fibrelmp {__version__}")
@@ -87,6 +116,10 @@ def _version(value: bool) -> None:
             lmp.close()
         except Exception as exc:  # version output must never crash
             typer.echo(f"LAMMPS unavailable: {exc}")
+        try:
+            typer.echo(f"MPI {_mpi_library_version()}")
+        except Exception as exc:  # no MPI library loaded (serial LAMMPS build)
+            typer.echo(f"MPI unavailable: {exc}")
         raise typer.Exit()
 
 
@@ -95,17 +128,26 @@ def main_options(
     quiet: bool = typer.Option(False, "--quiet", "-q", help="Only warnings and errors."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help="Show every warning and more detail."),
     version: Optional[bool] = typer.Option(None, "--version", callback=_version, is_eager=True,
-                                           help="Print fibrelmp and LAMMPS versions."),
+                                           help="Print the fibrelmp, LAMMPS and MPI library versions."),
 ) -> None:
     _state["quiet"], _state["verbose"] = quiet, verbose
 
 
 @app.command()
 @_guard
-def check(input: Path = typer.Argument(..., help="Any supported input file.")) -> None:
-    """Parse and validate INPUT without running; print a summary.
+def check(input: Path = typer.Argument(..., help="Any supported input file.",
+                                       readable=False)) -> None:   # fibrelmp says why, as path: message
+    """Parse and validate INPUT without running LAMMPS; print a summary, the unit system and
+    the time step against the fastest spring / contact it has to resolve.
 
-    Example: fibrelmp check examples/fibre_network/input.txt
+    For FibreNet inputs and models, MUSEN scenes and cmusen scripts every error is listed
+    (run stops at the first); for DEMDF files the first.  Exit code 2 on any error.
+
+    \b
+    Examples:
+      fibrelmp check examples/fibre_network/input.txt
+      fibrelmp check examples/musen/single_particle_job.txt
+      fibrelmp --verbose check examples/demdf/head_on.json   # every warning
     """
     from .formats import detect
 
@@ -114,17 +156,18 @@ def check(input: Path = typer.Argument(..., help="Any supported input file.")) -
         from .granular_api import model_for_check
         from .granular_check import summary
 
-        model = model_for_check(input, kind)
+        model = _read_for_check(lambda: model_for_check(input, kind), kind, input)
         typer.echo("\n".join(summary(model)))
         _report_warnings(model.warnings)
         typer.echo(f"warnings     {len(model.warnings)}")
         return
     from .api import read_input
+    from .sanity import spring_check, units_line
 
-    model = read_input(input)
+    model = _read_for_check(lambda: read_input(input), kind, input)
     p = model.particles
     lines = [f"input        {model.source}",
-             f"units        {model.units}",
+             units_line(model),
              f"beads        {p.count}",
              f"springs      {model.bonds.count}",
              f"angles       {model.angles.count}",
@@ -138,23 +181,49 @@ def check(input: Path = typer.Argument(..., help="Any supported input file.")) -
         extra = f" in chunks of {st.chunk}" + (", velocities reset" if st.reset else "") if st.name == "relax" else \
             f", output every {model.plan.output.every}"
         lines.append(f"stage        {st.name}: {st.steps} steps{extra}")
-    if p.count and model.bonds.count:
-        k_over_m = model.bonds.k / np.maximum(np.minimum(p.masses[model.bonds.atoms[:, 0]],
-                                                         p.masses[model.bonds.atoms[:, 1]]), 1e-300)
-        period = 2 * np.pi / np.sqrt(k_over_m.max())
-        lines.append(f"spring period {period:.4g} (shortest) = {period / model.dynamics.dt:.1f} time steps")
+    lines += spring_check(model)
     typer.echo("\n".join(lines))
     _report_warnings(model.warnings)
     typer.echo(f"warnings     {len(model.warnings)}")
 
 
+def _read_for_check(read, kind: str, input: Path):
+    """``read()``; on an input error in a line-oriented format, every error of the file (the
+    readers stop at the first: ``collect_errors`` re-reads with failing lines patched out)."""
+    from .errors import InputError
+    from .textio import MAX_ERRORS, collect_errors
+
+    try:
+        return read()
+    except InputError as first:
+        if kind == "demdf":
+            raise
+        if kind == "fibrenet":
+            from .translate.fibrenet import check_patch
+
+            patch = check_patch(input)
+        else:
+            from .translate.musen_script import check_patch as patch
+        errors = collect_errors(read, first, patch)
+    if len(errors) == 1:
+        raise errors[0]
+    files = list(dict.fromkeys(e.path for e in errors))          # in the order they were met
+    errors.sort(key=lambda e: (files.index(e.path), e.line or 0))
+    more = " (the limit: fix these and check again)" if len(errors) >= MAX_ERRORS else ""
+    _fail("\n".join(f"error: {e}" for e in errors) + f"\n{len(errors)} errors{more}", 2)
+
+
 @app.command()
 @_guard
-def translate(input: Path = typer.Argument(..., help="Any supported input file."),
+def translate(input: Path = typer.Argument(..., help="Any supported input file.", readable=False),
               out: Path = typer.Option(..., "-o", "--out", help="Folder for in.lammps and the data file.")) -> None:
     """Write a stock-LAMMPS job (in.lammps + data file) for INPUT into a folder.
 
-    Example: fibrelmp translate input.txt -o job/ && cd job && lmp -in in.lammps
+    \b
+    Examples:
+      fibrelmp translate input.txt -o job/ && cd job && lmp -in in.lammps
+      fibrelmp translate examples/musen/single_particle_job.txt -o job/
+      fibrelmp translate examples/demdf/head_on.json -o job/
     """
     from .formats import detect
 
@@ -179,7 +248,7 @@ def translate(input: Path = typer.Argument(..., help="Any supported input file."
 @app.command()
 @_guard
 def run(input: Path = typer.Argument(..., help="FibreNet input, MUSEN text scene, cmusen job script "
-                                     "or DEMDF JSON file."),
+                                     "or DEMDF JSON file.", readable=False),
         out: Optional[Path] = typer.Option(None, "--out", "-o", help="Where results go: a folder "
                                            "(FibreNet, DEMDF) or the result file (MUSEN scene). "
                                            "Default: next to the input."),
@@ -265,7 +334,8 @@ def _bad_option(path: Path, message: str):
 
 @app.command("post")
 @_guard
-def post(dump: Path = typer.Argument(..., help="LAMMPS text dump (.gz too), or any MDAnalysis trajectory."),
+def post(dump: Path = typer.Argument(..., help="LAMMPS text dump (.gz too), or any MDAnalysis trajectory.",
+                                     readable=False),
          to: Optional[str] = typer.Option(None, "--to", help="xyz, res, mercury, vtk, musen or demdf."),
          out: Optional[Path] = typer.Option(None, "-o", "--out", help="Output base name (folder/name)."),
          info: bool = typer.Option(False, "--info", help="Describe the dump (frames, atoms, columns, box)."),
@@ -284,12 +354,21 @@ def post(dump: Path = typer.Argument(..., help="LAMMPS text dump (.gz too), or a
                                                  "trajectory formats.")) -> None:
     """Convert an existing dump into FibreNet, MercuryDPM, ParaView, MUSEN or DEMDF files.
 
-    Example: fibrelmp post dump.lammpstrj --to vtk -o run --data data.lammps
+    Outputs are written only when the whole conversion succeeded; existing ones are kept
+    unless --force is given.
+
+    \b
+    Examples:
+      fibrelmp post dump.lammpstrj --info
+      fibrelmp post dump.lammpstrj --to vtk -o run --data data.lammps
+      fibrelmp post frames.dump.gz --to xyz -o out/fibres --frames 0:100:10 --types F1
+      fibrelmp post atoms.dump --to mercury -o run --local contacts.dump --gravity 0 0 -9.81
+      fibrelmp post traj.dcd --topology top.pdb --to res -o final
     """
     from .post.cli_post import post_command
 
     written = post_command(dump, to, out, info, frames, types, data, local, gravity, force, topology,
-                           typer.echo if info else _say)
+                           typer.echo if info else _say, report=_report_warnings)
     for path in written:
         _say(f"wrote {path}")
 
@@ -297,8 +376,6 @@ def post(dump: Path = typer.Argument(..., help="LAMMPS text dump (.gz too), or a
 def main() -> None:
     app()
 
-
-import numpy as np  # noqa: E402  (used by check; cheap compared with lammps)
 
 if __name__ == "__main__":
     main()

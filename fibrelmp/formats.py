@@ -20,7 +20,7 @@ _READERS: dict[str, tuple[str, re.Pattern, tuple[str, ...]]] = {
     # an object line "0 ID 1 TYPE 5 ...", or a scene line (22 domain / 32 material) of an object-less scene
     "musen": ("fibrelmp.translate.musen",
               re.compile(rb"\A\s*(0\s+\d+\s+1\s+\d+\s+5\b|(22|32)\s+\S)"), (".txt",)),
-    "demdf": ("fibrelmp.translate.demdf", re.compile(rb"\A(\xef\xbb\xbf)?\s*\{"), (".json",)),
+    "demdf": ("fibrelmp.translate.demdf", re.compile(rb"\A\s*\{"), (".json",)),
 }
 
 _HINT = ("expected a FibreNet input (with a 'model_file' line), a MUSEN text scene, a cmusen job "
@@ -37,11 +37,14 @@ def detect(path: str | Path) -> str:
         head = path.read_bytes()[:1 << 20]
     except OSError as exc:
         raise InputError(path, None, f"cannot read input: {exc.strerror or exc}") from None
-    if path.suffix.lower() == ".mdem" or (b"\0" in head[:4096] and not head.startswith((b"\xff\xfe", b"\xfe\xff"))):
-        if path.suffix.lower() == ".mdem":
-            raise InputError(path, None, "binary MUSEN .mdem files cannot be read: export the scene "
-                             "as text (MUSEN: File > Export > Text, or a cmusen job with "
-                             "'COMPONENT EXPORT_TO_TEXT') and run that file")
+    if path.suffix.lower() == ".mdem":
+        raise InputError(path, None, "binary MUSEN .mdem files cannot be read: export the scene "
+                         "as text (MUSEN: File > Export > Text, or a cmusen job with "
+                         "'COMPONENT EXPORT_TO_TEXT') and run that file")
+    if head.startswith((b"\xff\xfe", b"\xfe\xff")):
+        raise InputError(path, None, "the file is UTF-16 encoded; save it as UTF-8 (or ASCII) text")
+    if head.startswith(b"\xef\xbb\xbf"):        # UTF-8 byte-order mark: the readers accept it
+        head = head[3:]
     for name, (_, magic, _) in _READERS.items():
         if magic.search(head):
             return name

@@ -213,6 +213,15 @@ def _script_model(job, handles: dict, path_of) -> GranularModel:
                          "this script produced this .mdem and fibrelmp cannot read binary MUSEN "
                          "files: export it as text (COMPONENT EXPORT_TO_TEXT) or import a text scene "
                          "first (COMPONENT IMPORT_FROM_TEXT)")
+    return _read_scene(source, job, "SOURCE_FILE")
+
+
+def _read_scene(source: Path, job, key: str) -> GranularModel:
+    """A text scene named by a script line: a missing file is reported at that line."""
+    from .translate import musen
+
+    if not source.exists():
+        raise InputError(job.path, job.where(key), f"{key} {source}: file not found")
     return musen.read(source)
 
 
@@ -231,7 +240,7 @@ def model_for_check(path: str | Path, kind: str) -> GranularModel:
             from .translate import musen
 
             handles[path_of(job.result_file, job, "RESULT_FILE")] = \
-                ("scene", musen.read(path_of(job.source_file, job, "SOURCE_FILE")))
+                ("scene", _read_scene(path_of(job.source_file, job, "SOURCE_FILE"), job, "SOURCE_FILE"))
         elif job.component == "SIMULATOR":
             model = _script_model(job, handles, path_of)
             apply_simulator_settings(model, job)
@@ -244,7 +253,9 @@ def _path_resolver(script: Path):
 
     def path_of(name: str | None, job, key: str) -> Path:
         if not name:
-            raise InputError(job.path, job.line, f"job {job.index} ({job.component}) has no {key}")
+            # no line: the job is named instead (and check's line patching stays quiet about it)
+            raise InputError(job.path, None, f"job {job.index} ({job.component}, line {job.line}) "
+                             f"has no '{key}'")
         p = Path(name)
         return (p if p.is_absolute() else base / p).resolve()
     return path_of
@@ -279,7 +290,7 @@ def run_musen_script(path: str | Path, work: str | Path | None = None, progress:
         for job in jobs:
             if job.component == "IMPORT_FROM_TEXT":
                 target = path_of(job.result_file, job, "RESULT_FILE")
-                model = musen.read(path_of(job.source_file, job, "SOURCE_FILE"))
+                model = _read_scene(path_of(job.source_file, job, "SOURCE_FILE"), job, "SOURCE_FILE")
                 handles[target] = ("scene", model)
                 say(f"job {job.index}: imported {job.source_file} ({model.spheres.count} spheres) "
                     f"as {job.result_file} (kept in memory)")

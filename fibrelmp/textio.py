@@ -5,15 +5,30 @@ from __future__ import annotations
 import math
 import os
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
 from .errors import InputError
 
 
+# In-memory replacements of files, keyed by absolute path: ``collect_errors`` re-reads an
+# input with its failing lines patched out without touching the user's files.  Empty (and
+# so free) outside ``fibrelmp check``.
+_OVERLAY: dict[str, str] = {}
+
+
+def _overlay_key(path: str | os.PathLike) -> str:
+    return os.path.realpath(path)
+
+
 def read_text(path: str | os.PathLike, what: str = "file") -> str:
     """Read a text file; every failure becomes an InputError naming the path."""
     p = Path(path)
+    if _OVERLAY:
+        patched = _OVERLAY.get(_overlay_key(p))
+        if patched is not None:
+            return patched
     if not p.exists():
         raise InputError(p, None, f"{what} not found")
     if p.is_dir():
@@ -23,7 +38,8 @@ def read_text(path: str | os.PathLike, what: str = "file") -> str:
     except OSError as exc:
         raise InputError(p, None, f"cannot read {what}: {exc.strerror or exc}") from None
     if raw.startswith((b"\xff\xfe", b"\xfe\xff")):
-        raise InputError(p, 1, f"{what} is UTF-16 encoded; save it as UTF-8 or ASCII text")
+        # about the whole file, so no line number
+        raise InputError(p, None, f"{what} is UTF-16 encoded; save it as UTF-8 or ASCII text")
     if raw.startswith(b"\xef\xbb\xbf"):
         raw = raw[3:]
     if b"\x00" in raw[:4096]:
@@ -33,6 +49,18 @@ def read_text(path: str | os.PathLike, what: str = "file") -> str:
     except UnicodeDecodeError as exc:
         line = raw[: exc.start].count(b"\n") + 1
         raise InputError(p, line, f"{what} is not valid UTF-8 text (byte {exc.start})") from None
+
+
+def read_bytes(path: str | os.PathLike) -> bytes:
+    """The bytes of a file ``read_text`` has accepted (its overlay text while checking)."""
+    if _OVERLAY:
+        patched = _OVERLAY.get(_overlay_key(path))
+        if patched is not None:
+            return patched.encode("utf-8")
+    return Path(path).read_bytes()
+
+
+MAX_INTEGER = 2 ** 53           # integers read through floats stay exact up to here
 
 
 def to_float(token: str, path: Path, line: int, name: str) -> float:
@@ -47,9 +75,12 @@ def to_float(token: str, path: Path, line: int, name: str) -> float:
 
 def to_int(token: str, path: Path, line: int, name: str) -> int:
     try:
-        return int(token)
+        value = int(token)
     except ValueError:
         raise InputError(path, line, f"{name}: expected an integer, got {token!r}") from None
+    if abs(value) > 2 ** 63 - 1:            # numpy and LAMMPS hold integers in 64 bits
+        raise InputError(path, line, f"{name}: integer {token} is out of range (64 bits)")
+    return value
 
 
 def parse_table(lines: list[str], line_numbers: list[int], ncols: int, path: Path,
@@ -94,6 +125,11 @@ def integer_column(values: np.ndarray, table: np.ndarray, col: int, path: Path,
         row = int(np.flatnonzero(bad)[0])
         raise InputError(path, line_numbers[row],
                          f"{what} column {col + 1}: expected an integer, got {table[row, col]!r}")
+    huge = np.abs(column) > MAX_INTEGER
+    if huge.any():
+        row = int(np.flatnonzero(huge)[0])
+        raise InputError(path, line_numbers[row], f"{what} column {col + 1}: integer "
+                         f"{table[row, col]} is out of range (at most 2^53 in magnitude)")
     return column.astype(np.int64)
 
 
@@ -123,3 +159,85 @@ def format_rows(fmt_row: str, columns: list) -> str:
     for c, col in enumerate(columns):
         flat[:, c] = col.tolist() if isinstance(col, np.ndarray) else col
     return (fmt_row * n) % tuple(flat.ravel().tolist())
+
+
+# --------------------------------------------------------------------------- fibrelmp check
+# patch(error, text of its line or None for an error about the whole file, attempt) -> the
+# replacement line (for a file error: a line to append to the file), or None to stop
+Patch = Callable[[InputError, "str | None", int], "str | None"]
+MAX_ERRORS = 50
+
+
+def blank_patch(err: InputError, line: str | None, attempt: int) -> str | None:
+    """Default: a failing line is blanked (every line format skips blank lines); give up
+    when the blanked line still fails, and at errors about the whole file."""
+    return "" if line is not None and attempt == 0 else None
+
+
+def _lines_of(path: str) -> list[str] | None:
+    try:
+        raw = Path(path).read_bytes()
+    except OSError:
+        return None
+    return raw.removeprefix(b"\xef\xbb\xbf").decode("utf-8", "replace").splitlines(keepends=True)
+
+
+def collect_errors(read: Callable[[], object], first: InputError, patch: Patch = blank_patch,
+                   limit: int = MAX_ERRORS) -> list[InputError]:
+    """Every problem ``read`` meets, for ``fibrelmp check``.  After each error the failing line
+    is replaced in memory by ``patch``'s text (or, for an error about the whole file such as a
+    missing keyword, ``patch``'s line is appended) and ``read`` runs again, until it succeeds.
+
+    Readers stay single-error, so the normal path is not slower; only ``check`` pays for the
+    re-reads.  An error without a line that names the keyword of a patched line ('step') is a
+    consequence of the patch and is not reported.  At most ``limit`` errors."""
+    errors = [first]
+    texts: dict[str, list[str]] = {}          # patched files, as lines with their endings
+    attempts: dict[tuple[str, int], int] = {}
+    appended: set[tuple[str, str]] = set()
+    patched_words: set[str] = set()
+    err = first
+    try:
+        while len(errors) < limit and err.path is not None:
+            key = _overlay_key(err.path)
+            if key not in texts:
+                lines = _lines_of(err.path)
+                if lines is None:
+                    break
+                texts[key] = lines
+            lines = texts[key]
+            if err.line is None:
+                new = patch(err, None, 0)
+                if new is None or (key, new) in appended:
+                    break
+                appended.add((key, new))
+                if lines and not lines[-1].endswith(("\n", "\r")):
+                    lines[-1] += "\n"
+                lines.append(new + "\n")
+            else:
+                if not 1 <= err.line <= len(lines):
+                    break
+                attempt = attempts.get((key, err.line), 0)
+                old = lines[err.line - 1]
+                body = old.rstrip("\r\n")
+                new = patch(err, body, attempt)
+                if new is None:
+                    break
+                attempts[(key, err.line)] = attempt + 1
+                if body.split():
+                    patched_words.add(body.split()[0])
+                lines[err.line - 1] = new + old[len(body):]
+            _OVERLAY[key] = "".join(lines)
+            try:
+                read()
+                break
+            except InputError as exc:
+                err = exc
+            if err.path is not None and err.line is not None:
+                if (_overlay_key(err.path), err.line) not in attempts:
+                    errors.append(err)      # else: the patched line still fails, unsaid
+            elif not any(f"'{w}'" in err.message for w in patched_words):
+                errors.append(err)
+    finally:
+        _OVERLAY.clear()
+    return errors

@@ -7,6 +7,9 @@ Frames stream from the reader through ``complete`` (facts from ``--data``, id or
 from __future__ import annotations
 
 import gzip
+import os
+import shutil
+import tempfile
 from pathlib import Path
 from typing import Callable, Iterator
 
@@ -155,10 +158,12 @@ class Source:
 class Completer:
     """Fill what writers need and the dump lacks; sort atoms by id; apply ``--types``."""
 
-    def __init__(self, data, types: list[str] | None, names: dict[int, str], warnings: list):
+    def __init__(self, data, types: list[str] | None, names: dict[int, str], warnings: list,
+                 target_units=None):
         self.data = data
         self.names = names
         self.warnings = warnings
+        self.target_units = target_units     # (format name, units.UnitSystem) of the output, if any
         self.warned: set[str] = set()
         self.labels = {v: k for k, v in names.items()}
         self.keep = self._types(types) if types else None
@@ -186,6 +191,12 @@ class Completer:
         cols = dict(frame.columns)
         n = frame.count
         data = self.data
+        if self.target_units is not None and frame.units is not None:
+            from ..units import mismatch_note
+
+            note = mismatch_note(frame.units, self.target_units[1], self.target_units[0])
+            if note is not None:
+                self._warn("units", f"{frame.source}: {note}")
         if "id" not in cols:
             cols["id"] = np.arange(1, n + 1, dtype=np.float64)
             self._warn("no ids", f"{frame.source}: the dump has no 'id' column; atoms are numbered "
@@ -195,6 +206,10 @@ class Completer:
             order = np.argsort(ids, kind="stable")
             cols = {k: v[order] for k, v in cols.items()}
             ids = cols["id"]
+            twice = np.flatnonzero(ids[1:] == ids[:-1])
+            if len(twice):        # every writer keys atoms by id: two would be merged or doubled
+                raise InputError(frame.source, frame.line, f"atom id {ids[twice[0]]:.0f} appears "
+                                 f"twice in the frame of step {frame.step}")
         rows = None
         if data is not None and n:
             rows = data.rows(ids, "--data facts")
@@ -231,6 +246,14 @@ class Completer:
                 if xu is None:
                     out.wrapped()                      # raises the "no positions" error
                 cols.update(xu=xu[:, 0], yu=xu[:, 1], zu=xu[:, 2])
+        for names in (("x", "y", "z"), ("xu", "yu", "zu")):
+            if out.has(*names):
+                bad = ~np.isfinite(out.vector(*names)).all(axis=1)
+                if bad.any():     # a blown-up run: no output format can hold these
+                    k = int(np.flatnonzero(bad)[0])
+                    raise InputError(frame.source, frame.line, f"atom id {ids[k]:.0f} has position "
+                                     f"{out.vector(*names)[k].tolist()} in the frame of step "
+                                     f"{frame.step} (did the simulation blow up?)")
         if self.keep is not None:
             out = out.select(np.isin(cols["type"].astype(np.int64), list(self.keep)))
         return out
@@ -251,6 +274,9 @@ def _outputs(to: str, out: Path, dump: Path) -> tuple[Path, list[Path]]:
     elif to == "vtk":
         files = [base.with_name(base.name + ".pvd")] + \
             sorted(base.parent.glob(f"{base.name}_[0-9][0-9][0-9][0-9][0-9][0-9].vtu"))
+    elif to == "demdf":           # snapshots <base>_<n>.json
+        files = sorted(p for p in base.parent.glob(f"{base.name}_*.json")
+                       if p.stem[len(base.name) + 1:].isdigit())
     else:
         files = [base]
     return base, files
@@ -291,14 +317,19 @@ def _dt(first: list[Frame], warn) -> float:
 def post_command(dump: Path, to: str | None, out: Path | None, info: bool, frames: str | None,
                  types: list[str] | None, data: Path | None, local: Path | None,
                  gravity: tuple | None, force: bool, topology: Path | None,
-                 say: Callable[[str], None]) -> list[Path]:
-    """Convert ``dump`` (see docs/post.md); returns the files written."""
+                 say: Callable[[str], None],
+                 report: Callable[[list[tuple[str, str]]], None] | None = None) -> list[Path]:
+    """Convert ``dump`` (see docs/post.md); returns the files written.  Warnings go to
+    ``report`` (the CLI's grouped, coloured report) or, without one, to ``say``."""
     dump = Path(dump)
     warnings: list[tuple[str, str]] = []
     try:
         return _post(dump, to, out, info, frames, types, data, local, gravity, force, topology, say, warnings)
     finally:
-        _report(warnings, say)
+        if report is not None:
+            report(warnings)
+        else:
+            _report(warnings, say)
 
 
 def _report(warnings: list[tuple[str, str]], say) -> None:
@@ -331,17 +362,35 @@ def _post(dump, to, out, info, frames, types, data, local, gravity, force, topol
     existing = [p for p in files if p.exists()]
     if existing and not force:
         raise InputError(existing[0], None, "output exists; use --force to overwrite")
-    if not base.parent.exists():
+    created = [p for p in (base.parent, *base.parent.parents) if not p.exists()]
+    if created:
         try:
             base.parent.mkdir(parents=True)
         except OSError as exc:
             raise InputError(base.parent, None, f"cannot create output folder: {exc.strerror or exc}") from None
+    try:
+        return _convert(dump, to, base, source, data, types, frames, local, gravity, warnings)
+    except BaseException:
+        for folder in created:        # a failed conversion leaves no new (empty) folders
+            try:
+                folder.rmdir()
+            except OSError:
+                break
+        raise
+
+
+def _convert(dump, to, base, source, data, types, frames, local, gravity, warnings) -> list[Path]:
+    """The conversion proper, once the output folder exists; returns the files written."""
     datafile = None
     if data is not None:
         from .data_file import read_data
         datafile = read_data(data)
     names: dict[int, str] = dict(datafile.type_names) if datafile else {}
-    complete = Completer(datafile, types, names, warnings)
+    from ..units import LJ, SI
+
+    # FibreNet files hold LAMMPS reduced numbers, MUSEN files SI; the others have no units
+    targets = {"xyz": ("FibreNet", LJ), "res": ("FibreNet", LJ), "musen": ("MUSEN", SI)}
+    complete = Completer(datafile, types, names, warnings, targets.get(to))
     sel = Selection(frames, default_last=(to == "res"))
     stream = (complete(f) for f in source.frames(sel, last_only=(to == "res" and frames is None)))
 
@@ -349,10 +398,32 @@ def _post(dump, to, out, info, frames, types, data, local, gravity, force, topol
         if kind not in {k for k, _ in warnings}:
             warnings.append((kind, text))
 
-    written = _CONVERTERS[to](stream, base, datafile, names, source, local, gravity, warn, warnings)
-    if not written:
-        raise InputError(dump, None, "no complete frame was selected; nothing written")
-    return written
+    # Convert into a staging folder beside the outputs and move the files into place only
+    # when the whole conversion succeeded: a bad frame half-way leaves earlier outputs
+    # (replaced with --force) untouched and writes nothing.
+    try:
+        stage = Path(tempfile.mkdtemp(prefix=f".{base.name}.post-", dir=base.parent))
+    except OSError as exc:
+        raise InputError(base.parent, None, f"cannot write output: {exc.strerror or exc}") from None
+    try:
+        written = _CONVERTERS[to](stream, stage / base.name, datafile, names, source, local,
+                                  gravity, warn, warnings)
+        if not written:
+            raise InputError(dump, None, "no complete frame was selected; nothing written")
+        if to == "vtk":
+            from .vtk import remove_stale
+            remove_stale(base)    # frames of an earlier conversion (exist only with --force)
+        final = []
+        for path in written:
+            target = base.parent / Path(path).relative_to(stage)
+            try:
+                os.replace(path, target)
+            except OSError as exc:
+                raise InputError(target, None, f"cannot write output: {exc.strerror or exc}") from None
+            final.append(target)
+        return final
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)
 
 
 class _Names(dict):
@@ -438,10 +509,9 @@ def _to_mercury(stream, base, datafile, names, source, local, gravity, warn, war
 
 
 def _to_vtk(stream, base, datafile, names, source, local, gravity, warn, warnings):
-    from .vtk import VtkWriter, remove_stale
+    from .vtk import VtkWriter
 
     writer = VtkWriter(base, datafile.bonds if datafile is not None else None)
-    remove_stale(base)            # outputs of an earlier conversion (exist only with --force)
     try:
         for frame in stream:
             writer.write(frame, _time_of(frame, warn))

@@ -83,7 +83,8 @@ class Frame:
 
     def _cartesian(self, names: tuple[str, str, str]) -> np.ndarray:
         s = self.vector(*names)
-        return self.lo + s @ self.cell.T
+        with np.errstate(all="ignore"):     # inf in a dump: reported where it matters, no warning
+            return self.lo + s @ self.cell.T
 
     def positions(self) -> np.ndarray | None:
         """Positions as dumped (``x y z``, else scaled ``xs ys zs``), or None."""
@@ -101,7 +102,8 @@ class Frame:
             return self._cartesian(("xsu", "ysu", "zsu"))
         x = self.positions()
         if x is not None and self.has("ix", "iy", "iz"):
-            return x + self.vector("ix", "iy", "iz") @ self.cell.T
+            with np.errstate(all="ignore"):
+                return x + self.vector("ix", "iy", "iz") @ self.cell.T
         return None
 
     def wrapped(self) -> np.ndarray:
@@ -114,9 +116,10 @@ class Frame:
             raise InputError(self.source, self.line, "the dump has no positions: needs x y z, xs ys zs, "
                              f"xu yu zu or xsu ysu zsu; columns: {' '.join(self.columns)}")
         per = self.periodic
-        s = np.linalg.solve(self.cell, (xu - self.lo).T).T
-        s[:, per] -= np.floor(s[:, per])
-        return self.lo + s @ self.cell.T
+        with np.errstate(all="ignore"):     # the header check keeps the cell invertible
+            s = np.linalg.solve(self.cell, (xu - self.lo).T).T
+            s[:, per] -= np.floor(s[:, per])
+            return self.lo + s @ self.cell.T
 
     def select(self, rows: np.ndarray | slice) -> "Frame":
         """A frame with only the given atom rows (a mask, index array or slice)."""
@@ -294,6 +297,8 @@ def _read_header(st: _Stream, path: Path, first: bytes,
                 step = int(values[0])
             elif item == "TIME":
                 time = float(values[0])
+                if not np.isfinite(time):
+                    raise ValueError
             elif item == "UNITS":
                 units = values[0]
             elif item.startswith("NUMBER OF"):
@@ -307,6 +312,8 @@ def _read_header(st: _Stream, path: Path, first: bytes,
                                      "are not supported; dump with dump_modify triclinic/general no")
                 nums = np.array([v.split()[:3] for v in values], dtype=float) if "xy" in words else \
                     np.array([v.split()[:2] for v in values], dtype=float)
+                if not np.isfinite(nums).all():
+                    raise ValueError
                 bnd = tuple(w for w in words if w not in ("xy", "xz", "yz"))[-3:]
                 if len(bnd) != 3:
                     bnd = ("pp", "pp", "pp")
@@ -318,6 +325,9 @@ def _read_header(st: _Stream, path: Path, first: bytes,
                     hi = nums[:, 1] - np.array([max(0.0, xy, xz, xy + xz), max(0.0, yz), 0.0])
                 else:
                     lo, hi = nums[:, 0].copy(), nums[:, 1].copy()
+                if not (hi > lo).all():
+                    raise InputError(path, st.line - 2, f"ITEM: {item}: the box has no volume "
+                                     f"(lo {' '.join(map(str, lo))}, hi {' '.join(map(str, hi))})")
                 box = (lo, hi, bnd)
             else:
                 raise InputError(path, st.line - nvalues, f"unknown dump item 'ITEM: {item}'")

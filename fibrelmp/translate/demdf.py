@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from ..granmodel import ContactLaw, GranularModel, Material, Plane, Spheres
+from ..units import DIMENSIONLESS
 from . import demdf_contact as hertz
 from .demdf_json import JsonDoc, describe, load_json
 from .demdf_plan import Output, PlanMixin
@@ -114,7 +115,7 @@ class _Reader(PlanMixin):
                 self.warn("demdf", f"{key} is not a DEMDF field; copied to snapshots unchanged")
         model = GranularModel(source=self.path, kind="demdf", materials=self.materials,
                               contacts=contacts, spheres=spheres, plan=plan, planes=planes,
-                              units="dimensionless")
+                              units=DIMENSIONLESS.name)
         model.passthrough["demdf"] = {
             "document": doc, "dimensionality": self.dim, "particle_rows": rows,
             "particles_file": source_file, "output_location": out.location,

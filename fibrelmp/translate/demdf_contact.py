@@ -23,20 +23,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-# 2 * integral_0^1 dx / sqrt(1 - x^(5/2)): Hertz contact duration in units of delta_max / v
-HERTZ_DURATION = 2.943
-
-
-def peak_overlap(m_eff: float, r_eff: float, e_star: float, speed: float) -> float:
-    return (15.0 * m_eff * speed ** 2 / (16.0 * e_star * math.sqrt(r_eff))) ** 0.4
+# the Hertz impact formulas live in fibrelmp.sanity (``fibrelmp check`` uses them too)
+from ..sanity import hertz_contact_time as contact_time  # noqa: F401
+from ..sanity import hertz_peak_overlap as peak_overlap  # noqa: F401
 
 
 def modulus_for_overlap(m_eff: float, r_eff: float, speed: float, overlap: float) -> float:
     return 15.0 * m_eff * speed ** 2 / (16.0 * math.sqrt(r_eff) * overlap ** 2.5)
-
-
-def contact_time(m_eff: float, r_eff: float, e_star: float, speed: float) -> float:
-    return HERTZ_DURATION * peak_overlap(m_eff, r_eff, e_star, speed) / speed
 
 
 def speed_bounds(velocity: np.ndarray, gravity: np.ndarray, extent: np.ndarray) -> np.ndarray:

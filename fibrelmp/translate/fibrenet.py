@@ -16,7 +16,8 @@ import numpy as np
 from ..errors import InputError
 from ..model import (Angles, Bonds, Box, Dynamics, Model, OutputSpec, PairLaw, Particles,
                      RunPlan, Stage)
-from ..textio import integer_column, parse_table, read_text, to_float, to_int
+from ..textio import integer_column, parse_table, read_bytes, read_text, to_float, to_int
+from ..units import LJ
 
 EXTENSIONS = (".txt", ".in", ".inp")
 
@@ -33,6 +34,7 @@ KEYWORDS: dict[str, tuple[int | None, bool]] = {
 }
 REQUIRED = ("model_file", "step", "lambda", "run", "cutoff", "box_unit_cell", "box_size",
             "box_type", "output_file", "output_freq", "output_type", "output_data")
+MAX_CHUNK = 2 ** 31 - 1        # steps of one LAMMPS ``run`` (fibrelmp runs whole chunks)
 _COMMENT = re.compile(r"^\s*(#|//|%|!)")
 _STOI = re.compile(r"^\s*[+-]?\d+")
 
@@ -100,7 +102,8 @@ class _InputFile:
             raise InputError(self.path, line.number, f"'{key}' must be >= 0, got {line.tokens[1]}")
         return value
 
-    def integer(self, key: str, default: int | None = None, minimum: int = 0) -> int:
+    def integer(self, key: str, default: int | None = None, minimum: int = 0,
+                maximum: int | None = None) -> int:
         line = self.first(key)
         if line is None:
             if default is None:
@@ -109,6 +112,9 @@ class _InputFile:
         value = to_int(line.tokens[1], self.path, line.number, key)
         if value < minimum:
             raise InputError(self.path, line.number, f"'{key}' must be >= {minimum}, got {value}")
+        if maximum is not None and value > maximum:
+            raise InputError(self.path, line.number, f"'{key}' must be <= {maximum}, the most "
+                             f"steps one LAMMPS run command takes; got {value}")
         return value
 
 
@@ -201,7 +207,7 @@ def read(path: str | Path) -> Model:
     run_steps = inp.integer("run", minimum=0)
     min_steps = inp.integer("minimize_steps", default=0)
     sub_default = min_steps if min_steps > 0 else 0
-    min_sub = inp.integer("minimize_substeps", default=sub_default)
+    min_sub = inp.integer("minimize_substeps", default=sub_default, maximum=MAX_CHUNK)
     if min_sub > min_steps:
         raise InputError(path, inp.first("minimize_substeps").number,
                          "minimize_substeps must not exceed minimize_steps")
@@ -213,7 +219,7 @@ def read(path: str | Path) -> Model:
         if r.tokens[1] not in ("yes", "no"):
             raise InputError(path, r.number, f"minimize_reset must be yes or no, got '{r.tokens[1]}'")
         reset = r.tokens[1] == "yes"
-    out_freq = inp.integer("output_freq", minimum=1)
+    out_freq = inp.integer("output_freq", minimum=1, maximum=MAX_CHUNK)
     if out_freq > run_steps:
         raise InputError(path, inp.first("output_freq").number,
                          f"output_freq ({out_freq}) must not exceed run ({run_steps})")
@@ -273,6 +279,7 @@ def read(path: str | Path) -> Model:
     _apply_modif_spring(inp, springs, notes)
     bonds = springs.to_bonds()
     _check_positions(particles, box, periodic, model_path, notes)
+    _check_lengths(particles, bonds, angles, model_path)
 
     # ---- exclusion rule ------------------------------------------------------------------
     exclusion = _exclusion_rule(particles, bonds, model_path)
@@ -311,7 +318,8 @@ def read(path: str | Path) -> Model:
     dyn = Dynamics(dt=dt, damping=damping, lambda_=lam, gravity=gravity, pair_cutoff=cutoff,
                    exclusion=exclusion)
     _note_quirks(particles, bonds, angles, pairs, dyn, notes, model_path)
-    model = Model(path, particles, bonds, angles, pairs, box, dyn, RunPlan(stages, output))
+    model = Model(path, particles, bonds, angles, pairs, box, dyn, RunPlan(stages, output),
+                  units=LJ.name)
     model.warnings.extend(notes)
     return model
 
@@ -349,7 +357,7 @@ def _read_model(path: Path, type_index: dict[str, int], type_names: list[str], s
     from .fibrenet_fast import fast_read_model
 
     read_text(path, "FibreNet model file")      # encoding / binary checks with clear messages
-    fast = fast_read_model(path.read_bytes(), type_index, type_names, size, _Springs)
+    fast = fast_read_model(read_bytes(path), type_index, type_names, size, _Springs)
     if fast is not None:
         return fast
     sections = _model_sections(path)
@@ -477,6 +485,11 @@ def _read_angles(path: Path, section: tuple[list[str], list[int]], n: int) -> An
         raise InputError(path, numbers[bad[0]], f"unknown angle kind '{table[bad[0], 1]}' (HR or HR_FL)")
     atoms = np.stack([integer_column(val, table, c, path, numbers, "ANGLE") for c in (3, 4, 5)], 1)
     _check_index(atoms, n, path, numbers, "ANGLE")
+    twice = (atoms[:, 0] == atoms[:, 1]) | (atoms[:, 1] == atoms[:, 2]) | (atoms[:, 0] == atoms[:, 2])
+    if twice.any():
+        row = int(np.flatnonzero(twice)[0])
+        raise InputError(path, numbers[row], f"ANGLE uses one bead twice "
+                         f"({' '.join(map(str, atoms[row]))}): an angle needs three different beads")
     # FibreNet reads theta0 with std::stof: float precision
     theta0 = val[:, 8].astype(np.float32).astype(np.float64)
     return Angles(atoms, val[:, 9].copy(), theta0)
@@ -566,6 +579,24 @@ def _apply_modif_spring(inp: _InputFile, springs: _Springs, notes: list) -> None
                              f"stiffness, c1, c2 or damping, got '{t[3]}'")
 
 
+def _check_lengths(p: Particles, bonds: Bonds, angles: Angles, path: Path) -> None:
+    """Springs and angle legs of zero length have no direction: FibreNet's forces divide by
+    the length (NaN), LAMMPS's bond style silently gives no force."""
+    x = p.unwrapped
+    for kind, pairs in (("SPRING", bonds.atoms), ("ANGLE", angles.atoms[:, :2]),
+                        ("ANGLE", angles.atoms[:, 1:])):
+        if not len(pairs):
+            continue
+        same = (x[pairs[:, 0]] == x[pairs[:, 1]]).all(axis=1)
+        if same.any():
+            row = int(np.flatnonzero(same)[0])
+            i, j = (int(v) for v in pairs[row])
+            line = _model_sections(path)[kind][1][row]     # only on error: no cost otherwise
+            what = "the spring has zero length" if kind == "SPRING" else "the angle is undefined"
+            raise InputError(path, line, f"{kind} joins beads {i} and {j}, which are at the same "
+                             f"position ({', '.join(f'{v:g}' for v in x[i])}): {what}")
+
+
 def _check_positions(p: Particles, box: Box, periodic: bool, path: Path, notes: list) -> None:
     diff = p.unwrapped - p.positions
     if periodic:
@@ -613,8 +644,60 @@ def _note_quirks(p: Particles, bonds: Bonds, angles: Angles, pairs: list[PairLaw
     if angles.count:
         a, b, c = (p.unwrapped[angles.atoms[:, k]] for k in range(3))
         u, v = a - b, c - b
-        cos = (u * v).sum(1) / np.sqrt((u * u).sum(1) * (v * v).sum(1))
+        with np.errstate(all="ignore"):         # huge coordinates overflow: not straight
+            cos = (u * v).sum(1) / np.sqrt((u * u).sum(1) * (v * v).sum(1))
         if (cos <= -1.0 + 1e-14).any():
             notes.append(("straight triple", f"{path}: some angle triples are exactly straight; "
                           "FibreNet clamps cos to -0.999999 there and applies a spurious force, "
                           "fibrelmp does not"))
+
+
+# --------------------------------------------------------------------------- fibrelmp check
+# Values that pass every check, appended by ``fibrelmp check`` when a required keyword is
+# missing (or its line was taken out), so that checking goes on.
+_NEUTRAL = {"step": "1", "lambda": "0.5", "cutoff": "1", "box_unit_cell": "1",
+            "box_type": "pbc", "box_wall_rep": "0", "box_size": "1e300 1e300 1e300",
+            "run": str(MAX_CHUNK), "output_freq": "1", "output_file": "out",
+            "output_data": "all", "output_type": "all"}
+_MISSING = re.compile(r"required keyword '(\w+)' is missing|'(box_wall_rep)' is missing|"
+                      r"no 'pair' line for types (\S+) (\S+):")
+
+
+def check_patch(input_path: str | Path):
+    """What ``textio.collect_errors`` puts in place of a failing line of a FibreNet input or
+    model file while ``fibrelmp check`` looks for further errors.
+
+    A BEAD line becomes a bead of the first type at the origin with a tag of its own (beads
+    are numbered by line, so removing one would shift every spring after it); a keyword line
+    is blanked (a 'type' line first loses surplus names); a missing keyword or pair gets a neutral
+    line appended."""
+    def first_type() -> str | None:
+        try:
+            text = read_text(input_path, "FibreNet input file")
+        except InputError:
+            return None
+        for raw in text.splitlines():
+            tok = raw.split()
+            if len(tok) == 2 and tok[0] == "type":
+                return tok[1]
+        return None
+
+    def patch(err: InputError, line: str | None, attempt: int) -> str | None:
+        if line is None:
+            m = _MISSING.search(err.message)
+            if m is None:
+                return None
+            key = m.group(1) or m.group(2)
+            if key is None:
+                return f"pair hs {m.group(3)} {m.group(4)} 0"
+            return f"{key} {_NEUTRAL[key]}" if key in _NEUTRAL else None
+        tok = line.split()
+        key = tok[0] if tok else ""
+        candidates: list[str] = []
+        if key == "BEAD" and (name := first_type()) is not None:
+            candidates.append(f"BEAD {name} {-(2 ** 40 + (err.line or 0))} 0" + " 0" * 14)
+        elif key == "type" and len(tok) > 2:     # keep the type defined: beads use it
+            candidates.append(" ".join(tok[:2]))
+        candidates.append("")
+        return candidates[attempt] if attempt < len(candidates) else None
+    return patch

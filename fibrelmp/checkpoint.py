@@ -58,6 +58,9 @@ class Checkpointing:
                 return
 
     def _request(self, signum, frame) -> None:
+        if self._stop:            # a second signal: stop now, without a checkpoint
+            signal.signal(signum, signal.SIG_DFL)
+            os.kill(os.getpid(), signum)
         self._stop = signum
 
     def stop_requested(self, size: int) -> int:

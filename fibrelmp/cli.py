@@ -33,12 +33,20 @@ signal N after writing a checkpoint (resume with run --resume).""")
 _state = {"quiet": False, "verbose": False}
 
 
+def _rank0() -> bool:
+    from .runner import mpi_rank_size
+
+    return mpi_rank_size()[0] == 0
+
+
 def _say(msg: str) -> None:
-    if not _state["quiet"]:
+    if not _state["quiet"] and _rank0():
         typer.echo(msg, err=True)
 
 
 def _report_warnings(warnings: list[tuple[str, str]]) -> None:
+    if not _rank0():
+        return
     groups: dict[str, list[str]] = {}
     for kind, text in warnings:
         groups.setdefault(kind, []).append(text)
@@ -61,6 +69,11 @@ def _fail(message: str, code: int) -> None:
         prefix = f"[rank {rank}] " if size > 1 and code != 2 else ""
         typer.secho(prefix + message, err=True, fg=typer.colors.RED)
     if size > 1:
+        if code == 2 and rank != 0:
+            # rank 0 has met the same input error: let it print before the abort kills it
+            import time
+
+            time.sleep(1.0)
         mpi_abort(code)
     raise typer.Exit(code)
 
@@ -73,8 +86,14 @@ def _guard(func):
     def wrapper(*args, **kwargs):
         from .errors import InputError, RunError
 
+        from ._lammps import mpi_finalize, mpi_init
+        from .runner import mpi_rank_size
+
+        size = mpi_rank_size()[1]
+        if size > 1:
+            mpi_init()       # before any rank-specific work: a failure anywhere can abort all
         try:
-            return func(*args, **kwargs)
+            result = func(*args, **kwargs)
         except InputError as exc:
             _fail(f"error: {exc}", 2)
         except (RunError, OSError) as exc:
@@ -86,7 +105,15 @@ def _guard(func):
 
             if isinstance(exc, CheckpointStop):
                 _fail(str(exc), 128 + exc.signum)
+            if size > 1:     # a bug on one rank: show it, then take every rank down
+                import traceback
+
+                traceback.print_exc()
+                _fail(f"internal error: {exc!r}", 1)
             raise
+        if size > 1:
+            mpi_finalize()   # rank 0 may still be writing results: nobody leaves before it
+        return result
     return wrapper
 
 

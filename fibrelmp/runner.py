@@ -83,9 +83,17 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
     if resume:
         bar.advance(steps)
     try:
-        if rank == 0 or script.parent.is_dir():
-            os.chdir(script.parent)
         lmp = new_lammps(args)
+        if size > 1:
+            # rank 0 wrote the job files before it got here; LAMMPS's read_data checks the
+            # data file on every rank, so no rank may decide where to run before that
+            from ._lammps import mpi_barrier
+            mpi_barrier()
+        try:
+            os.chdir(script.parent)
+        except OSError as exc:
+            raise RunError(f"{script.parent}: job folder not visible on MPI rank {rank} ({exc.strerror}): "
+                           "the work folder must be on a file system shared by all ranks") from None
         if checkpoints is not None:
             checkpoints.install()
         for number, line in enumerate(lines, 1):

@@ -10,7 +10,8 @@ Tolerances and why:
   pre-strained (rest lengths with 25 digits, coordinates with 6: |dL/L0| up to 1.5e-5) while
   LAMMPS's bpm bonds take their rest length from the positions, so the two runs carry
   different ~1e-8 m vibrations.  Measured: 2.2e-8 m (6 digits), 1.3e-8 m (17 digits, end).
-- the agglomerate's fall (mean displacement) within 0.1 % (measured 5e-5 relative).
+- the agglomerate's fall (mean displacement) within 1 % + 3e-9 m at 6 digits (rounding of
+  near-rigid motion biases the mean), within 0.1 % at 17 digits (measured 5e-5 relative).
 - broken bonds: exactly MUSEN's count (0).
 """
 
@@ -70,8 +71,11 @@ def test_positions_at_every_saved_time(agglomerate_run):
             fall_real = (xr - x0)[:, 2].mean()
             fall_ours = (xo - x0)[:, 2].mean()
             # the free fall itself, independently: -g t^2 / 2
+            # 6 significant digits resolve 1e-8 m on these ~1e-3 m coordinates; our spheres
+            # move almost rigidly, so they round alike and the mean is biased by up to ~1e-9 m
+            # (MUSEN's pre-strained spheres spread and average the rounding out)
             assert fall_real == pytest.approx(-G * t * t / 2, rel=0.05, abs=1e-9)
-            assert fall_ours == pytest.approx(fall_real, rel=0.01, abs=1e-9)
+            assert fall_ours == pytest.approx(fall_real, rel=0.01, abs=3e-9)
 
 
 def test_final_state_at_full_precision(agglomerate_run):

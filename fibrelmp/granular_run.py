@@ -1,0 +1,364 @@
+"""Run a GranularModel on LAMMPS and stream every saved frame as a ``GranularFrame``.
+
+The job is rendered to disk (``translate.granular_job``) and executed line by line by
+``runner.run_script``, so ``lmp -in in.lammps`` replays it identically.  Each saved frame is
+read back from the dumps as soon as LAMMPS has written it and handed to ``on_frame``; only
+one frame (plus per-bond/per-sphere end times) is held in memory.
+
+MPI: LAMMPS runs on every rank; the job files, the frame conversion and ``on_frame`` happen on
+rank 0 only (other ranks render the same script text in memory and hand it to the runner).
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+from itertools import islice
+from pathlib import Path
+from typing import Callable, Iterator
+
+import numpy as np
+
+from .errors import InputError, RunError
+from .granmodel import GranularFrame, GranularModel
+from .post.lammps_dump import iter_frames
+from .runner import mpi_rank_size, run_script
+from .translate.granular_job import GranularJob, build_granular_job, write_granular_job
+from .translate.granular_walls import nearest_triangle
+
+
+def quat_multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Hamilton product a (x) b of (n,4) w,x,y,z quaternions."""
+    w1, v1 = a[:, :1], a[:, 1:]
+    w2, v2 = b[:, :1], b[:, 1:]
+    w = w1 * w2 - (v1 * v2).sum(1, keepdims=True)
+    v = w1 * v2 + w2 * v1 + np.cross(v1, v2)
+    return np.hstack([w, v])
+
+
+def iter_local(path: Path) -> Iterator[tuple[int, dict[str, np.ndarray]]]:
+    """Frames of a LAMMPS local dump (``write_dump ... local``): (step, columns)."""
+    with open(path, "rb") as fh:
+        while True:
+            line = fh.readline()
+            if not line:
+                return
+            if not line.strip():
+                continue
+            header = list(islice(fh, 8))
+            if not line.startswith(b"ITEM: TIMESTEP") or len(header) < 8:
+                raise InputError(path, None, "malformed local dump")
+            step, n = int(header[0]), int(header[2])
+            names = [w.decode() for w in header[7].split()[2:]]
+            rows = list(islice(fh, n))
+            data = np.array(b" ".join(rows).split(), dtype=np.float64).reshape(n, len(names))
+            yield step, {name: data[:, k] for k, name in enumerate(names)}
+
+
+class _BreakLog:
+    """Reads the per-step broken-bond dump (``step id1 id2`` lines) as LAMMPS appends it."""
+
+    def __init__(self, path: Path | None):
+        self.path = path
+        self.fh = None
+        self.pending = b""
+        self.rows: list[tuple[float, float, float]] = []
+
+    def upto(self, step: int) -> list[tuple[int, int, int]]:
+        if self.path is None:
+            return []
+        if self.fh is None:
+            if not self.path.exists():
+                return []
+            self.fh = open(self.path, "rb")
+        self.pending += self.fh.read()
+        *complete, self.pending = self.pending.split(b"\n")
+        for ln in complete:
+            w = ln.split()
+            if len(w) >= 3:
+                self.rows.append((float(w[0]), float(w[1]), float(w[2])))
+        out = [(int(s), int(a), int(b)) for s, a, b in self.rows if s <= step]
+        self.rows = [r for r in self.rows if r[0] > step]
+        return out
+
+    def close(self) -> None:
+        if self.fh is not None:
+            self.fh.close()
+
+
+class FrameBuilder:
+    """Turns the dumps of one saved step into a GranularFrame (call ``next`` in order)."""
+
+    def __init__(self, model: GranularModel, job: GranularJob):
+        self.model, self.job = model, job
+        sp = model.spheres
+        self.q0 = np.asarray(sp.quaternion, float)
+        self.frames = iter_frames(job.frames)
+        self.bonds = iter_local(job.bond_dump) if job.bond_dump is not None else None
+        self.tiles = iter_frames(job.tile_dump) if job.tile_dump is not None else None
+        self.breaks = _BreakLog(job.breaks)
+        self.sphere_end = np.full(sp.count, np.inf)
+        self.present = np.zeros(sp.count, bool)
+        self.present[job.sphere_rows] = True
+        self.removed = np.zeros(sp.count, bool)
+        self.prev_t = job.t_start
+        self.prev_x = np.asarray(sp.position, float).copy()
+        self.prev_v = np.asarray(sp.velocity, float).copy()
+        self.deletion_time: dict[int, float] = {}
+        for step, rows in job.deletions:
+            for r in rows:
+                self.deletion_time[int(r)] = job.t_start + step * job.dt
+        b = model.bonds
+        self.nb = b.count if b is not None else 0
+        if self.nb:
+            self.bond_alive = np.zeros(self.nb, bool)
+            self.bond_alive[job.bond_rows] = True
+            self.bond_end = np.where(self.bond_alive, np.inf, np.asarray(b.active_end, float))
+            # bonds of spheres dropped at the start end at the start
+            dropped = ~self.bond_alive & (b.active_end > job.t_start) & (b.active_start <= job.t_start + 0.5 * job.dt)
+            self.bond_end[dropped] = job.t_start
+            pair = b.pair.astype(np.int64) + 1
+            lo, hi = pair.min(1), pair.max(1)
+            self.id_base = int(pair.max()) + 1
+            key = lo * self.id_base + hi
+            sim = job.bond_rows
+            order = np.argsort(key[sim], kind="stable")
+            self.bkeys = key[sim][order]
+            self.brows = sim[order]
+            self.first_id = pair[:, 0]
+        tri = model.triangles
+        self.v0 = np.asarray(tri.vertices, float) if tri is not None and tri.count else None
+
+    def _bond_lookup(self, id1: np.ndarray, id2: np.ndarray) -> np.ndarray:
+        """Bond rows (or -1) for atom-id pairs."""
+        key = np.minimum(id1, id2) * self.id_base + np.maximum(id1, id2)
+        pos = np.searchsorted(self.bkeys, key)
+        pos = np.minimum(pos, len(self.bkeys) - 1)
+        ok = self.bkeys[pos] == key if len(self.bkeys) else np.zeros(len(key), bool)
+        return np.where(ok, self.brows[pos], -1)
+
+    def next(self, step: int) -> GranularFrame:
+        job = self.job
+        t = job.t_start + step * job.dt
+        f = next(self.frames)
+        if f.step != step:
+            raise RunError(f"{job.frames}: expected frame at step {step}, found step {f.step}")
+        c = f.columns
+        rows = c["id"].astype(np.int64) - 1
+        pos = np.column_stack([c["x"], c["y"], c["z"]])
+        # LAMMPS drops atoms beyond an 'f' face at its next re-neighbouring: a sphere already
+        # outside the domain (or removed before) counts as removed now
+        keep = ~self.removed[rows]
+        if job.domain_lo is not None:
+            for a in np.flatnonzero(job.removal_axes):
+                keep &= (pos[:, a] >= job.domain_lo[a]) & (pos[:, a] <= job.domain_hi[a])
+        if not keep.all():
+            c = {k: col[keep] for k, col in c.items()}
+            rows, pos = rows[keep], pos[keep]
+        vel = np.column_stack([c["vx"], c["vy"], c["vz"]])
+        omega = np.column_stack([c["omegax"], c["omegay"], c["omegaz"]])
+        force = np.column_stack([c["fx"], c["fy"], c["fz"]])
+        ql = np.column_stack([c[f"c_fl_quat[{k}]"] for k in range(1, 5)])
+        quat = quat_multiply(ql, self.q0[rows])
+
+        # spheres gone since the previous frame: activity end (exact) or domain exit (estimate)
+        now = np.zeros_like(self.present)
+        now[rows] = True
+        gone = np.flatnonzero(self.present & ~now)
+        self.removed[gone] = True
+        for r in gone:
+            if int(r) in self.deletion_time:
+                self.sphere_end[r] = self.deletion_time[int(r)]
+            else:
+                self.sphere_end[r] = self._exit_time(int(r), t)
+        self.present = now
+
+        frame = GranularFrame(time=t, step=step, sphere_rows=rows, position=pos, velocity=vel,
+                              omega=omega, force=force, quaternion=quat)
+        if self.nb:
+            broken = np.array(self.breaks.upto(step), np.int64).reshape(-1, 3)
+            if len(broken):
+                broken = broken[np.argsort(broken[:, 0], kind="stable")]
+                r = self._bond_lookup(broken[:, 1], broken[:, 2])
+                ok = r >= 0
+                r, bsteps = r[ok], broken[ok, 0]
+                r, first = np.unique(r, return_index=True)     # earliest record per bond (MPI
+                bsteps = bsteps[first]                          # ranks may both report it)
+                live = self.bond_alive[r]
+                self.bond_alive[r[live]] = False
+                self.bond_end[r[live]] = job.t_start + bsteps[live] * job.dt
+            pair = self.model.bonds.pair
+            end = np.minimum(self.sphere_end[pair[:, 0]], self.sphere_end[pair[:, 1]])
+            dead = self.bond_alive & np.isfinite(end)
+            self.bond_alive[dead] = False
+            self.bond_end[dead] = end[dead]
+            frame.bond_alive = self.bond_alive.copy()
+            frame.bond_end_time = self.bond_end.copy()
+            bf = np.full((self.nb, 3), np.nan)
+            bstep, cols = next(self.bonds)
+            if len(cols.get("c_fl_bpair[1]", [])):
+                i1 = cols["c_fl_bpair[1]"].astype(np.int64)
+                i2 = cols["c_fl_bpair[2]"].astype(np.int64)
+                fb = np.column_stack([cols[f"c_fl_bforce[{k}]"] for k in range(1, 4)])
+                br = self._bond_lookup(i1, i2)
+                ok = br >= 0
+                # b5..b7 is the force on batom1; report the force on the bond's first sphere
+                sign = np.where(i1[ok] == self.first_id[br[ok]], 1.0, -1.0)
+                bf[br[ok]] = fb[ok] * sign[:, None]
+            bf[~self.bond_alive] = 0.0
+            frame.bond_force = bf
+        if self.v0 is not None:
+            self._triangles(frame, t, c)
+        self.prev_t, self.prev_x[rows], self.prev_v[rows] = t, pos, vel
+        return frame
+
+    def _exit_time(self, r: int, t: float) -> float:
+        """Ballistic estimate of when sphere r crossed the domain, from the previous frame."""
+        job = self.job
+        if job.domain_lo is None:
+            return t
+        x, v = self.prev_x[r], self.prev_v[r]
+        best = np.inf
+        for a in np.flatnonzero(job.removal_axes):
+            if v[a] > 0:
+                best = min(best, (job.domain_hi[a] - x[a]) / v[a])
+            elif v[a] < 0:
+                best = min(best, (job.domain_lo[a] - x[a]) / v[a])
+        if not np.isfinite(best):
+            return t
+        return float(self.prev_t + min(max(best, 0.0), t - self.prev_t))
+
+    def _triangles(self, frame: GranularFrame, t: float, cols: dict) -> None:
+        tri = self.model.triangles
+        verts = self.v0.copy()
+        tvel = np.zeros((tri.count, 3))
+        tforce = np.zeros((tri.count, 3))
+        for wp in self.job.wall_plans:
+            if not len(wp.triangle_rows):
+                continue
+            if wp.kinematics.moving:
+                R, b = wp.kinematics.transform(t)
+                verts[wp.triangle_rows] = self.v0[wp.triangle_rows] @ R.T + b
+                tvel[wp.triangle_rows] = wp.kinematics.velocity(t)
+            if wp.contact_vars:
+                fw = np.column_stack([cols[v] for v in wp.contact_vars[:3]])
+                cp = np.column_stack([cols[v] for v in wp.contact_vars[3:]])
+                hit = np.flatnonzero(np.abs(fw).sum(1) > 0)
+                if len(hit):
+                    k = nearest_triangle(cp[hit], verts[wp.triangle_rows])
+                    np.add.at(tforce, wp.triangle_rows[k], -fw[hit])
+        if self.tiles is not None:
+            ft = next(self.tiles).columns
+            ids = ft["id"].astype(np.int64)
+            fxyz = np.column_stack([ft["fx"], ft["fy"], ft["fz"]])
+            for wp in self.job.wall_plans:
+                if wp.tile_ids is None or not len(wp.tile_ids):
+                    continue
+                pos = ids - wp.tile_ids[0]
+                sel = (pos >= 0) & (pos < len(wp.tile_ids))
+                np.add.at(tforce, wp.tile_owner[pos[sel]], fxyz[sel])
+        frame.triangle_vertices = verts
+        frame.triangle_velocity = tvel
+        frame.triangle_force = tforce
+
+    def close(self) -> None:
+        self.breaks.close()
+
+
+def run_granular(model: GranularModel, work: str | Path,
+                 on_frame: Callable[[GranularFrame], None], progress: bool = True) -> GranularJob:
+    """Translate ``model`` into ``work``, run it and call ``on_frame`` for every saved frame
+    (rank 0 only), in time order, as soon as LAMMPS has written it."""
+    work = Path(work).resolve()
+    rank, size = mpi_rank_size()
+    if rank == 0:
+        job = write_granular_job(model, work)
+        for p in (job.frames, job.bond_dump, job.tile_dump, job.breaks):
+            if p is not None and p.exists():
+                p.unlink()
+    else:       # the same script text; LAMMPS reads the data file on rank 0 only
+        job, text, _ = build_granular_job(model, work)
+        run_script(job.script, job.total_steps, progress=False, text=text)
+        mpi_barrier()
+        return job
+
+    builder = FrameBuilder(model, job)
+    steps = iter(job.save_steps)
+    threaded = size == 1 and (os.cpu_count() or 1) > 1
+    try:
+        if not threaded:
+            def hook(words: list[str]) -> None:
+                if words[:3] == ["write_dump", "spheres", "custom"]:
+                    on_frame(builder.next(next(steps)))
+            run_script(job.script, job.total_steps, progress=progress, on_command=hook)
+        else:
+            _run_threaded(job, builder, steps, on_frame, progress)
+    finally:
+        builder.close()
+    if size > 1:
+        mpi_barrier()
+    return job
+
+
+def mpi_barrier() -> None:
+    """MPI_Barrier on MPI_COMM_WORLD (through the MPICH library LAMMPS loaded).
+
+    Ranks > 0 must not run ahead of rank 0's frame conversion: when a rank exits, mpiexec
+    (hydra) ends the others, so rank 0 would be killed before its outputs are complete."""
+    import ctypes
+
+    try:
+        lib = ctypes.CDLL("libmpi.so.12", mode=os.RTLD_NOLOAD | ctypes.RTLD_GLOBAL)
+    except OSError:
+        return
+    flag = ctypes.c_int(0)
+    if lib.MPI_Initialized(ctypes.byref(flag)) != 0 or not flag.value:
+        return
+    if lib.MPI_Finalized(ctypes.byref(flag)) != 0 or flag.value:
+        return
+    lib.MPI_Barrier(ctypes.c_int(0x44000000))      # MPI_COMM_WORLD in the MPICH ABI
+
+
+def _run_threaded(job, builder, steps, on_frame, progress) -> None:
+    """Convert frames on a second thread while LAMMPS computes the next ones (the lammps
+    module releases the GIL inside the library).  The queue holds step numbers only."""
+    import queue
+
+    ready: queue.Queue = queue.Queue()
+    result: dict = {}
+
+    def work() -> None:
+        try:
+            while True:
+                token = ready.get()
+                if token is None:
+                    return
+                if token == "abort":
+                    return
+                on_frame(builder.next(token))
+        except BaseException as exc:
+            result["error"] = exc
+            while True:           # drain until LAMMPS is done (it never waits for us)
+                token = ready.get()
+                if token is None or token == "abort":
+                    return
+
+    worker = threading.Thread(target=work, daemon=True)
+    worker.start()
+
+    def hook(words: list[str]) -> None:
+        if words[:3] == ["write_dump", "spheres", "custom"]:
+            if "error" in result:
+                raise result["error"]
+            ready.put(next(steps))
+
+    try:
+        run_script(job.script, job.total_steps, progress=progress, on_command=hook)
+    except BaseException:
+        ready.put("abort")
+        worker.join()
+        raise
+    ready.put(None)
+    worker.join()
+    if "error" in result:
+        raise result["error"]

@@ -195,7 +195,8 @@ class FrameBuilder:
             frame.bond_alive = self.bond_alive.copy()
             frame.bond_end_time = self.bond_end.copy()
             bf = np.full((self.nb, 3), np.nan)
-            bstep, cols = next(self.bonds)
+            # no bond dump when no bond survives the start (e.g. all left the domain at t = 0)
+            cols = next(self.bonds)[1] if self.bonds is not None else {}
             if len(cols.get("c_fl_bpair[1]", [])):
                 i1 = cols["c_fl_bpair[1]"].astype(np.int64)
                 i2 = cols["c_fl_bpair[2]"].astype(np.int64)

@@ -105,3 +105,24 @@ def test_broken_bond_count(agglomerate_run):
         broken = int(np.isfinite(model.bonds.active_end).sum())
         assert broken == 0, name
     assert model.bonds.count == 18802
+
+
+def test_scene_domain_removes_what_musen_removed(tmp_path):
+    """cmusen_own_domain_test.log: with the scene's own 1 mm domain MUSEN deactivated 5,695 of
+    5,696 spheres and every bond at t = 0 (activity 24 0 0)."""
+    real = shared_path("real-outputs", "musen", "agglomerate")
+    scene = shared_path("real-inputs", "musen", "SphericalAgglomerate_text.txt")
+    (tmp_path / scene.name).symlink_to(scene)
+    script = ("JOB\nSOURCE_FILE SphericalAgglomerate_text.txt\nRESULT_FILE agglo_init.mdem\n"
+              "COMPONENT IMPORT_FROM_TEXT\nJOB\n" + (real / "job_own_domain_test.txt").read_text())
+    (tmp_path / "job.txt").write_text(script)
+    done = subprocess.run([sys.executable, "-m", "fibrelmp.cli", "run", "job.txt"], cwd=tmp_path,
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert "5695 of 5696 active spheres lie outside the simulation domain" in done.stderr
+    from fibrelmp.translate.musen import read
+
+    model = read(tmp_path / "agglo_domaintest.txt")
+    removed = model.spheres.active_end == 0
+    assert removed.sum() == 5695
+    assert (model.bonds.active_end == 0).all()

@@ -309,6 +309,10 @@ def run(input: Path = typer.Argument(..., help="FibreNet input, MUSEN text scene
 
     kind = detect(input)
     start = time.monotonic()
+    if kind != "fibrenet":
+        from . import granular_api
+
+        granular_api.CHECKPOINTS.update(every=checkpoint_every, resume=resume)
     if kind == "fibrenet":
         from .api import read_input, run as do_run
 
@@ -320,6 +324,13 @@ def run(input: Path = typer.Argument(..., help="FibreNet input, MUSEN text scene
         result = do_run(model, out=out, work=work, progress=not _state["quiet"],
                         checkpoint_every=checkpoint_every, resume=resume)
         outputs, script = result.outputs, result.job.script
+    elif resume and not _has_checkpoint(input, kind, out, work):
+        from .errors import InputError
+
+        raise InputError(input, None, "no checkpoint to resume from (run without --resume, or "
+                         "give the same --work folder as the interrupted run)")
+    if kind == "fibrenet":
+        pass
     elif kind == "musen-script":
         from .granular_api import run_musen_script
 
@@ -351,6 +362,20 @@ def run(input: Path = typer.Argument(..., help="FibreNet input, MUSEN text scene
     for path in outputs:
         _say(f"wrote {path}")
     _say(f"done in {time.monotonic() - start:.1f} s (LAMMPS job: {script})")
+
+
+def _has_checkpoint(input: Path, kind: str, out: Optional[Path], work: Optional[Path]) -> bool:
+    """Is there a checkpoint for this granular input's work folder(s)?"""
+    if work is not None:
+        folders = [work]
+    elif kind == "musen-script":
+        folders = [input.resolve().parent / f"{input.stem}_work"]
+    elif kind == "demdf":
+        folders = [(out or input.resolve().parent) / f"{input.stem}_work"]
+    else:
+        target = out if out is not None else input.with_name(f"{input.stem}_result.txt")
+        folders = [target.resolve().parent / f"{target.stem}_work"]
+    return any(next(Path(f).rglob("checkpoint.json"), None) is not None for f in folders if Path(f).exists())
 
 
 def _bad_option(path: Path, message: str):

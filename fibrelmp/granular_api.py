@@ -29,6 +29,10 @@ def _is_rank0() -> bool:
     return mpi_rank_size()[0] == 0
 
 
+# checkpoint settings of the current command (set by the CLI): every simulation of a run uses them
+CHECKPOINTS: dict = {"every": None, "resume": False}
+
+
 def simulate(model: GranularModel, work: Path, sinks: list, progress: bool = True):
     """Run ``model`` and feed every saved frame to each sink's ``add``; sinks are closed on
     success and aborted (temp files removed) on any failure."""
@@ -39,7 +43,10 @@ def simulate(model: GranularModel, work: Path, sinks: list, progress: bool = Tru
             sink.add(frame)
 
     try:
-        job = run_granular(model, Path(work), on_frame, progress=progress)
+        # a script resumes the simulation that was interrupted; finished ones simply run again
+        resume = CHECKPOINTS["resume"] and (Path(work) / "checkpoint.json").exists()
+        job = run_granular(model, Path(work), on_frame, progress=progress,
+                           checkpoint_every=CHECKPOINTS["every"], resume=resume)
     except BaseException:
         for sink in sinks:
             abort = getattr(sink, "abort", None)

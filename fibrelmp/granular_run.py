@@ -267,19 +267,30 @@ class FrameBuilder:
 
 
 def run_granular(model: GranularModel, work: str | Path,
-                 on_frame: Callable[[GranularFrame], None], progress: bool = True) -> GranularJob:
+                 on_frame: Callable[[GranularFrame], None], progress: bool = True,
+                 checkpoint_every: int | None = None, resume: bool = False) -> GranularJob:
     """Translate ``model`` into ``work``, run it and call ``on_frame`` for every saved frame
-    (rank 0 only), in time order, as soon as LAMMPS has written it."""
+    (rank 0 only), in time order, as soon as LAMMPS has written it.  ``checkpoint_every`` /
+    ``resume``: see fibrelmp.checkpoint (a resumed run feeds the frames saved before the
+    checkpoint to ``on_frame`` again, from the dumps, so writers see every frame once)."""
+    from .api import prepare_checkpoints
+
     work = Path(work).resolve()
     rank, size = mpi_rank_size()
     if rank == 0:
         job = write_granular_job(model, work)
-        for p in (job.frames, job.bond_dump, job.tile_dump, job.breaks):
-            if p is not None and p.exists():
-                p.unlink()
-    else:       # the same script text; LAMMPS reads the data file on rank 0 only
+        text = job.script.read_text()
+    else:
         job, text, _ = build_granular_job(model, work)
-        run_script(job.script, job.total_steps, progress=False, text=text)
+    dumps = [p for p in (job.frames, job.bond_dump, job.tile_dump, job.breaks) if p is not None]
+    checkpoints = prepare_checkpoints(work, text, checkpoint_every, resume,
+                                      [p.name for p in dumps], rank)
+    if rank == 0 and not resume:
+        for p in dumps:
+            if p.exists():
+                p.unlink()
+    if rank != 0:       # the same script text; LAMMPS reads the data file on rank 0 only
+        run_script(job.script, job.total_steps, progress=False, text=text, checkpoints=checkpoints)
         mpi_barrier()
         return job
 
@@ -291,9 +302,10 @@ def run_granular(model: GranularModel, work: str | Path,
             def hook(words: list[str]) -> None:
                 if words[:3] == ["write_dump", "spheres", "custom"]:
                     on_frame(builder.next(next(steps)))
-            run_script(job.script, job.total_steps, progress=progress, on_command=hook)
+            run_script(job.script, job.total_steps, progress=progress, on_command=hook,
+                       checkpoints=checkpoints)
         else:
-            _run_threaded(job, builder, steps, on_frame, progress)
+            _run_threaded(job, builder, steps, on_frame, progress, checkpoints)
     finally:
         builder.close()
     if size > 1:
@@ -320,7 +332,7 @@ def mpi_barrier() -> None:
     lib.MPI_Barrier(ctypes.c_int(0x44000000))      # MPI_COMM_WORLD in the MPICH ABI
 
 
-def _run_threaded(job, builder, steps, on_frame, progress) -> None:
+def _run_threaded(job, builder, steps, on_frame, progress, checkpoints=None) -> None:
     """Convert frames on a second thread while LAMMPS computes the next ones (the lammps
     module releases the GIL inside the library).  The queue holds step numbers only."""
     import queue
@@ -354,7 +366,8 @@ def _run_threaded(job, builder, steps, on_frame, progress) -> None:
             ready.put(next(steps))
 
     try:
-        run_script(job.script, job.total_steps, progress=progress, on_command=hook)
+        run_script(job.script, job.total_steps, progress=progress, on_command=hook,
+                   checkpoints=checkpoints)
     except BaseException:
         ready.put("abort")
         worker.join()

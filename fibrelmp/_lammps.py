@@ -103,6 +103,7 @@ def mpi_init() -> None:
 
 
 def mpi_barrier() -> None:
+    """MPI_Barrier on MPI_COMM_WORLD when MPI is running (a no-op in serial runs)."""
     lib = _libmpi()
     if _mpi_initialized(lib):
         lib.MPI_Barrier(ctypes.c_int(_COMM_WORLD))

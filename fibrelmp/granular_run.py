@@ -22,6 +22,7 @@ import numpy as np
 from .errors import InputError, RunError
 from .granmodel import GranularFrame, GranularModel
 from .post.lammps_dump import iter_frames
+from ._lammps import mpi_barrier
 from .runner import mpi_rank_size, run_script
 from .translate.granular_job import GranularJob, build_granular_job, write_granular_job
 from .translate.granular_walls import nearest_triangle
@@ -311,25 +312,6 @@ def run_granular(model: GranularModel, work: str | Path,
     if size > 1:
         mpi_barrier()
     return job
-
-
-def mpi_barrier() -> None:
-    """MPI_Barrier on MPI_COMM_WORLD (through the MPICH library LAMMPS loaded).
-
-    Ranks > 0 must not run ahead of rank 0's frame conversion: when a rank exits, mpiexec
-    (hydra) ends the others, so rank 0 would be killed before its outputs are complete."""
-    import ctypes
-
-    try:
-        lib = ctypes.CDLL("libmpi.so.12", mode=os.RTLD_NOLOAD | ctypes.RTLD_GLOBAL)
-    except OSError:
-        return
-    flag = ctypes.c_int(0)
-    if lib.MPI_Initialized(ctypes.byref(flag)) != 0 or not flag.value:
-        return
-    if lib.MPI_Finalized(ctypes.byref(flag)) != 0 or flag.value:
-        return
-    lib.MPI_Barrier(ctypes.c_int(0x44000000))      # MPI_COMM_WORLD in the MPICH ABI
 
 
 def _run_threaded(job, builder, steps, on_frame, progress, checkpoints=None) -> None:

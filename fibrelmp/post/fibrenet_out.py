@@ -14,6 +14,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..textio import atomic_write, format_rows, parse_table, read_text
+from .fastparse import format_xyz_parts
 from .textfmt import fixed_chars, join_fields, name_chars
 
 XYZ_SUFFIX = {"position": "_coord.xyz", "velocity": "_vel.xyz", "force": "_force.xyz"}
@@ -28,22 +29,32 @@ def _xyz_head(n: int, step: int, dt: float, lengths: np.ndarray) -> str:
     return f"{n}\nFRAME\t{step}\t{dt:.5f}\t{lengths[0]:.5f}\t{lengths[1]:.5f}\t{lengths[2]:.5f}\n"
 
 
+def xyz_frame_parts(step: int, dt: float, lengths: np.ndarray, codes: np.ndarray, table: list[str],
+                    values: np.ndarray) -> list:
+    """One xyz frame as buffers to write in turn (see xyz_frame_bytes)."""
+    n = len(codes)
+    head = _xyz_head(n, step, dt, lengths).encode()
+    fast = format_xyz_parts(codes, table, values, 5) if n else None     # optional C path
+    if fast is not None:
+        return [head] + fast
+    chars = fixed_chars(values.ravel(), 5) if n else None
+    if chars is None:
+        names = np.array(table, dtype=object)[codes] if n else np.zeros(0, object)
+        return [head + _rows("%s\t%.5f\t%.5f\t%.5f\n", names, values).encode()]
+    chars = chars.reshape(n, 3, -1)
+    return [head + join_fields([name_chars(codes, table), b"\t", chars[:, 0], b"\t", chars[:, 1],
+                                b"\t", chars[:, 2], b"\n"], n)]
+
+
 def xyz_frame_bytes(step: int, dt: float, lengths: np.ndarray, codes: np.ndarray, table: list[str],
                     values: np.ndarray) -> bytes:
     """One xyz frame; row i is ``table[codes[i]]`` and values[i] ("%s\t%.5f\t%.5f\t%.5f").
 
-    Formatted with array operations (textfmt, byte-identical to ``%.5f``); values that
-    need it (nan, inf, huge) take the ``%`` path.
+    Formatted in C when available (fastparse), else with array operations (textfmt); both
+    byte-identical to ``%.5f``; values that need it (nan, inf, huge) take the ``%`` path.
     """
-    n = len(codes)
-    head = _xyz_head(n, step, dt, lengths).encode()
-    chars = fixed_chars(values.ravel(), 5) if n else None
-    if chars is None:
-        names = np.array(table, dtype=object)[codes] if n else np.zeros(0, object)
-        return head + _rows("%s\t%.5f\t%.5f\t%.5f\n", names, values).encode()
-    chars = chars.reshape(n, 3, -1)
-    return head + join_fields([name_chars(codes, table), b"\t", chars[:, 0], b"\t", chars[:, 1],
-                               b"\t", chars[:, 2], b"\n"], n)
+    parts = xyz_frame_parts(step, dt, lengths, codes, table, values)
+    return parts[0] if len(parts) == 1 else b"".join(bytes(p) for p in parts)
 
 
 def xyz_frame(step: int, dt: float, lengths: np.ndarray, names: np.ndarray, values: np.ndarray) -> str:
@@ -67,7 +78,8 @@ class XyzWriter:
 
     def write_codes(self, step: int, dt: float, lengths: np.ndarray, codes: np.ndarray, table: list[str],
                     values: np.ndarray) -> None:
-        self.fh.write(xyz_frame_bytes(step, dt, lengths, codes, table, values))
+        for part in xyz_frame_parts(step, dt, lengths, codes, table, values):
+            self.fh.write(part)
 
     def close(self) -> None:
         self.fh.close()

@@ -3,7 +3,7 @@
 A frame is the items from ``ITEM: UNITS`` / ``ITEM: TIME`` / ``ITEM: TIMESTEP`` to the end
 of its ``ITEM: ATOMS`` (or ``ITEM: ENTRIES``) block; the block's length is the frame's own
 ``NUMBER OF ATOMS`` (so the atom count may change between frames).  Each block is parsed
-by one C-level call (``np.loadtxt``); memory holds one frame at a time, read in chunks, so
+by one C-level call (the optional C parser of ``fastparse``, else ``np.loadtxt``); memory holds one frame at a time, read in chunks, so
 a 10 GB dump converts frame by frame.  ``.gz`` dumps are read through gzip.
 
 A truncated last frame is dropped with a warning; every other defect is an InputError
@@ -23,6 +23,7 @@ from typing import Callable, Iterator
 import numpy as np
 
 from ..errors import InputError
+from .fastparse import nth_newline, parse_numbers
 
 # columns that may hold text (type labels with ``dump_modify types labels``, element names)
 TEXT_COLUMNS = {"type", "element"}
@@ -220,16 +221,21 @@ class _Stream:
             # search a window sized from the line length seen so far, not the whole buffer
             # (many small frames would otherwise rescan a 16 MB buffer each)
             stop = min(end, scan + max(1 << 16, int(need * self.line_bytes * 1.25)))
-            if stop > scan:
+            fast = nth_newline(self.buf, scan, stop, need)     # optional C search
+            if fast is not None:
+                c, rel = fast
+            elif stop > scan:
                 view = np.frombuffer(self.buf, np.uint8, count=stop - scan, offset=scan)
                 nl = np.flatnonzero(view == 10)
                 del view                  # release the export before the buffer grows
+                c = len(nl)
+                rel = int(nl[need - 1]) if c >= need else -1
             else:
-                nl = np.zeros(0, np.int64)
-            c = len(nl)
+                c, rel = 0, -1
             if c >= need:
-                k = scan + int(nl[need - 1])
-                out = bytes(self.buf[start:k + 1])
+                k = scan + rel
+                with memoryview(self.buf) as mv:    # one copy (a bytearray slice would be two)
+                    out = bytes(mv[start:k + 1])
                 self.pos = k + 1
                 self.line += n
                 self.line_bytes = max(1.0, len(out) / n)
@@ -347,6 +353,9 @@ def parse_block(block: bytes, head: Header, path: Path | str | None) -> dict[str
     names, n = head.names, head.count
     if n == 0:
         return {c: np.zeros(0) for c in names}
+    data = parse_numbers(block, n, len(names))      # optional C parser; None: numpy path
+    if data is not None:
+        return {c: data[:, k] for k, c in enumerate(names)}
     try:
         with _warnings.catch_warnings():
             _warnings.simplefilter("ignore")

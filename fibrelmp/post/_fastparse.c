@@ -1,0 +1,280 @@
+/* Optional C helpers for fibrelmp.post (compiled lazily by fastparse.py, loaded with ctypes).
+ *
+ * fp_parse_block: a block of whitespace-separated decimal numbers, exactly nrows lines of
+ *   ncols tokens, into a row-major float64 array.  Correctly rounded (bit-identical to
+ *   strtod / float() / np.loadtxt): Clinger's fast path (mantissa < 2^53, |exp10| <= 22:
+ *   one exact multiply or divide), otherwise strtod on the token.  Anything unusual (inf,
+ *   nan, hex, text, wrong token count, blank line, odd whitespace) returns -1 so that the
+ *   caller uses its numpy path, which produces the result or the precise error.
+ *
+ * fp_format_xyz: rows "name\t%.5f\t%.5f\t%.5f\n" byte-identical to printf: |x| 10^5 is
+ *   split into an exact sum p + e (Dekker's product), so rounding (ties to even) is decided
+ *   on the exact binary value, as glibc does.  Non-finite or |x| 10^5 >= 2^51 returns -1.
+ *
+ * Build flags must keep IEEE double semantics (no -ffast-math; -ffp-contract=off).
+ */
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <math.h>
+#include <float.h>
+
+#if !defined(FLT_EVAL_METHOD) || FLT_EVAL_METHOD != 0
+#define FP_EXCESS_PRECISION 1     /* x87: the fast paths would double-round; decline everything */
+#else
+#define FP_EXCESS_PRECISION 0
+#endif
+
+static const double P10[23] = {
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+    1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+
+#define MAXTOK 400
+
+static inline int is_sep(char c)
+{
+    return c == ' ' || c == '\t' || c == '\n' || c == '\r';
+}
+
+/* strtod on the token [s, e) (correctly rounded); 0 ok, -1 if it is not all consumed */
+static int slow_token(const char *s, const char *e, double *out)
+{
+    char buf[MAXTOK + 1];
+    size_t len = (size_t)(e - s);
+    if (len > MAXTOK) return -1;
+    memcpy(buf, s, len);
+    buf[len] = 0;
+    char *end;
+    *out = strtod(buf, &end);
+    return end == buf + len ? 0 : -1;
+}
+
+/* parse the token at *pp matching [+-]digits[.digits][(e|E)[+-]digits] and ending at a
+   separator or the end of the buffer; advances *pp; 0 ok, -1 otherwise */
+static inline int parse_token(const char **pp, const char *e, double *out)
+{
+    const char *s = *pp, *p = s;
+    int neg = 0;
+    if (p < e && (*p == '+' || *p == '-')) {
+        neg = (*p == '-');
+        p++;
+    }
+    uint64_t mant = 0;
+    const char *d0 = p;
+    while (p < e && (unsigned)(*p - '0') < 10) {
+        mant = mant * 10 + (unsigned)(*p - '0');      /* wraps if > 19 digits: see below */
+        p++;
+    }
+    long ndig = p - d0, nfrac = 0;
+    if (p < e && *p == '.') {
+        p++;
+        const char *f0 = p;
+        while (p < e && (unsigned)(*p - '0') < 10) {
+            mant = mant * 10 + (unsigned)(*p - '0');
+            p++;
+        }
+        nfrac = p - f0;
+        ndig += nfrac;
+    }
+    if (ndig == 0) return -1;
+    long exp10 = -nfrac;
+    if (p < e && (*p == 'e' || *p == 'E')) {
+        p++;
+        int eneg = 0;
+        if (p < e && (*p == '+' || *p == '-')) {
+            eneg = (*p == '-');
+            p++;
+        }
+        if (!(p < e && (unsigned)(*p - '0') < 10)) return -1;
+        long x = 0;
+        while (p < e && (unsigned)(*p - '0') < 10) {
+            if (x < 100000) x = x * 10 + (*p - '0');
+            p++;
+        }
+        exp10 += eneg ? -x : x;
+    }
+    if (p < e && !is_sep(*p)) return -1;
+    *pp = p;
+    if (ndig > 19 || mant >= (1ULL << 53) || exp10 < -22 || exp10 > 22)
+        return slow_token(s, p, out);
+    double v = (double)mant;           /* exact */
+    if (exp10 < 0) v /= P10[-exp10];
+    else if (exp10 > 0) v *= P10[exp10];
+    *out = neg ? -v : v;
+    return 0;
+}
+
+/* 0 on success; -1: caller must use its own (numpy) path */
+int fp_parse_block(const char *buf, int64_t len, double *out, int64_t nrows, int64_t ncols)
+{
+    const char *p = buf, *end = buf + len;
+    int64_t row = 0;
+    double *o = out;
+    if (FP_EXCESS_PRECISION) return -1;
+    while (row < nrows) {
+        if (p >= end) return -1;
+        int64_t col = 0;
+        for (;;) {
+            while (p < end && (*p == ' ' || *p == '\t')) p++;
+            if (p >= end || *p == '\n' || *p == '\r') break;
+            if (col >= ncols) return -1;
+            if (parse_token(&p, end, o)) return -1;
+            o++;
+            col++;
+        }
+        if (col != ncols) return -1;
+        if (p < end && *p == '\r') {
+            p++;
+            if (!(p < end && *p == '\n')) return -1;
+        }
+        if (p < end) p++;   /* '\n' */
+        row++;
+    }
+    return p == end ? 0 : -1;
+}
+
+/* ---------------------------------------------------------------- %.5f formatting */
+
+static const double SPLIT = 134217729.0;   /* 2^27 + 1 */
+static const double LIMIT = 2251799813685248.0;   /* 2^51 */
+
+static inline int round_scaled(double x, double scale, int64_t *m)
+{
+    double a = fabs(x);
+    double p = a * scale;
+    if (!(p < LIMIT)) return -1;           /* also nan, inf */
+    double c = SPLIT * a, ah = c - (c - a), al = a - ah;
+    double cb = SPLIT * scale, bh = cb - (cb - scale), bl = scale - bh;
+    double err = ((ah * bh - p) + ah * bl + al * bh) + al * bl;
+    int64_t r = (int64_t)p;                /* floor: 0 <= p < 2^51 */
+    double f = p - (double)r;
+    r += (f > 0.5);                        /* branch-free: f is random */
+    if (f == 0.5) r += (err > 0 || (err == 0 && (r & 1)));
+    *m = r;
+    return 0;
+}
+
+static const char DIG2[201] =
+    "00010203040506070809101112131415161718192021222324252627282930313233343536373839"
+    "40414243444546474849505152535455565758596061626364656667686970717273747576777879"
+    "8081828384858687888990919293949596979899";
+
+static inline char *put_int(char *o, uint64_t ip)
+{
+    if (ip < 100) {                /* branch-free for the common 1-2 digit case */
+        int two = ip >= 10;
+        o[0] = DIG2[2 * ip + 1 - two];
+        o[1] = DIG2[2 * ip + 1];
+        return o + 1 + two;
+    }
+    int nd = 3;
+    for (uint64_t t = 1000; nd < 20 && ip >= t; t *= 10) nd++;
+    char *q = o + nd;
+    while (ip >= 100) {
+        unsigned r = (unsigned)(ip % 100);
+        ip /= 100;
+        *--q = DIG2[2 * r + 1];
+        *--q = DIG2[2 * r];
+    }
+    if (ip >= 10) {
+        *--q = DIG2[2 * ip + 1];
+        *--q = DIG2[2 * ip];
+    } else {
+        *--q = (char)('0' + ip);
+    }
+    return o + nd;
+}
+
+static inline char *put_fixed(char *o, double x, int64_t m, int decimals, int64_t unit)
+{
+    *o = '-';
+    o += signbit(x) != 0;
+    if (decimals == 5) {            /* the xyz case: constant divisors */
+        uint64_t ip = (uint64_t)m / 100000u;
+        unsigned fr = (unsigned)((uint64_t)m - ip * 100000u);
+        o = put_int(o, ip);
+        o[0] = '.';
+        unsigned a = fr / 1000u, b = (fr / 10u) % 100u;
+        o[1] = DIG2[2 * a];
+        o[2] = DIG2[2 * a + 1];
+        o[3] = DIG2[2 * b];
+        o[4] = DIG2[2 * b + 1];
+        o[5] = (char)('0' + fr % 10u);
+        return o + 6;
+    }
+    int64_t ip = m / unit, fr = m - ip * unit;
+    o = put_int(o, (uint64_t)ip);
+    if (decimals) {
+        *o++ = '.';
+        for (int j = decimals - 1; j >= 0; j--) {
+            o[j] = (char)('0' + fr % 10);
+            fr /= 10;
+        }
+        o += decimals;
+    }
+    return o;
+}
+
+/* rows name[codes[i]] \t v[i,0] \t v[i,1] \t v[i,2] \n into out (capacity cap);
+   returns bytes written or -1 (fall back). names: nnames entries of width namew, NUL-padded */
+int64_t fp_format_xyz(const int64_t *codes, const double *vals, int64_t n, const char *names,
+                      int64_t nnames, int64_t namew, int decimals, char *out, int64_t cap)
+{
+    double scale = 1.0;
+    int64_t unit = 1;
+    if (FP_EXCESS_PRECISION || decimals < 0 || decimals > 9) return -1;
+    for (int j = 0; j < decimals; j++) {
+        scale *= 10.0;
+        unit *= 10;
+    }
+    char *o = out, *stop = out + cap;
+    for (int64_t i = 0; i < n; i++) {
+        /* worst case per row: name + 3 * (sign + 16 digits + '.' + decimals) + 4 separators */
+        if (stop - o < namew + 3 * (28 + decimals) + 4) return -1;
+        int64_t c = codes[i];
+        if (c < 0 || c >= nnames) return -1;
+        const char *nm = names + c * namew;
+        for (int64_t j = 0; j < namew && nm[j]; j++) *o++ = nm[j];
+        for (int k = 0; k < 3; k++) {
+            double x = vals[3 * i + k];
+            int64_t m;
+            if (round_scaled(x, scale, &m)) return -1;
+            *o++ = '\t';
+            o = put_fixed(o, x, m, decimals, unit);
+        }
+        *o++ = '\n';
+    }
+    return (int64_t)(o - out);
+}
+
+/* number of '\n' in buf[0, len) */
+int64_t fp_count_lines(const char *buf, int64_t len)
+{
+    int64_t c = 0;
+    const char *p = buf, *end = buf + len;
+    while (p < end) {
+        const char *q = memchr(p, '\n', (size_t)(end - p));
+        if (!q) break;
+        c++;
+        p = q + 1;
+    }
+    return c;
+}
+
+/* offset of the need-th '\n' in buf[0, len) (need >= 1), or -1 with *found = how many */
+int64_t fp_nth_newline(const char *buf, int64_t len, int64_t need, int64_t *found)
+{
+    int64_t c = 0;
+    const char *p = buf, *end = buf + len;
+    while (p < end) {
+        const char *q = memchr(p, '\n', (size_t)(end - p));
+        if (!q) break;
+        if (++c == need) {
+            *found = c;
+            return (int64_t)(q - buf);
+        }
+        p = q + 1;
+    }
+    *found = c;
+    return -1;
+}

@@ -74,10 +74,6 @@ def run(model: Model, out: str | Path | None = None, work: str | Path | None = N
     return RunResult(job, outputs)
 
 
-class _RunAborted(Exception):
-    """Tells the converter thread that LAMMPS failed: discard partial outputs."""
-
-
 def prepare_checkpoints(folder: Path, text: str, every: int | None, resume: bool,
                         appended: list[str], rank: int):
     """Checkpointing for a job (always on: a SIGTERM/Ctrl-C leaves a checkpoint behind);
@@ -93,45 +89,16 @@ def prepare_checkpoints(folder: Path, text: str, every: int | None, resume: bool
 
 
 def _run_with_converter(job: Job, progress: bool, convert, checkpoints=None) -> list[Path]:
-    import queue
-    import threading
-
     from .post.lammps_dump import iter_frames
-    from .runner import run_script
+    from .runner import run_overlapped
 
-    ready: queue.Queue = queue.Queue()      # True per finished write_dump, then None or "abort"
-    result: dict = {}
+    def consume(tokens) -> list[Path]:
+        frames = iter_frames(job.frames)
+        return convert(next(frames) for _ in tokens)
 
-    def frames():
-        it = iter_frames(job.frames)
-        while True:
-            token = ready.get()
-            if token is None:
-                return
-            if token == "abort":
-                raise _RunAborted()
-            yield next(it)
-
-    def work() -> None:
-        try:
-            result["outputs"] = convert(frames())
-        except BaseException as exc:          # writers already removed their temp files
-            result["error"] = exc               # (the queue is unbounded: LAMMPS never waits)
-
-    worker = threading.Thread(target=work, daemon=True)
-    worker.start()
-    try:
-        run_script(job.script, job.total_steps, progress=progress, checkpoints=checkpoints,
-                   on_command=lambda w: ready.put(True) if w[0] == "write_dump" else None)
-    except BaseException:
-        ready.put("abort")
-        worker.join()
-        raise
-    ready.put(None)
-    worker.join()
-    if "error" in result:
-        raise result["error"]
-    return result["outputs"]
+    return run_overlapped(job.script, job.total_steps,
+                          lambda words: True if words[0] == "write_dump" else None,
+                          consume, progress=progress, checkpoints=checkpoints)
 
 
 @dataclass

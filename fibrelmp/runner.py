@@ -145,3 +145,62 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
         os.chdir(cwd)
         if lmp is not None:
             lmp.close()
+
+
+class RunAborted(Exception):
+    """Raised inside the consumer when LAMMPS failed: writers discard partial outputs."""
+
+
+def run_overlapped(script: Path, total_steps: int, frame_token: Callable[[list[str]], object],
+                   consume: Callable, progress: bool = True, checkpoints=None):
+    """Run ``script`` while ``consume(tokens)`` converts frames on a second thread (the lammps
+    module releases the GIL inside the library, so conversion overlaps the next steps).
+
+    ``frame_token(words)`` is called after every command and returns a token (not None) when
+    that command wrote a frame; ``consume`` receives an iterator over those tokens, which ends
+    when the run is done and raises RunAborted when it failed.  Returns what ``consume``
+    returns.  LAMMPS never waits for the consumer (the queue is unbounded); a consumer error
+    stops the run at the next frame.
+    """
+    import queue
+    import threading
+
+    ready: queue.Queue = queue.Queue()
+    done, abort = object(), object()
+    result: dict = {}
+
+    def tokens():
+        while True:
+            token = ready.get()
+            if token is done:
+                return
+            if token is abort:
+                raise RunAborted()
+            yield token
+
+    def work() -> None:
+        try:
+            result["value"] = consume(tokens())
+        except BaseException as exc:       # writers already removed their temp files
+            result["error"] = exc
+
+    def hook(words: list[str]) -> None:
+        token = frame_token(words)
+        if token is not None:
+            if "error" in result:
+                raise result["error"]
+            ready.put(token)
+
+    worker = threading.Thread(target=work, daemon=True)
+    worker.start()
+    try:
+        run_script(script, total_steps, progress=progress, on_command=hook, checkpoints=checkpoints)
+    except BaseException:
+        ready.put(abort)
+        worker.join()
+        raise
+    ready.put(done)
+    worker.join()
+    if "error" in result:
+        raise result["error"]
+    return result.get("value")

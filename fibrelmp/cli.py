@@ -312,6 +312,9 @@ def run(input: Path = typer.Argument(..., help="FibreNet input, MUSEN text scene
     if kind != "fibrenet":
         from . import granular_api
 
+        if resume and not _has_checkpoint(input, kind, out, work):
+            raise _bad_option(input, "no checkpoint to resume from (run without --resume, or "
+                              "give the same --work folder as the interrupted run)")
         granular_api.CHECKPOINTS.update(every=checkpoint_every, resume=resume)
     if kind == "fibrenet":
         from .api import read_input, run as do_run
@@ -324,13 +327,6 @@ def run(input: Path = typer.Argument(..., help="FibreNet input, MUSEN text scene
         result = do_run(model, out=out, work=work, progress=not _state["quiet"],
                         checkpoint_every=checkpoint_every, resume=resume)
         outputs, script = result.outputs, result.job.script
-    elif resume and not _has_checkpoint(input, kind, out, work):
-        from .errors import InputError
-
-        raise InputError(input, None, "no checkpoint to resume from (run without --resume, or "
-                         "give the same --work folder as the interrupted run)")
-    if kind == "fibrenet":
-        pass
     elif kind == "musen-script":
         from .granular_api import run_musen_script
 

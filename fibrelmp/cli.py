@@ -310,12 +310,12 @@ def run(input: Path = typer.Argument(..., help="FibreNet input, MUSEN text scene
     kind = detect(input)
     start = time.monotonic()
     if kind != "fibrenet":
-        from . import granular_api
+        from .granular_api import Checkpoints
 
         if resume and not _has_checkpoint(input, kind, out, work):
             raise _bad_option(input, "no checkpoint to resume from (run without --resume, or "
                               "give the same --work folder as the interrupted run)")
-        granular_api.CHECKPOINTS.update(every=checkpoint_every, resume=resume)
+        checkpoints = Checkpoints(checkpoint_every, resume)
     if kind == "fibrenet":
         from .api import read_input, run as do_run
 
@@ -334,7 +334,7 @@ def run(input: Path = typer.Argument(..., help="FibreNet input, MUSEN text scene
             raise _bad_option(input, "a cmusen job script sets END_TIME, SIMULATION_STEP and "
                               "SAVING_STEP itself; edit the script instead")
         res = run_musen_script(input, work=work, progress=not _state["quiet"], say=_say,
-                               warn=_report_warnings)
+                               warn=_report_warnings, checkpoints=checkpoints)
         outputs, script = res.outputs, (res.jobs[-1].script if res.jobs else None)
         for note in res.notes:
             _say(note)
@@ -343,7 +343,8 @@ def run(input: Path = typer.Argument(..., help="FibreNet input, MUSEN text scene
 
         if kind == "demdf":
             res = run_demdf(input, out=out, work=work, progress=not _state["quiet"], time_end=end_time,
-                            steps=steps, save_every=save_step, warn=_report_warnings, say=_say)
+                            steps=steps, save_every=save_step, warn=_report_warnings, say=_say,
+                            checkpoints=checkpoints)
         else:
             model, overrides = read_granular(input, kind, end_time, step, save_step, steps)
             for text in overrides:
@@ -351,7 +352,7 @@ def run(input: Path = typer.Argument(..., help="FibreNet input, MUSEN text scene
             _report_warnings(model.warnings)
             target = out if out is not None else input.with_name(f"{input.stem}_result.txt")
             res = run_musen_scene(model, target, work=work, progress=not _state["quiet"],
-                                  precision=precision)
+                                  precision=precision, checkpoints=checkpoints)
         for note in res.notes:
             _say(note)
         outputs, script = res.outputs, (res.jobs[-1].script if res.jobs else None)

@@ -29,11 +29,16 @@ def _is_rank0() -> bool:
     return mpi_rank_size()[0] == 0
 
 
-# checkpoint settings of the current command (set by the CLI): every simulation of a run uses them
-CHECKPOINTS: dict = {"every": None, "resume": False}
+@dataclass(frozen=True)
+class Checkpoints:
+    """Checkpoint settings of a run (see fibrelmp.checkpoint)."""
+
+    every: int | None = None       # steps between checkpoints
+    resume: bool = False           # continue from the checkpoint in the work folder
 
 
-def simulate(model: GranularModel, work: Path, sinks: list, progress: bool = True):
+def simulate(model: GranularModel, work: Path, sinks: list, progress: bool = True,
+             checkpoints: Checkpoints = Checkpoints()):
     """Run ``model`` and feed every saved frame to each sink's ``add``; sinks are closed on
     success and aborted (temp files removed) on any failure."""
     from .granular_run import run_granular
@@ -44,9 +49,9 @@ def simulate(model: GranularModel, work: Path, sinks: list, progress: bool = Tru
 
     try:
         # a script resumes the simulation that was interrupted; finished ones simply run again
-        resume = CHECKPOINTS["resume"] and (Path(work) / "checkpoint.json").exists()
+        resume = checkpoints.resume and (Path(work) / "checkpoint.json").exists()
         job = run_granular(model, Path(work), on_frame, progress=progress,
-                           checkpoint_every=CHECKPOINTS["every"], resume=resume)
+                           checkpoint_every=checkpoints.every, resume=resume)
     except BaseException:
         for sink in sinks:
             abort = getattr(sink, "abort", None)
@@ -63,7 +68,8 @@ def simulate(model: GranularModel, work: Path, sinks: list, progress: bool = Tru
 def run_demdf(path: str | Path, out: str | Path | None = None, work: str | Path | None = None,
               progress: bool = True, time_end: float | None = None, steps: int | None = None,
               save_every: float | None = None, warn: Callable | None = None,
-              say: Callable[[str], None] | None = None) -> GranularResult:
+              say: Callable[[str], None] | None = None,
+              checkpoints: Checkpoints = Checkpoints()) -> GranularResult:
     """DEMDF: snapshots ``<filename>_<saveCount>.json`` next to the input (or in ``out``)."""
     from .post.demdf_out import DemdfSnapshotWriter
     from .translate import demdf
@@ -75,7 +81,7 @@ def run_demdf(path: str | Path, out: str | Path | None = None, work: str | Path 
     work_folder = (Path(work) if work is not None else folder / f"{Path(path).stem}_work").resolve()
     result = GranularResult()
     writer = DemdfSnapshotWriter(model, folder) if _is_rank0() else None
-    job = simulate(model, work_folder, [writer] if writer else [], progress)
+    job = simulate(model, work_folder, [writer] if writer else [], progress, checkpoints)
     result.jobs.append(job)
     if writer is not None:
         result.outputs.extend(getattr(writer, "written", []))
@@ -92,7 +98,8 @@ def musen_result_path(path: str | Path) -> tuple[Path, str | None]:
 
 
 def run_musen_scene(model: GranularModel, result: str | Path, work: str | Path | None = None,
-                    progress: bool = True, precision: int = 6) -> GranularResult:
+                    progress: bool = True, precision: int = 6,
+                    checkpoints: Checkpoints = Checkpoints()) -> GranularResult:
     """Simulate a MUSEN scene whose plan (step, end, saves) is already set."""
     from .post.musen_out import MusenResultWriter
 
@@ -102,7 +109,7 @@ def run_musen_scene(model: GranularModel, result: str | Path, work: str | Path |
     work_folder = (Path(work) if work is not None else target.parent / f"{target.stem}_work").resolve()
     res = GranularResult(notes=[note] if note else [])
     writer = MusenResultWriter(model, target, precision=precision) if _is_rank0() else None
-    res.jobs.append(simulate(model, work_folder, [writer] if writer else [], progress))
+    res.jobs.append(simulate(model, work_folder, [writer] if writer else [], progress, checkpoints))
     if writer is not None:
         res.outputs.append(target)
     return res
@@ -270,7 +277,8 @@ def _path_resolver(script: Path):
 
 def run_musen_script(path: str | Path, work: str | Path | None = None, progress: bool = True,
                      say: Callable[[str], None] | None = None,
-                     warn: Callable | None = None) -> GranularResult:
+                     warn: Callable | None = None,
+                     checkpoints: Checkpoints = Checkpoints()) -> GranularResult:
     """Run a cmusen job script unchanged.
 
     ``.mdem`` files produced by an earlier job of the script are handles: IMPORT_FROM_TEXT
@@ -324,7 +332,7 @@ def run_musen_script(path: str | Path, work: str | Path | None = None, progress:
                     if rank0:
                         sinks.append(MusenResultWriter(model, text))
                         res.outputs.append(text)
-                res.jobs.append(simulate(model, job_work, sinks, progress))
+                res.jobs.append(simulate(model, job_work, sinks, progress, checkpoints))
                 handles[target] = ("result", (model, spool))
             elif job.component == "EXPORT_TO_TEXT":
                 source = path_of(job.source_file, job, "SOURCE_FILE")

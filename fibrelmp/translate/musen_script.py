@@ -332,29 +332,30 @@ def _pbc_flags(job: MusenJob, line: _Line) -> None:
     job.pbc_flags = tuple(flags)
 
 
-def _material_property(job: MusenJob, line: _Line) -> None:
-    if len(line.tok) < 3:
-        raise line.error("needs PROPERTY COMPOUND_KEY VALUE")
+def _property_line(line: _Line, table: dict[str, int], what: str, usage: str,
+                   nkeys: int) -> tuple[int, list[str], float]:
+    """``NAME KEY... VALUE`` of a MATERIAL_PROPERTY / INTERACTION_PROPERTY line."""
+    if len(line.tok) < nkeys + 2:
+        raise line.error(f"needs {usage}")
     name = line.tok[0].upper()
-    if name not in MATERIAL_PROPERTIES:
-        near = difflib.get_close_matches(name, list(MATERIAL_PROPERTIES), n=1)
-        raise line.error(f"unknown material property {name!r}"
+    if name not in table:
+        near = difflib.get_close_matches(name, list(table), n=1)
+        raise line.error(f"unknown {what} property {name!r}"
                          + (f"; did you mean {near[0]}?" if near else ""))
-    value = _Line(line.path, line.ln, line.key, line.tok[2]).floats(1)[0]
-    job.material_properties.append((MATERIAL_PROPERTIES[name], line.tok[1], value, line.ln))
+    value = _Line(line.path, line.ln, line.key, line.tok[nkeys + 1]).floats(1)[0]
+    return table[name], line.tok[1:nkeys + 1], value
+
+
+def _material_property(job: MusenJob, line: _Line) -> None:
+    pid, (key,), value = _property_line(line, MATERIAL_PROPERTIES, "material",
+                                        "PROPERTY COMPOUND_KEY VALUE", 1)
+    job.material_properties.append((pid, key, value, line.ln))
 
 
 def _interaction_property(job: MusenJob, line: _Line) -> None:
-    if len(line.tok) < 4:
-        raise line.error("needs PROPERTY KEY1 KEY2 VALUE")
-    name = line.tok[0].upper()
-    if name not in INTERACTION_PROPERTIES:
-        near = difflib.get_close_matches(name, list(INTERACTION_PROPERTIES), n=1)
-        raise line.error(f"unknown interaction property {name!r}"
-                         + (f"; did you mean {near[0]}?" if near else ""))
-    value = _Line(line.path, line.ln, line.key, line.tok[3]).floats(1)[0]
-    job.interaction_properties.append((INTERACTION_PROPERTIES[name], line.tok[1], line.tok[2],
-                                       value, line.ln))
+    pid, (key1, key2), value = _property_line(line, INTERACTION_PROPERTIES, "interaction",
+                                              "PROPERTY KEY1 KEY2 VALUE", 2)
+    job.interaction_properties.append((pid, key1, key2, value, line.ln))
 
 
 def _precision(job: MusenJob, line: _Line) -> None:

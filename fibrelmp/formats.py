@@ -12,14 +12,15 @@ from types import ModuleType
 
 from .errors import InputError
 
-# name -> (module path, content test, extensions)
+# name -> (module path, content test, extensions that pick the reader when the content test
+# fails, so that reader explains what is wrong; ".txt" is too common to mean MUSEN)
 _READERS: dict[str, tuple[str, re.Pattern, tuple[str, ...]]] = {
     "fibrenet": ("fibrelmp.translate.fibrenet", re.compile(rb"^[ \t]*model_file\s", re.M), ()),
     "musen-script": ("fibrelmp.translate.musen_script",
                      re.compile(rb"^[ \t]*(JOB|SOURCE_FILE|COMPONENT)\b", re.M), ()),
     # an object line "0 ID 1 TYPE 5 ...", or a scene line (22 domain / 32 material) of an object-less scene
     "musen": ("fibrelmp.translate.musen",
-              re.compile(rb"\A\s*(0\s+\d+\s+1\s+\d+\s+5\b|(22|32)\s+\S)"), (".txt",)),
+              re.compile(rb"\A\s*(0\s+\d+\s+1\s+\d+\s+5\b|(22|32)\s+\S)"), ()),
     "demdf": ("fibrelmp.translate.demdf", re.compile(rb"\A\s*\{"), (".json",)),
 }
 
@@ -49,7 +50,7 @@ def detect(path: str | Path) -> str:
         if magic.search(head):
             return name
     for name, (_, _, exts) in _READERS.items():
-        if path.suffix.lower() in exts and name != "musen":
+        if path.suffix.lower() in exts:
             return name                 # let the reader explain what is wrong inside
     raise InputError(path, None, f"cannot tell the input format: {_HINT}")
 

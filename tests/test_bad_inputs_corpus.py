@@ -54,12 +54,10 @@ def test_corpus_size_and_every_file_is_a_case():
 
 
 @pytest.mark.parametrize("case", CASES, ids=[c.name for c in CASES])
-def test_case(case: Case, tmp_path, request):
+def test_case(case: Case, tmp_path):
     if case.needs_unreadable and not unreadable_possible(tmp_path):
         pytest.skip("running as root (or with CAP_DAC_OVERRIDE): chmod 000 does not stop "
                     "reading, so an unreadable file cannot be made")
-    if case.known_bug:      # fails loudly (XPASS) once fixed: then drop known_bug and regenerate
-        request.applymarker(pytest.mark.xfail(strict=True, reason=case.known_bug))
     before_corpus = _snapshot(CORPUS)
     args = case.args(tmp_path)
     before_tmp = _snapshot(tmp_path)

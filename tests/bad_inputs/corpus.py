@@ -35,7 +35,6 @@ class Case:
     command: str = "check"       # check | post | run
     make: Callable[[Path], list[str]] | None = None   # generated: build in tmp, give CLI args
     needs_unreadable: bool = False                    # cannot be made as root
-    known_bug: str = ""          # accepted by design, still rejected: where the bug is
 
     def args(self, tmp: Path) -> list[str]:
         if self.make is not None:
@@ -47,17 +46,13 @@ class Case:
 
 # a UTF-8 BOM is fine (read_text drops it), but format detection matches the first line
 # before it is dropped; fixing it belongs to fibrelmp/formats.py
-BOM_BUG = "formats.detect matches its patterns before removing a UTF-8 BOM"
-
-
 def _c(fmt: str, folder: str, rows: list[tuple], ext: str = ".txt") -> list[Case]:
     out = []
     for row in rows:
         name, what = row[0], row[1]
-        accept = len(row) > 2 and row[2] in ("accept", "bug")
+        accept = len(row) > 2 and row[2] == "accept"
         out.append(Case(f"{folder}/{name}", fmt, f"{folder}/{name}{ext}", what, accept,
-                        "post" if folder == "dump" else "check",
-                        known_bug=BOM_BUG if len(row) > 2 and row[2] == "bug" else ""))
+                        "post" if folder == "dump" else "check"))
     return out
 
 
@@ -336,10 +331,7 @@ def _cell(text: str) -> str:
 
 
 def row(case: Case, outcome: Outcome) -> str:
-    if case.known_bug:
-        result = f"exit {outcome.exit_code}: should be accepted (known bug: {case.known_bug})"
-        message = "<br>".join(f"`{_cell(e)}`" for e in outcome.errors) or "—"
-    elif case.accept:
+    if case.accept:
         result, message = f"accepted (exit {outcome.exit_code})", "—"
     else:
         result = f"exit {outcome.exit_code}"

@@ -6,10 +6,14 @@ import os
 import shutil
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from .errors import InputError
 from .formats import detect, reader
 from .model import Model
+
+if TYPE_CHECKING:
+    from .outputs import Outputs
 from .translate.lammps_job import Job, write_job
 
 
@@ -29,63 +33,122 @@ class RunResult:
     outputs: list[Path]
 
 
+def fibrenet_outputs(model: Model, out: str | Path | None = None,
+                     work: str | Path | None = None) -> tuple["Outputs", Path, str]:
+    """Where a FibreNet run writes: (outputs, output folder, file name prefix).
+
+    ``output_file`` is a name inside the output folder (``-o``, default the input's folder);
+    one that leaves it (``..``) is refused, and an absolute one is honoured only without
+    ``-o`` (as FibreNet would write it)."""
+    from .outputs import Outputs
+    from .post.fibrenet_out import RESTART_SUFFIX, XYZ_SUFFIX
+
+    spec = model.plan.output
+    name = Path(spec.basename)
+    if name.is_absolute():
+        if out is not None:
+            raise InputError(model.source, spec.line, f"output_file {spec.basename} is an absolute "
+                             "path, which -o cannot place: give a plain name, or leave out -o")
+        target = name
+    else:
+        folder = (Path(out) if out is not None else spec.folder).resolve()
+        if ".." in name.parts:
+            raise InputError(model.source, spec.line, f"output_file {spec.basename} leaves the "
+                             f"output folder {folder}: give a name inside it")
+        target = folder / name
+    if not target.name or target.name in (".", ".."):
+        raise InputError(model.source, spec.line, f"output_file {spec.basename!r} names no file")
+    folder, prefix = target.parent, target.name
+    work_folder = (Path(work) if work is not None else folder / f"{prefix}_work").resolve()
+    files = [folder / f"{prefix}{XYZ_SUFFIX[f]}" for f in spec.fields] + [folder / f"{prefix}{RESTART_SUFFIX}"]
+    family = [folder / f"{prefix}{suffix}" for suffix in (*XYZ_SUFFIX.values(), RESTART_SUFFIX)]
+    return Outputs(model.source, work_folder, files, family, inputs=list(model.inputs)), folder, prefix
+
+
 def run(model: Model, out: str | Path | None = None, work: str | Path | None = None,
         progress: bool = True, keep_work: bool = True, checkpoint_every: int | None = None,
-        resume: bool = False) -> RunResult:
+        resume: bool = False, force: bool = False) -> RunResult:
     """Translate, run in-process and write the results in the input's own format.
 
     ``checkpoint_every`` writes a checkpoint every that many steps (and one on SIGTERM or
-    Ctrl-C in any case); ``resume`` continues from the checkpoint in the work folder."""
+    Ctrl-C in any case); ``resume`` continues from the checkpoint in the work folder.
+    Existing results are replaced (completely) only with ``force``; the output and work
+    folders are locked for the run."""
+    from .outputs import finish, locked
     from .post.lammps_dump import iter_frames
     from .post.to_fibrenet import write_fibrenet
     from .runner import mpi_rank_size, run_script
 
     spec = model.plan.output
-    # absolute paths: the runner changes directory while the converter thread writes
-    out_folder = (Path(out) if out is not None else spec.folder).resolve()
-    work_folder = (Path(work) if work is not None else out_folder / f"{spec.basename}_work").resolve()
+    outputs, out_folder, prefix = fibrenet_outputs(model, out, work)
+    work_folder = outputs.work
     rank, size = mpi_rank_size()
-    # every rank parses and renders identically; only rank 0 writes the job files
-    job = write_job(model, work_folder, write_files=rank == 0)
-    checkpoints = prepare_checkpoints(job.folder, job.text, checkpoint_every, resume,
-                                      [job.frames.name], rank)
-    if rank == 0 and job.frames.exists() and not resume:
-        job.frames.unlink()
-    names = {lt: model.particles.type_names[t] for lt, t in enumerate(job.type_of_ltype) if lt > 0}
-    types = None if spec.types is None else {model.particles.type_names[t] for t in spec.types}
+    if checkpoint_every is not None and checkpoint_every <= 0:
+        raise InputError(None, None, f"--checkpoint-every must be a positive number of steps, got {checkpoint_every}")
+    # resuming continues this run's own (locked) work: its partial results are not "earlier" ones
+    with locked(outputs, force or resume, rank):
+        # every rank parses and renders identically; only rank 0 writes the job files
+        job = write_job(model, work_folder, write_files=rank == 0)
+        if size > 1:
+            from ._lammps import mpi_barrier
+            mpi_barrier()        # the data file is complete before any rank hashes it
+        checkpoints = prepare_checkpoints(job.folder, job.text, checkpoint_every, resume,
+                                          [job.frames.name], rank, [job.data])
+        if rank == 0 and job.frames.exists() and not resume:
+            job.frames.unlink()
+        names = {lt: model.particles.type_names[t] for lt, t in enumerate(job.type_of_ltype) if lt > 0}
+        types = None if spec.types is None else {model.particles.type_names[t] for t in spec.types}
 
-    def convert(frames) -> list[Path]:
-        out_folder.mkdir(parents=True, exist_ok=True)
-        return write_fibrenet(frames, spec.basename, out_folder, spec.fields, names,
-                              model.dynamics.dt, model.box.lengths, types)
+        def convert(frames) -> list[Path]:
+            return write_fibrenet(_expected_frames(frames, job), prefix, out_folder, spec.fields,
+                                  names, model.dynamics.dt, model.box.lengths, types)
 
-    outputs: list[Path] = []
-    if rank == 0 and size == 1 and (os.cpu_count() or 1) > 1:
-        # convert each frame on a second core while LAMMPS computes the next one (the lammps
-        # module releases the GIL inside the library)
-        outputs = _run_with_converter(job, progress, convert, checkpoints)
-    else:
-        run_script(job.script, job.total_steps, progress=progress, text=job.text,
-                   checkpoints=checkpoints)
+        outputs_written: list[Path] = []
+        if rank == 0 and size == 1 and (os.cpu_count() or 1) > 1:
+            # convert each frame on a second core while LAMMPS computes the next one (the lammps
+            # module releases the GIL inside the library)
+            outputs_written = _run_with_converter(job, progress, convert, checkpoints)
+        else:
+            run_script(job.script, job.total_steps, progress=progress, text=job.text,
+                       checkpoints=checkpoints)
+            if rank == 0:
+                outputs_written = convert(iter_frames(job.frames))
         if rank == 0:
-            outputs = convert(iter_frames(job.frames))
-    if rank == 0 and not keep_work:
-        shutil.rmtree(work_folder, ignore_errors=True)
-    return RunResult(job, outputs)
+            finish(outputs, outputs_written)
+            if not keep_work:
+                shutil.rmtree(work_folder, ignore_errors=True)
+    return RunResult(job, outputs_written)
+
+
+def _expected_frames(frames, job: Job):
+    """``frames``, checked against the job's schedule: a missing, repeated or extra frame is
+    a RunError, never a silently wrong output file."""
+    from .errors import RunError
+
+    expected = iter(job.output_steps)
+    for frame in frames:
+        want = next(expected, None)
+        if frame.step != want:
+            raise RunError(f"{job.frames}: expected the frame of step {want}, found step {frame.step}")
+        yield frame
+    want = next(expected, None)
+    if want is not None:
+        raise RunError(f"{job.frames}: the run ended without the frame of step {want}")
 
 
 def prepare_checkpoints(folder: Path, text: str, every: int | None, resume: bool,
-                        appended: list[str], rank: int):
+                        appended: list[str], rank: int, inputs: list[Path] = ()):
     """Checkpointing for a job (always on: a SIGTERM/Ctrl-C leaves a checkpoint behind);
-    when resuming, load the state and cut the dumps back to the checkpoint."""
+    when resuming, load the state (refused when the script or any of ``inputs``, the files
+    the job reads, changed) and cut the dumps back to the checkpoint."""
     from .checkpoint import Checkpointing, load, truncate_outputs
 
     if every is not None and every <= 0:
         raise InputError(None, None, f"--checkpoint-every must be a positive number of steps, got {every}")
-    state = load(folder, text) if resume else None
+    state = load(folder, text, inputs) if resume else None
     if state is not None and rank == 0:
         truncate_outputs(folder, state)
-    return Checkpointing(Path(folder), every, state, list(appended))
+    return Checkpointing(Path(folder), every, state, list(appended), list(inputs))
 
 
 def _run_with_converter(job: Job, progress: bool, convert, checkpoints=None) -> list[Path]:

@@ -2,13 +2,14 @@
 
 A checkpoint sits in the job folder: ``checkpoint.restart`` (LAMMPS ``write_restart``: atoms,
 velocities, bonds, contact and bond history, per-atom fix data) and ``checkpoint.json``
-(fibrelmp's own state: the script line to continue from, steps done, and the byte size of
-every dump the script appends to, so frames written after the checkpoint are dropped).
+(fibrelmp's own state: how many script commands were done, steps done, a hash of the script
+and of every file the job reads, and the byte size of every dump the script appends to, so
+frames written after the checkpoint are dropped).
 
 Resuming replays the same rendered script: set-up commands run again (styles, fixes,
 variables must exist), ``read_data`` becomes ``read_restart``, and commands that change the
 state or write output (run, velocity, displace_atoms, write_dump, ...) are skipped up to the
-checkpoint line.  Checkpoints are taken only between ``run`` commands of the script, so every
+checkpoint's position in the command stream (loops included).  Checkpoints are taken only between ``run`` commands of the script, so every
 MPI rank stops at the same command (the stop request is agreed with an MPI all-reduce).
 """
 
@@ -47,15 +48,23 @@ class Checkpointing:
     every: int | None = None             # steps between checkpoints (None: only on signals)
     resume: dict | None = None           # state of the checkpoint to continue from
     appended: list[str] = field(default_factory=list)   # dumps the script appends to
+    inputs: list[Path] = field(default_factory=list)    # files the job reads (data files)
     _stop: int = 0
+    _saved: dict = field(default_factory=dict)           # signal handlers to restore
 
     # -- signals --------------------------------------------------------------------------
     def install(self) -> None:
         for sig in (signal.SIGTERM, signal.SIGINT):
             try:
-                signal.signal(sig, self._request)
+                self._saved[sig] = signal.signal(sig, self._request)
             except ValueError:           # not the main thread: no signal handling
                 return
+
+    def uninstall(self) -> None:
+        """Put back the handlers ``install`` replaced (a notebook keeps its Ctrl-C)."""
+        for sig, handler in self._saved.items():
+            signal.signal(sig, handler)
+        self._saved.clear()
 
     def _request(self, signum, frame) -> None:
         if self._stop:            # a second signal: stop now, without a checkpoint
@@ -70,13 +79,15 @@ class Checkpointing:
         return _allreduce_max(self._stop)
 
     # -- files -----------------------------------------------------------------------------
-    def write(self, lmp, rank: int, line: int, steps: int, frames: int, script_text: str) -> None:
+    def write(self, lmp, rank: int, commands: int, line: int, steps: int, frames: int,
+              script_text: str) -> None:
         tmp = self.folder / (RESTART + ".tmp")
         lmp.command(f"write_restart {tmp.name}")
         if rank != 0:
             return
         os.replace(tmp, self.folder / RESTART)
-        state = {"line": line, "steps": steps, "frames": frames, "script_sha256": _sha(script_text),
+        state = {"commands": commands, "line": line, "steps": steps, "frames": frames,
+                 "script_sha256": _sha(script_text), "inputs_sha256": inputs_digest(self.inputs),
                  "sizes": {name: (self.folder / name).stat().st_size
                            for name in self.appended if (self.folder / name).exists()}}
         part = self.folder / (STATE + ".tmp")
@@ -89,22 +100,23 @@ class Checkpointing:
                 (self.folder / name).unlink(missing_ok=True)
 
 
-def load(folder: Path, script_text: str) -> dict:
-    """The checkpoint state in ``folder``; an InputError when there is none or the input
-    changed since it was written."""
+def load(folder: Path, script_text: str, inputs: list[Path] = ()) -> dict:
+    """The checkpoint state in ``folder``; an InputError when there is none or the job
+    (script or any file it reads) changed since it was written."""
     path = Path(folder) / STATE
     if not path.exists() or not (Path(folder) / RESTART).exists():
         raise InputError(path, None, "no checkpoint to resume from (run without --resume, or "
                          "give the same --work folder as the interrupted run)")
     try:
         state = json.loads(path.read_text())
-        line, steps = int(state["line"]), int(state["steps"])
+        commands, line, steps = int(state["commands"]), int(state["line"]), int(state["steps"])
     except (ValueError, KeyError, TypeError):
         raise InputError(path, None, "the checkpoint state is damaged; run again without --resume") from None
-    if state.get("script_sha256") != _sha(script_text):
+    if state.get("script_sha256") != _sha(script_text) or \
+            state.get("inputs_sha256") != inputs_digest(inputs):
         raise InputError(path, None, "the input changed since this checkpoint was written: the "
                          "translated job differs; run again without --resume")
-    state["line"], state["steps"] = line, steps
+    state["commands"], state["line"], state["steps"] = commands, line, steps
     return state
 
 
@@ -115,6 +127,20 @@ def truncate_outputs(folder: Path, state: dict) -> None:
         if path.exists() and path.stat().st_size > size:
             with open(path, "r+b") as fh:
                 fh.truncate(size)
+
+
+def inputs_digest(paths) -> str:
+    """One hash over the files a job reads besides its script (the data file holds the whole
+    model: any edit of an input or model file changes it)."""
+    h = hashlib.sha256()
+    for p in paths:
+        p = Path(p)
+        h.update(p.name.encode() + b"\0")
+        with open(p, "rb") as fh:
+            for block in iter(lambda: fh.read(1 << 20), b""):
+                h.update(block)
+        h.update(b"\0")
+    return h.hexdigest()
 
 
 def _sha(text: str) -> str:

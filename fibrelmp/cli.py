@@ -32,6 +32,15 @@ signal N after writing a checkpoint (resume with run --resume).""")
 
 _state = {"quiet": False, "verbose": False}
 
+# every sub-command takes these too, so "fibrelmp run X --quiet" works as "fibrelmp -q run X"
+_QUIET = typer.Option(False, "--quiet", "-q", help="Only warnings and errors.")
+_VERBOSE = typer.Option(False, "--verbose", "-v", help="Show every warning and more detail.")
+
+
+def _set_flags(quiet: bool, verbose: bool) -> None:
+    _state["quiet"] = _state["quiet"] or quiet
+    _state["verbose"] = _state["verbose"] or verbose
+
 
 def _rank0() -> bool:
     from .runner import mpi_rank_size
@@ -69,11 +78,13 @@ def _fail(message: str, code: int) -> None:
         prefix = f"[rank {rank}] " if size > 1 and code != 2 else ""
         typer.secho(prefix + message, err=True, fg=typer.colors.RED)
     if size > 1:
-        if code == 2 and rank != 0:
-            # rank 0 has met the same input error: let it print before the abort kills it
-            import time
+        import time
 
-            time.sleep(1.0)
+        sys.stderr.flush()
+        # MPI_Abort makes mpiexec kill every rank at once: its stdio proxy may not have
+        # forwarded what this rank just wrote.  Give it time (a rank meeting the same input
+        # error as rank 0 waits longer, so that rank 0's message is the one shown).
+        time.sleep(1.0 if code == 2 and rank != 0 else 0.5)
         mpi_abort(code)
     raise typer.Exit(code)
 
@@ -163,7 +174,8 @@ def main_options(
 @app.command()
 @_guard
 def check(input: Path = typer.Argument(..., help="Any supported input file.",
-                                       readable=False)) -> None:   # fibrelmp says why, as path: message
+                                       readable=False),    # fibrelmp says why, as path: message
+          quiet: bool = _QUIET, verbose: bool = _VERBOSE) -> None:
     """Parse and validate INPUT without running LAMMPS; print a summary, the unit system and
     the time step against the fastest spring / contact it has to resolve.
 
@@ -174,19 +186,20 @@ def check(input: Path = typer.Argument(..., help="Any supported input file.",
     Examples:
       fibrelmp check examples/fibre_network/input.txt
       fibrelmp check examples/musen/single_particle_job.txt
-      fibrelmp --verbose check examples/demdf/head_on.json   # every warning
+      fibrelmp check examples/demdf/head_on.json --verbose   # every warning
     """
     from .formats import detect
 
+    _set_flags(quiet, verbose)
     kind = detect(input)
     if kind != "fibrenet":
         from .granular_api import model_for_check
         from .granular_check import summary
 
         model = _read_for_check(lambda: model_for_check(input, kind), kind, input)
-        typer.echo("\n".join(summary(model)))
+        _summary(summary(model))
         _report_warnings(model.warnings)
-        typer.echo(f"warnings     {len(model.warnings)}")
+        _summary([f"warnings     {len(model.warnings)}"])
         return
     from .api import read_input
     from .sanity import spring_check, units_line
@@ -209,9 +222,15 @@ def check(input: Path = typer.Argument(..., help="Any supported input file.",
             f", output every {model.plan.output.every}"
         lines.append(f"stage        {st.name}: {st.steps} steps{extra}")
     lines += spring_check(model)
-    typer.echo("\n".join(lines))
+    _summary(lines)
     _report_warnings(model.warnings)
-    typer.echo(f"warnings     {len(model.warnings)}")
+    _summary([f"warnings     {len(model.warnings)}"])
+
+
+def _summary(lines: list[str]) -> None:
+    """check's report on stdout (--quiet: warnings and errors only)."""
+    if not _state["quiet"]:
+        typer.echo("\n".join(lines))
 
 
 def _read_for_check(read, kind: str, input: Path):
@@ -243,7 +262,8 @@ def _read_for_check(read, kind: str, input: Path):
 @app.command()
 @_guard
 def translate(input: Path = typer.Argument(..., help="Any supported input file.", readable=False),
-              out: Path = typer.Option(..., "-o", "--out", help="Folder for in.lammps and the data file.")) -> None:
+              out: Path = typer.Option(..., "-o", "--out", help="Folder for in.lammps and the data file."),
+              quiet: bool = _QUIET, verbose: bool = _VERBOSE) -> None:
     """Write a stock-LAMMPS job (in.lammps + data file) for INPUT into a folder.
 
     \b
@@ -254,6 +274,7 @@ def translate(input: Path = typer.Argument(..., help="Any supported input file."
     """
     from .formats import detect
 
+    _set_flags(quiet, verbose)
     kind = detect(input)
     if kind != "fibrenet":
         from .granular_api import model_for_check
@@ -293,6 +314,9 @@ def run(input: Path = typer.Argument(..., help="FibreNet input, MUSEN text scene
                                                        "written on SIGTERM/Ctrl-C)."),
         resume: bool = typer.Option(False, "--resume", help="Continue an interrupted run from the "
                                     "checkpoint in its work folder."),
+        force: bool = typer.Option(False, "--force", help="Replace the results of an earlier run "
+                                   "(all of them: stale files are removed)."),
+        quiet: bool = _QUIET, verbose: bool = _VERBOSE,
         ) -> None:
     """Translate INPUT, run it on LAMMPS and write the results in the input's own format.
 
@@ -302,11 +326,15 @@ def run(input: Path = typer.Argument(..., help="FibreNet input, MUSEN text scene
       fibrelmp run examples/musen/single_particle_job.txt
       fibrelmp run scene.txt --end-time 0.1 --step 1e-6 --save-step 1e-3 -o result.txt
       fibrelmp run examples/demdf/head_on.json --time-end 2
+
+    Results are never overwritten silently: an existing result needs --force.  The output
+    and work folders are locked while the run writes them.
     """
     import time
 
     from .formats import detect
 
+    _set_flags(quiet, verbose)
     kind = detect(input)
     start = time.monotonic()
     if kind != "fibrenet":
@@ -325,7 +353,7 @@ def run(input: Path = typer.Argument(..., help="FibreNet input, MUSEN text scene
         model = read_input(input)
         _report_warnings(model.warnings)
         result = do_run(model, out=out, work=work, progress=not _state["quiet"],
-                        checkpoint_every=checkpoint_every, resume=resume)
+                        checkpoint_every=checkpoint_every, resume=resume, force=force)
         outputs, script = result.outputs, result.job.script
     elif kind == "musen-script":
         from .granular_api import run_musen_script
@@ -334,7 +362,7 @@ def run(input: Path = typer.Argument(..., help="FibreNet input, MUSEN text scene
             raise _bad_option(input, "a cmusen job script sets END_TIME, SIMULATION_STEP and "
                               "SAVING_STEP itself; edit the script instead")
         res = run_musen_script(input, work=work, progress=not _state["quiet"], say=_say,
-                               warn=_report_warnings, checkpoints=checkpoints)
+                               warn=_report_warnings, checkpoints=checkpoints, out=out, force=force)
         outputs, script = res.outputs, (res.jobs[-1].script if res.jobs else None)
         for note in res.notes:
             _say(note)
@@ -344,7 +372,7 @@ def run(input: Path = typer.Argument(..., help="FibreNet input, MUSEN text scene
         if kind == "demdf":
             res = run_demdf(input, out=out, work=work, progress=not _state["quiet"], time_end=end_time,
                             steps=steps, save_every=save_step, warn=_report_warnings, say=_say,
-                            checkpoints=checkpoints)
+                            checkpoints=checkpoints, force=force)
         else:
             model, overrides = read_granular(input, kind, end_time, step, save_step, steps)
             for text in overrides:
@@ -352,7 +380,7 @@ def run(input: Path = typer.Argument(..., help="FibreNet input, MUSEN text scene
             _report_warnings(model.warnings)
             target = out if out is not None else input.with_name(f"{input.stem}_result.txt")
             res = run_musen_scene(model, target, work=work, progress=not _state["quiet"],
-                                  precision=precision, checkpoints=checkpoints)
+                                  precision=precision, checkpoints=checkpoints, force=force)
         for note in res.notes:
             _say(note)
         outputs, script = res.outputs, (res.jobs[-1].script if res.jobs else None)
@@ -366,7 +394,7 @@ def _has_checkpoint(input: Path, kind: str, out: Optional[Path], work: Optional[
     if work is not None:
         folders = [work]
     elif kind == "musen-script":
-        folders = [input.resolve().parent / f"{input.stem}_work"]
+        folders = [(out or input.resolve().parent) / f"{input.stem}_work"]
     elif kind == "demdf":
         folders = [(out or input.resolve().parent) / f"{input.stem}_work"]
     else:
@@ -400,7 +428,8 @@ def post(dump: Path = typer.Argument(..., help="LAMMPS text dump (.gz too), or a
                                                                       "the gravitational energy."),
          force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
          topology: Optional[Path] = typer.Option(None, "--topology", help="Topology for MDAnalysis "
-                                                 "trajectory formats.")) -> None:
+                                                 "trajectory formats."),
+         quiet: bool = _QUIET, verbose: bool = _VERBOSE) -> None:
     """Convert an existing dump into FibreNet, MercuryDPM, ParaView, MUSEN or DEMDF files.
 
     Outputs are written only when the whole conversion succeeded; existing ones are kept
@@ -416,6 +445,7 @@ def post(dump: Path = typer.Argument(..., help="LAMMPS text dump (.gz too), or a
     """
     from .post.cli_post import post_command
 
+    _set_flags(quiet, verbose)
     written = post_command(dump, to, out, info, frames, types, data, local, gravity, force, topology,
                            typer.echo if info else _say, report=_report_warnings)
     for path in written:

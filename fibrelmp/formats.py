@@ -6,6 +6,7 @@ FibreNet file never imports the DEM code (and vice versa).
 
 from __future__ import annotations
 
+import os
 import re
 from pathlib import Path
 from types import ModuleType
@@ -28,14 +29,32 @@ _HINT = ("expected a FibreNet input (with a 'model_file' line), a MUSEN text sce
          "script or a DEMDF JSON file")
 
 
+DETECT_BYTES = 1 << 20          # detection reads at most this much of a file
+
+
+def check_regular_file(path: Path, what: str = "input") -> None:
+    """A readable regular file: not missing, not a folder, not a device or FIFO (reading
+    /dev/zero never ends, a FIFO blocks for ever)."""
+    import stat
+
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        raise InputError(path, None, f"{what} file not found") from None
+    except OSError as exc:
+        raise InputError(path, None, f"cannot read {what}: {exc.strerror or exc}") from None
+    if stat.S_ISDIR(mode):
+        raise InputError(path, None, f"{what} is a directory, expected a file")
+    if not stat.S_ISREG(mode):
+        raise InputError(path, None, f"{what} is not a regular file (a device, FIFO or socket)")
+
+
 def detect(path: str | Path) -> str:
     path = Path(path)
-    if not path.exists():
-        raise InputError(path, None, "input file not found")
-    if path.is_dir():
-        raise InputError(path, None, "input is a directory, expected a file")
+    check_regular_file(path)
     try:
-        head = path.read_bytes()[:1 << 20]
+        with open(path, "rb") as fh:
+            head = fh.read(DETECT_BYTES)
     except OSError as exc:
         raise InputError(path, None, f"cannot read input: {exc.strerror or exc}") from None
     if path.suffix.lower() == ".mdem":

@@ -10,10 +10,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
 
 from .errors import InputError
 from .granmodel import GranularModel
+
+if TYPE_CHECKING:
+    from .outputs import Outputs
 
 
 @dataclass
@@ -65,26 +68,50 @@ def simulate(model: GranularModel, work: Path, sinks: list, progress: bool = Tru
     return job
 
 
+def demdf_outputs(model: GranularModel, out: str | Path | None = None,
+                  work: str | Path | None = None) -> tuple["Outputs", Path]:
+    """Where a DEMDF run writes: ``<filename>_<n>.json`` in the input's folder (or ``-o``);
+    a ``filename`` that leaves that folder is refused."""
+    import re
+
+    from .outputs import Outputs
+
+    info = model.passthrough["demdf"]
+    folder = (Path(out) if out is not None else Path(model.source).parent).resolve()
+    name = str(info["filename"])
+    if Path(name).is_absolute() or ".." in Path(name).parts or "/" in name or "\\" in name:
+        raise InputError(model.source, None, f"output filename {name!r} must be a plain file name: "
+                         f"snapshots are written into {folder}")
+    work_folder = (Path(work) if work is not None else folder / f"{Path(model.source).stem}_work").resolve()
+    inputs = [Path(model.source)] + ([Path(info["particles_file"])] if info.get("particles_file") else [])
+    pattern = re.compile(re.escape(name) + r"_\d+\.json")
+    return Outputs(Path(model.source), work_folder, patterns=[(folder, pattern)], inputs=inputs), folder
+
+
 def run_demdf(path: str | Path, out: str | Path | None = None, work: str | Path | None = None,
               progress: bool = True, time_end: float | None = None, steps: int | None = None,
               save_every: float | None = None, warn: Callable | None = None,
               say: Callable[[str], None] | None = None,
-              checkpoints: Checkpoints = Checkpoints()) -> GranularResult:
-    """DEMDF: snapshots ``<filename>_<saveCount>.json`` next to the input (or in ``out``)."""
+              checkpoints: Checkpoints = Checkpoints(), force: bool = False) -> GranularResult:
+    """DEMDF: snapshots ``<filename>_<saveCount>.json`` next to the input (or in ``out``);
+    earlier snapshots of the same name are replaced, all of them, only with ``force``."""
+    from .outputs import finish, locked
     from .post.demdf_out import DemdfSnapshotWriter
     from .translate import demdf
 
     model = demdf.read(path, time_end=time_end, steps=steps, save_every=save_every)
     if warn is not None:
         warn(model.warnings)
-    folder = (Path(out) if out is not None else Path(path).parent).resolve()
-    work_folder = (Path(work) if work is not None else folder / f"{Path(path).stem}_work").resolve()
+    outputs, folder = demdf_outputs(model, out, work)
     result = GranularResult()
-    writer = DemdfSnapshotWriter(model, folder) if _is_rank0() else None
-    job = simulate(model, work_folder, [writer] if writer else [], progress, checkpoints)
-    result.jobs.append(job)
-    if writer is not None:
-        result.outputs.extend(getattr(writer, "written", []))
+    rank0 = _is_rank0()
+    with locked(outputs, force or checkpoints.resume, 0 if rank0 else 1):
+        writer = DemdfSnapshotWriter(model, folder) if rank0 else None
+        job = simulate(model, outputs.work, [writer] if writer else [], progress, checkpoints)
+        result.jobs.append(job)
+        if writer is not None:
+            result.outputs.extend(getattr(writer, "written", []))
+            finish(outputs, result.outputs)
     return result
 
 
@@ -99,19 +126,24 @@ def musen_result_path(path: str | Path) -> tuple[Path, str | None]:
 
 def run_musen_scene(model: GranularModel, result: str | Path, work: str | Path | None = None,
                     progress: bool = True, precision: int = 6,
-                    checkpoints: Checkpoints = Checkpoints()) -> GranularResult:
+                    checkpoints: Checkpoints = Checkpoints(), force: bool = False) -> GranularResult:
     """Simulate a MUSEN scene whose plan (step, end, saves) is already set."""
+    from .outputs import Outputs, finish, locked
     from .post.musen_out import MusenResultWriter
 
     check_musen_runnable(model)
     target, note = musen_result_path(result)
     target = target.resolve()
     work_folder = (Path(work) if work is not None else target.parent / f"{target.stem}_work").resolve()
+    outputs = Outputs(Path(model.source), work_folder, [target], inputs=[Path(model.source)])
     res = GranularResult(notes=[note] if note else [])
-    writer = MusenResultWriter(model, target, precision=precision) if _is_rank0() else None
-    res.jobs.append(simulate(model, work_folder, [writer] if writer else [], progress, checkpoints))
-    if writer is not None:
-        res.outputs.append(target)
+    rank0 = _is_rank0()
+    with locked(outputs, force or checkpoints.resume, 0 if rank0 else 1):
+        writer = MusenResultWriter(model, target, precision=precision) if rank0 else None
+        res.jobs.append(simulate(model, work_folder, [writer] if writer else [], progress, checkpoints))
+        if writer is not None:
+            res.outputs.append(target)
+            finish(outputs, res.outputs)
     return res
 
 
@@ -209,10 +241,8 @@ def _initial_frame(model: GranularModel):
 
 
 def _script_model(job, handles: dict, path_of) -> GranularModel:
-    """The scene a SIMULATOR job starts from: a handle made earlier, or a text scene."""
+    """The scene a SIMULATOR job starts from (a copy): a handle made earlier, or a text scene."""
     import copy
-
-    from .translate import musen
 
     source = path_of(job.source_file, job, "SOURCE_FILE")
     if source in handles:
@@ -241,24 +271,14 @@ def _read_scene(source: Path, job, key: str) -> GranularModel:
 
 def model_for_check(path: str | Path, kind: str) -> GranularModel:
     """The model ``check``/``translate`` show: the input itself, or for a cmusen script the
-    scene of its first SIMULATOR job with that job's settings applied."""
+    scene of its first SIMULATOR job with that job's settings applied (after checking every
+    job of the script, as ``run`` does before it starts)."""
     if kind != "musen-script":
         return read_granular(path, kind)[0]
-    from .translate.musen_script import apply_simulator_settings, read_script
-
-    jobs = read_script(path)
-    handles: dict = {}
-    path_of = _path_resolver(Path(path))
-    for job in jobs:
-        if job.component == "IMPORT_FROM_TEXT":
-            from .translate import musen
-
-            handles[path_of(job.result_file, job, "RESULT_FILE")] = \
-                ("scene", _read_scene(path_of(job.source_file, job, "SOURCE_FILE"), job, "SOURCE_FILE"))
-        elif job.component == "SIMULATOR":
-            model = _script_model(job, handles, path_of)
-            apply_simulator_settings(model, job)
-            return model
+    plan = plan_musen_script(path)
+    for step in plan.steps:
+        if step.kind == "simulate":
+            return step.model
     raise InputError(path, None, "the script has no SIMULATOR job")
 
 
@@ -275,95 +295,172 @@ def _path_resolver(script: Path):
     return path_of
 
 
-def run_musen_script(path: str | Path, work: str | Path | None = None, progress: bool = True,
-                     say: Callable[[str], None] | None = None,
-                     warn: Callable | None = None,
-                     checkpoints: Checkpoints = Checkpoints()) -> GranularResult:
-    """Run a cmusen job script unchanged.
+@dataclass
+class ScriptStep:
+    """One job of a cmusen script, resolved and checked before anything runs."""
+    job: object                          # MusenJob
+    kind: str                            # "import" | "simulate" | "export"
+    handle: Path | None = None           # the .mdem name it makes (import/simulate)
+    source: Path | None = None           # the handle it reads (export)
+    model: GranularModel | None = None   # import: the scene; simulate: scene + settings
+    written: Path | None = None          # the MUSEN text file it writes, if any
+    spool: bool = False                  # simulate: keep the frames for a later export
+    notes: list[str] = field(default_factory=list)
 
-    ``.mdem`` files produced by an earlier job of the script are handles: IMPORT_FROM_TEXT
-    stores the scene in memory, SIMULATOR stores its frames in an on-disk spool, and
-    EXPORT_TO_TEXT writes them as MUSEN text.  A SIMULATOR result nobody exports is written as
-    text next to its ``.mdem`` name (said as a note)."""
-    from .post.frame_spool import FrameSpool
-    from .post.musen_out import MusenResultWriter
-    from .translate import musen
+
+@dataclass
+class ScriptPlan:
+    script: Path
+    steps: list[ScriptStep]
+    inputs: list[Path]                   # the script and every text scene it reads
+
+
+def plan_musen_script(path: str | Path, out: str | Path | None = None) -> ScriptPlan:
+    """Check every job of a cmusen script before any of them runs: scenes read, settings
+    applied, the LAMMPS job of every simulation built (in memory), every result located.
+
+    Results go where RESULT_FILE says (relative to the script), or with ``out`` into that
+    folder under their relative RESULT_FILE names (an absolute or ``..`` name is refused)."""
+    from .translate.granular_job import build_granular_job
     from .translate.musen_script import apply_simulator_settings, read_script
 
-    say = say or (lambda text: None)
     script = Path(path).resolve()
     jobs = read_script(script)
     path_of = _path_resolver(script)
-    work_root = (Path(work) if work is not None else script.parent / f"{script.stem}_work").resolve()
+    out_folder = Path(out).resolve() if out is not None else None
+
+    def written_path(job) -> tuple[Path, str | None]:
+        name = job.result_file
+        if out_folder is None:
+            return musen_result_path(path_of(name, job, "RESULT_FILE"))
+        if not name:
+            path_of(name, job, "RESULT_FILE")       # the usual message
+        rel = Path(name)
+        if rel.is_absolute() or ".." in rel.parts:
+            raise InputError(job.path, job.where("RESULT_FILE"), f"RESULT_FILE {name} cannot be "
+                             f"placed in -o {out_folder}: use a relative name without '..', or leave out -o")
+        return musen_result_path(out_folder / rel)
+
     exported = {path_of(j.source_file, j, "SOURCE_FILE") for j in jobs
                 if j.component == "EXPORT_TO_TEXT" and j.source_file}
-    handles: dict[Path, tuple[str, object]] = {}
-    res = GranularResult()
-    spools: list[FrameSpool] = []
-    rank0 = _is_rank0()
-    try:
-        for job in jobs:
-            if job.component == "IMPORT_FROM_TEXT":
-                target = path_of(job.result_file, job, "RESULT_FILE")
-                model = _read_scene(path_of(job.source_file, job, "SOURCE_FILE"), job, "SOURCE_FILE")
-                handles[target] = ("scene", model)
-                say(f"job {job.index}: imported {job.source_file} ({model.spheres.count} spheres) "
-                    f"as {job.result_file} (kept in memory)")
-            elif job.component == "SIMULATOR":
-                model = _script_model(job, handles, path_of)
-                apply_simulator_settings(model, job)
-                if warn is not None:
-                    warn(model.warnings)
-                target = path_of(job.result_file, job, "RESULT_FILE")
-                job_work = work_root / f"job{job.index}"
-                say(f"job {job.index}: simulating {job.source_file} to t = {model.plan.t_end:g} s")
-                sinks: list = []
-                spool = None
-                if target in exported and rank0:
-                    spool = FrameSpool(job_work / "frames")
-                    spools.append(spool)
-                    sinks.append(spool)
-                if not (target.suffix.lower() == ".mdem" and target in exported):
-                    # nobody exports this result: write it as MUSEN text right away
-                    check_musen_runnable(model)
-                    text, note = musen_result_path(target)
-                    if note:
-                        res.notes.append(note)
-                    if rank0:
-                        sinks.append(MusenResultWriter(model, text))
-                        res.outputs.append(text)
-                res.jobs.append(simulate(model, job_work, sinks, progress, checkpoints))
-                handles[target] = ("result", (model, spool))
-            elif job.component == "EXPORT_TO_TEXT":
-                source = path_of(job.source_file, job, "SOURCE_FILE")
-                if source not in handles:
-                    raise InputError(job.path, job.where("SOURCE_FILE"),
-                                     f"{job.source_file}: no earlier job of this script produced it"
-                                     + (" and fibrelmp cannot read binary MUSEN files"
-                                        if source.suffix.lower() == ".mdem" else ""))
-                target, note = musen_result_path(path_of(job.result_file, job, "RESULT_FILE"))
+    handles: dict[Path, tuple[str, GranularModel]] = {}
+    inputs: list[Path] = [script]
+    steps: list[ScriptStep] = []
+    for job in jobs:
+        if job.component == "IMPORT_FROM_TEXT":
+            source = path_of(job.source_file, job, "SOURCE_FILE")
+            model = _read_scene(source, job, "SOURCE_FILE")
+            inputs.append(source)
+            handle = path_of(job.result_file, job, "RESULT_FILE")
+            handles[handle] = ("scene", model)
+            steps.append(ScriptStep(job, "import", handle=handle, model=model))
+        elif job.component == "SIMULATOR":
+            source = path_of(job.source_file, job, "SOURCE_FILE")
+            if source not in handles and source.suffix.lower() != ".mdem":
+                inputs.append(source)
+            model = _script_model(job, handles, path_of)
+            apply_simulator_settings(model, job)
+            check_musen_runnable(model)
+            build_granular_job(model, script.parent)     # translation errors now, not mid-script
+            handle = path_of(job.result_file, job, "RESULT_FILE")
+            step = ScriptStep(job, "simulate", handle=handle, model=model, spool=handle in exported)
+            if not (handle.suffix.lower() == ".mdem" and handle in exported):
+                # nobody exports this result: it is written as MUSEN text right away
+                step.written, note = written_path(job)
                 if note:
-                    res.notes.append(note)
-                kind, value = handles[source]
-                model, spool = (value, None) if kind == "scene" else value
-                if rank0:
-                    writer = MusenResultWriter(model, target, precision=job.precision,
-                                               time_interval=job.time_interval,
-                                               selectors=job.text_export)
-                    try:
-                        for frame in (spool if spool is not None else [_initial_frame(model)]):
-                            writer.add(frame)
-                    except BaseException:
-                        writer.abort()
-                        raise
-                    writer.close()
-                    res.outputs.append(target)
-                say(f"job {job.index}: exported {job.source_file} as {target.name}")
-            else:
-                raise InputError(job.path, job.where("COMPONENT"), f"COMPONENT {job.component} is "
-                                 "not supported (fibrelmp runs SIMULATOR, IMPORT_FROM_TEXT and "
-                                 "EXPORT_TO_TEXT jobs)")
-    finally:
-        for spool in spools:
-            spool.remove()
+                    step.notes.append(note)
+            handles[handle] = ("result", model)
+            steps.append(step)
+        elif job.component == "EXPORT_TO_TEXT":
+            source = path_of(job.source_file, job, "SOURCE_FILE")
+            if source not in handles:
+                raise InputError(job.path, job.where("SOURCE_FILE"),
+                                 f"{job.source_file}: no earlier job of this script produced it"
+                                 + (" and fibrelmp cannot read binary MUSEN files"
+                                    if source.suffix.lower() == ".mdem" else ""))
+            step = ScriptStep(job, "export", source=source, model=handles[source][1])
+            step.written, note = written_path(job)
+            if note:
+                step.notes.append(note)
+            steps.append(step)
+        else:
+            raise InputError(job.path, job.where("COMPONENT"), f"COMPONENT {job.component} is "
+                             "not supported (fibrelmp runs SIMULATOR, IMPORT_FROM_TEXT and "
+                             "EXPORT_TO_TEXT jobs)")
+    inputs = list(dict.fromkeys(inputs))
+    for step in steps:
+        if step.written is not None and step.written in inputs:
+            raise InputError(step.job.path, step.job.where("RESULT_FILE"), f"RESULT_FILE "
+                             f"{step.job.result_file} is an input of this script ({step.written}): "
+                             "the result would overwrite it; choose another name")
+    return ScriptPlan(script, steps, inputs)
+
+
+def run_musen_script(path: str | Path, work: str | Path | None = None, progress: bool = True,
+                     say: Callable[[str], None] | None = None,
+                     warn: Callable | None = None,
+                     checkpoints: Checkpoints = Checkpoints(), out: str | Path | None = None,
+                     force: bool = False) -> GranularResult:
+    """Run a cmusen job script unchanged, after checking all of it (``plan_musen_script``).
+
+    ``.mdem`` files produced by an earlier job of the script are handles: IMPORT_FROM_TEXT
+    keeps the scene in memory, SIMULATOR keeps its frames in an on-disk spool, and
+    EXPORT_TO_TEXT writes them as MUSEN text.  A SIMULATOR result nobody exports is written as
+    text next to its ``.mdem`` name (said as a note)."""
+    from .outputs import Outputs, finish, locked
+    from .post.frame_spool import FrameSpool
+    from .post.musen_out import MusenResultWriter
+
+    say = say or (lambda text: None)
+    plan = plan_musen_script(path, out)
+    script = plan.script
+    base = Path(out) if out is not None else script.parent
+    work_root = (Path(work) if work is not None else base / f"{script.stem}_work").resolve()
+    files = [st.written for st in plan.steps if st.written is not None]
+    outputs = Outputs(script, work_root, list(dict.fromkeys(files)), inputs=plan.inputs)
+    res = GranularResult()
+    spools: dict[Path, FrameSpool] = {}
+    rank0 = _is_rank0()
+    with locked(outputs, force or checkpoints.resume, 0 if rank0 else 1):
+        try:
+            for step in plan.steps:
+                job = step.job
+                res.notes.extend(step.notes)
+                if step.kind == "import":
+                    say(f"job {job.index}: imported {job.source_file} ({step.model.spheres.count} "
+                        f"spheres) as {job.result_file} (kept in memory)")
+                elif step.kind == "simulate":
+                    model = step.model
+                    if warn is not None:
+                        warn(model.warnings)
+                    job_work = work_root / f"job{job.index}"
+                    say(f"job {job.index}: simulating {job.source_file} to t = {model.plan.t_end:g} s")
+                    sinks: list = []
+                    if step.spool and rank0:
+                        spools[step.handle] = FrameSpool(job_work / "frames")
+                        sinks.append(spools[step.handle])
+                    if step.written is not None and rank0:
+                        sinks.append(MusenResultWriter(model, step.written))
+                        res.outputs.append(step.written)
+                    res.jobs.append(simulate(model, job_work, sinks, progress, checkpoints))
+                else:
+                    spool = spools.get(step.source)
+                    if rank0:
+                        writer = MusenResultWriter(step.model, step.written, precision=job.precision,
+                                                   time_interval=job.time_interval,
+                                                   selectors=job.text_export)
+                        try:
+                            for frame in (spool if spool is not None else [_initial_frame(step.model)]):
+                                writer.add(frame)
+                        except BaseException:
+                            writer.abort()
+                            raise
+                        writer.close()
+                        res.outputs.append(step.written)
+                    say(f"job {job.index}: exported {job.source_file} as {step.written.name}")
+            if rank0:
+                finish(outputs, res.outputs)
+        finally:
+            for spool in spools.values():
+                spool.remove()
     return res

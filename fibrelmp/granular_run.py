@@ -284,8 +284,10 @@ def run_granular(model: GranularModel, work: str | Path,
     else:
         job, text, _ = build_granular_job(model, work)
     dumps = [p for p in (job.frames, job.bond_dump, job.tile_dump, job.breaks) if p is not None]
+    if size > 1:
+        mpi_barrier()        # the data file is complete before any rank hashes it
     checkpoints = prepare_checkpoints(work, text, checkpoint_every, resume,
-                                      [p.name for p in dumps], rank)
+                                      [p.name for p in dumps], rank, [job.data])
     if rank == 0 and not resume:
         for p in dumps:
             if p.exists():
@@ -307,6 +309,10 @@ def run_granular(model: GranularModel, work: str | Path,
                        checkpoints=checkpoints)
         else:
             _run_threaded(job, builder, steps, on_frame, progress, checkpoints)
+        missing = next(steps, None)
+        if missing is not None:     # never a result with frames silently missing
+            raise RunError(f"{job.script}: the run ended without the frame of step {missing} "
+                           f"({len(job.save_steps)} were scheduled)")
     finally:
         builder.close()
     if size > 1:

@@ -124,6 +124,7 @@ class OutputSpec:
     fields: tuple[str, ...]      # subset of ("position", "velocity", "force")
     types: tuple[int, ...] | None    # type indices written; None = all
     every: int
+    line: int | None = None      # the output_file line (for messages)
 
 
 @dataclass
@@ -144,6 +145,7 @@ class Model:
     plan: RunPlan
     warnings: list[tuple[str, str]] = field(default_factory=list)   # (kind, message)
     units: str = "lj"
+    inputs: list[Path] = field(default_factory=list)     # every file it was read from
 
     def warn(self, kind: str, message: str) -> None:
         self.warnings.append((kind, message))

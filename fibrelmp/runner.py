@@ -1,6 +1,11 @@
-"""Run a rendered LAMMPS script in-process, line by line, with progress and MPI safety.
+"""Run a rendered LAMMPS script in-process, command by command, with progress and MPI safety.
 
-The same file replays with ``lmp -in in.lammps``: the runner adds nothing but progress.
+The same file replays with ``lmp -in in.lammps``: the runner feeds LAMMPS exactly the commands
+that ``lmp -in`` reads (lines split on ``\\n`` only, loops through ``label``/``next``/
+``jump SELF`` followed as LAMMPS follows them) and adds only progress, frame hooks and
+checkpoints.  Schedules with many frames are LAMMPS loops, so neither the script nor the
+runner grows with the number of frames.
+
 MPI rule: LAMMPS runs on every rank; only rank 0 writes files and progress; any error
 aborts all ranks.
 """
@@ -10,13 +15,12 @@ from __future__ import annotations
 import os
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
+from typing import TYPE_CHECKING, Callable, Iterator
 
 from ._lammps import new_lammps
 from .errors import RunError
-
-from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from .checkpoint import Checkpointing  # noqa: F401
@@ -36,13 +40,18 @@ class Progress:
         self.total, self.done = max(total, 1), 0
         self.enabled = enabled and sys.stderr.isatty()
         self.start = time.monotonic()
+        self.shown = -1.0
 
     def advance(self, steps: int) -> None:
         self.done += steps
         if not self.enabled:
             return
         frac = min(self.done / self.total, 1.0)
-        elapsed = time.monotonic() - self.start
+        now = time.monotonic()
+        if now - self.shown < 0.1 and frac < 1.0:      # loops of tiny runs: redraw 10x a second
+            return
+        self.shown = now
+        elapsed = now - self.start
         eta = elapsed * (1 - frac) / frac if frac > 0 else 0.0
         bar = "#" * int(30 * frac)
         sys.stderr.write(f"\r[{bar:<30}] {100 * frac:5.1f}%  step {self.done}/{self.total}  ETA {eta:6.1f}s")
@@ -53,6 +62,78 @@ class Progress:
             sys.stderr.write("\n")
 
 
+def script_lines(text: str) -> list[str]:
+    """The lines LAMMPS reads from ``text``: split on ``\\n`` only (not on the other Unicode
+    line breaks ``str.splitlines`` knows), a trailing ``\\r`` dropped."""
+    return [ln[:-1] if ln.endswith("\r") else ln for ln in text.split("\n")]
+
+
+@dataclass
+class Command:
+    number: int          # 1-based line in the script
+    text: str
+    words: list[str]
+
+
+def parse_commands(text: str, where: str = "in.lammps") -> tuple[list[Command], dict[str, int]]:
+    """Commands of a rendered script and the index of every ``label``.
+
+    The renderers never write continuation lines (``&``), quotes or ``$`` substitutions into
+    control flow; a script that has them is not one of ours and is refused, so the runner
+    never interprets a line differently from ``lmp -in``."""
+    commands: list[Command] = []
+    labels: dict[str, int] = {}
+    for number, line in enumerate(script_lines(text), 1):
+        body = line.strip()
+        if not body or body.startswith("#"):
+            continue
+        if body.endswith("&") or '"""' in body:
+            raise RunError(f"{where}:{number}: continuation lines and triple quotes are not "
+                           "written by fibrelmp; the runner refuses them")
+        words = body.split()
+        if words[0] == "label" and len(words) == 2:
+            labels[words[1]] = len(commands)
+        commands.append(Command(number, body, words))
+    return commands, labels
+
+
+def execute(commands: list[Command], labels: dict[str, int], where: str = "in.lammps") -> Iterator[Command]:
+    """The commands in the order LAMMPS executes them, following loops the way ``lmp -in``
+    does: ``variable V loop N`` counts, ``next V`` advances (and past N the next ``jump`` is
+    skipped), ``jump SELF L`` continues after ``label L``.  Yields every command (the caller
+    sends all but ``label``/``jump`` to LAMMPS, whose ``next`` keeps its own copy in step)."""
+    loops: dict[str, list[int]] = {}
+    skip_jump = False
+    pc = 0
+    while pc < len(commands):
+        cmd = commands[pc]
+        pc += 1
+        w = cmd.words
+        if w[0] == "variable" and len(w) >= 4 and w[2] == "loop":
+            lo, hi = (1, int(w[3])) if len(w) == 4 or not w[4].isdigit() else (int(w[3]), int(w[4]))
+            loops[w[1]] = [lo, hi]
+        elif w[0] == "next":
+            for name in w[1:]:
+                state = loops.get(name)
+                if state is None:
+                    raise RunError(f"{where}:{cmd.number}: 'next {name}' without a loop variable")
+                state[0] += 1
+                if state[0] > state[1]:
+                    del loops[name]
+                    skip_jump = True
+        elif w[0] == "jump":
+            yield cmd
+            if skip_jump:
+                skip_jump = False
+                continue
+            if len(w) != 3 or w[1] != "SELF" or w[2] not in labels:
+                raise RunError(f"{where}:{cmd.number}: only 'jump SELF label' with a label of "
+                               "this script is supported")
+            pc = labels[w[2]] + 1
+            continue
+        yield cmd
+
+
 def run_script(script: Path, total_steps: int, progress: bool = True, log: bool = False,
                on_command: Callable[[list[str]], None] | None = None, text: str | None = None,
                checkpoints: "Checkpointing | None" = None) -> None:
@@ -60,8 +141,8 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
 
     ``text`` is the script's content when this rank did not write the file (MPI ranks > 0:
     LAMMPS opens data files and writes dumps on rank 0 only).  ``on_command`` is called with
-    the words of every command after LAMMPS finished it (also for the ``write_dump`` lines a
-    resumed run skips: their frames are in the dump already).  ``checkpoints`` enables
+    the words of every command after LAMMPS finished it (also for the ``write_dump`` commands
+    a resumed run skips: their frames are in the dump already).  ``checkpoints`` enables
     checkpoints and resuming (see fibrelmp.checkpoint).
     """
     from .checkpoint import ACTIONS, CheckpointStop
@@ -70,14 +151,16 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
     rank, size = mpi_rank_size()
     args = ["-nocite", "-log", "log.lammps" if log and rank == 0 else "none", "-screen", "none"]
     script_text = text if text is not None else script.read_text()
-    lines = script_text.splitlines()
+    commands, labels = parse_commands(script_text, str(script))
     cwd = os.getcwd()
     bar = Progress(total_steps, progress and rank == 0)
     resume = checkpoints.resume if checkpoints is not None else None
-    skip_to = resume["line"] if resume else 0
+    skip_to = resume["commands"] if resume else 0     # commands done before the checkpoint
     steps = resume["steps"] if resume else 0
     frames = 0
     since = 0
+    done = 0                         # commands executed (the position in the command stream)
+    rebuild = False                  # a checkpoint re-exchanged the atoms: rebuild neighbours
     deferred: list[str] = []         # per-atom fixes: defined after read_restart to get their data
     lmp = None
     if resume:
@@ -96,12 +179,13 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
                            "the work folder must be on a file system shared by all ranks") from None
         if checkpoints is not None:
             checkpoints.install()
-        for number, line in enumerate(lines, 1):
-            text = line.strip()
-            if not text or text.startswith("#"):
-                continue
-            words = text.split()
-            if number <= skip_to:
+        for cmd in execute(commands, labels, str(script)):
+            done += 1
+            words, text = cmd.words, cmd.text
+            if words[0] in ("label", "jump"):
+                continue                 # followed by execute(); LAMMPS's own jump needs a file
+            replaying = done <= skip_to
+            if replaying:
                 if words[0] in ACTIONS:
                     if words[0] == "write_dump":
                         frames += 1
@@ -114,18 +198,24 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
                 if words[0] == "read_data":
                     text = "read_restart checkpoint.restart"
             try:
+                if rebuild and words[0] == "run":
+                    _rebuild_neighbours(lmp)
+                    rebuild = False
+                before = _timestep(lmp) if words[0] == "run" else 0
                 lmp.command(text)
-                if number <= skip_to and words[0] == "read_data":
+                if replaying and words[0] == "read_data":
                     for fix in deferred:
                         lmp.command(fix)
-                if number <= skip_to and words[0] == "dump":     # keep what it wrote before
+                if replaying and words[0] == "dump":     # keep what it wrote before
                     lmp.command(f"dump_modify {words[1]} append yes")
+            except RunError:
+                raise
             except Exception as exc:       # LAMMPS raises plain Exception subclasses
-                raise RunError(f"{script}:{number}: LAMMPS error: {str(exc).strip()}") from None
+                raise RunError(f"{script}:{cmd.number}: LAMMPS error: {str(exc).strip()}") from None
             if words[0] == "write_dump":
                 frames += 1
-            if words[0] == "run" and len(words) > 1:
-                n = int(words[1])
+            if words[0] == "run":
+                n = _timestep(lmp) - before
                 bar.advance(n)
                 steps += n
                 since += n
@@ -134,7 +224,8 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
             if checkpoints is not None and words[0] == "run":
                 signum = checkpoints.stop_requested(size)
                 if signum or (checkpoints.every and since >= checkpoints.every):
-                    checkpoints.write(lmp, rank, number, steps, frames, script_text)
+                    checkpoints.write(lmp, rank, done, cmd.number, steps, frames, script_text)
+                    rebuild = True
                     since = 0
                     if signum:
                         raise CheckpointStop(script.parent, signum)
@@ -143,8 +234,24 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
     finally:
         bar.close()
         os.chdir(cwd)
+        if checkpoints is not None:
+            checkpoints.uninstall()
         if lmp is not None:
             lmp.close()
+
+
+def _timestep(lmp) -> int:
+    return int(lmp.extract_global("ntimestep"))
+
+
+def _rebuild_neighbours(lmp) -> None:
+    """After ``write_restart`` (which re-exchanges atoms and rebuilds ghosts) a ``run … pre
+    no`` would use a stale neighbour list.  ``run 0`` rebuilds it; the forces it recomputes
+    are replaced by the ones the run would have started from (they include drag on half-step
+    velocities), so a checkpointed run continues exactly as an uninterrupted one."""
+    forces = lmp.gather_atoms("f", 1, 3)
+    lmp.command("run 0 post no")
+    lmp.scatter_atoms("f", 1, 3, forces)
 
 
 class RunAborted(Exception):

@@ -297,7 +297,7 @@ def test_free_flight_gravity_velocity_at_position_time(tmp_path):
     model = gm.model(sph, [glass], contacts, dt=1e-5, t_end=0.1, save_every_time=0.0123, gravity=g)
     job, frames = run(model, tmp_path)
     steps = [f.step for f in frames]
-    assert steps == job.save_steps
+    assert steps == list(job.save_steps)
     assert steps[:4] == [0, 1230, 2460, 3690] and steps[-1] == 10000
     for f in frames:
         t = f.time

@@ -194,7 +194,9 @@ def test_round_trip_single_particle_exact(tmp_path):
     assert tp.times.tolist() == times
     s = list(tp.ids).index(12)
     assert np.array_equal(tp.fields[20][:, s], np.array([f.force[0] for f in frames]))
-    assert np.array_equal(tp.fields[18][:, s, 0], [np.linalg.norm(f.force[0]) for f in frames])
+    # |F| is computed, not copied: allow the last bit (numpy's SIMD paths differ between builds)
+    np.testing.assert_allclose(tp.fields[18][:, s, 0], [np.linalg.norm(f.force[0]) for f in frames],
+                               rtol=4e-16, atol=0)
     assert np.array_equal(tp.fields[20][:, 0], np.array([f.triangle_force[0] for f in frames]))
     text = out.read_text().splitlines()
     assert text[0].startswith("0 0 1 14 5  23 KYDX71DJATPLUTAHNBZX 24 0 1e+300 2 0 44 ")

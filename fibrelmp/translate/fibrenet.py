@@ -303,7 +303,8 @@ def read(path: str | Path) -> Model:
         out_types.add(type_index[line.tokens[1]])
     output = OutputSpec("fibrenet", inp.require("output_file").tokens[1], folder,
                         tuple(f for f in ("position", "velocity", "force") if f in fields),
-                        None if out_types is None else tuple(sorted(out_types)), out_freq)
+                        None if out_types is None else tuple(sorted(out_types)), out_freq,
+                        inp.require("output_file").number)
 
     stages: list[Stage] = []
     if min_steps > 0:
@@ -321,6 +322,7 @@ def read(path: str | Path) -> Model:
     model = Model(path, particles, bonds, angles, pairs, box, dyn, RunPlan(stages, output),
                   units=LJ.name)
     model.warnings.extend(notes)
+    model.inputs = [path, model_path] + ([folder / restart_lines[-1].tokens[1]] if restart_lines else [])
     return model
 
 

@@ -62,8 +62,7 @@ class GranularJob:
     script: Path
     data: Path
     total_steps: int
-    save_steps: list[int]
-    save_times: list[float]
+    save_steps: SaveSteps                # lazy: iterate, len(), `in`
     frames: Path                     # spheres, one write_dump per saved frame
     bond_dump: Path | None           # alive bonds (compute bond/local) per frame
     tile_dump: Path | None           # wall tiles (forces) per frame
@@ -148,16 +147,51 @@ def rolling_spring(m_min: float, dt: float) -> tuple[float, float]:
 
 
 # ----------------------------------------------------------------------------------------
-def _schedule(total: int, save_steps: list[int], deletions: list[tuple[int, np.ndarray]]):
+# explicit (irregular) save schedules longer than this are refused: regular ones are loops
+MAX_IRREGULAR_SAVES = 100_000
+
+
+class SaveSteps:
+    """The steps at which frames are saved, in order, without listing them: every ``period``
+    steps up to ``total`` (and ``total``), or a short explicit list."""
+
+    def __init__(self, total: int, period: int | None = None, explicit: list[int] | None = None):
+        self.total, self.period = total, period
+        self.explicit = sorted(set(explicit)) if explicit is not None else None
+
+    def __iter__(self):
+        if self.explicit is not None:
+            yield from self.explicit
+            return
+        yield from range(0, self.total + 1, self.period)
+        if self.total % self.period:
+            yield self.total
+
+    def __len__(self) -> int:
+        if self.explicit is not None:
+            return len(self.explicit)
+        return self.total // self.period + 1 + (1 if self.total % self.period else 0)
+
+    def __contains__(self, step: int) -> bool:
+        if self.explicit is not None:
+            return step in self.explicit
+        return 0 <= step <= self.total and (step % self.period == 0 or step == self.total)
+
+    def __eq__(self, other) -> bool:
+        return list(self) == list(other)
+
+
+def _schedule(total: int, saves: SaveSteps, deletions: list[tuple[int, np.ndarray]]):
+    """Actions of the script: runs (in pieces of at most 1/50 of the run, for progress),
+    activity-end deletions and frames.  A stretch of regular saves with no deletion in it is
+    one LAMMPS loop ("loop" ... "end"), so the script does not grow with the number of frames."""
     piece = max(1, math.ceil(total / 50))
     acts: list[tuple] = [("run0",), ("frame", 0)]
-    events = sorted(set(save_steps) | {s for s, _ in deletions})
     dels = {s: rows for s, rows in deletions}
-    saves = set(save_steps)
     step, pre = 0, False
-    for ev in events:
-        if ev <= 0:
-            continue
+
+    def event(ev: int) -> None:
+        nonlocal step, pre
         while step < ev:
             n = min(piece, ev - step)
             acts.append(("run", n, pre))
@@ -168,24 +202,66 @@ def _schedule(total: int, save_steps: list[int], deletions: list[tuple[int, np.n
             pre = True
         if ev in saves:
             acts.append(("frame", ev))
+
+    if saves.explicit is not None:
+        for ev in sorted(set(saves.explicit) | set(dels)):
+            if ev > 0:
+                event(ev)
+        return acts
+    k = saves.period
+    last_regular = (total // k) * k
+    for stop in sorted(d for d in dels if d > 0) + [None]:
+        limit = min(stop - 1 if stop is not None else total, last_regular)
+        first = (step // k + 1) * k
+        if first <= limit:
+            event(first)                  # its gap (or pre) may differ from the regular ones
+            more = (limit - first) // k
+            if more == 1:
+                event(first + k)
+            elif more > 1:
+                name = f"fl_loop{sum(1 for a in acts if a[0] == 'loop') + 1}"
+                acts.append(("loop", name, more))
+                body_step, n_left = step, k
+                while n_left > 0:
+                    n = min(piece, n_left)
+                    acts.append(("run", n, False))
+                    n_left -= n
+                acts.append(("frame", None))
+                acts.append(("end", name))
+                step = body_step + more * k
+        if stop is not None:
+            event(stop)
+    if step < total:
+        event(total)
     return acts
 
 
-def _save_steps(model: GranularModel, total: int, dt: float) -> list[int]:
+def _save_steps(model: GranularModel, total: int, dt: float) -> SaveSteps:
     plan = model.plan
-    steps = {0, total}
     if plan.save_every_steps:
         k = int(plan.save_every_steps)
         if k <= 0:
             raise InputError(model.source, None, f"save interval must be > 0 steps, got {k}")
-        steps.update(range(0, total + 1, k))
-    elif plan.save_every_time:
+        return SaveSteps(total, period=k)
+    if plan.save_every_time:
         dts = float(plan.save_every_time)
         if not dts > 0:
             raise InputError(model.source, None, f"save interval must be > 0, got {dts!r}")
-        j = np.arange(0, int(math.floor(total * dt / dts * (1 + 1e-12))) + 1)
+        count = int(math.floor(total * dt / dts * (1 + 1e-12)))     # saves after the first
+        ratio = dts / dt
+        k = int(round(ratio))
+        # j * ratio rounds to j * k for every j <= count: the saves are regular
+        if k >= 1 and abs(ratio - k) * count + 1e-15 * ratio * count < 0.25:
+            return SaveSteps(total, period=k)
+        if count > MAX_IRREGULAR_SAVES:
+            raise InputError(model.source, None, f"the saving step {dts:g} s is not a multiple of "
+                             f"the simulation step {dt:g} s and the run saves {count + 1} times: "
+                             "make the saving step a multiple of the simulation step")
+        j = np.arange(0, count + 1)
+        steps = {0, total}
         steps.update(int(s) for s in np.rint(j * dts / dt) if 0 <= s <= total)
-    return sorted(steps)
+        return SaveSteps(total, explicit=sorted(steps))
+    return SaveSteps(total, explicit=[0, total])
 
 
 def _tol_bins(values: np.ndarray, rtol: float) -> np.ndarray:
@@ -577,7 +653,7 @@ def build_granular_job(model: GranularModel, folder: str | Path):
     script_path = folder / SCRIPT_NAME
     job = GranularJob(
         folder=folder, script=script_path, data=data_path, total_steps=total,
-        save_steps=save_steps, save_times=[t_start + s * dt for s in save_steps],
+        save_steps=save_steps,
         frames=folder / FRAMES_NAME,
         bond_dump=folder / BONDS_NAME if has_bonds else None,
         tile_dump=folder / TILES_NAME if tile_total else None,

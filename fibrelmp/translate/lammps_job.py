@@ -32,7 +32,7 @@ class Job:
     frames: Path
     total_steps: int
     type_of_ltype: np.ndarray            # LAMMPS type (1-based, index 0 unused) -> user type
-    output_steps: list[int] = field(default_factory=list)
+    output_steps: object = ()              # the steps of the frames (lazy: range-like)
     text: str = ""                        # the script, also when only rank 0 wrote files
 
 
@@ -109,16 +109,18 @@ def angle_expression(c: float, theta0: float) -> str:
             f"-{_fmt(c)}*theta^2;phi={_fmt(u)}-theta")
 
 
-def _schedule(model: Model, general_lambda: bool) -> tuple[list[tuple], list[int], int]:
+def _schedule(model: Model, general_lambda: bool) -> tuple[list[tuple], range, int]:
     """The sequence of actions the script performs (see the template for each action).
 
     FibreNet's first step of a fresh start (or after a velocity reset) uses a stored force
-    instead of F(x): the "kick" action reproduces that step exactly.
+    instead of F(x): the "kick" action reproduces that step exactly.  Repeated identical
+    chunks (relaxation chunks with resets, production chunks between frames) become one
+    LAMMPS loop ("loop" ... "end"), so the script does not grow with the number of frames.
+    Returns the actions, the output steps (a lazy range) and the total number of steps.
     """
     acts: list[tuple] = []
     total = sum(st.steps for st in model.plan.stages)
     piece = max(1, math.ceil(total / 50))          # progress granularity
-    out_steps: list[int] = []
     fresh = True                                   # next step starts from the stored state
 
     def advance(n: int, store_before_last: bool) -> None:
@@ -140,32 +142,68 @@ def _schedule(model: Model, general_lambda: bool) -> tuple[list[tuple], list[int
             acts.append(("store_force",))
             acts.append(("run", 1))
 
+    def repeat(count: int, body) -> None:
+        """``body()`` ``count`` times: as a loop when that is shorter than writing it out."""
+        if count <= 0:
+            return
+        if count == 1:
+            body()
+            return
+        name = f"fn_loop{sum(1 for a in acts if a[0] == 'loop') + 1}"
+        acts.append(("loop", name, count))
+        body()
+        acts.append(("end", name))
+
     relax = [st for st in model.plan.stages if st.name == "relax"]
     production = [st for st in model.plan.stages if st.name == "production"][0]
     frame0 = "state"
     if relax:
         st = relax[0]
         if st.reset:        # FibreNet zeroes v and F before and after every chunk
-            for _ in range(st.steps // st.chunk):
+            def chunk() -> None:
+                nonlocal fresh
                 acts.append(("reset",))
                 fresh = True
                 advance(st.chunk, False)
+            repeat(st.steps // st.chunk, chunk)
             acts.append(("reset",))
             fresh = True
         else:               # without resets the chunks are one continuous damped run
             advance(st.steps, general_lambda)
             frame0 = "dynamic"
         acts.append(("reset_timestep",))
-    acts.append(("frame", frame0, 0))
-    out_steps.append(0)
-    step = 0
-    while step < production.steps:
-        n = min(production.chunk, production.steps - step)
+    acts.append(("frame", frame0))
+    every, steps = production.chunk, production.steps
+
+    def frame_chunk(n: int) -> None:
         advance(n, general_lambda and not (fresh and n == 1))
-        step += n
-        acts.append(("frame", "dynamic", step))
-        out_steps.append(step)
+        acts.append(("frame", "dynamic"))
+
+    if steps > 0:
+        first = min(every, steps)
+        frame_chunk(first)                   # a fresh start begins with the kick
+        full, rest = divmod(steps - first, every)
+        repeat(full, lambda: frame_chunk(every))
+        if rest:
+            frame_chunk(rest)
+    out_steps = range(0, steps + every, every) if steps % every == 0 else None
+    if out_steps is None:
+        out_steps = _Steps(every, steps)
     return acts, out_steps, total
+
+
+class _Steps:
+    """0, every, 2 every, ..., and ``last`` (a partial last chunk): lazily."""
+
+    def __init__(self, every: int, last: int):
+        self.every, self.last = every, last
+
+    def __iter__(self):
+        yield from range(0, self.last, self.every)
+        yield self.last
+
+    def __len__(self) -> int:
+        return len(range(0, self.last, self.every)) + 1
 
 
 def write_job(model: Model, folder: str | Path, write_files: bool = True) -> Job:

@@ -1,0 +1,164 @@
+"""Where a run writes, checked and locked before LAMMPS starts.
+
+Every run (FibreNet, MUSEN scene, cmusen script, DEMDF) describes its outputs as an
+``Outputs``: the exact files it writes, the files of earlier runs it replaces (a family: all
+four FibreNet files, every ``<filename>_<n>.json`` snapshot), the files it reads (never
+overwritten) and its work folder.  ``prepare`` refuses, as an InputError before anything is
+written, an output that is an input, a location under a regular file or not writable, and
+existing results unless ``force``; then it creates the folders and takes an exclusive lock on
+each (``flock`` on the folder itself: nothing is left behind, and a killed run releases it).
+``finish`` removes what an earlier run wrote that this run did not (``--force`` replaces
+results completely).
+"""
+
+from __future__ import annotations
+
+import errno
+import fcntl
+import os
+import re
+import tempfile
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Iterator
+
+from .errors import InputError
+
+
+@dataclass
+class Outputs:
+    source: Path                                    # the input (for messages)
+    work: Path                                      # job folder(s) live here
+    files: list[Path] = field(default_factory=list)         # written by this run
+    family: list[Path] = field(default_factory=list)        # earlier runs' files this run replaces
+    patterns: list[tuple[Path, re.Pattern]] = field(default_factory=list)   # families by name
+    inputs: list[Path] = field(default_factory=list)        # read by this run: never written
+
+    def folders(self) -> list[Path]:
+        found = {f.parent for f in self.files} | {f.parent for f in self.family} | \
+            {folder for folder, _ in self.patterns}
+        return sorted(found | {self.work})
+
+    def existing(self) -> list[Path]:
+        """Results of earlier runs this run would replace."""
+        found = [f for f in dict.fromkeys(self.files + self.family) if f.is_file()]
+        for folder, pattern in self.patterns:
+            if folder.is_dir():
+                found += sorted(p for p in folder.iterdir() if pattern.fullmatch(p.name) and p.is_file())
+        return list(dict.fromkeys(found))
+
+
+def inside(path: Path, folder: Path) -> bool:
+    """Is ``path`` (resolved) ``folder`` or below it?"""
+    try:
+        Path(path).resolve().relative_to(Path(folder).resolve())
+        return True
+    except ValueError:
+        return False
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    try:
+        return a.resolve() == b.resolve() or (a.exists() and b.exists() and os.path.samefile(a, b))
+    except OSError:
+        return False
+
+
+def _check_location(path: Path, what: str, source: Path) -> None:
+    """``path`` can be created: its nearest existing ancestor is a writable folder."""
+    if path.is_dir() and what == "output":
+        raise InputError(path, None, "is a directory, but fibrelmp writes a result file there")
+    probe = path.parent if what == "output" else path
+    while not probe.exists():
+        if probe.is_symlink():
+            raise InputError(probe, None, f"{what} location: a broken symbolic link")
+        probe = probe.parent
+    if not probe.is_dir():
+        raise InputError(probe, None, f"is a file, so the {what} location {path} cannot be created below it")
+    if not os.access(probe, os.W_OK | os.X_OK):
+        raise InputError(probe, None, f"{what} location {path}: this folder is not writable")
+
+
+def check(outputs: Outputs, force: bool) -> None:
+    """Everything about the locations that can be known before the run (no side effects)."""
+    for out in outputs.files + outputs.family:
+        for inp in outputs.inputs:
+            if _same_file(out, inp):
+                raise InputError(out, None, f"is an input of this run ({outputs.source}) and would "
+                                 "be overwritten by a result: choose another result name")
+        _check_location(out, "output", outputs.source)
+    for inp in outputs.inputs:
+        if inside(inp, outputs.work) and Path(inp).resolve() != Path(outputs.work).resolve():
+            raise InputError(outputs.work, None, f"the work folder contains the input {inp}, "
+                             "and fibrelmp clears work folders: choose another --work")
+    _check_location(outputs.work, "work folder", outputs.source)
+    if outputs.work.exists() and not outputs.work.is_dir():
+        raise InputError(outputs.work, None, "is a file, not a folder (--work)")
+    if not force:
+        old = outputs.existing()
+        if old:
+            more = f" and {len(old) - 1} more" if len(old) > 1 else ""
+            raise InputError(old[0], None, f"exists already{more} (results of an earlier run): "
+                             "give --force to replace them, or choose another output location")
+
+
+@contextmanager
+def locked(outputs: Outputs, force: bool, rank: int = 0) -> Iterator[Outputs]:
+    """Check, create the folders, lock them for this run; rank 0 only does the file work
+    (other MPI ranks only check)."""
+    check(outputs, force)
+    if rank != 0:
+        yield outputs
+        return
+    fds: list[int] = []
+    try:
+        for folder in outputs.folders():
+            try:
+                folder.mkdir(parents=True, exist_ok=True)
+                fd = os.open(folder, os.O_RDONLY | os.O_DIRECTORY)
+            except OSError as exc:
+                raise InputError(folder, None, f"cannot create the folder: {exc.strerror or exc}") from None
+            fds.append(fd)
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError as exc:
+                if exc.errno in (errno.EWOULDBLOCK, errno.EACCES):
+                    raise InputError(folder, None, "another fibrelmp run is using this folder; "
+                                     "wait for it to finish, or choose another output/work "
+                                     "location") from None
+                raise
+            try:     # writable in fact (read-only mounts, quotas), not just by its mode bits
+                fh, name = tempfile.mkstemp(prefix=".fibrelmp-probe-", dir=folder)
+                os.close(fh)
+                os.unlink(name)
+            except OSError as exc:
+                raise InputError(folder, None, f"cannot write here: {exc.strerror or exc}") from None
+        _remove_stale_temps(outputs)
+        yield outputs
+    finally:
+        for fd in fds:
+            os.close(fd)          # closing releases the lock
+
+
+def _remove_stale_temps(outputs: Outputs) -> None:
+    """Temp files of a killed earlier run (SIGKILL leaves no chance to clean up)."""
+    names = {f.name for f in outputs.files + outputs.family}
+    for folder in {f.parent for f in outputs.files + outputs.family} | {p for p, _ in outputs.patterns}:
+        if not folder.is_dir():
+            continue
+        for p in folder.glob(".*.tmp*"):
+            base = p.name[1:].split(".tmp", 1)[0]
+            if base in names or any(pat.fullmatch(base) for fo, pat in outputs.patterns if fo == folder):
+                p.unlink(missing_ok=True)
+
+
+def finish(outputs: Outputs, written: list[Path]) -> list[Path]:
+    """After success: remove the earlier runs' files this run did not write again."""
+    keep = {Path(p).resolve() for p in written}
+    removed = []
+    for old in outputs.existing():
+        if old.resolve() not in keep:
+            old.unlink(missing_ok=True)
+            removed.append(old)
+    return removed

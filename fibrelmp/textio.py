@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import errno
 import math
 import os
 from pathlib import Path
@@ -9,7 +10,7 @@ from typing import Callable
 
 import numpy as np
 
-from .errors import InputError
+from .errors import InputError, RunError
 
 
 # In-memory replacements of files, keyed by absolute path: ``collect_errors`` re-reads an
@@ -23,20 +24,22 @@ def _overlay_key(path: str | os.PathLike) -> str:
 
 
 def read_text(path: str | os.PathLike, what: str = "file") -> str:
-    """Read a text file; every failure becomes an InputError naming the path."""
+    """Read a text file; every failure becomes an InputError naming the path.
+
+    What went wrong comes from the read itself (not from checks made before it), so a
+    directory is "is a directory", an unreadable file "cannot read" and only a path that
+    does not exist "not found"."""
     p = Path(path)
     if _OVERLAY:
         patched = _OVERLAY.get(_overlay_key(p))
         if patched is not None:
             return patched
-    if not p.exists():
-        raise InputError(p, None, f"{what} not found")
-    if p.is_dir():
-        raise InputError(p, None, f"{what} is a directory, expected a text file")
     try:
         raw = p.read_bytes()
     except OSError as exc:
-        raise InputError(p, None, f"cannot read {what}: {exc.strerror or exc}") from None
+        raise InputError(p, None, read_failure(exc, what)) from None
+    except ValueError:                      # a NUL byte in the name: no such file
+        raise InputError(p, None, f"{what} not found") from None
     if raw.startswith((b"\xff\xfe", b"\xfe\xff")):
         # about the whole file, so no line number
         raise InputError(p, None, f"{what} is UTF-16 encoded; save it as UTF-8 or ASCII text")
@@ -49,6 +52,15 @@ def read_text(path: str | os.PathLike, what: str = "file") -> str:
     except UnicodeDecodeError as exc:
         line = raw[: exc.start].count(b"\n") + 1
         raise InputError(p, line, f"{what} is not valid UTF-8 text (byte {exc.start})") from None
+
+
+def read_failure(exc: OSError, what: str = "file") -> str:
+    """The message for an OSError met opening or reading an input file."""
+    if isinstance(exc, IsADirectoryError):
+        return f"{what} is a directory, expected a file"
+    if isinstance(exc, (FileNotFoundError, NotADirectoryError)):
+        return f"{what} not found"
+    return f"cannot read {what}: {exc.strerror or exc}"
 
 
 def read_bytes(path: str | os.PathLike) -> bytes:
@@ -133,21 +145,61 @@ def integer_column(values: np.ndarray, table: np.ndarray, col: int, path: Path,
     return column.astype(np.int64)
 
 
-def atomic_write(path: str | os.PathLike, data: str | bytes) -> None:
-    """Write a file through a temp file + rename so no half-written output is left."""
-    p = Path(path)
-    tmp = p.with_name(f".{p.name}.tmp{os.getpid()}")
-    mode = "wb" if isinstance(data, bytes) else "w"
-    try:
-        with open(tmp, mode) as fh:
-            fh.write(data)
-        os.replace(tmp, p)
-    except OSError as exc:
+# errors that mean the output path itself is wrong (exit 2, as bad input); any other
+# failure while writing -- a full disk, a quota, an I/O error -- is the machine's (exit 1)
+_PATH_ERRNOS = {errno.EACCES, errno.EPERM, errno.EROFS, errno.ENOTDIR, errno.ENOENT,
+                errno.EISDIR, errno.ENAMETOOLONG, errno.ELOOP}
+
+
+def write_failure(path: str | os.PathLike, exc: OSError) -> InputError | RunError:
+    """The error to raise when writing the output ``path`` failed with ``exc``: it names
+    the output (not a temp file) and the reason, e.g. ``out.xyz: cannot write output: No
+    space left on device``."""
+    reason = exc.strerror or str(exc) or type(exc).__name__
+    if exc.errno in _PATH_ERRNOS:
+        return InputError(path, None, f"cannot write output: {reason}")
+    return RunError(f"{path}: cannot write output: {reason}")
+
+
+def discard(tmp: str | os.PathLike, fh=None) -> None:
+    """Close ``fh`` (its buffered data may fail to flush on a full disk: ignored) and remove
+    the temp file ``tmp``; never raises."""
+    if fh is not None:
         try:
-            tmp.unlink()
+            fh.close()
         except OSError:
             pass
-        raise InputError(p, None, f"cannot write output: {exc.strerror or exc}") from None
+    try:
+        os.unlink(tmp)
+    except OSError:
+        pass
+
+
+def temp_name(path: str | os.PathLike) -> Path:
+    """The temp file beside ``path`` an atomic write goes through."""
+    p = Path(path)
+    return p.with_name(f".{p.name}.tmp{os.getpid()}")
+
+
+def atomic_write(path: str | os.PathLike, data: str | bytes) -> None:
+    """Write a file through a temp file + rename so no half-written output is left.
+
+    On any failure the temp file is removed and the error names ``path`` (write_failure)."""
+    p = Path(path)
+    tmp = temp_name(p)
+    mode = "wb" if isinstance(data, bytes) else "w"
+    fh = None
+    try:
+        fh = open(tmp, mode)
+        fh.write(data)
+        fh.close()
+        os.replace(tmp, p)
+    except OSError as exc:
+        discard(tmp, fh)
+        raise write_failure(p, exc) from None
+    except BaseException:
+        discard(tmp, fh)
+        raise
 
 
 def format_rows(fmt_row: str, columns: list) -> str:

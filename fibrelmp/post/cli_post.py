@@ -15,7 +15,8 @@ from typing import Callable, Iterator
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, RunError
+from ..textio import write_failure
 from .lammps_dump import Frame, frame_from, iter_frames, iter_headers
 
 FORMATS = ("xyz", "res", "mercury", "vtk", "musen", "demdf")
@@ -167,6 +168,8 @@ class Completer:
         self.warned: set[str] = set()
         self.labels = {v: k for k, v in names.items()}
         self.keep = self._types(types) if types else None
+        self.kept_any = False            # --types: some frame had an atom of those types
+        self.present: set[int] = set()   # types met until then (for the error if none is)
 
     def _types(self, tokens: list[str]) -> set[int]:
         out = set()
@@ -255,8 +258,24 @@ class Completer:
                                      f"{out.vector(*names)[k].tolist()} in the frame of step "
                                      f"{frame.step} (did the simulation blow up?)")
         if self.keep is not None:
-            out = out.select(np.isin(cols["type"].astype(np.int64), list(self.keep)))
+            codes = cols["type"].astype(np.int64)
+            mask = np.isin(codes, list(self.keep))
+            if not self.kept_any:
+                self.kept_any = bool(mask.any())
+                if not self.kept_any:
+                    self.present.update(np.unique(codes).tolist())
+            out = out.select(mask)
         return out
+
+    def check_types(self, source) -> None:
+        """``--types`` selecting no atom of any frame read is an error, not empty frames."""
+        if self.keep is None or self.kept_any:
+            return
+        name = lambda t: f"{self.names[t]}={t}" if t in self.names else str(t)     # noqa: E731
+        have = ", ".join(name(t) for t in sorted(self.present)) or "none (no atoms)"
+        raise InputError(source, None, f"--types {', '.join(name(t) for t in sorted(self.keep))}: "
+                         f"no atom of the selected frames has these types (types present: "
+                         f"{have}); nothing written")
 
 
 # -- the command -----------------------------------------------------------------------------
@@ -392,7 +411,11 @@ def _convert(dump, to, base, source, data, types, frames, local, gravity, warnin
     targets = {"xyz": ("FibreNet", LJ), "res": ("FibreNet", LJ), "musen": ("MUSEN", SI)}
     complete = Completer(datafile, types, names, warnings, targets.get(to))
     sel = Selection(frames, default_last=(to == "res"))
-    stream = (complete(f) for f in source.frames(sel, last_only=(to == "res" and frames is None)))
+
+    def completed():
+        yield from (complete(f) for f in source.frames(sel, last_only=(to == "res" and frames is None)))
+        complete.check_types(dump)        # before the writers finish their files
+    stream = completed()
 
     def warn(kind: str, text: str) -> None:
         if kind not in {k for k, _ in warnings}:
@@ -404,10 +427,16 @@ def _convert(dump, to, base, source, data, types, frames, local, gravity, warnin
     try:
         stage = Path(tempfile.mkdtemp(prefix=f".{base.name}.post-", dir=base.parent))
     except OSError as exc:
-        raise InputError(base.parent, None, f"cannot write output: {exc.strerror or exc}") from None
+        raise write_failure(base.parent, exc) from None
     try:
-        written = _CONVERTERS[to](stream, stage / base.name, datafile, names, source, local,
-                                  gravity, warn, warnings)
+        try:
+            written = _CONVERTERS[to](stream, stage / base.name, datafile, names, source, local,
+                                      gravity, warn, warnings)
+        except (InputError, RunError) as exc:
+            raise _unstaged(exc, stage, base.parent) from None
+        except OSError as exc:            # a writer without its own message (mercury's .data...)
+            raise _unstaged(write_failure(base, exc), stage, base.parent) from None
+        complete.check_types(dump)
         if not written:
             raise InputError(dump, None, "no complete frame was selected; nothing written")
         if to == "vtk":
@@ -419,11 +448,23 @@ def _convert(dump, to, base, source, data, types, frames, local, gravity, warnin
             try:
                 os.replace(path, target)
             except OSError as exc:
-                raise InputError(target, None, f"cannot write output: {exc.strerror or exc}") from None
+                raise write_failure(target, exc) from None
             final.append(target)
         return final
     finally:
         shutil.rmtree(stage, ignore_errors=True)
+
+
+def _unstaged(exc: InputError | RunError, stage: Path, folder: Path) -> InputError | RunError:
+    """``exc`` with the outputs' staging folder in its path or message replaced by the output
+    folder: a writer's error (a full disk...) names the output the user asked for."""
+    staged = str(stage)
+    if isinstance(exc, InputError):
+        if exc.path is None or not exc.path.startswith(staged):
+            return exc
+        return InputError(str(folder) + exc.path[len(staged):], exc.line, exc.message)
+    text = Exception.__str__(exc)
+    return RunError(text.replace(staged, str(folder))) if staged in text else exc
 
 
 class _Names(dict):

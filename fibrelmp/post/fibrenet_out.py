@@ -13,7 +13,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from ..textio import atomic_write, format_rows, parse_table, read_text
+from ..textio import (atomic_write, discard, format_rows, parse_table, read_text, temp_name,
+                      write_failure)
 from .fastparse import format_xyz_parts
 from .textfmt import fixed_chars, join_fields, name_chars
 
@@ -63,31 +64,47 @@ def xyz_frame(step: int, dt: float, lengths: np.ndarray, names: np.ndarray, valu
 
 
 class XyzWriter:
-    """Append frames to a temp file; ``close`` renames it into place (no half outputs)."""
+    """Append frames to a temp file; ``close`` renames it into place (no half outputs).
+
+    Any OSError (a full disk...) removes the temp file and raises ``write_failure``'s
+    error naming the output."""
 
     def __init__(self, path: str | Path):
         self.path = Path(path)
-        self.tmp = self.path.with_name(f".{self.path.name}.tmp{os.getpid()}")
+        self.tmp = temp_name(self.path)
+        self.fh = None
         try:
             self.fh = open(self.tmp, "wb")
         except OSError as exc:
-            raise InputError(self.path, None, f"cannot write output: {exc.strerror or exc}") from None
+            self._fail(exc)
+
+    def _fail(self, exc: OSError):
+        self.abort()
+        raise write_failure(self.path, exc) from None
 
     def write(self, step: int, dt: float, lengths: np.ndarray, names: np.ndarray, values: np.ndarray) -> None:
-        self.fh.write(xyz_frame(step, dt, lengths, names, values).encode())
+        try:
+            self.fh.write(xyz_frame(step, dt, lengths, names, values).encode())
+        except OSError as exc:
+            self._fail(exc)
 
     def write_codes(self, step: int, dt: float, lengths: np.ndarray, codes: np.ndarray, table: list[str],
                     values: np.ndarray) -> None:
-        for part in xyz_frame_parts(step, dt, lengths, codes, table, values):
-            self.fh.write(part)
+        try:
+            for part in xyz_frame_parts(step, dt, lengths, codes, table, values):
+                self.fh.write(part)
+        except OSError as exc:
+            self._fail(exc)
 
     def close(self) -> None:
-        self.fh.close()
-        os.replace(self.tmp, self.path)
+        try:
+            self.fh.close()
+            os.replace(self.tmp, self.path)
+        except OSError as exc:
+            self._fail(exc)
 
     def abort(self) -> None:
-        self.fh.close()
-        self.tmp.unlink(missing_ok=True)
+        discard(self.tmp, self.fh)
 
 
 def _g(x: float) -> str:

@@ -6,8 +6,9 @@ of its ``ITEM: ATOMS`` (or ``ITEM: ENTRIES``) block; the block's length is the f
 by one C-level call (the optional C parser of ``fastparse``, else ``np.loadtxt``); memory holds one frame at a time, read in chunks, so
 a 10 GB dump converts frame by frame.  ``.gz`` dumps are read through gzip.
 
-A truncated last frame is dropped with a warning; every other defect is an InputError
-``path:line: message``.
+Only the real end of the file truncates: a last frame cut there is dropped with a warning.
+Every other defect -- among them a ``NUMBER OF ATOMS`` that does not match the atom lines of
+its frame, wherever the frame is -- is an InputError ``path:line: message`` naming the frame.
 """
 
 from __future__ import annotations
@@ -256,9 +257,31 @@ def _decode(raw: bytes) -> str:
     return raw.decode("utf-8", "replace").strip()
 
 
-def _read_header(st: _Stream, path: Path, first: bytes,
-                 warnings: list | None) -> Header | None:
-    """Parse the ITEM lines of one frame, ``first`` being its first (already read) line."""
+def _frame_name(index: int, head: Header) -> str:
+    """How messages name a frame: its index (from 0, as ``--frames`` counts), step and first
+    line."""
+    return f"frame {index}: step {head.step}, from line {head.line}"
+
+
+def _miscount(rows: int, head: Header) -> str:
+    """The message for an 'ITEM:' line met after ``rows`` atom lines of the frame ``head``."""
+    frame = (_frame_name(head.extra["index"], head) if "index" in head.extra
+             else f"step {head.step}, from line {head.line}")
+    return f"frame has {rows} atom lines but NUMBER OF {head.kind} says {head.count} ({frame})"
+
+
+def _item_row(block: bytes) -> int | None:
+    """Row (from 0) of the first line of ``block`` that starts with 'ITEM:', or None."""
+    if block.startswith(b"ITEM:"):
+        return 0
+    k = block.find(b"\nITEM:")
+    return None if k < 0 else block.count(b"\n", 0, k + 1)
+
+
+def _read_header(st: _Stream, path: Path, first: bytes, warnings: list | None,
+                 prev: tuple[int, Header] | None = None) -> Header | None:
+    """Parse the ITEM lines of one frame, ``first`` being its first (already read) line;
+    ``prev`` is (index, header) of the frame before it."""
     start = st.line
     step = count = None
     time = units = tilt = None
@@ -269,11 +292,13 @@ def _read_header(st: _Stream, path: Path, first: bytes,
         if not text.startswith("ITEM:"):
             if line is not first:
                 msg = f"expected an 'ITEM:' line, got {text[:60]!r}"
-            elif start == 1:
+            elif prev is None:
                 msg = f"not a LAMMPS text dump: expected 'ITEM: TIMESTEP', got {text[:60]!r}"
             else:
+                i, ph = prev
                 msg = (f"expected 'ITEM: TIMESTEP' starting the next frame, got {text[:60]!r} "
-                       "(more atom lines than the previous frame's NUMBER OF ATOMS?)")
+                       f"(more atom lines than NUMBER OF {ph.kind} {ph.count} of "
+                       f"{_frame_name(i, ph)}?)")
             raise InputError(path, st.line, msg)
         item = text[5:].strip()
         if item.startswith(("ATOMS", "ENTRIES")):
@@ -372,11 +397,10 @@ def _parse_slow(block: bytes, head: Header, path) -> dict[str, np.ndarray]:
     rows = block.decode("utf-8", "replace").split("\n")[:head.count]
     ncol = len(head.names)
     for k, row in enumerate(rows):
+        if row.startswith("ITEM:"):
+            raise InputError(path, first + k, _miscount(k, head))
         got = len(row.split())
         if got != ncol:
-            if row.startswith("ITEM:"):
-                raise InputError(path, first + k, f"frame has {k} atom lines but NUMBER OF "
-                                 f"{head.kind} says {head.count}")
             raise InputError(path, first + k, f"atom line has {got} values; ITEM: {head.kind} "
                              f"names {ncol} columns ({' '.join(head.names)})")
     table = np.array(" ".join(rows).split(), dtype=object).reshape(len(rows), ncol)
@@ -401,8 +425,13 @@ Selector = Callable[[int, "Header"], bool]
 
 
 def iter_headers(path: str | Path, warnings: list[tuple[str, str]] | None = None,
-                 want: Selector | None = None) -> Iterator[tuple[Header, bytes | None]]:
-    """Yield (header, atom block bytes or None if ``want(index, header)`` is False)."""
+                 want: Selector | None = None,
+                 parsed: bool = False) -> Iterator[tuple[Header, bytes | None]]:
+    """Yield (header, atom block bytes or None if ``want(index, header)`` is False).
+
+    ``parsed``: the caller parses every block it gets (``frame_from``), which reports an
+    'ITEM:' line among the atom lines itself; the blocks are then not scanned for one here.
+    """
     path = Path(path)
     if not path.exists():
         raise InputError(path, None, "dump file not found")
@@ -416,6 +445,7 @@ def iter_headers(path: str | Path, warnings: list[tuple[str, str]] | None = None
         st = _Stream(fh, path)
         index = 0
         seen_any = False
+        prev = None
         while True:
             line = st.readline()
             if line is None:
@@ -427,12 +457,22 @@ def iter_headers(path: str | Path, warnings: list[tuple[str, str]] | None = None
                                  "expected (binary dumps are not supported)")
             if not line.strip():
                 continue
-            head = _read_header(st, path, line, warnings)
+            head = _read_header(st, path, line, warnings, prev)
             if head is None:
                 return
             seen_any = True
             head.extra["header_lines"] = st.line - head.line + 1
+            head.extra["index"] = index
             block, got = st.lines(head.count)
+            wanted = want is None or want(index, head)
+            if not (parsed and wanted) or got < head.count or not block.endswith(b"\n"):
+                # The next frame beginning inside this one's atom block is a wrong NUMBER OF
+                # ATOMS, not a truncated file (only the end of the file truncates).  A block
+                # that is parsed finds this itself (_parse_slow): no second scan for it.
+                row = _item_row(block)
+                if row is not None:
+                    raise InputError(path, head.line + head.extra["header_lines"] + row,
+                                     _miscount(row, head))
             if got < head.count:
                 if warnings is not None:
                     warnings.append(("truncated dump", f"{path}:{head.line}: last frame has {got} "
@@ -446,7 +486,8 @@ def iter_headers(path: str | Path, warnings: list[tuple[str, str]] | None = None
                         warnings.append(("truncated dump", f"{path}:{head.line}: last frame ends "
                                          "inside an atom line; ignored"))
                     return
-            yield head, (block if want is None or want(index, head) else None)
+            yield head, (block if wanted else None)
+            prev = (index, head)
             index += 1
 
 
@@ -462,7 +503,7 @@ def iter_frames(path: str | Path, warnings: list[tuple[str, str]] | None = None,
 
     ``want(index, header)`` (optional) skips frames without parsing their atom blocks.
     """
-    for head, block in iter_headers(path, warnings, want):
+    for head, block in iter_headers(path, warnings, want, parsed=True):
         if block is not None:
             yield frame_from(head, block, path)
 

@@ -22,8 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError, RunError
 from ..granmodel import GranularFrame, GranularModel
+from ..textio import temp_name, write_failure
 from ..translate.musen import (ACTIVE_INTERACTIONS, ACTIVE_PROPERTIES, DEFAULT_ACTIVITY_END,
                                PROPERTY_DEFAULTS)
 
@@ -105,8 +105,8 @@ class MusenResultWriter:
             self.spool = Path(tempfile.mkdtemp(prefix=f".{self.path.name}.spool.",
                                                dir=self.path.parent))
         except OSError as exc:
-            raise InputError(self.path, None, f"cannot write output: {exc.strerror or exc}") from None
-        self.tmp = self.path.with_name(f".{self.path.name}.tmp{os.getpid()}")
+            raise write_failure(self.path, exc) from None
+        self.tmp = temp_name(self.path)
 
     # ------------------------------------------------------------------ frames
     def add(self, frame: GranularFrame) -> None:
@@ -138,9 +138,9 @@ class MusenResultWriter:
             for name, block in blocks.items():        # one growing (T, n, K) file per type
                 with open(self.spool / f"{name}.bin", "ab") as fh:
                     fh.write(np.ascontiguousarray(block, np.float64).tobytes())
-        except OSError as exc:
-            raise RunError(f"cannot spool MUSEN result frame to {self.spool}: "
-                           f"{exc.strerror or exc}") from None
+        except OSError as exc:          # the spool is part of the output being written
+            self.abort()
+            raise write_failure(self.path, exc) from None
         self.times.append(t)
 
     def _sphere_block(self, f: GranularFrame, rows: np.ndarray) -> np.ndarray:
@@ -195,7 +195,7 @@ class MusenResultWriter:
             os.replace(self.tmp, self.path)
         except OSError as exc:
             self.abort()
-            raise InputError(self.path, None, f"cannot write output: {exc.strerror or exc}") from None
+            raise write_failure(self.path, exc) from None
         except BaseException:
             self.abort()
             raise

@@ -15,6 +15,7 @@ from typing import Callable
 
 from ._lammps import new_lammps
 from .errors import RunError
+from .lammps_text import input_lines, read_script
 
 from typing import TYPE_CHECKING
 
@@ -69,8 +70,8 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
     script = Path(script)
     rank, size = mpi_rank_size()
     args = ["-nocite", "-log", "log.lammps" if log and rank == 0 else "none", "-screen", "none"]
-    script_text = text if text is not None else script.read_text()
-    lines = script_text.splitlines()
+    script_text = text if text is not None else read_script(script)
+    lines = input_lines(script_text, script)      # exactly the lines `lmp -in` executes
     cwd = os.getcwd()
     bar = Progress(total_steps, progress and rank == 0)
     resume = checkpoints.resume if checkpoints is not None else None

@@ -35,7 +35,9 @@ from _common import load_generator  # noqa: E402
 
 def setup_and_read_data(script: Path) -> tuple[list[str], str]:
     """The commands of in.lammps before ``read_data`` and the read_data line itself."""
-    lines = [ln.strip() for ln in script.read_text().splitlines()]
+    from fibrelmp.lammps_text import input_lines, read_script
+
+    lines = [ln.strip() for ln in input_lines(read_script(script), script)]
     lines = [ln for ln in lines if ln and not ln.startswith("#")]
     k = next(i for i, ln in enumerate(lines) if ln.split()[0] == "read_data")
     return lines[:k], lines[k]

@@ -181,10 +181,11 @@ def evaluate(model: Model, folder: str | Path) -> Evaluation:
 
     from ._lammps import new_lammps
     from .errors import RunError
+    from .lammps_text import input_lines
     import os
 
     job = translate(model, folder)
-    lines = job.script.read_text().splitlines()
+    lines = input_lines(job.text, job.script)
     stop = next(i for i, ln in enumerate(lines) if ln.startswith(("displace_atoms", "velocity", "write_dump")))
     cwd = os.getcwd()
     lmp = new_lammps(["-nocite", "-log", "none", "-screen", "none"])

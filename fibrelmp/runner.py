@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Callable, Iterator
 
 from ._lammps import new_lammps
 from .errors import RunError
+from .lammps_text import input_lines, read_script
 
 if TYPE_CHECKING:
     from .checkpoint import Checkpointing  # noqa: F401
@@ -62,12 +63,6 @@ class Progress:
             sys.stderr.write("\n")
 
 
-def script_lines(text: str) -> list[str]:
-    """The lines LAMMPS reads from ``text``: split on ``\\n`` only (not on the other Unicode
-    line breaks ``str.splitlines`` knows), a trailing ``\\r`` dropped."""
-    return [ln[:-1] if ln.endswith("\r") else ln for ln in text.split("\n")]
-
-
 @dataclass
 class Command:
     number: int          # 1-based line in the script
@@ -76,20 +71,14 @@ class Command:
 
 
 def parse_commands(text: str, where: str = "in.lammps") -> tuple[list[Command], dict[str, int]]:
-    """Commands of a rendered script and the index of every ``label``.
-
-    The renderers never write continuation lines (``&``), quotes or ``$`` substitutions into
-    control flow; a script that has them is not one of ours and is refused, so the runner
-    never interprets a line differently from ``lmp -in``."""
+    """Commands of a rendered script and the index of every ``label``: the lines ``lmp -in``
+    reads (``lammps_text.input_lines`` refuses lines LAMMPS would join or split otherwise)."""
     commands: list[Command] = []
     labels: dict[str, int] = {}
-    for number, line in enumerate(script_lines(text), 1):
+    for number, line in enumerate(input_lines(text, where), 1):
         body = line.strip()
         if not body or body.startswith("#"):
             continue
-        if body.endswith("&") or '"""' in body:
-            raise RunError(f"{where}:{number}: continuation lines and triple quotes are not "
-                           "written by fibrelmp; the runner refuses them")
         words = body.split()
         if words[0] == "label" and len(words) == 2:
             labels[words[1]] = len(commands)
@@ -150,7 +139,7 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
     script = Path(script)
     rank, size = mpi_rank_size()
     args = ["-nocite", "-log", "log.lammps" if log and rank == 0 else "none", "-screen", "none"]
-    script_text = text if text is not None else script.read_text()
+    script_text = text if text is not None else read_script(script)
     commands, labels = parse_commands(script_text, str(script))
     cwd = os.getcwd()
     bar = Progress(total_steps, progress and rank == 0)

@@ -12,10 +12,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from jinja2 import Environment, PackageLoader, StrictUndefined
 
 from ..errors import InputError
 from ..granmodel import ContactLaw, Geometry, GranularModel
+from ..lammps_text import comment_text, template_environment
 from ..textio import atomic_write
 from .granular_walls import (BoxShape, CylinderShape, Kinematics, detect_cylinder, detect_oriented_box,
                              geometry_kinematics, geometry_triangle_rows, particle_side,
@@ -631,8 +631,7 @@ def build_granular_job(model: GranularModel, folder: str | Path):
     g = np.asarray(plan.gravity, float)
     if dim == 2 and g[2] != 0:
         raise InputError(model.source, None, "2D model with a z component of gravity")
-    env = Environment(loader=PackageLoader("fibrelmp", "templates"), undefined=StrictUndefined,
-                      trim_blocks=True, lstrip_blocks=True, keep_trailing_newline=True)
+    env = template_environment()
     tile_groups = [(wp, f"w{k + 1}") for k, wp in enumerate(wall_plans)
                    if wp.kind == "tiles" and wp.tile_ids is not None and len(wp.tile_ids)]
     script = env.get_template("granular.lammps.j2").render(
@@ -681,7 +680,7 @@ def _bond_coeffs(model: GranularModel, mat: int, d: float, L0: float, count: int
         frc=sn * A if sn else BIG, fsc=ts * A if ts else BIG,
         tbc=sn * math.pi * d ** 3 / 32.0 if sn else BIG,
         ttc=ts * math.pi * d ** 3 / 16.0 if ts else BIG,
-        comment=f"{m.name} d={d:.6g} L0={L0:.6g} ({count} bonds)")
+        comment=f"{comment_text(m.name)} d={d:.6g} L0={L0:.6g} ({count} bonds)")
 
 
 def _region_wall(model, wp: WallPlan, tag: str, mat_groups, xs, smat, m_min, dt, wall_cmds,
@@ -842,7 +841,7 @@ def _write_data(model, path: Path, rows, type_of_mat, smat, crad, lo, hi, ntypes
                 tx, ttype, tv, tids, tile_radius, tile_mass, bond_rows, btype, nbtypes) -> None:
     sp = model.spheres
     n = len(rows) + len(tx)
-    parts = [f"LAMMPS data file written by fibrelmp from {model.source.name}\n\n",
+    parts = [f"LAMMPS data file written by fibrelmp from {comment_text(model.source.name)}\n\n",
              f"{n} atoms\n{ntypes} atom types\n"]
     if len(bond_rows):
         parts.append(f"{len(bond_rows)} bonds\n{nbtypes} bond types\n")

@@ -11,10 +11,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from jinja2 import Environment, PackageLoader, StrictUndefined
 
 from ..errors import InputError
 from ..fastfmt import rows_text
+from ..lammps_text import comment_text, template_environment
 from ..model import Model
 from ..textio import atomic_write, format_rows
 
@@ -250,9 +250,7 @@ def write_job(model: Model, folder: str | Path, write_files: bool = True) -> Job
     data_path = folder / DATA_NAME
     if write_files:
         _write_data(model, bonds, data_path, ltypes, atype, btypes, btype, atypes, antype, use_mvv)
-    env = Environment(loader=PackageLoader("fibrelmp", "templates"), undefined=StrictUndefined,
-                      trim_blocks=True, lstrip_blocks=True, keep_trailing_newline=True)
-    script = env.get_template("bead_spring.lammps.j2").render(
+    script = template_environment().get_template("bead_spring.lammps.j2").render(
         model=model, dyn=dyn, box=box, fmt=_fmt, use_mvv=use_mvv,
         frozen_types=frozen_types, mobile_types=mobile_types,
         bond_types=btypes, angle_types=atypes, pair_lines=pair_lines, pair_styles=pair_styles,
@@ -333,7 +331,7 @@ def _write_data(model: Model, bonds, path: Path, ltypes, atype, btypes, btype, a
     p, box = model.particles, model.box
     n = p.count
     ids = np.arange(1, n + 1)
-    parts = [f"LAMMPS data file written by fibrelmp from {model.source.name}\n\n",
+    parts = [f"LAMMPS data file written by fibrelmp from {comment_text(model.source.name)}\n\n",
              f"{n} atoms\n{bonds.count} bonds\n{model.angles.count} angles\n",
              f"{len(ltypes)} atom types\n{len(btypes) if bonds.count else 0} bond types\n",
              f"{len(atypes) if model.angles.count else 0} angle types\n\n"]
@@ -350,7 +348,7 @@ def _write_data(model: Model, bonds, path: Path, ltypes, atype, btypes, btype, a
     parts.append("\nMasses\n\n")
     for i, row in enumerate(ltypes):
         mass = row[1] if row[1] > 0 else 1.0      # mass-0 beads are not integrated: placeholder
-        parts.append(f"{i + 1} {_fmt(mass)}  # {p.type_names[int(row[0])]} m={row[1]:g} R={row[2]:g}\n")
+        parts.append(f"{i + 1} {_fmt(mass)}  # {comment_text(p.type_names[int(row[0])])} m={row[1]:g} R={row[2]:g}\n")
     # unwrapped coordinates: read_data wraps them into periodic boxes and sets image flags
     cols = [ids, p.molecules, atype + 1, x[:, 0], x[:, 1], x[:, 2]]
     if use_mvv:

@@ -108,7 +108,11 @@ def _guard(func):
         except InputError as exc:
             _fail(f"error: {exc}", 2)
         except (RunError, OSError) as exc:
-            _fail(f"run failed: {exc}", 1)
+            from .errors import visible
+
+            _fail(f"run failed: {visible(str(exc), keep_newlines=True)}", 1)
+        except MemoryError:
+            _fail("run failed: out of memory (the input is too large for this machine's memory)", 1)
         except KeyboardInterrupt:
             _fail("interrupted", 130)
         except Exception as exc:

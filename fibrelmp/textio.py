@@ -5,6 +5,7 @@ from __future__ import annotations
 import errno
 import math
 import os
+import stat
 from pathlib import Path
 from typing import Callable
 
@@ -35,11 +36,18 @@ def read_text(path: str | os.PathLike, what: str = "file") -> str:
         if patched is not None:
             return patched
     try:
+        mode = os.stat(p).st_mode
+        if not stat.S_ISREG(mode) and not stat.S_ISDIR(mode):
+            # /dev/zero never ends, opening a FIFO blocks until someone writes to it
+            raise InputError(p, None, f"{what} is not a regular file (a device, FIFO or socket)")
         raw = p.read_bytes()
     except OSError as exc:
         raise InputError(p, None, read_failure(exc, what)) from None
     except ValueError:                      # a NUL byte in the name: no such file
         raise InputError(p, None, f"{what} not found") from None
+    except MemoryError:
+        raise InputError(p, None, f"{what} does not fit in memory "
+                         f"({p.stat().st_size / 1e9:.1f} GB)") from None
     if raw.startswith((b"\xff\xfe", b"\xfe\xff")):
         # about the whole file, so no line number
         raise InputError(p, None, f"{what} is UTF-16 encoded; save it as UTF-8 or ASCII text")
@@ -61,6 +69,44 @@ def read_failure(exc: OSError, what: str = "file") -> str:
     if isinstance(exc, (FileNotFoundError, NotADirectoryError)):
         return f"{what} not found"
     return f"cannot read {what}: {exc.strerror or exc}"
+
+
+def check_text_file(path: str | os.PathLike, what: str = "file") -> None:
+    """The checks of ``read_text`` (regular file, UTF-8, not UTF-16, not binary) in 16 MB
+    blocks, holding no decoded copy: for large files whose bytes are parsed directly."""
+    import codecs
+
+    p = Path(path)
+    if _OVERLAY and _OVERLAY.get(_overlay_key(p)) is not None:
+        return
+    try:
+        mode = os.stat(p).st_mode
+        if not stat.S_ISREG(mode) and not stat.S_ISDIR(mode):
+            raise InputError(p, None, f"{what} is not a regular file (a device, FIFO or socket)")
+        with open(p, "rb") as fh:
+            decoder = codecs.getincrementaldecoder("utf-8")()
+            first, offset, lines = True, 0, 1
+            while True:
+                block = fh.read(1 << 24)
+                if first:
+                    if block.startswith((b"\xff\xfe", b"\xfe\xff")):
+                        raise InputError(p, None, f"{what} is UTF-16 encoded; save it as UTF-8 or ASCII text")
+                    body = block[3:] if block.startswith(b"\xef\xbb\xbf") else block
+                    if b"\x00" in body[:4096]:
+                        raise InputError(p, None, f"{what} looks binary (contains NUL bytes), expected text")
+                    first = False
+                try:
+                    decoder.decode(block, final=not block)
+                except UnicodeDecodeError as exc:
+                    line = lines + block[: max(exc.start, 0)].count(b"\n")
+                    raise InputError(p, line, f"{what} is not valid UTF-8 text (byte "
+                                     f"{offset + max(exc.start, 0)})") from None
+                if not block:
+                    return
+                offset += len(block)
+                lines += block.count(b"\n")
+    except OSError as exc:
+        raise InputError(p, None, read_failure(exc, what)) from None
 
 
 def read_bytes(path: str | os.PathLike) -> bytes:
@@ -228,8 +274,10 @@ def blank_patch(err: InputError, line: str | None, attempt: int) -> str | None:
 
 def _lines_of(path: str) -> list[str] | None:
     try:
+        if not stat.S_ISREG(os.stat(path).st_mode):
+            return None                   # a device or FIFO: never read it
         raw = Path(path).read_bytes()
-    except OSError:
+    except (OSError, MemoryError):
         return None
     return raw.removeprefix(b"\xef\xbb\xbf").decode("utf-8", "replace").splitlines(keepends=True)
 

@@ -299,6 +299,8 @@ def test_snapshot_round_trip(tmp_path):
         vel = rng.normal(size=(n, 3)) / 3
         frames.append((pos, vel))
         writer.add(_frame(model, t, pos, vel))
+    assert not writer.written and not list(tmp_path.glob("output_*.json"))   # staged until close
+    writer.close()
     assert [p.name for p in writer.written] == ["output_0.json", "output_1.json", "output_2.json"]
     original = json.loads(src.read_text())
     for i, (path, (pos, vel)) in enumerate(zip(writer.written, frames)):
@@ -326,6 +328,7 @@ def test_snapshot_keeps_removed_particles(tmp_path):
     pos, vel = model.spheres.position.copy(), model.spheres.velocity.copy()
     writer.add(_frame(model, 0.0, pos, vel))
     writer.add(_frame(model, 0.5, pos[1:] + 1, vel[1:], rows=np.array([1])))
+    writer.close()
     snap = json.loads(writer.written[-1].read_text())["objects"]["particles"]
     assert snap[0] == [3.5, 2.0, 2.0, 1.5, 0.0, 0.0, 0]            # last saved state kept
     assert snap[1][:3] == [7.5, 3.0, 3.0]
@@ -338,6 +341,7 @@ def test_snapshot_2d_rows(tmp_path):
     writer = DemdfSnapshotWriter(model, tmp_path)
     s = model.spheres
     writer.add(_frame(model, 0.25, s.position + [0.125, 0, 0], s.velocity))
+    writer.close()
     rows = json.loads(writer.written[0].read_text())["objects"]["particles"]
     doc = json.loads((EXAMPLES / "disks_2d.json").read_text())["objects"]["particles"]
     assert [len(r) for r in rows] == [5] * len(doc)
@@ -355,6 +359,7 @@ def test_snapshot_unicode_and_missing_output(tmp_path):
     s = model.spheres
     for t in (0.0, 0.5):
         writer.add(_frame(model, t, s.position, s.velocity))
+    writer.close()
     assert [p.name for p in writer.written] == ["output_0.json", "output_1.json"]
     snap = json.loads(writer.written[1].read_bytes().decode("utf-8"))
     assert snap["name"] == doc["name"]

@@ -26,6 +26,7 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples" / "demdf"
 def run(model, tmp_path: Path) -> list[dict]:
     writer = DemdfSnapshotWriter(model, tmp_path / "out")
     run_granular(model, tmp_path / "work", writer.add, progress=False)
+    writer.close()
     return [json.loads(p.read_text()) for p in writer.written]
 
 

@@ -323,6 +323,7 @@ def test_demdf_roundtrip_and_snapshot(case):
                                         sphere_rows=np.arange(s.count), position=s.position,
                                         velocity=s.velocity, omega=s.omega,
                                         force=np.zeros((s.count, 3)), quaternion=s.quaternion))
+        writer.close()
         again = demdf.read_snapshot(snap)
     for name in ("position", "velocity", "radius", "mass", "material"):
         np.testing.assert_array_equal(getattr(again.spheres, name), getattr(s, name), err_msg=name)

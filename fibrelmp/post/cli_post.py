@@ -593,7 +593,7 @@ def _to_granular(kind: str, stream, base, source, names, warn):
             "filename": base.name, "save_count": 0, "file_time_step": dt, "substeps": 1,
             "time_step_count": 0}
         writer = DemdfSnapshotWriter(model, base.parent)
-        done = lambda: list(writer.written)                      # noqa: E731
+        done = lambda: (writer.close(), list(writer.written))[1]  # noqa: E731
     count = 0
     try:
         for frame in frames:

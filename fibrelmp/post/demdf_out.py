@@ -15,6 +15,8 @@ from __future__ import annotations
 import copy
 import json
 import math
+import shutil
+import os
 from pathlib import Path
 from typing import Any
 
@@ -47,6 +49,11 @@ class DemdfSnapshotWriter:
         self.position = model.spheres.position.copy()
         self.velocity = model.spheres.velocity.copy()
         self.written: list[Path] = []
+        # snapshots are staged and moved into place by close(): a failed run leaves the
+        # folder as it was (an earlier run's snapshots untouched); the run holds the folder's
+        # lock, so a staging folder found here is a killed run's
+        self.staging = self.folder / f".{self.filename}.fibrelmp-staging"
+        self.staged: list[Path] = []
         self.removed: dict[int, float] = {}      # particle index -> time it was first missing
         self.doc.setdefault("objects", {})
         self.doc["objects"]["particles"] = _MARK
@@ -66,12 +73,14 @@ class DemdfSnapshotWriter:
             raise RunError(f"non-finite particle positions or velocities at time {frame.time:g}; "
                            "the run became unstable")
         self._set_counters(frame.time)
-        path = self.folder / f"{self.filename}_{self.count}.json"
-        path.parent.mkdir(parents=True, exist_ok=True)
-        atomic_write(path, self.render().encode("utf-8"))
-        self.written.append(path)
+        name = f"{self.filename}_{self.count}.json"
+        if not self.staged:
+            shutil.rmtree(self.staging, ignore_errors=True)
+            self.staging.mkdir(parents=True)
+        atomic_write(self.staging / name, self.render().encode("utf-8"))
+        self.staged.append(self.staging / name)
         self.count += 1
-        return path
+        return self.folder / name
 
     def _set_counters(self, time: float) -> None:
         doc = self.doc
@@ -107,10 +116,18 @@ class DemdfSnapshotWriter:
         return "[\n" + ",\n".join(rows) + "\n" + " " * indent + "]"
 
     def close(self) -> None:
-        """Nothing is held open; every snapshot is complete when ``add`` returns."""
+        """Move the staged snapshots into place."""
+        for path in self.staged:
+            target = self.folder / path.name
+            os.replace(path, target)
+            self.written.append(target)
+        self.staged = []
+        shutil.rmtree(self.staging, ignore_errors=True)
 
     def abort(self) -> None:
-        """Snapshots already written are complete states and are kept."""
+        """Drop the staged snapshots: the folder stays as it was."""
+        self.staged = []
+        shutil.rmtree(self.staging, ignore_errors=True)
 
 
 def _num(x: float) -> str:

@@ -16,7 +16,7 @@ import numpy as np
 from ..errors import InputError
 from ..model import (Angles, Bonds, Box, Dynamics, Model, OutputSpec, PairLaw, Particles,
                      RunPlan, Stage)
-from ..textio import integer_column, parse_table, read_bytes, read_text, to_float, to_int
+from ..textio import check_text_file, integer_column, parse_table, read_bytes, read_text, to_float, to_int
 from ..units import LJ
 
 EXTENSIONS = (".txt", ".in", ".inp")
@@ -358,7 +358,7 @@ def _read_model(path: Path, type_index: dict[str, int], type_names: list[str], s
                 notes: list) -> tuple[Particles, "_Springs", Angles]:
     from .fibrenet_fast import fast_read_model
 
-    read_text(path, "FibreNet model file")      # encoding / binary checks with clear messages
+    check_text_file(path, "FibreNet model file")    # encoding / binary checks, streamed
     fast = fast_read_model(read_bytes(path), type_index, type_names, size, _Springs)
     if fast is not None:
         return fast

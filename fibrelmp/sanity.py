@@ -25,6 +25,40 @@ STEP_FRACTION = 0.1
 HERTZ_DURATION = 2.943
 
 
+def close_pairs(points: np.ndarray, reach: float) -> np.ndarray:
+    """Index pairs (k, 2), i < j, of points whose Euclidean distance is <= ``reach``.
+
+    Robust for any finite coordinates: ``cKDTree`` with the Euclidean metric squares the
+    coordinate differences and overflows beyond ~1e154 (``ValueError: Encountering floating
+    point overflow``), and the tree's extent overflows when the points span more than the
+    double range.  So candidates come from the Chebyshev metric (p = inf, no squares) on
+    coordinates scaled by an exact power of two, and are confirmed with the true distance
+    (the difference of two candidates is at most ``reach`` per axis, so it cannot overflow).
+    """
+    x = np.asarray(points, float)
+    if len(x) < 2 or not reach >= 0:
+        return np.zeros((0, 2), np.int64)
+    from scipy.spatial import cKDTree
+
+    big = float(np.abs(x).max())
+    scale = 1.0
+    if big > 1e300:                      # keep max - min finite; exact (power of two)
+        scale = 2.0 ** -4
+    r = reach * scale
+    if not math.isfinite(r):
+        r = np.inf
+    pairs = cKDTree(x * scale).query_pairs(r, p=np.inf, output_type="ndarray")
+    if not len(pairs):
+        return np.zeros((0, 2), np.int64)
+    d = x[pairs[:, 0]] - x[pairs[:, 1]]
+    with np.errstate(over="ignore"):
+        # hypot-style scaling keeps the norm finite even for differences near the double max
+        m = np.abs(d).max(axis=1)
+        safe = np.where(m > 0, m, 1.0)
+        dist = m * np.sqrt(((d / safe[:, None]) ** 2).sum(axis=1))
+    return pairs[dist <= reach].astype(np.int64)
+
+
 def hertz_peak_overlap(m_eff: float, r_eff: float, e_star: float, speed: float) -> float:
     """Peak overlap of an elastic Hertz impact at normal speed ``speed``:
     ``(15 m* v^2 / (16 E* sqrt(R*)))^(2/5)``."""

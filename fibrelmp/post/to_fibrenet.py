@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
-from typing import Iterable, Sequence
+from typing import Callable, Iterable, Sequence
 
 import numpy as np
 
@@ -13,6 +14,30 @@ from .lammps_dump import Frame
 # dump column names for the velocity FibreNet writes (v~) and its total force
 VEL_COLUMNS = ("v_fn_vx", "v_fn_vy", "v_fn_vz")
 FORCE_COLUMNS = ("v_fn_fx", "v_fn_fy", "v_fn_fz")
+OUTSIDE_KIND = "beads outside finite box"
+
+
+class FibreNetDivergenceWarning(UserWarning):
+    """The run has left the regime where fibrelmp reproduces FibreNet (see docs/fibrenet.md)."""
+
+
+def outside_finite_box(wrapped: np.ndarray, periodic: np.ndarray, lengths: np.ndarray) -> np.ndarray:
+    """Per bead: is its centre outside FibreNet's grid [0, L) on a finite (walled) axis?
+
+    FibreNet's FillGrid (kernel.cl) puts a bead in cell floor(x / cell) and drops it when that
+    cell is outside 0 .. n-1, i.e. when x < 0 or x >= L: such a bead has no pair contacts."""
+    fin = ~np.asarray(periodic, bool)
+    if not fin.any() or not len(wrapped):
+        return np.zeros(len(wrapped), bool)
+    x = wrapped[:, fin]
+    return ((x < 0) | (x >= np.asarray(lengths, float)[fin])).any(axis=1)
+
+
+def outside_message(step: int, count: int, lengths: np.ndarray) -> str:
+    return (f"from the frame at step {step} on ({count} bead(s) then), bead centres lie outside the "
+            f"finite box [0, L) (L = {' x '.join(f'{v:g}' for v in lengths)}), i.e. pressed into a "
+            "wall: FibreNet drops such beads from its contact grid, so they lose every hs/st/lj "
+            "pair contact, while LAMMPS keeps them; results diverge from FibreNet's from there on")
 
 
 def _pick(frame: Frame, preferred: Sequence[str], fallback: Sequence[str]) -> np.ndarray:
@@ -59,14 +84,21 @@ def _small_unique(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def write_fibrenet(frames: Iterable[Frame], basename: str, folder: Path, fields: Sequence[str],
                    names_of_type: dict[int, str], dt: float, box_lengths: np.ndarray | None,
-                   output_types: set[str] | None, restart: bool = True) -> list[Path]:
+                   output_types: set[str] | None, restart: bool = True,
+                   warn: Callable[[str, str], None] | None = None) -> list[Path]:
     """Write ``<basename>_coord/_vel/_force.xyz`` (every frame) and ``_restart.res`` (last).
 
     ``box_lengths`` None: each frame's own box (post-processing of dumps whose box changes).
+
+    With ``box_lengths`` (FibreNet's box [0, L]) the first frame with a bead centre outside
+    [0, L) on a finite axis triggers one warning (``outside_message``): ``warn(kind, text)``
+    when given (e.g. ``model.warn``), otherwise a ``FibreNetDivergenceWarning`` through Python's
+    ``warnings`` module (printed on stderr by default).
     """
     folder = Path(folder)
     writers = {f: XyzWriter(folder / f"{basename}{XYZ_SUFFIX[f]}") for f in fields}
     last = None
+    warned = box_lengths is None
     try:
         for frame in frames:
             ids = frame.column("id")
@@ -76,6 +108,15 @@ def write_fibrenet(frames: Iterable[Frame], basename: str, folder: Path, fields:
             keep = slice(None) if output_types is None else \
                 np.isin(codes, [k for k, name in enumerate(table) if name in output_types])
             wrapped, unwrapped = wrapped_and_unwrapped(frame)
+            if not warned:
+                out = outside_finite_box(wrapped, frame.periodic, box_lengths)
+                if out.any():
+                    warned = True
+                    text = outside_message(frame.step, int(out.sum()), np.asarray(box_lengths, float))
+                    if warn is not None:
+                        warn(OUTSIDE_KIND, text)
+                    else:
+                        warnings.warn(f"[{OUTSIDE_KIND}] {text}", FibreNetDivergenceWarning, stacklevel=2)
             data = {"position": wrapped[order]}
             if "velocity" in fields or restart:
                 data["velocity"] = _pick(frame, VEL_COLUMNS, ("vx", "vy", "vz"))[order]

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from ..granmodel import ContactLaw, GranularModel, Material, Plane, Spheres
+from ..sanity import close_pairs
 from ..units import DIMENSIONLESS
 from . import demdf_contact as hertz
 from .demdf_json import JsonDoc, describe, load_json
@@ -392,11 +393,10 @@ class _Reader(PlanMixin):
 
     def _check_overlaps(self, s: Spheres) -> None:
         try:
-            from scipy.spatial import cKDTree
+            # any finite coordinates (a bare cKDTree overflows beyond ~1e154)
+            pairs = close_pairs(s.position, 2 * float(s.radius.max()))
         except ImportError:             # pragma: no cover - scipy comes with MDAnalysis
             return
-        tree = cKDTree(s.position)
-        pairs = tree.query_pairs(2 * float(s.radius.max()), output_type="ndarray")
         if not len(pairs):
             return
         gap = np.linalg.norm(s.position[pairs[:, 0]] - s.position[pairs[:, 1]], axis=1) \

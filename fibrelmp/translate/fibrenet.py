@@ -280,6 +280,7 @@ def read(path: str | Path) -> Model:
     bonds = springs.to_bonds()
     _check_positions(particles, box, periodic, model_path, notes)
     _check_lengths(particles, bonds, angles, model_path)
+    _check_periodic_extent(particles, bonds, angles, box, model_path)
 
     # ---- exclusion rule ------------------------------------------------------------------
     exclusion = _exclusion_rule(particles, bonds, model_path)
@@ -597,6 +598,48 @@ def _check_lengths(p: Particles, bonds: Bonds, angles: Angles, path: Path) -> No
             what = "the spring has zero length" if kind == "SPRING" else "the angle is undefined"
             raise InputError(path, line, f"{kind} joins beads {i} and {j}, which are at the same "
                              f"position ({', '.join(f'{v:g}' for v in x[i])}): {what}")
+
+
+def _check_periodic_extent(p: Particles, bonds: Bonds, angles: Angles, box: Box, path: Path) -> None:
+    """Springs and angle legs must span less than half the box along every periodic axis.
+
+    FibreNet computes springs and angles on the unwrapped positions (ix iy iz) with no minimum
+    image (kernel.cl ResolveSprings/ResolveAngles), so a spring longer than half the box acts
+    along its own, long, vector.  LAMMPS takes every bond and angle partner as the periodic
+    image nearest to the atom that owns it, i.e. the minimum image: such a spring would act on
+    a different, shorter vector (a spring at rest in FibreNet pulls hard in LAMMPS).  Nothing
+    in LAMMPS can reproduce that, so it is an error rather than a silently different run."""
+    per = np.asarray(box.periodic, bool)
+    if not per.any():
+        return
+    x = p.unwrapped
+    half = 0.5 * box.lengths
+    for kind, pairs in (("SPRING", bonds.atoms), ("ANGLE", angles.atoms[:, :2]),
+                        ("ANGLE", angles.atoms[:, 1:])):
+        if not len(pairs):
+            continue
+        with np.errstate(all="ignore"):
+            d = x[pairs[:, 1]] - x[pairs[:, 0]]
+            bad = (~(np.abs(d[:, per]) < half[per])).any(axis=1)
+        if not bad.any():
+            continue
+        row = int(np.flatnonzero(bad)[0])
+        i, j = (int(v) for v in pairs[row])
+        with np.errstate(all="ignore"):
+            dv = d[row]
+            image = dv.copy()
+            image[per] -= box.lengths[per] * np.round(dv[per] / box.lengths[per])
+            r, r_img = float(np.linalg.norm(dv)), float(np.linalg.norm(image))
+        axes = "".join("xyz"[a] for a in range(3) if per[a] and not abs(dv[a]) < half[a])
+        line = _model_sections(path)[kind][1][row]     # only on error: no cost otherwise
+        what = "spring" if kind == "SPRING" else "angle leg"
+        raise InputError(path, line, f"{kind}: the {what} between beads {i} and {j} spans "
+                         f"{', '.join(f'{dv[a]:g}' for a in range(3))} (length {r:g}), at least half "
+                         f"the periodic box ({', '.join(f'{v:g}' for v in box.lengths)}) along "
+                         f"{axes} ({int(bad.sum())} {what}(s) do): FibreNet uses this unwrapped "
+                         f"vector, LAMMPS the nearest periodic image (length {r_img:g}), so the "
+                         "forces would differ; enlarge box_size or split the "
+                         f"{'spring' if kind == 'SPRING' else 'fibre'} into shorter segments")
 
 
 def _check_positions(p: Particles, box: Box, periodic: bool, path: Path, notes: list) -> None:

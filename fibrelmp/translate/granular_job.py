@@ -16,6 +16,7 @@ import numpy as np
 from ..errors import InputError
 from ..granmodel import ContactLaw, Geometry, GranularModel
 from ..lammps_text import comment_text, template_environment
+from ..sanity import close_pairs
 from ..textio import atomic_write
 from .granular_walls import (BoxShape, CylinderShape, Kinematics, detect_cylinder, detect_oriented_box,
                              geometry_kinematics, geometry_triangle_rows, particle_side,
@@ -35,6 +36,16 @@ TILE_SPACING_FACTOR = 0.5   # wall tiles: spacing = 0.5 * smallest sphere contac
 TILE_RADIUS_FACTOR = 0.6    # wall tile radius = 0.6 * spacing
 TILE_MASS_FACTOR = 1e20     # wall tiles weigh 1e20 x the heaviest sphere (m* = m_p)
 BIG = 1e300                 # "never breaks"
+MAX_STEPS = 2.0 ** 63 - 1   # LAMMPS counts time steps in a 64-bit integer
+# box and binning (docs/granular.md, "Domain, activity, periodicity, 2D")
+OVERSIZED_BINS = 1_000_000  # a domain box with more neighbour bins than this ...
+OVERSIZED_RATIO = 64        # ... and this many times those of the spheres' box is oversized
+BIN_CAP = 10_000_000        # above this many default-size bins (and BINS_PER_ATOM x the
+BINS_PER_ATOM = 8           # atoms), bins are coarsened
+REACH_SAFETY = 2.0          # wall particles: kept within twice the distance a sphere can travel
+TILE_CLIP_MIN = 100_000     # geometries needing more wall particles are tiled within reach only
+CHECK_EVERY_MAX = 100       # domain removal / reach check at least every this many steps
+NSQ_RATIO = 50.0            # coarse bins > this x the thinnest box extent: neighbor nsq instead
 
 
 @dataclass
@@ -137,12 +148,22 @@ def _check_law(model: GranularModel, a: int, b: int) -> ContactLaw:
     return law
 
 
-def rolling_spring(m_min: float, dt: float) -> tuple[float, float]:
+def rolling_spring(m_min: float, dt: float, source=None) -> tuple[float, float]:
     """k and gamma of ``rolling sds``: the rolling spring's angular frequency is at most
     ROLL_OMEGA_DT/dt for the lightest sphere involved (I = 2/5 m R^2, R_eff <= R), critically
-    damped; MUSEN's rolling torque is a constant plateau, reached after mu F/k of rolling."""
-    k = 0.4 * m_min * (ROLL_OMEGA_DT / dt) ** 2
-    g = 2.0 * math.sqrt(0.4 * k * m_min)
+    damped; MUSEN's rolling torque is a constant plateau, reached after mu F/k of rolling.
+
+    k grows as 1/dt^2: a step so small that k or gamma leaves the double range is an
+    InputError (``source``: the input path for the message), never an OverflowError."""
+    try:
+        k = 0.4 * m_min * (ROLL_OMEGA_DT / dt) ** 2
+        g = 2.0 * math.sqrt(0.4 * k * m_min)
+    except (OverflowError, ZeroDivisionError, ValueError):
+        k = g = math.nan
+    if not (math.isfinite(k) and math.isfinite(g)):
+        raise InputError(source, None, f"time step {dt:g} is too small for spheres of mass "
+                         f"{m_min:g}: the rolling-resistance spring (stiffness ~ m/dt^2) "
+                         "overflows; use a larger time step")
     return k, g
 
 
@@ -280,6 +301,189 @@ def _compress_ids(ids: np.ndarray) -> str:
 
 
 # ----------------------------------------------------------------------------------------
+# box, binning and reach
+@dataclass
+class BoxFit:
+    oversized: bool              # removal axes shrink-wrapped, fix evaporate at the domain faces
+    domain_bins: float           # default-size neighbour bins of the box with 'f' domain faces
+    bins: float                  # default-size neighbour bins of the box used
+    binsize: float | None        # coarser neighbour / sort bin size, None: LAMMPS' default
+    nsq: bool = False            # no bins at all: neighbor nsq, no atom sorting
+
+
+def _bin_count(lo: np.ndarray, hi: np.ndarray, binsize: float, dim: int) -> float:
+    """Approximate number of LAMMPS bins of size ``binsize`` over a box (float: never
+    overflows; z is not binned in 2D)."""
+    ext = np.maximum(np.asarray(hi, float) - np.asarray(lo, float), 0.0)[:dim]
+    with np.errstate(over="ignore", invalid="ignore"):
+        n = float(np.prod(ext / binsize + 1.0))
+    return n if n == n else math.inf
+
+
+def _fit_box(pts, box_lo, box_hi, bnd, removal_axes, dom_lo, face_hi, r_max: float,
+             r_bin: float, dim: int, atoms: int) -> BoxFit:
+    """Fill box_lo/box_hi (and 'm' into ``bnd`` when the domain is oversized) in place.
+
+    LAMMPS allocates neighbour bins (and atom-sort bins) of half the neighbour cutoff over the
+    whole box, 1.25 x the largest radius here (cutoff 2 r + skin r/2).  A MUSEN domain of 2 m
+    around 1 mm spheres is ~4e9 bins: "Too many atom sorting bins" after minutes and GBs.
+    So a domain whose box has > OVERSIZED_BINS bins and > OVERSIZED_RATIO x the bins of the
+    box around spheres and wall particles is not used as the box: its axes are shrink-wrapped
+    like axes without a domain, and the caller deletes spheres beyond the domain faces.
+
+    If the box used still has more than max(BIN_CAP, BINS_PER_ATOM x atoms) bins (sparse
+    spheres, a huge periodic box), the bins are made just large enough to stay below that.
+    LAMMPS refuses bins > 100 x the box's thinnest extent, so a box that needs more (one sphere
+    1e6 radii away from the others along one axis) gets no bins at all: ``neighbor nsq``,
+    O(N^2) but only ever for such sparse scenes."""
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    pad = np.maximum(np.maximum(r_max, 1e-6 * (hi - lo)), 1e-12)
+    c_lo, c_hi = lo - pad, hi + pad
+    for a in range(3):
+        if bnd[a] == "m":
+            box_lo[a], box_hi[a] = c_lo[a], c_hi[a]
+    binsize = 1.25 * r_bin
+    oversized = False
+    domain_bins = 0.0
+    if removal_axes.any():
+        f_lo, f_hi = box_lo.copy(), box_hi.copy()
+        m_lo, m_hi = box_lo.copy(), box_hi.copy()
+        f_lo[removal_axes], f_hi[removal_axes] = dom_lo[removal_axes], face_hi[removal_axes]
+        m_lo[removal_axes], m_hi[removal_axes] = c_lo[removal_axes], c_hi[removal_axes]
+        domain_bins = _bin_count(f_lo, f_hi, binsize, dim)
+        oversized = (domain_bins > OVERSIZED_BINS
+                     and domain_bins > OVERSIZED_RATIO * _bin_count(m_lo, m_hi, binsize, dim))
+        src_lo, src_hi = (m_lo, m_hi) if oversized else (f_lo, f_hi)
+        box_lo[removal_axes], box_hi[removal_axes] = src_lo[removal_axes], src_hi[removal_axes]
+        if oversized:
+            for a in np.flatnonzero(removal_axes):
+                bnd[a] = "m"
+    bins = _bin_count(box_lo, box_hi, binsize, dim)
+    coarse = None
+    cap = max(BIN_CAP, BINS_PER_ATOM * atoms)
+    if bins > cap:
+        # smallest bin size with <= cap bins (bisection on log(size); monotone)
+        lo_b, hi_b = math.log(binsize), math.log(max(float(np.max((box_hi - box_lo)[:dim])), binsize)) + 1.0
+        for _ in range(100):
+            mid = 0.5 * (lo_b + hi_b)
+            if _bin_count(box_lo, box_hi, math.exp(mid), dim) > cap:
+                lo_b = mid
+            else:
+                hi_b = mid
+        coarse = math.exp(hi_b)
+        if coarse > NSQ_RATIO * float(np.min(box_hi - box_lo)):
+            return BoxFit(oversized, domain_bins, bins, None, True)
+    return BoxFit(oversized, domain_bins, bins, coarse)
+
+
+def speed_bound(model: GranularModel, rows: np.ndarray, crad: np.ndarray, mass: np.ndarray,
+                smat: np.ndarray) -> float:
+    """Estimate of the fastest a sphere can get without gravity and moving walls: the largest
+    |v| + |w| r in the input, plus the speed the elastic (Hertz) energy of all initial
+    overlaps would give the lightest sphere."""
+    sp = model.spheres
+    if not len(rows):
+        return 0.0
+    r = crad[rows]
+    with np.errstate(all="ignore"):
+        fast = float(np.max(np.linalg.norm(sp.velocity[rows], axis=1)
+                            + np.linalg.norm(sp.omega[rows], axis=1) * r))
+    if not math.isfinite(fast):
+        return math.inf
+    try:
+        pairs = close_pairs(sp.position[rows], 2.0 * float(r.max()))
+    except ImportError:                  # pragma: no cover - scipy comes with MDAnalysis
+        return fast
+    if not len(pairs):
+        return fast
+    i, j = pairs[:, 0], pairs[:, 1]
+    delta = r[i] + r[j] - np.linalg.norm(sp.position[rows][i] - sp.position[rows][j], axis=1)
+    sel = delta > 0
+    if not sel.any():
+        return fast
+    i, j, delta = i[sel], j[sel], delta[sel]
+    estar = np.array([getattr(model.contacts.get((min(a, b), max(a, b))), "youngs_eff", 0.0)
+                      for a, b in zip(smat[i].tolist(), smat[j].tolist())], float)
+    reff = r[i] * r[j] / (r[i] + r[j])
+    with np.errstate(all="ignore"):
+        energy = float(np.sum(8.0 / 15.0 * estar * np.sqrt(reff) * delta ** 2.5))
+        fast += math.sqrt(2.0 * energy / float(mass.min()))
+    return fast if math.isfinite(fast) else math.inf
+
+
+def _wall_speed(wall_plans: list[WallPlan]) -> float:
+    """Fastest translation speed of any moving geometry (pacing only)."""
+    out = 0.0
+    for wp in wall_plans:
+        for _, _, vel in wp.kinematics.intervals:
+            out = max(out, float(np.linalg.norm(vel)))
+    return out
+
+
+def _tile_counts(v: np.ndarray, spacing: float) -> np.ndarray:
+    """Per triangle the grid divisions ``tile_triangles`` uses."""
+    e = np.max(np.stack([np.linalg.norm(v[:, 1] - v[:, 0], axis=1),
+                         np.linalg.norm(v[:, 2] - v[:, 0], axis=1),
+                         np.linalg.norm(v[:, 2] - v[:, 1], axis=1)]), axis=0)
+    with np.errstate(all="ignore"):
+        return np.maximum(1.0, np.ceil(e / spacing - 1e-9))
+
+
+def tile_estimate(v: np.ndarray, spacing: float) -> float:
+    """Number of grid points ``tile_triangles`` generates (before de-duplication)."""
+    if not len(v):
+        return 0.0
+    n = _tile_counts(v, spacing)
+    return float(np.sum((n + 1) * (n + 2) / 2))
+
+
+def tile_triangles_within(v: np.ndarray, spacing: float, lo: np.ndarray, hi: np.ndarray):
+    """``tile_triangles`` restricted to the points inside [lo, hi]: the same points in the same
+    order, without generating the others (a 1 m triangle tiled for 1 mm spheres has 4e6)."""
+    pts, owner = [], []
+    for k, tri in enumerate(v):
+        e = max(np.linalg.norm(tri[1] - tri[0]), np.linalg.norm(tri[2] - tri[0]),
+                np.linalg.norm(tri[2] - tri[1]))
+        n = max(1, int(math.ceil(e / spacing - 1e-9)))
+        if (tri.max(axis=0) < lo).any() or (tri.min(axis=0) > hi).any():
+            continue
+        i = np.arange(n + 1)
+        e1, e2 = tri[1] - tri[0], tri[2] - tri[0]
+        base = tri[0] + (i / n)[:, None] * e1
+        jlo, jhi = np.zeros(n + 1), (n - i).astype(float)
+        with np.errstate(all="ignore"):
+            for ax in range(3):
+                if e2[ax] != 0:
+                    t1 = (lo[ax] - base[:, ax]) / e2[ax] * n
+                    t2 = (hi[ax] - base[:, ax]) / e2[ax] * n
+                    jlo = np.maximum(jlo, np.minimum(t1, t2) - 1.0)
+                    jhi = np.minimum(jhi, np.maximum(t1, t2) + 1.0)
+                else:
+                    jhi[(base[:, ax] < lo[ax]) | (base[:, ax] > hi[ax])] = -1.0
+        jlo = np.ceil(np.clip(jlo, 0, n)).astype(np.int64)
+        jhi = np.floor(np.clip(jhi, -1, n)).astype(np.int64)
+        ok = jhi >= jlo
+        cnt = (jhi - jlo + 1)[ok]
+        if not cnt.sum():
+            continue
+        ii = np.repeat(i[ok], cnt)
+        start = np.repeat(np.cumsum(cnt) - cnt, cnt)
+        jj = np.repeat(jlo[ok], cnt) + (np.arange(int(cnt.sum())) - start)
+        p = tri[0] + (ii / n)[:, None] * (tri[1] - tri[0]) + (jj / n)[:, None] * (tri[2] - tri[0])
+        p = p[((p >= lo) & (p <= hi)).all(axis=1)]
+        pts.append(p)
+        owner.append(np.full(len(p), k))
+    if not pts:
+        return np.zeros((0, 3)), np.zeros(0, np.int64)
+    p = np.concatenate(pts)
+    o = np.concatenate(owner)
+    key = np.round(p / (spacing * 1e-6)).astype(np.int64)
+    _, first = np.unique(key, axis=0, return_index=True)
+    first.sort()
+    return p[first], o[first]
+
+
+# ----------------------------------------------------------------------------------------
 def plan_walls(model: GranularModel, dt: float, t_end: float) -> list[WallPlan]:
     """Representation of every geometry / plane (no files, used by ``fibrelmp check`` too)."""
     plans: list[WallPlan] = []
@@ -388,7 +592,11 @@ def build_granular_job(model: GranularModel, folder: str | Path):
     span = float(plan.t_end) - float(plan.t_start)
     if not span >= 0:
         raise InputError(model.source, None, f"end time {plan.t_end!r} is before start time {plan.t_start!r}")
-    total = int(round(span / dt))
+    steps = span / dt
+    if not steps <= MAX_STEPS:
+        raise InputError(model.source, None, f"time step {dt:g} is too small: {span:g} time units "
+                         f"take {steps:.3g} steps, more than LAMMPS can count ({MAX_STEPS:.3g})")
+    total = int(round(steps))
     t_start = float(plan.t_start)
     t_end = t_start + total * dt
     warnings: list[tuple[str, str]] = []
@@ -441,6 +649,8 @@ def build_granular_job(model: GranularModel, folder: str | Path):
     r_mean = {m: float(crad[rows][smat == m].mean()) for m in mats}
     r_min = float(crad[rows].min()) if len(rows) else 1.0
     r_max = float(crad[rows].max()) if len(rows) else 1.0
+    if m_min:                       # the rolling spring of the heaviest sphere is the stiffest
+        rolling_spring(max(m_min.values()), dt, model.source)
 
     # ---- walls
     wall_plans = plan_walls(model, dt, t_end)
@@ -452,11 +662,13 @@ def build_granular_job(model: GranularModel, folder: str | Path):
     if ntypes == 0:
         ntypes = 1
 
-    # ---- box: periodic axes = periodic box, 'f' axes = domain (leaving it removes a sphere);
-    # otherwise shrink-wrapped around spheres and wall particles
+    # ---- box: periodic axes = periodic box; non-periodic axes with a domain = 'f' faces at the
+    # domain (leaving it removes a sphere), unless the domain is oversized (see _fit_box);
+    # otherwise shrink-wrapped ('m') around spheres and wall particles
     box_lo, box_hi = np.zeros(3), np.zeros(3)
     bnd = [""] * 3
     removal_axes = np.zeros(3, bool)
+    face_hi = np.zeros(3)
     for a in range(3):
         if dim == 2 and a == 2:
             h = max(2.0 * r_max, 1e-9)
@@ -469,14 +681,40 @@ def build_granular_job(model: GranularModel, folder: str | Path):
             box_lo[a], box_hi[a] = float(pb[0][a]), float(pb[1][a])
             bnd[a] = "p"
         elif dom_lo is not None:
-            box_lo[a], box_hi[a] = dom_lo[a], dom_hi[a]
-            box_hi[a] += 1e-12 * max(dom_hi[a] - dom_lo[a], abs(dom_hi[a]), 1e-300)
+            face_hi[a] = dom_hi[a] + 1e-12 * max(dom_hi[a] - dom_lo[a], abs(dom_hi[a]), 1e-300)
             bnd[a] = "f"
             removal_axes[a] = True
         else:
             bnd[a] = "m"
     if dim == 2 and len(rows) and np.abs(x[rows, 2]).max() > 0:
         raise InputError(model.source, None, "2D model with non-zero z coordinates")
+
+    # how far a sphere can travel during the run (bounds the wall particles that matter); the
+    # speed bound needs a pair search, so only for many wall particles or an oversized domain
+    span_run = total * dt
+    gabs = float(np.linalg.norm(plan.gravity))
+    v_bound: list[float] = []
+
+    def speed() -> float:
+        if not v_bound:
+            v_bound.append(speed_bound(model, rows, crad, mass, smat))
+        return v_bound[0]
+
+    many_tiles = any(wp.kind == "tiles" and tile_estimate(model.triangles.vertices[wp.triangle_rows],
+                                                          tile_spacing) > TILE_CLIP_MIN
+                     for wp in wall_plans)
+    reach = math.inf
+    if many_tiles and not any(wp.kinematics.moving for wp in wall_plans):
+        reach = max(REACH_SAFETY * (speed() * span_run + 0.5 * gabs * span_run ** 2), 2.0 * r_max)
+    keep_lo = keep_hi = None
+    if len(rows) and math.isfinite(reach):
+        pad_keep = reach + 2.0 * (r_max + tile_radius)
+        keep_lo = x[rows].min(axis=0) - pad_keep
+        keep_hi = x[rows].max(axis=0) + pad_keep
+        for a in range(3):
+            if bnd[a] == "p":
+                keep_lo[a], keep_hi[a] = -math.inf, math.inf
+    clipped: list[str] = []
 
     # ---- wall tiles
     tile_x, tile_type, tile_v, tile_ids_all = [], [], [], []
@@ -486,15 +724,25 @@ def build_granular_job(model: GranularModel, folder: str | Path):
         if wp.kind != "tiles":
             continue
         v = model.triangles.vertices[wp.triangle_rows]
-        p, owner = tile_triangles(v, tile_spacing)
+        clip = (keep_lo is not None and not wp.kinematics.moving
+                and tile_estimate(v, tile_spacing) > TILE_CLIP_MIN
+                and not ((v >= keep_lo) & (v <= keep_hi)).all())
+        if clip:
+            p, owner = tile_triangles_within(v, tile_spacing, keep_lo - tile_radius, keep_hi + tile_radius)
+        else:
+            p, owner = tile_triangles(v, tile_spacing)
         side = particle_side(v, x[rows], 4.0 * r_max)
         nrm = triangle_normals(v)
         # offset tiles behind the face by their radius so the contact surface is the face
         p = p - (side[owner] * tile_radius)[:, None] * nrm[owner]
+        if clip:
+            near = ((p >= keep_lo) & (p <= keep_hi)).all(axis=1)
+            p, owner = p[near], owner[near]
+            clipped.append(wp.name)
         inbox = np.ones(len(p), bool)
         for a in range(3):
-            if bnd[a] == "f":
-                inbox &= (p[:, a] >= box_lo[a]) & (p[:, a] < box_hi[a])
+            if removal_axes[a]:
+                inbox &= (p[:, a] >= dom_lo[a]) & (p[:, a] < face_hi[a])
         if not inbox.all():
             warnings.append(("wall tiles outside domain", f"{wp.name}: {int((~inbox).sum())} wall "
                              "particle(s) outside the simulation domain are left out"))
@@ -515,20 +763,66 @@ def build_granular_job(model: GranularModel, folder: str | Path):
         tile_v.append(vel)
         tile_ids_all.append(ids)
         wp.description += (f" ({len(p)} wall particles, spacing {tile_spacing:.4g}, radius "
-                           f"{tile_radius:.4g})")
+                           f"{tile_radius:.4g}{', only within reach of the spheres' if clip else ''})")
     if tile_total > 2_000_000:
         warnings.append(("many wall particles", f"{tile_total} wall particles tile the triangle "
                          "walls; the run will be slow"))
     pts = np.vstack([x[rows]] + tile_x)
     if not len(pts):
         pts = np.zeros((1, 3))
+    fit = _fit_box(pts, box_lo, box_hi, bnd, removal_axes, dom_lo, face_hi, r_max,
+                   max(r_max, tile_radius if tile_total else 0.0), dim, len(rows) + tile_total)
     for a in range(3):
-        if bnd[a] == "m":
-            lo, hi = float(pts[:, a].min()), float(pts[:, a].max())
-            pad = max(r_max, 1e-6 * (hi - lo), 1e-12)
-            box_lo[a], box_hi[a] = lo - pad, hi + pad
         if not box_hi[a] > box_lo[a]:
             raise InputError(model.source, None, f"empty simulation box along {'xyz'[a]}")
+    # LAMMPS re-neighbours when a sphere has moved half the skin: the same interval (at the
+    # fastest speed the run can reach) paces the domain removal and the reach check below
+    skin_est = 0.5 * max(r_max, tile_radius if tile_total else 0.0)
+    every = CHECK_EVERY_MAX
+    if fit.oversized or clipped:
+        v_end = speed() + gabs * span_run + 2.0 * _wall_speed(wall_plans)
+        if v_end > 0:
+            every = int(min(CHECK_EVERY_MAX, max(1, math.floor(0.5 * skin_est / (v_end * dt)))))
+    box_cmds: list[str] = []
+    if fit.oversized:
+        warnings.append(("oversized domain", f"the simulation domain spans {fit.domain_bins:.3g} "
+                         "neighbour bins, far more than the spheres and walls need: the LAMMPS box "
+                         "is shrink-wrapped around them and spheres beyond the domain faces are "
+                         f"deleted every {every} step(s) (fix evaporate)"))
+        lim = " ".join(f"{_fmt(dom_lo[a])} {_fmt(dom_hi[a])}" if removal_axes[a] else "INF INF"
+                       for a in range(3))
+        box_cmds += ["# the domain is far larger than the spheres need: shrink-wrapped box, spheres "
+                     "beyond the domain faces are deleted",
+                     f"region          fl_domain block {lim} side out units box",
+                     f"fix             fl_domain spheres evaporate {every} {max(1, len(rows))} "
+                     "fl_domain 4711"]
+    if fit.binsize is not None:
+        box_cmds += [f"# coarse bins: the box spans {fit.bins:.3g} bins of the default size",
+                     f"neigh_modify    binsize {_fmt(fit.binsize)}",
+                     f"atom_modify     sort 1000 {_fmt(fit.binsize)}"]
+    elif fit.nsq:
+        box_cmds += [f"# no bins: the box spans {fit.bins:.3g} bins of the default size and is too "
+                     "thin for coarse ones",
+                     f"neighbor        {_fmt(skin_est)} nsq",
+                     "atom_modify     sort 0 0.0"]
+    if fit.binsize is not None or fit.nsq:
+        warnings.append(("sparse spheres", f"the LAMMPS box spans {fit.bins:.3g} neighbour bins of "
+                         "the default size (spheres far apart): "
+                         + (f"bins of {fit.binsize:.3g} are used" if fit.binsize is not None else
+                            "neighbour lists are built without bins (O(N^2))")))
+    if clipped and len(rows):
+        lim = " ".join(f"{_fmt(keep_lo[a] + 2.0 * (r_max + tile_radius))} "
+                       f"{_fmt(keep_hi[a] - 2.0 * (r_max + tile_radius))}" if math.isfinite(keep_lo[a])
+                       else "INF INF" for a in range(3))
+        warnings.append(("wall particles within reach", f"{', '.join(clipped)}: wall particles are "
+                         f"placed only within {reach:.3g} of the spheres (twice the distance they can "
+                         "travel in the run from their speeds, initial overlaps and gravity); the run "
+                         "stops with an error if a sphere gets farther"))
+        box_cmds += ["# wall particles exist only within reach of the spheres: stop if one gets farther",
+                     f"region          fl_reach block {lim} side out units box",
+                     "variable        fl_reach_out equal count(spheres,fl_reach)",
+                     f"fix             fl_sphere_beyond_wall_particles spheres halt {every} "
+                     "v_fl_reach_out > 0 error hard message yes"]
 
     # ---- bonds
     bonds = model.bonds
@@ -594,7 +888,7 @@ def build_granular_job(model: GranularModel, folder: str | Path):
     pair_lines = [f"pair_coeff      {i} {j} {a if a is not None else fallback}" for i, j, a in pair_lines]
 
     # ---- wall fixes (regions and planes)
-    wall_cmds: list[str] = []
+    wall_cmds: list[str] = list(box_cmds)
     var_cmds: list[str] = []
     frame_columns: list[str] = []
     mat_groups = [(type_of_mat[m], m) for m in mats]
@@ -646,7 +940,7 @@ def build_granular_job(model: GranularModel, folder: str | Path):
         tile_groups=[(tag, _compress_ids(wp.tile_ids)) for wp, tag in tile_groups],
         mat_groups=mat_groups, dt=dt, t_start=t_start, gravity=g, gnorm=float(np.linalg.norm(g)),
         var_cmds=var_cmds, wall_cmds=wall_cmds, frame_columns=frame_columns,
-        acts=acts, compress_ids=_compress_ids, lost=any(b == "f" for b in bnd),
+        acts=acts, compress_ids=_compress_ids, lost=bool(removal_axes.any()),
         walls=[(wp.name, wp.description) for wp in wall_plans],
     )
     script_path = folder / SCRIPT_NAME

@@ -321,11 +321,12 @@ def plan_musen_script(path: str | Path, out: str | Path | None = None) -> Script
 
     Results go where RESULT_FILE says (relative to the script), or with ``out`` into that
     folder under their relative RESULT_FILE names (an absolute or ``..`` name is refused)."""
+    from .textio import patched_reading
     from .translate.granular_job import build_granular_job
     from .translate.musen_script import apply_simulator_settings, read_script
 
     script = Path(path).resolve()
-    jobs = read_script(script)
+    jobs = read_script(Path(path))          # messages name the script as the user did
     path_of = _path_resolver(script)
     out_folder = Path(out).resolve() if out is not None else None
 
@@ -361,7 +362,8 @@ def plan_musen_script(path: str | Path, out: str | Path | None = None) -> Script
             model = _script_model(job, handles, path_of)
             apply_simulator_settings(model, job)
             check_musen_runnable(model)
-            build_granular_job(model, script.parent)     # translation errors now, not mid-script
+            if not patched_reading():        # (check re-reading with placeholder values)
+                build_granular_job(model, script.parent)  # translation errors now, not mid-script
             handle = path_of(job.result_file, job, "RESULT_FILE")
             step = ScriptStep(job, "simulate", handle=handle, model=model, spool=handle in exported)
             if not (handle.suffix.lower() == ".mdem" and handle in exported):

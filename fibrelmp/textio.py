@@ -24,6 +24,12 @@ def _overlay_key(path: str | os.PathLike) -> str:
     return os.path.realpath(path)
 
 
+def patched_reading() -> bool:
+    """Is ``collect_errors`` re-reading files with failing lines patched?  (Values derived
+    from patched lines are placeholders: checks of them would report artifacts.)"""
+    return bool(_OVERLAY)
+
+
 def read_text(path: str | os.PathLike, what: str = "file") -> str:
     """Read a text file; every failure becomes an InputError naming the path.
 

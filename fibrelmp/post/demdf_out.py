@@ -24,7 +24,7 @@ import numpy as np
 
 from ..errors import RunError
 from ..granmodel import GranularFrame, GranularModel
-from ..textio import atomic_write
+from ..textio import discard, write_failure
 from ..translate.demdf import read_snapshot
 
 __all__ = ["DemdfSnapshotWriter", "read_snapshot"]
@@ -74,11 +74,17 @@ class DemdfSnapshotWriter:
                            "the run became unstable")
         self._set_counters(frame.time)
         name = f"{self.filename}_{self.count}.json"
-        if not self.staged:
-            shutil.rmtree(self.staging, ignore_errors=True)
-            self.staging.mkdir(parents=True)
-        atomic_write(self.staging / name, self.render().encode("utf-8"))
-        self.staged.append(self.staging / name)
+        staged = self.staging / name
+        try:
+            if not self.staged:
+                shutil.rmtree(self.staging, ignore_errors=True)
+                self.staging.mkdir(parents=True)
+            with open(staged, "wb") as fh:
+                fh.write(self.render().encode("utf-8"))
+        except OSError as exc:        # the message names the snapshot, not the staging copy
+            discard(staged)
+            raise write_failure(self.folder / name, exc) from None
+        self.staged.append(staged)
         self.count += 1
         return self.folder / name
 
@@ -119,7 +125,11 @@ class DemdfSnapshotWriter:
         """Move the staged snapshots into place."""
         for path in self.staged:
             target = self.folder / path.name
-            os.replace(path, target)
+            try:
+                os.replace(path, target)
+            except OSError as exc:
+                self.abort()
+                raise write_failure(target, exc) from None
             self.written.append(target)
         self.staged = []
         shutil.rmtree(self.staging, ignore_errors=True)

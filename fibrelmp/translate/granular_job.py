@@ -15,7 +15,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..granmodel import ContactLaw, Geometry, GranularModel
-from ..lammps_text import comment_text, template_environment
+from ..lammps_text import LammpsText, comment_text, template_environment
 from ..sanity import close_pairs
 from ..textio import atomic_write
 from .granular_walls import (BoxShape, CylinderShape, Kinematics, detect_cylinder, detect_oriented_box,
@@ -148,6 +148,11 @@ def _check_law(model: GranularModel, a: int, b: int) -> ContactLaw:
     return law
 
 
+def _note(text: str) -> LammpsText:
+    """A comment line of fibrelmp's own in the script (escaped like user text all the same)."""
+    return LammpsText("# " + comment_text(text))
+
+
 def rolling_spring(m_min: float, dt: float, source=None) -> tuple[float, float]:
     """k and gamma of ``rolling sds``: the rolling spring's angular frequency is at most
     ROLL_OMEGA_DT/dt for the lightest sphere involved (I = 2/5 m R^2, R_eff <= R), critically
@@ -206,7 +211,7 @@ def _schedule(total: int, saves: SaveSteps, deletions: list[tuple[int, np.ndarra
     """Actions of the script: runs (in pieces of at most 1/50 of the run, for progress),
     activity-end deletions and frames.  A stretch of regular saves with no deletion in it is
     one LAMMPS loop ("loop" ... "end"), so the script does not grow with the number of frames."""
-    piece = max(1, math.ceil(total / 50))
+    piece = max(1, min(math.ceil(total / 50), 2 ** 31 - 1))     # LAMMPS: run N <= 2^31-1
     acts: list[tuple] = [("run0",), ("frame", 0)]
     dels = {s: rows for s, rows in deletions}
     step, pre = 0, False
@@ -791,18 +796,18 @@ def build_granular_job(model: GranularModel, folder: str | Path):
                          f"deleted every {every} step(s) (fix evaporate)"))
         lim = " ".join(f"{_fmt(dom_lo[a])} {_fmt(dom_hi[a])}" if removal_axes[a] else "INF INF"
                        for a in range(3))
-        box_cmds += ["# the domain is far larger than the spheres need: shrink-wrapped box, spheres "
-                     "beyond the domain faces are deleted",
+        box_cmds += [_note("the domain is far larger than the spheres need: shrink-wrapped box, spheres "
+                           "beyond the domain faces are deleted"),
                      f"region          fl_domain block {lim} side out units box",
                      f"fix             fl_domain spheres evaporate {every} {max(1, len(rows))} "
                      "fl_domain 4711"]
     if fit.binsize is not None:
-        box_cmds += [f"# coarse bins: the box spans {fit.bins:.3g} bins of the default size",
+        box_cmds += [_note(f"coarse bins: the box spans {fit.bins:.3g} bins of the default size"),
                      f"neigh_modify    binsize {_fmt(fit.binsize)}",
                      f"atom_modify     sort 1000 {_fmt(fit.binsize)}"]
     elif fit.nsq:
-        box_cmds += [f"# no bins: the box spans {fit.bins:.3g} bins of the default size and is too "
-                     "thin for coarse ones",
+        box_cmds += [_note(f"no bins: the box spans {fit.bins:.3g} bins of the default size and is too "
+                           "thin for coarse ones"),
                      f"neighbor        {_fmt(skin_est)} nsq",
                      "atom_modify     sort 0 0.0"]
     if fit.binsize is not None or fit.nsq:
@@ -818,7 +823,7 @@ def build_granular_job(model: GranularModel, folder: str | Path):
                          f"placed only within {reach:.3g} of the spheres (twice the distance they can "
                          "travel in the run from their speeds, initial overlaps and gravity); the run "
                          "stops with an error if a sphere gets farther"))
-        box_cmds += ["# wall particles exist only within reach of the spheres: stop if one gets farther",
+        box_cmds += [_note("wall particles exist only within reach of the spheres: stop if one gets farther"),
                      f"region          fl_reach block {lim} side out units box",
                      "variable        fl_reach_out equal count(spheres,fl_reach)",
                      f"fix             fl_sphere_beyond_wall_particles spheres halt {every} "

@@ -120,7 +120,7 @@ def _schedule(model: Model, general_lambda: bool) -> tuple[list[tuple], range, i
     """
     acts: list[tuple] = []
     total = sum(st.steps for st in model.plan.stages)
-    piece = max(1, math.ceil(total / 50))          # progress granularity
+    piece = max(1, min(math.ceil(total / 50), 2 ** 31 - 1))    # progress; LAMMPS: run N <= 2^31-1
     fresh = True                                   # next step starts from the stored state
 
     def advance(n: int, store_before_last: bool) -> None:

@@ -138,6 +138,7 @@ MUSEN_SCRIPT = _c("cmusen script", "musen_script", [
     ("huge_end_time", "END_TIME 1e400"),
     ("component", "unsupported component"),
     ("model_typo", "misspelt model name"),
+    ("irregular_saves", "saving step not a multiple of the step, a million saves"),
     ("missing_scene", "SOURCE_FILE that does not exist"),
     ("bad_scene", "SOURCE_FILE scene with a bad material"),
     ("step_longer_than_run", "simulation step longer than the run"),
@@ -238,6 +239,58 @@ def _post_directory(tmp: Path) -> list[str]:
     return ["post", str(tmp / "frames.dump"), "--to", "xyz", "-o", str(tmp / "out")]
 
 
+def _fibrenet_copy(tmp: Path, **keys: str) -> Path:
+    """The good FibreNet input and its model in ``tmp``, keyword lines replaced."""
+    lines = (CORPUS / "fibrenet" / "good.txt").read_text().splitlines()
+    for name in ("model.txt",):
+        src = CORPUS / "fibrenet" / name
+        if src.exists():
+            (tmp / name).write_bytes(src.read_bytes())
+    lines = [ln for ln in lines if not ln.split() or ln.split()[0] not in keys]
+    lines += [f"{k}\t{v}" for k, v in keys.items()]
+    (tmp / "input.txt").write_text("\n".join(lines) + "\n")
+    return tmp / "input.txt"
+
+
+def _run_existing(tmp: Path) -> list[str]:
+    inp = _fibrenet_copy(tmp)
+    (tmp / "out").mkdir()
+    prefix = next(ln.split()[1] for ln in inp.read_text().splitlines() if ln.startswith("output_file"))
+    (tmp / "out" / f"{prefix}_coord.xyz").write_text("an earlier result\n")
+    return ["run", str(inp), "-o", str(tmp / "out")]
+
+
+_HELD: list[int] = []          # folder locks held for the rest of the test process
+
+
+def _run_locked(tmp: Path) -> list[str]:
+    import fcntl
+    import os
+
+    (tmp / "out").mkdir()
+    fd = os.open(tmp / "out", os.O_RDONLY)
+    fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)      # as a running fibrelmp holds it
+    _HELD.append(fd)
+    return ["run", str(_fibrenet_copy(tmp)), "-o", str(tmp / "out")]
+
+
+def _run_escape(tmp: Path) -> list[str]:
+    return ["run", str(_fibrenet_copy(tmp, output_file="../../x")), "-o", str(tmp / "out")]
+
+
+def _script_overwrites_scene(tmp: Path) -> list[str]:
+    (tmp / "scene.txt").write_bytes((CORPUS / "musen_script" / "scene.txt").read_bytes())
+    text = (CORPUS / "musen_script" / "good.txt").read_text()
+    import re
+    text = re.sub(r"(?m)^RESULT_FILE.*$", "RESULT_FILE scene.txt", text)
+    (tmp / "job.txt").write_text(text)
+    return ["run", str(tmp / "job.txt")]
+
+
+def _device(tmp: Path) -> list[str]:
+    return ["check", "/dev/zero"]
+
+
 GENERATED = [
     Case("generated/directory", "any", "", "a directory given as the input", make=_directory),
     Case("generated/model_directory", "FibreNet model", "", "model_file names a directory",
@@ -254,6 +307,15 @@ GENERATED = [
          "(none is left behind)", command="post", make=_post_new_folder),
     Case("generated/run_unwritable", "DEMDF", "", "run --out below a regular file",
          command="run", make=_run_unwritable),
+    Case("generated/run_existing", "FibreNet", "", "an earlier run's result in -o, no --force",
+         command="run", make=_run_existing),
+    Case("generated/run_locked", "FibreNet", "", "-o folder locked by another run",
+         command="run", make=_run_locked),
+    Case("generated/run_escape", "FibreNet", "", "output_file ../../x with -o",
+         command="run", make=_run_escape),
+    Case("generated/script_overwrites_scene", "cmusen script", "", "RESULT_FILE names the "
+         "SOURCE_FILE scene", command="run", make=_script_overwrites_scene),
+    Case("generated/device", "any", "", "/dev/zero as the input", make=_device),
 ]
 
 CASES: list[Case] = (FIBRENET + FIBRENET_MODEL + MUSEN + MUSEN_SCRIPT + DEMDF + DUMP + GENERIC

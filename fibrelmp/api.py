@@ -101,7 +101,8 @@ def run(model: Model, out: str | Path | None = None, work: str | Path | None = N
 
         def convert(frames) -> list[Path]:
             return write_fibrenet(_expected_frames(frames, job), prefix, out_folder, spec.fields,
-                                  names, model.dynamics.dt, model.box.lengths, types)
+                                  names, model.dynamics.dt, model.box.lengths, types,
+                                  warn=model.warn)
 
         outputs_written: list[Path] = []
         if rank == 0 and size == 1 and (os.cpu_count() or 1) > 1:

@@ -356,8 +356,10 @@ def run(input: Path = typer.Argument(..., help="FibreNet input, MUSEN text scene
                               "inputs; FibreNet inputs set their own steps")
         model = read_input(input)
         _report_warnings(model.warnings)
+        said = len(model.warnings)
         result = do_run(model, out=out, work=work, progress=not _state["quiet"],
                         checkpoint_every=checkpoint_every, resume=resume, force=force)
+        _report_warnings(model.warnings[said:])        # found while running (e.g. beads outside)
         outputs, script = result.outputs, result.job.script
     elif kind == "musen-script":
         from .granular_api import run_musen_script
@@ -382,9 +384,11 @@ def run(input: Path = typer.Argument(..., help="FibreNet input, MUSEN text scene
             for text in overrides:
                 _say(f"override: {text}")
             _report_warnings(model.warnings)
+            said = len(model.warnings)
             target = out if out is not None else input.with_name(f"{input.stem}_result.txt")
             res = run_musen_scene(model, target, work=work, progress=not _state["quiet"],
                                   precision=precision, checkpoints=checkpoints, force=force)
+            _report_warnings(model.warnings[said:])    # found while translating or running
         for note in res.notes:
             _say(note)
         outputs, script = res.outputs, (res.jobs[-1].script if res.jobs else None)

@@ -103,6 +103,7 @@ def run_demdf(path: str | Path, out: str | Path | None = None, work: str | Path 
     if warn is not None:
         warn(model.warnings)
     outputs, folder = demdf_outputs(model, out, work)
+    said = len(model.warnings)
     result = GranularResult()
     rank0 = _is_rank0()
     with locked(outputs, force or checkpoints.resume, 0 if rank0 else 1):
@@ -112,6 +113,8 @@ def run_demdf(path: str | Path, out: str | Path | None = None, work: str | Path 
         if writer is not None:
             result.outputs.extend(getattr(writer, "written", []))
             finish(outputs, result.outputs)
+    if warn is not None:
+        warn(model.warnings[said:])          # found while translating or running
     return result
 
 
@@ -435,6 +438,7 @@ def run_musen_script(path: str | Path, work: str | Path | None = None, progress:
                     model = step.model
                     if warn is not None:
                         warn(model.warnings)
+                    said = len(model.warnings)
                     job_work = work_root / f"job{job.index}"
                     say(f"job {job.index}: simulating {job.source_file} to t = {model.plan.t_end:g} s")
                     sinks: list = []
@@ -445,6 +449,8 @@ def run_musen_script(path: str | Path, work: str | Path | None = None, progress:
                         sinks.append(MusenResultWriter(model, step.written))
                         res.outputs.append(step.written)
                     res.jobs.append(simulate(model, job_work, sinks, progress, checkpoints))
+                    if warn is not None:
+                        warn(model.warnings[said:])  # found while translating or running
                 else:
                     spool = spools.get(step.source)
                     if rank0:

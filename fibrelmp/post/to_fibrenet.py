@@ -131,8 +131,15 @@ def write_fibrenet(frames: Iterable[Frame], basename: str, folder: Path, fields:
         for w in writers.values():
             w.abort()
         raise
-    for w in writers.values():
-        w.close()
+    pending = list(writers.values())
+    try:
+        while pending:
+            pending[0].close()
+            pending.pop(0)
+    except BaseException:            # e.g. a full disk: no temp file of the others stays
+        for w in pending[1:]:
+            w.abort()
+        raise
     written = [w.path for w in writers.values()]
     if restart and last is not None:
         path = folder / f"{basename}{RESTART_SUFFIX}"

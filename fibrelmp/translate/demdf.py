@@ -321,7 +321,7 @@ class _Reader(PlanMixin):
         if isinstance(value, str):
             source = value
             file = self.path.parent / value
-            if not file.is_file():
+            if not file.exists():          # a folder: load_json says "is a directory"
                 self.j.fail(where, f"particles file {value!r} not found (looked for {file}; the "
                             "name is relative to the input file's folder)")
             sub = load_json(file, "DEMDF particles file")

@@ -112,10 +112,14 @@ def locked(outputs: Outputs, force: bool, rank: int = 0) -> Iterator[Outputs]:
         yield outputs
         return
     fds: list[int] = []
+    created: list[Path] = []          # removed again when a later location fails
+    ready = False
     try:
         for folder in outputs.folders():
             try:
+                missing = [p for p in [folder, *folder.parents] if not p.exists()]
                 folder.mkdir(parents=True, exist_ok=True)
+                created += missing
                 fd = os.open(folder, os.O_RDONLY | os.O_DIRECTORY)
             except OSError as exc:
                 raise InputError(folder, None, f"cannot create the folder: {exc.strerror or exc}") from None
@@ -135,10 +139,17 @@ def locked(outputs: Outputs, force: bool, rank: int = 0) -> Iterator[Outputs]:
             except OSError as exc:
                 raise InputError(folder, None, f"cannot write here: {exc.strerror or exc}") from None
         _remove_stale_temps(outputs)
+        ready = True
         yield outputs
     finally:
         for fd in fds:
             os.close(fd)          # closing releases the lock
+        if not ready:
+            for folder in sorted(set(created), key=lambda p: len(p.parts), reverse=True):
+                try:
+                    folder.rmdir()
+                except OSError:
+                    pass
 
 
 def _remove_stale_temps(outputs: Outputs) -> None:

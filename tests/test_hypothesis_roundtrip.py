@@ -82,6 +82,12 @@ def fibrenet_cases(draw):
             "gravity": draw(st.lists(unit(-10, 10), min_size=3, max_size=3)),
             "run": run, "freq": draw(st.integers(1, run))}
     style = {"spell": draw(SPELL), "sep": draw(SEP), "eol": draw(EOL)}
+    # a periodic box needs every spring and angle leg shorter than half the box (FibreNet does
+    # not take the minimum image, LAMMPS does: such inputs are refused); otherwise walls
+    legs = [(i, j) for i, j, *_ in springs] + [(a, b) for a, b, *_ in angles] + \
+        [(b, c) for _, b, c, *_ in angles]
+    if any((np.abs(pos[j] - pos[i]) >= 0.5 * size).any() for i, j in legs):
+        plan["box_type"] = "finite"
     return types, size, beads, springs, angles, pairs, plan, style
 
 

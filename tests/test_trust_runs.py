@@ -90,7 +90,7 @@ def test_checkpoint_every_gives_the_uninterrupted_run_granular(tmp_path, kind):
 
 
 def test_sigkill_then_resume_and_no_temp_files_left(tmp_path):
-    inp = fibre_case(tmp_path / "in", run="20000", output_freq="2000")
+    inp = fibre_case(tmp_path / "in", run="6000", output_freq="1000")
     assert cli(["-q", "run", inp, "-o", tmp_path / "whole"], tmp_path).returncode == 0
     out = tmp_path / "cut"
     state = out / "fibre_network_work" / "checkpoint.json"
@@ -98,7 +98,7 @@ def test_sigkill_then_resume_and_no_temp_files_left(tmp_path):
                             stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 120
     while proc.poll() is None and time.monotonic() < deadline:
-        if state.exists() and json.loads(state.read_text() or "{}").get("steps", 0) >= 4000:
+        if state.exists() and json.loads(state.read_text() or "{}").get("steps", 0) >= 2000:
             break
         time.sleep(0.01)
     proc.kill()                       # SIGKILL: no chance to clean up
@@ -109,7 +109,7 @@ def test_sigkill_then_resume_and_no_temp_files_left(tmp_path):
     assert not [p.name for p in out.iterdir() if ".tmp" in p.name], "temp files of the killed run"
     for kind in ("coord", "vel", "force"):
         ours, ref = read_xyz(out / f"fibre_network_{kind}.xyz"), read_xyz(tmp_path / "whole" / f"fibre_network_{kind}.xyz")
-        assert [f.step for f in ours] == [f.step for f in ref] == list(range(0, 20001, 2000))
+        assert [f.step for f in ours] == [f.step for f in ref] == list(range(0, 6001, 1000))
         for a, b in zip(ours, ref):       # README: not bitwise after a resume (drag restarts)
             assert np.abs(a.values - b.values).max() <= (1.1e-5 if kind == "coord" else 2e-3)
 
@@ -132,7 +132,7 @@ def test_checkpoint_every_two_ranks(tmp_path):
 
 # -- 3. two runs, one folder -----------------------------------------------------------------
 def test_second_run_into_a_busy_folder_exits_2(tmp_path):
-    inp = fibre_case(tmp_path / "in", run="40000", output_freq="4000")
+    inp = fibre_case(tmp_path / "in", run="12000", output_freq="2000")
     out = tmp_path / "out"
     first = subprocess.Popen(CLI + ["-q", "run", str(inp), "-o", str(out)], stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 60
@@ -145,7 +145,7 @@ def test_second_run_into_a_busy_folder_exits_2(tmp_path):
     assert "another fibrelmp run is using this folder" in second.stderr
     assert "Traceback" not in second.stderr
     frames = read_xyz(out / "fibre_network_coord.xyz")
-    assert [f.step for f in frames] == list(range(0, 40001, 4000))
+    assert [f.step for f in frames] == list(range(0, 12001, 2000))
 
 
 # -- 4. overwriting --------------------------------------------------------------------------
@@ -244,6 +244,28 @@ def test_output_folder_below_a_file_is_refused_before_the_run(tmp_path, kind):
     assert time.monotonic() - start < 30
     assert sorted(p.name for p in (tmp_path / "in").iterdir()) == sorted(p.name for p in inp.parent.iterdir())
     assert not list((tmp_path / "in").glob("*_work"))
+
+
+def test_read_only_output_folder_is_refused_before_the_run(tmp_path):
+    """Was: the whole run, then a raw errno with exit 1.  A read-only mount (root ignores
+    mode bits, so the test mounts one)."""
+    ro = tmp_path / "ro"
+    (tmp_path / "src").mkdir()
+    ro.mkdir()
+    if subprocess.run(["mount", "--bind", str(tmp_path / "src"), str(ro)], capture_output=True).returncode:
+        pytest.skip("needs permission to bind-mount a read-only folder")
+    try:
+        if subprocess.run(["mount", "-o", "remount,bind,ro", str(ro)], capture_output=True).returncode:
+            pytest.skip("needs permission to remount read-only")
+        (tmp_path / "in").mkdir()
+        shutil.copy(DEMDF / "head_on.json", tmp_path / "in")
+        start = time.monotonic()
+        res = cli(["-q", "run", tmp_path / "in" / "head_on.json", "-o", ro, "--work", tmp_path / "w"], tmp_path)
+        assert res.returncode == 2 and "Read-only file system" in res.stderr, res.stderr
+        assert time.monotonic() - start < 30
+        assert not (tmp_path / "w" / "in.lammps").exists(), "LAMMPS was set up before the check"
+    finally:
+        subprocess.run(["umount", str(ro)], capture_output=True)
 
 
 # -- 7. bounded resources --------------------------------------------------------------------

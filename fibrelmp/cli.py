@@ -201,7 +201,7 @@ def check(input: Path = typer.Argument(..., help="Any supported input file.",
         from .granular_check import summary
 
         model = _read_for_check(lambda: model_for_check(input, kind), kind, input)
-        _summary(summary(model))
+        _summary(summary(model) + [f"results      {_granular_results(input, kind, model)}"])
         _report_warnings(model.warnings)
         _summary([f"warnings     {len(model.warnings)}"])
         return
@@ -226,9 +226,26 @@ def check(input: Path = typer.Argument(..., help="Any supported input file.",
             f", output every {model.plan.output.every}"
         lines.append(f"stage        {st.name}: {st.steps} steps{extra}")
     lines += spring_check(model)
+    from .api import fibrenet_outputs
+
+    outputs, folder, prefix = fibrenet_outputs(model)
+    lines.append(f"results      {', '.join(str(p) for p in outputs.files)} (or in -o DIR)")
     _summary(lines)
     _report_warnings(model.warnings)
     _summary([f"warnings     {len(model.warnings)}"])
+
+
+def _granular_results(input: Path, kind: str, model) -> str:
+    """Where ``run`` would write (without -o), as check reports it."""
+    from .granular_api import demdf_outputs, musen_result_path, plan_musen_script
+
+    if kind == "demdf":
+        outputs, folder = demdf_outputs(model)
+        return f"{folder / model.passthrough['demdf']['filename']}_<n>.json (or in -o DIR)"
+    if kind == "musen-script":
+        written = [str(st.written) for st in plan_musen_script(input).steps if st.written is not None]
+        return ", ".join(written) or "none (the script exports nothing)"
+    return f"{musen_result_path(input.resolve().with_name(f'{input.stem}_result.txt'))[0]} (or -o FILE)"
 
 
 def _summary(lines: list[str]) -> None:

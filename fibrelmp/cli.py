@@ -162,6 +162,12 @@ def _version(value: bool) -> None:
             typer.echo(f"MPI {_mpi_library_version()}")
         except Exception as exc:  # no MPI library loaded (serial LAMMPS build)
             typer.echo(f"MPI unavailable: {exc}")
+        try:
+            from .post.fastparse import active_path
+
+            typer.echo(f"post fast path: {active_path()}")
+        except Exception as exc:  # version output must never crash
+            typer.echo(f"post fast path: unknown ({exc})")
         raise typer.Exit()
 
 

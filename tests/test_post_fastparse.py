@@ -141,6 +141,8 @@ def test_fallback_without_library(monkeypatch):
 def test_build_failure_is_silent(monkeypatch, tmp_path):
     monkeypatch.setattr(fastparse, "_lib", None)
     monkeypatch.setattr(fastparse, "_tried", False)
+    monkeypatch.setattr(fastparse, "_path", fastparse._path)
+    monkeypatch.setattr(fastparse, "_INSTALLED", tmp_path / "not-installed.so")   # as in a checkout
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
     monkeypatch.setenv("CC", str(tmp_path / "no-such-compiler"))
     assert fastparse.library() is None

@@ -1,4 +1,5 @@
-/* Optional C helpers for fibrelmp.post (compiled lazily by fastparse.py, loaded with ctypes).
+/* Optional C helpers for fibrelmp.post (built by setup.py at install time, else compiled on
+ * first use by fastparse.py; a plain shared library loaded with ctypes, not a Python module).
  *
  * fp_parse_block: a block of whitespace-separated decimal numbers, exactly nrows lines of
  *   ncols tokens, into a row-major float64 array.  Correctly rounded (bit-identical to

@@ -1,10 +1,20 @@
 """Optional C fast paths for dump parsing and xyz formatting (``_fastparse.c``).
 
-The C source is compiled at first use with the system C compiler into a per-user cache
-(``$XDG_CACHE_HOME/fibrelmp`` or ``~/.cache/fibrelmp``, keyed by a hash of the source) and
-loaded with ctypes.  If anything fails (no compiler, read-only cache, load error) every
-function here returns None and callers keep their numpy paths, which give identical results.
-Set ``FIBRELMP_NO_C=1`` to disable the C paths.
+The C source is normally compiled when fibrelmp is installed (``setup.py``: an optional
+build step that never fails the installation) into ``_fastparse_c<EXT_SUFFIX>`` next to this
+file, and loaded with ctypes.  The library is looked for in this order:
+
+1. the one built at install time, inside the package;
+2. else (a source checkout, or no compiler at install time) the source is compiled at first
+   use with the system C compiler into a per-user cache (``$XDG_CACHE_HOME/fibrelmp`` or
+   ``~/.cache/fibrelmp``, keyed by a hash of the source and flags); a lock file makes
+   concurrent processes (MPI ranks) wait for one compiler instead of each running their own;
+3. else every function here returns None and callers keep their numpy paths, which give
+   identical results (several times slower).
+
+Each library is self-checked against Python's conversions before it is trusted.  Set
+``FIBRELMP_NO_C=1`` to disable the C paths.  ``active_path()`` (printed by
+``fibrelmp --version``) says which path is in use and why.
 
 Both C functions decline (return None here) on anything unusual -- text, inf/nan, bad token
 counts, huge values -- so errors and edge cases are always handled by the numpy code.
@@ -25,9 +35,17 @@ from pathlib import Path
 import numpy as np
 
 _SRC = Path(__file__).with_name("_fastparse.c")
+# built by setup.py (Extension "fibrelmp.post._fastparse_c"); loaded with ctypes, never imported
+_INSTALLED = Path(__file__).with_name("_fastparse_c" + (sysconfig.get_config_var("EXT_SUFFIX") or ".so"))
+_FLAGS = ["-O3", "-shared", "-fPIC", "-fno-fast-math", "-ffp-contract=off"]
 _lock = threading.Lock()
 _lib = None
 _tried = False
+_path = "not loaded yet"
+
+
+class _Unavailable(Exception):
+    """The C library could not be built or loaded; str() says why, in a few words."""
 
 
 def _cache_dir() -> Path:
@@ -35,58 +53,135 @@ def _cache_dir() -> Path:
     return Path(base) / "fibrelmp"
 
 
-def _build() -> ctypes.CDLL | None:
+def _first_line(text: str) -> str:
+    lines = [ln.strip() for ln in text.splitlines() if ln.strip()]
+    hits = [ln for ln in lines if "error" in ln.lower()]
+    line = (hits or lines or [""])[0]
+    return line if len(line) <= 200 else line[:197] + "..."
+
+
+def _locked(path: Path):
+    """An exclusive lock file (released when the returned file is closed), or None when the
+    file system cannot lock: os.replace keeps unlocked concurrent builds harmless anyway."""
+    try:
+        import fcntl
+
+        handle = open(path, "a")
+    except (ImportError, OSError):
+        return None
+    try:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+    except OSError:
+        handle.close()
+        return None
+    return handle
+
+
+def _compile() -> Path:
+    """Compile _fastparse.c into the cache once (per source, compiler and flags); its path."""
     src = _SRC.read_bytes()
     cc = (os.environ.get("CC") or sysconfig.get_config_var("CC") or "cc").split()
-    flags = ["-O3", "-shared", "-fPIC", "-fno-fast-math", "-ffp-contract=off"]
-    key = hashlib.sha256(src + " ".join(cc + flags).encode() + sys.platform.encode()).hexdigest()[:16]
+    key = hashlib.sha256(src + " ".join(cc + _FLAGS).encode() + sys.platform.encode()).hexdigest()[:16]
     folder = _cache_dir()
     lib = folder / f"fastparse-{key}.so"
-    if not lib.exists():
+    if lib.exists():
+        return lib
+    try:
         folder.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(suffix=".so", dir=folder)
+    except OSError as exc:
+        raise _Unavailable(f"cannot create the cache folder {folder}: {exc.strerror or exc}") from exc
+    lock = _locked(folder / f"fastparse-{key}.lock")
+    try:
+        if lib.exists():                    # another process built it while we waited
+            return lib
+        try:
+            fd, tmp = tempfile.mkstemp(suffix=".so", dir=folder)
+        except OSError as exc:
+            raise _Unavailable(f"cannot write to the cache folder {folder}: {exc.strerror or exc}") from exc
         os.close(fd)
         try:
-            subprocess.run(cc + flags + ["-o", tmp, str(_SRC), "-lm"], check=True,
-                           stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                           stderr=subprocess.DEVNULL, timeout=120)
+            proc = subprocess.run(cc + _FLAGS + ["-o", tmp, str(_SRC), "-lm"], stdin=subprocess.DEVNULL,
+                                  capture_output=True, text=True, errors="replace", timeout=120)
+            if proc.returncode != 0:
+                why = _first_line(proc.stderr + proc.stdout) or f"exit status {proc.returncode}"
+                raise _Unavailable(f"no C compiler: {' '.join(cc)} failed: {why}")
             os.replace(tmp, lib)            # atomic: concurrent builders are harmless
+        except FileNotFoundError as exc:
+            raise _Unavailable(f"no C compiler: {cc[0]!r} not found") from exc
+        except subprocess.TimeoutExpired as exc:
+            raise _Unavailable(f"no C compiler: {' '.join(cc)} timed out") from exc
         finally:
             if os.path.exists(tmp):
                 os.unlink(tmp)
-    dll = ctypes.CDLL(str(lib))
-    i64, ptr = ctypes.c_int64, ctypes.c_void_p
-    dll.fp_parse_block.argtypes = [ptr, i64, ptr, i64, i64]
-    dll.fp_parse_block.restype = ctypes.c_int
-    dll.fp_format_xyz.argtypes = [ptr, ptr, i64, ctypes.c_char_p, i64, i64, ctypes.c_int, ptr, i64]
-    dll.fp_format_xyz.restype = i64
-    dll.fp_count_lines.argtypes = [ptr, i64]
-    dll.fp_count_lines.restype = i64
-    dll.fp_nth_newline.argtypes = [ptr, i64, i64, ctypes.POINTER(i64)]
-    dll.fp_nth_newline.restype = i64
+    finally:
+        if lock is not None:
+            lock.close()
+    return lib
+
+
+def _open(lib: Path) -> ctypes.CDLL:
+    """Load the library, declare its functions and self-check it (else _Unavailable)."""
+    try:
+        dll = ctypes.CDLL(str(lib))
+        i64, ptr = ctypes.c_int64, ctypes.c_void_p
+        dll.fp_parse_block.argtypes = [ptr, i64, ptr, i64, i64]
+        dll.fp_parse_block.restype = ctypes.c_int
+        dll.fp_format_xyz.argtypes = [ptr, ptr, i64, ctypes.c_char_p, i64, i64, ctypes.c_int, ptr, i64]
+        dll.fp_format_xyz.restype = i64
+        dll.fp_count_lines.argtypes = [ptr, i64]
+        dll.fp_count_lines.restype = i64
+        dll.fp_nth_newline.argtypes = [ptr, i64, i64, ctypes.POINTER(i64)]
+        dll.fp_nth_newline.restype = i64
+    except (OSError, AttributeError) as exc:
+        raise _Unavailable(f"cannot load: {exc}") from exc
     # self-check against Python's correctly rounded conversions before trusting it
     probe = b"0.1 -2.5e-3 1.7976931348623157e308 123456789012345678901 4.9e-324 -0\n"
     out = np.empty(6)
     praw = np.frombuffer(probe, np.uint8)
     if dll.fp_parse_block(praw.ctypes.data, len(probe), out.ctypes.data, 1, 6) != 0 or \
             out.tobytes() != np.array([float(t) for t in probe.split()]).tobytes():
-        return None
+        raise _Unavailable(f"{lib} failed its self-check")
     return dll
 
 
+def _load() -> tuple[ctypes.CDLL | None, str]:
+    """(library or None, description of the path in use) -- see active_path()."""
+    if os.environ.get("FIBRELMP_NO_C"):
+        return None, f"numpy (FIBRELMP_NO_C={os.environ['FIBRELMP_NO_C']})"
+    if _INSTALLED.exists():
+        try:
+            return _open(_INSTALLED), f"C (installed: {_INSTALLED})"
+        except Exception as exc:            # e.g. built for another machine, or corrupted
+            installed = f"installed library unusable: {exc}"
+    else:
+        installed = "not built at install time"
+    try:
+        lib = _compile()
+        return _open(lib), f"C (compiled at first use: {lib}; {installed})"
+    except _Unavailable as exc:
+        return None, f"numpy ({exc}; {installed})"
+    except Exception as exc:                # never let the optional path break a conversion
+        return None, f"numpy (C build failed: {type(exc).__name__}: {exc}; {installed})"
+
+
 def library() -> ctypes.CDLL | None:
-    """The loaded C helpers, or None (built once per process; failures are silent)."""
-    global _lib, _tried
+    """The loaded C helpers, or None (loaded once per process; failures are silent)."""
+    global _lib, _tried, _path
     if _tried:
         return _lib
     with _lock:
         if not _tried:
-            try:
-                _lib = None if os.environ.get("FIBRELMP_NO_C") else _build()
-            except Exception:
-                _lib = None
+            _lib, _path = _load()
             _tried = True
     return _lib
+
+
+def active_path() -> str:
+    """Which implementation the post fast paths use, e.g. ``C (installed: /path/lib.so)``,
+    ``C (compiled at first use: ...)``, ``numpy (FIBRELMP_NO_C=1)`` or
+    ``numpy (no C compiler: ...)``.  Loads the library first if needed."""
+    library()
+    return _path
 
 
 # blocks / frames at least this large are split across two threads (ctypes drops the GIL)

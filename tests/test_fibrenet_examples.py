@@ -9,7 +9,7 @@ from fibrelmp import api
 from fibrelmp.model import Stage
 from fibrelmp.post.fibrenet_out import read_xyz
 
-from .conftest import REPO
+from .conftest import REPO, data_path
 
 
 def test_readme_example_warns_and_runs_shortened(tmp_path):
@@ -38,10 +38,7 @@ def test_translate_then_replay_with_lmp_matches_run(tmp_path):
     from fibrelmp._lammps import lmp_executable_env
     from fibrelmp.post.lammps_dump import iter_frames
 
-    src = REPO.parent / "shared" / "real-outputs" / "fibrenet" / "lambda_07_damped" / "input.txt"
-    if not src.exists():
-        import pytest
-        pytest.skip("shared data missing")
+    src = data_path("real-outputs", "fibrenet", "lambda_07_damped", "input.txt")
     model = api.read_input(src)
     run = api.run(model, out=tmp_path / "run", progress=False)
     job = api.translate(model, tmp_path / "job")

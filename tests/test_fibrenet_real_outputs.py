@@ -1,4 +1,4 @@
-"""fibrelmp run vs the real FibreNet program (shared/real-outputs/fibrenet).
+"""fibrelmp run vs the real FibreNet program (tests/data/real-outputs/fibrenet).
 
 Tolerances are FibreNet's own precision (see that folder's README): its pair and spring
 distances use single-precision native_sqrt, and its files hold 5 decimals (xyz) or 6
@@ -11,7 +11,7 @@ import pytest
 from fibrelmp import api
 from fibrelmp.post.fibrenet_out import XYZ_SUFFIX, read_restart, read_xyz
 
-from .conftest import shared_path
+from .conftest import data_path
 
 CASES = ["network_pbc_hs", "lambda_07_damped", "st_pairs_network", "lj_two_types_minimize",
          "restart_continue", "restart_continue/first_run"]
@@ -20,7 +20,7 @@ TOL = {"position": 2e-5, "velocity": 3e-5, "force": 1e-3}
 
 @pytest.mark.parametrize("case", CASES)
 def test_matches_real_fibrenet(case, tmp_path):
-    folder = shared_path("real-outputs", "fibrenet", case)
+    folder = data_path("real-outputs", "fibrenet", case)
     model = api.read_input(folder / "input.txt")
     base = model.plan.output.basename
     api.run(model, out=tmp_path, progress=False)

@@ -24,7 +24,7 @@ from fibrelmp.translate.granular_walls import (detect_box, detect_cylinder, dete
                                                nearest_triangle, closest_points, tile_triangles)
 
 from . import granular_models as gm
-from .conftest import REPO, SHARED
+from .conftest import REPO, data_path
 
 R = 0.0005
 G = 9.81
@@ -49,10 +49,8 @@ FLOOR = [[-0.004, -0.004, 0], [0.004, -0.004, 0], [0.004, 0.004, 0], [-0.004, 0.
 # shape detection
 def singel_particle_plate() -> np.ndarray:
     """The 12 triangles of geometry 'Plate' in MUSEN's SingelParticle_text.txt (old format:
-    12 = V1, 31 = V2 (+0), 16 = V3), read straight from the shared copy when available."""
-    path = SHARED / "real-inputs" / "musen" / "SingelParticle_text.txt"
-    if not path.exists():
-        pytest.skip("shared MUSEN example missing")
+    12 = V1, 31 = V2 (+0), 16 = V3), read straight from the reference copy."""
+    path = data_path("real-inputs", "musen", "SingelParticle_text.txt")
     tris = []
     for line in path.read_text().splitlines():
         w = line.split()

@@ -12,7 +12,7 @@ from fibrelmp.post.musen_out import MusenResultWriter
 from fibrelmp.translate import musen
 from fibrelmp.translate import musen_script as ms
 
-from .conftest import REPO, shared_path
+from .conftest import REPO, data_path
 
 EX = REPO / "examples" / "musen"
 SINGLE = EX / "SingelParticle_text.txt"
@@ -22,7 +22,7 @@ AGGLO = EX / "SphericalAgglomerate_text.txt"
 @pytest.fixture(scope="module")
 def agglo_result(tmp_path_factory):
     """The real 12-time-point MUSEN result, unpacked once (64 MB)."""
-    src = shared_path("real-outputs", "musen", "agglomerate", "agglo_result.txt.gz")
+    src = data_path("real-outputs", "musen", "agglomerate", "agglo_result.txt.gz")
     dst = tmp_path_factory.mktemp("musen") / "agglo_result.txt"
     with gzip.open(src, "rb") as fi, open(dst, "wb") as fo:
         shutil.copyfileobj(fi, fo, 1 << 22)
@@ -122,7 +122,7 @@ def test_real_result_as_scene(agglo_result):
 
 
 def test_real_prec17_agrees_with_prec6(agglo_result, tmp_path):
-    src = shared_path("real-outputs", "musen", "agglomerate", "agglo_result_final_prec17.txt.gz")
+    src = data_path("real-outputs", "musen", "agglomerate", "agglo_result_final_prec17.txt.gz")
     dst = tmp_path / "prec17.txt"
     dst.write_bytes(gzip.decompress(src.read_bytes()))
     fine = musen.read_time_points(dst, types=(1,), tags=(12,))
@@ -315,7 +315,7 @@ def test_writer_abort_leaves_nothing(tmp_path):
 # ------------------------------------------------------------------ job scripts
 
 def test_real_job_script():
-    path = shared_path("real-outputs", "musen", "agglomerate", "job_agglomerate.txt")
+    path = data_path("real-outputs", "musen", "agglomerate", "job_agglomerate.txt")
     jobs = ms.read_script(path)
     assert [j.component for j in jobs] == ["IMPORT_FROM_TEXT", "SIMULATOR", "EXPORT_TO_TEXT",
                                            "EXPORT_TO_TEXT"]
@@ -335,7 +335,7 @@ def test_real_job_script():
 
 
 def test_keywords_before_first_job_form_job_one():
-    jobs = ms.read_script(shared_path("real-outputs", "musen", "agglomerate",
+    jobs = ms.read_script(data_path("real-outputs", "musen", "agglomerate",
                                       "job_own_domain_test.txt"))
     assert len(jobs) == 2 and jobs[0].line == 1                 # cmusen: "Number of jobs: 2"
     assert jobs[0].component == "SIMULATOR" and jobs[0].simulation_domain is None
@@ -343,7 +343,7 @@ def test_keywords_before_first_job_form_job_one():
 
 
 def test_recommended_step_factor_matches_cmusen():
-    jobs = ms.read_script(shared_path("real-outputs", "musen", "agglomerate",
+    jobs = ms.read_script(data_path("real-outputs", "musen", "agglomerate",
                                       "job_recommended_step.txt"))
     m = musen.read(AGGLO)
     ms.apply_simulator_settings(m, jobs[0])

@@ -1,6 +1,6 @@
 """fibrelmp against the real MUSEN (cmusen 1.74.2, CPU) run of the spherical agglomerate.
 
-The very job script cmusen ran (shared/real-outputs/musen/agglomerate/job_agglomerate.txt:
+The very job script cmusen ran (tests/data/real-outputs/musen/agglomerate/job_agglomerate.txt:
 import the text scene, simulate 2e-4 s at 1e-8 s steps with gravity, export twice) is run
 unchanged by ``fibrelmp run``; its results are compared with MUSEN's exported text.
 
@@ -27,15 +27,15 @@ import pytest
 
 from fibrelmp.translate.musen import read_time_points
 
-from .conftest import shared_path
+from .conftest import data_path
 
 G = 9.81
 
 
 @pytest.fixture(scope="module")
 def agglomerate_run(tmp_path_factory):
-    real = shared_path("real-outputs", "musen", "agglomerate")
-    scene = shared_path("real-inputs", "musen", "SphericalAgglomerate_text.txt")
+    real = data_path("real-outputs", "musen", "agglomerate")
+    scene = data_path("real-inputs", "musen", "SphericalAgglomerate_text.txt")
     folder = tmp_path_factory.mktemp("agglomerate")
     shutil.copy(real / "job_agglomerate.txt", folder)
     (folder / scene.name).symlink_to(scene)
@@ -110,8 +110,8 @@ def test_broken_bond_count(agglomerate_run):
 def test_scene_domain_removes_what_musen_removed(tmp_path):
     """cmusen_own_domain_test.log: with the scene's own 1 mm domain MUSEN deactivated 5,695 of
     5,696 spheres and every bond at t = 0 (activity 24 0 0)."""
-    real = shared_path("real-outputs", "musen", "agglomerate")
-    scene = shared_path("real-inputs", "musen", "SphericalAgglomerate_text.txt")
+    real = data_path("real-outputs", "musen", "agglomerate")
+    scene = data_path("real-inputs", "musen", "SphericalAgglomerate_text.txt")
     (tmp_path / scene.name).symlink_to(scene)
     script = ("JOB\nSOURCE_FILE SphericalAgglomerate_text.txt\nRESULT_FILE agglo_init.mdem\n"
               "COMPONENT IMPORT_FROM_TEXT\nJOB\n" + (real / "job_own_domain_test.txt").read_text())

@@ -1,5 +1,5 @@
 """MercuryDPM files written by fibrelmp have the layouts of MercuryDPM's own files
-(shared/real-inputs/mercurydpm: a 2D run's .data/.ene/.fstat and a 3D .data)."""
+(tests/data/real-inputs/mercurydpm: a 2D run's .data/.ene/.fstat and a 3D .data)."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import numpy as np
 
 from fibrelmp.post.mercury import ENE_HEADER, g10, read_data_file, read_ene, read_fstat
 
-from .conftest import shared_path
+from .conftest import data_path
 from .test_post_roundtrip import granular, granular2d, post  # noqa: F401  (fixtures)
 
 REAL = ("real-inputs", "mercurydpm")
@@ -36,13 +36,13 @@ def _shape(path, dim: int) -> tuple[int, int, set[int]]:
 
 
 def test_real_files_parse_with_our_readers():
-    d2 = read_data_file(shared_path(*REAL, "PolydisperseInsertionBoundarySelfTest.data"))
+    d2 = read_data_file(data_path(*REAL, "PolydisperseInsertionBoundarySelfTest.data"))
     assert len(d2) == 51 and d2[1].rows.shape == (45, 8)
-    d3 = read_data_file(shared_path(*REAL, "TwoParticleCollisionInteractionWithLiquidMigrationWilletViscousSelfTest.data"))
+    d3 = read_data_file(data_path(*REAL, "TwoParticleCollisionInteractionWithLiquidMigrationWilletViscousSelfTest.data"))
     assert len(d3) == 22 and d3[0].rows.shape == (2, 14)
-    labels, ene = read_ene(shared_path(*REAL, "PolydisperseInsertionBoundarySelfTest.ene"))
+    labels, ene = read_ene(data_path(*REAL, "PolydisperseInsertionBoundarySelfTest.ene"))
     assert labels[0] == "time" and ene.shape == (26, 8)
-    fst = read_fstat(shared_path(*REAL, "PolydisperseInsertionBoundarySelfTest.fstat"))
+    fst = read_fstat(data_path(*REAL, "PolydisperseInsertionBoundarySelfTest.fstat"))
     assert len(fst) == 26 and sum(len(f.rows) for f in fst) == 1246 + 217
     walls = np.concatenate([f.rows[f.rows[:, 2] < 0] for f in fst])
     assert len(walls) == 217
@@ -50,25 +50,25 @@ def test_real_files_parse_with_our_readers():
 
 def test_data_layout_matches_real_3d(granular, tmp_path):  # noqa: F811
     post(granular / "atoms.dump", "mercury", tmp_path / "run")
-    real = _shape(shared_path(*REAL, "TwoParticleCollisionInteractionWithLiquidMigrationWilletViscousSelfTest.data"), 3)
+    real = _shape(data_path(*REAL, "TwoParticleCollisionInteractionWithLiquidMigrationWilletViscousSelfTest.data"), 3)
     mine = _shape(tmp_path / "run.data", 3)
     assert mine == real == (8, 14, {True})
 
 
 def test_data_layout_matches_real_2d(granular2d, tmp_path):  # noqa: F811
     post(granular2d / "atoms.dump", "mercury", tmp_path / "run", data=granular2d / "data.lammps")
-    real = _shape(shared_path(*REAL, "PolydisperseInsertionBoundarySelfTest.data"), 2)
+    real = _shape(data_path(*REAL, "PolydisperseInsertionBoundarySelfTest.data"), 2)
     mine = _shape(tmp_path / "run.data", 2)
     assert mine == real == (6, 8, {True})
     # particles that do not rotate: MercuryDPM prints "-0 -0" for angle and -omega_z
-    real_first = shared_path(*REAL, "PolydisperseInsertionBoundarySelfTest.data").read_text().splitlines()[2]
+    real_first = data_path(*REAL, "PolydisperseInsertionBoundarySelfTest.data").read_text().splitlines()[2]
     mine_first = (tmp_path / "run.data").read_text().splitlines()[1]
     assert real_first.split()[5:7] == mine_first.split()[5:7] == ["-0", "-0"]
 
 
 def test_ene_layout_matches_real(granular, tmp_path):  # noqa: F811
     post(granular / "atoms.dump", "mercury", tmp_path / "run", gravity=(0, 0, -9.81))
-    real = shared_path(*REAL, "PolydisperseInsertionBoundarySelfTest.ene").read_text().splitlines()
+    real = data_path(*REAL, "PolydisperseInsertionBoundarySelfTest.ene").read_text().splitlines()
     mine = (tmp_path / "run.ene").read_text().splitlines()
     assert mine[0] + "\n" == ENE_HEADER and mine[0] == real[0]      # byte-identical header
     # every row: 8 values right-aligned in 16 characters, one space apart
@@ -79,7 +79,7 @@ def test_ene_layout_matches_real(granular, tmp_path):  # noqa: F811
 
 def test_fstat_layout_matches_real(granular, tmp_path):  # noqa: F811
     post(granular / "atoms.dump", "mercury", tmp_path / "run", local=granular / "contacts.dump")
-    for path in (shared_path(*REAL, "PolydisperseInsertionBoundarySelfTest.fstat"), tmp_path / "run.fstat"):
+    for path in (data_path(*REAL, "PolydisperseInsertionBoundarySelfTest.fstat"), tmp_path / "run.fstat"):
         lines = path.read_text().splitlines()
         comment_runs, k = 0, 0
         while k < len(lines):

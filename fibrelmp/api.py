@@ -13,6 +13,8 @@ from .formats import detect, reader
 from .model import Model
 
 if TYPE_CHECKING:
+    import numpy as np
+
     from .outputs import Outputs
 from .translate.lammps_job import Job, write_job
 

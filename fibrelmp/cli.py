@@ -222,7 +222,7 @@ def check(input: Path = typer.Argument(..., help="Any supported input file.",
              f"springs      {model.bonds.count}",
              f"angles       {model.angles.count}",
              f"types        {', '.join(p.type_names)}",
-             f"pairs        " + "; ".join(f"{law.kind} {p.type_names[law.type_i]}-{p.type_names[law.type_j]}"
+             "pairs        " + "; ".join(f"{law.kind} {p.type_names[law.type_i]}-{p.type_names[law.type_j]}"
                                          for law in model.pairs),
              f"box          {' x '.join(f'{x:g}' for x in model.box.lengths)} "
              f"({'periodic' if all(model.box.periodic) else 'finite, wall k = %g' % model.box.wall_stiffness})",

@@ -12,7 +12,6 @@ rank 0 only (other ranks render the same script text in memory and hand it to th
 from __future__ import annotations
 
 import os
-import threading
 from itertools import islice
 from pathlib import Path
 from typing import Callable, Iterator

@@ -449,7 +449,7 @@ class Net:
                 pairs[(a, b)] = ("lj", *vals)
             else:
                 raise ValueError(p[0])
-        nb, ns, na = len(self.beads), len(self.spring_rows), len(self.angle_rows)
+        ns, na = len(self.spring_rows), len(self.angle_rows)
         col = lambda key, rows, dtype=float: np.array([r[key] for r in rows], dtype=dtype)  # noqa: E731
         springs = np.array([[s["i"], s["j"]] for s in self.spring_rows], int).reshape(ns, 2)
         fl = np.array([s["c1"] is not None for s in self.spring_rows], bool)

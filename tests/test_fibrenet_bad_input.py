@@ -1,6 +1,5 @@
 """Bad FibreNet input: one `path:line: message`, exit code 2, no traceback, no output file."""
 
-import os
 import subprocess
 import sys
 from pathlib import Path

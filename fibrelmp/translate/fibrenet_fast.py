@@ -8,7 +8,6 @@ so error messages keep their exact line numbers.
 from __future__ import annotations
 
 import io
-from pathlib import Path
 
 import numpy as np
 

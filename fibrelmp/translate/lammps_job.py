@@ -7,7 +7,7 @@ job folder replays exactly what ``fibrelmp run`` executes line by line.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np

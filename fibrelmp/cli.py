@@ -359,85 +359,20 @@ def run(input: Path = typer.Argument(..., help="FibreNet input, MUSEN text scene
     """
     import time
 
-    from .formats import detect
+    from .python_api import run as run_any
 
     _set_flags(quiet, verbose)
-    kind = detect(input)
     start = time.monotonic()
-    if kind != "fibrenet":
-        from .granular_api import Checkpoints
-
-        if resume and not _has_checkpoint(input, kind, out, work):
-            raise _bad_option(input, "no checkpoint to resume from (run without --resume, or "
-                              "give the same --work folder as the interrupted run)")
-        checkpoints = Checkpoints(checkpoint_every, resume)
-    if kind == "fibrenet":
-        from .api import read_input, run as do_run
-
-        if any(v is not None for v in (end_time, step, save_step, steps)):
-            raise _bad_option(input, "--end-time/--step/--save-step/--steps are for MUSEN and DEMDF "
-                              "inputs; FibreNet inputs set their own steps")
-        model = read_input(input)
-        _report_warnings(model.warnings)
-        said = len(model.warnings)
-        result = do_run(model, out=out, work=work, progress=not _state["quiet"],
-                        checkpoint_every=checkpoint_every, resume=resume, force=force)
-        _report_warnings(model.warnings[said:])        # found while running (e.g. beads outside)
-        outputs, script = result.outputs, result.job.script
-    elif kind == "musen-script":
-        from .granular_api import run_musen_script
-
-        if any(v is not None for v in (end_time, step, save_step, steps)):
-            raise _bad_option(input, "a cmusen job script sets END_TIME, SIMULATION_STEP and "
-                              "SAVING_STEP itself; edit the script instead")
-        res = run_musen_script(input, work=work, progress=not _state["quiet"], say=_say,
-                               warn=_report_warnings, checkpoints=checkpoints, out=out, force=force)
-        outputs, script = res.outputs, (res.jobs[-1].script if res.jobs else None)
-        for note in res.notes:
-            _say(note)
-    else:
-        from .granular_api import read_granular, run_demdf, run_musen_scene
-
-        if kind == "demdf":
-            res = run_demdf(input, out=out, work=work, progress=not _state["quiet"], time_end=end_time,
-                            steps=steps, save_every=save_step, warn=_report_warnings, say=_say,
-                            checkpoints=checkpoints, force=force)
-        else:
-            model, overrides = read_granular(input, kind, end_time, step, save_step, steps)
-            for text in overrides:
-                _say(f"override: {text}")
-            _report_warnings(model.warnings)
-            said = len(model.warnings)
-            target = out if out is not None else input.with_name(f"{input.stem}_result.txt")
-            res = run_musen_scene(model, target, work=work, progress=not _state["quiet"],
-                                  precision=precision, checkpoints=checkpoints, force=force)
-            _report_warnings(model.warnings[said:])    # found while translating or running
-        for note in res.notes:
-            _say(note)
-        outputs, script = res.outputs, (res.jobs[-1].script if res.jobs else None)
-    for path in outputs:
+    result = run_any(input, out, work=work, force=force, checkpoint_every=checkpoint_every,
+                     resume=resume, end_time=end_time, step=step, save_step=save_step, steps=steps,
+                     precision=precision, progress=not _state["quiet"], say=_say,
+                     warn=_report_warnings)
+    for note in result.notes:
+        _say(note)
+    for path in result.outputs:
         _say(f"wrote {path}")
+    script = result.scripts[-1] if result.scripts else None
     _say(f"done in {time.monotonic() - start:.1f} s (LAMMPS job: {script})")
-
-
-def _has_checkpoint(input: Path, kind: str, out: Optional[Path], work: Optional[Path]) -> bool:
-    """Is there a checkpoint for this granular input's work folder(s)?"""
-    if work is not None:
-        folders = [work]
-    elif kind == "musen-script":
-        folders = [(out or input.resolve().parent) / f"{input.stem}_work"]
-    elif kind == "demdf":
-        folders = [(out or input.resolve().parent) / f"{input.stem}_work"]
-    else:
-        target = out if out is not None else input.with_name(f"{input.stem}_result.txt")
-        folders = [target.resolve().parent / f"{target.stem}_work"]
-    return any(next(Path(f).rglob("checkpoint.json"), None) is not None for f in folders if Path(f).exists())
-
-
-def _bad_option(path: Path, message: str):
-    from .errors import InputError
-
-    return InputError(path, None, message)
 
 
 @app.command("post")

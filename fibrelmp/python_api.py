@@ -1,0 +1,183 @@
+"""The Python API: what the command line does, as functions that return results.
+
+``fibrelmp.read``, ``fibrelmp.translate_job``, ``fibrelmp.run`` and ``fibrelmp.convert``
+(see docs/python.md; ``fibrelmp.translate`` is the translators' subpackage).  They raise ``fibrelmp.InputError`` (bad input, ``path:line: message``) or
+``fibrelmp.RunError`` (LAMMPS or the machine failed) and never exit the interpreter; a run
+restores the signal handlers it installed for checkpoints when it returns.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable, Iterator
+
+from .errors import InputError
+
+Say = Callable[[str], None]
+Warn = Callable[[list[tuple[str, str]]], None]
+
+
+def _quiet(_: object) -> None:
+    pass
+
+
+def read(path: str | Path):
+    """The neutral model of any supported input: a ``Model`` (FibreNet), a ``GranularModel``
+    (MUSEN scene, DEMDF) or, for a cmusen job script, its checked ``ScriptPlan``."""
+    from .formats import detect
+
+    kind = detect(path)
+    if kind == "fibrenet":
+        from .api import read_input
+
+        return read_input(path)
+    if kind == "musen-script":
+        from .granular_api import plan_musen_script
+
+        return plan_musen_script(path)
+    from .granular_api import read_granular
+
+    return read_granular(path, kind)[0]
+
+
+def translate_job(path: str | Path, folder: str | Path) -> Path:
+    """Write ``folder/in.lammps`` and its data file for the input at ``path`` (a cmusen
+    script: its first simulation); returns the script's path (replay: ``lmp -in in.lammps``)."""
+    from .formats import detect
+
+    kind = detect(path)
+    if kind == "fibrenet":
+        from .api import read_input, translate as write
+
+        return write(read_input(path), folder).script
+    from .granular_api import model_for_check
+    from .translate.granular_job import write_granular_job
+
+    return write_granular_job(model_for_check(path, kind), folder).script
+
+
+@dataclass
+class RunResult:
+    """What a run wrote: the result files in the input's own format, and each simulation's
+    LAMMPS script and frame dump (read back lazily: memory does not grow with frames)."""
+    outputs: list[Path] = field(default_factory=list)
+    scripts: list[Path] = field(default_factory=list)
+    dumps: list[Path] = field(default_factory=list)
+    warnings: list[tuple[str, str]] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+
+    def frames(self, simulation: int = -1) -> Iterator:
+        """The saved frames of one simulation (default: the last), one at a time, as
+        ``fibrelmp.post.lammps_dump.Frame`` (``.step``, ``.column('x')``, ``.vector('x','y','z')``)."""
+        from .post.lammps_dump import iter_frames
+
+        return iter_frames(self.dumps[simulation])
+
+    def universe(self, simulation: int = -1):
+        """The frames as an MDAnalysis ``Universe`` (needs MDAnalysis)."""
+        import MDAnalysis
+
+        return MDAnalysis.Universe(str(self.dumps[simulation]), format="LAMMPSDUMP")
+
+
+def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | None = None,
+        force: bool = False, checkpoint_every: int | None = None, resume: bool = False,
+        end_time: float | None = None, step: float | None = None, save_step: float | None = None,
+        steps: int | None = None, precision: int = 6, progress: bool = False,
+        say: Say = _quiet, warn: Warn | None = None) -> RunResult:
+    """Run any supported input on LAMMPS and write its results in the input's own format.
+
+    ``out``: the results' folder (FibreNet, DEMDF, cmusen script) or file (MUSEN scene);
+    default next to the input.  Existing results are replaced, completely, only with
+    ``force``.  ``end_time``/``step``/``save_step`` (MUSEN scene, DEMDF) and ``steps``
+    (DEMDF) override the input.  ``say`` receives progress notes, ``warn`` lists of
+    ``(kind, text)`` warnings as they are found (they are also in the result)."""
+    from .formats import detect
+    from .granular_api import Checkpoints
+
+    path = Path(path)
+    kind = detect(path)
+    result = RunResult()
+
+    def warned(items: list[tuple[str, str]]) -> None:
+        result.warnings.extend(items)
+        if warn is not None and items:
+            warn(list(items))
+
+    if kind == "fibrenet":
+        from .api import read_input, run as run_fibrenet
+
+        _no_overrides(path, (end_time, step, save_step, steps), "FibreNet inputs set their own "
+                      "steps: --end-time/--step/--save-step/--steps are for MUSEN and DEMDF inputs")
+        model = read_input(path)
+        warned(model.warnings)
+        said = len(model.warnings)
+        done = run_fibrenet(model, out=out, work=work, progress=progress,
+                            checkpoint_every=checkpoint_every, resume=resume, force=force)
+        warned(model.warnings[said:])            # found while running (beads outside the box)
+        result.outputs, result.scripts, result.dumps = done.outputs, [done.job.script], [done.job.frames]
+        return result
+    if resume and not has_checkpoint(path, kind, out, work):
+        raise InputError(path, None, "no checkpoint to resume from (run without --resume, or "
+                         "give the same --work folder as the interrupted run)")
+    checkpoints = Checkpoints(checkpoint_every, resume)
+    if kind == "musen-script":
+        from .granular_api import run_musen_script
+
+        _no_overrides(path, (end_time, step, save_step, steps), "a cmusen job script sets "
+                      "END_TIME, SIMULATION_STEP and SAVING_STEP itself; edit the script instead")
+        res = run_musen_script(path, work=work, progress=progress, say=say, warn=warned,
+                               checkpoints=checkpoints, out=out, force=force)
+    elif kind == "demdf":
+        from .granular_api import run_demdf
+
+        res = run_demdf(path, out=out, work=work, progress=progress, time_end=end_time,
+                        steps=steps, save_every=save_step, warn=warned, say=say,
+                        checkpoints=checkpoints, force=force)
+    else:
+        from .granular_api import read_granular, run_musen_scene
+
+        model, overrides = read_granular(path, kind, end_time, step, save_step, steps)
+        for text in overrides:
+            say(f"override: {text}")
+        warned(model.warnings)
+        said = len(model.warnings)
+        target = out if out is not None else path.with_name(f"{path.stem}_result.txt")
+        res = run_musen_scene(model, target, work=work, progress=progress, precision=precision,
+                              checkpoints=checkpoints, force=force)
+        warned(model.warnings[said:])            # found while translating or running
+    result.outputs, result.notes = res.outputs, res.notes
+    result.scripts = [job.script for job in res.jobs]
+    result.dumps = [job.frames for job in res.jobs]
+    return result
+
+
+def _no_overrides(path: Path, values: tuple, message: str) -> None:
+    if any(v is not None for v in values):
+        raise InputError(path, None, message)
+
+
+def has_checkpoint(path: Path, kind: str, out: str | Path | None, work: str | Path | None) -> bool:
+    """Is there a checkpoint for this granular input's work folder(s)?"""
+    if work is not None:
+        folders = [Path(work)]
+    elif kind in ("musen-script", "demdf"):
+        folders = [Path(out or path.resolve().parent) / f"{path.stem}_work"]
+    else:
+        target = Path(out) if out is not None else path.with_name(f"{path.stem}_result.txt")
+        folders = [target.resolve().parent / f"{target.stem}_work"]
+    return any(next(f.rglob("checkpoint.json"), None) is not None for f in folders if f.exists())
+
+
+def convert(dump: str | Path, to: str, out: str | Path, *, frames: str | None = None,
+            types: list[str] | None = None, data: str | Path | None = None,
+            local: str | Path | None = None, gravity: tuple[float, float, float] | None = None,
+            force: bool = False, topology: str | Path | None = None, say: Say = _quiet) -> list[Path]:
+    """Convert a LAMMPS dump (or an MDAnalysis trajectory with ``topology``) into ``to``
+    (xyz, res, musen, demdf, mercury, vtk); returns the files written (docs/post.md)."""
+    from .post.cli_post import post_command
+
+    return post_command(Path(dump), to, Path(out), False, frames, types,
+                        None if data is None else Path(data), None if local is None else Path(local),
+                        gravity, force, None if topology is None else Path(topology), say)

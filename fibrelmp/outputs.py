@@ -26,6 +26,11 @@ from typing import Iterator
 from .errors import InputError
 
 
+# what a run writes into its work folder (translate.lammps_job / granular_job, checkpoint)
+WORK_FILES = frozenset({"in.lammps", "data.lammps", "frames.dump", "bonds.dump", "walls.dump",
+                        "breaks.dump", "checkpoint.restart", "checkpoint.json", "log.lammps"})
+
+
 @dataclass
 class Outputs:
     source: Path                                    # the input (for messages)
@@ -89,9 +94,12 @@ def check(outputs: Outputs, force: bool) -> None:
                                  "be overwritten by a result: choose another result name")
         _check_location(out, "output", outputs.source)
     for inp in outputs.inputs:
-        if inside(inp, outputs.work) and Path(inp).resolve() != Path(outputs.work).resolve():
-            raise InputError(outputs.work, None, f"the work folder contains the input {inp}, "
-                             "and fibrelmp clears work folders: choose another --work")
+        # the job files a run writes into its work folder (cmusen scripts: one level down)
+        inp = Path(inp).resolve()
+        work = Path(outputs.work).resolve()
+        if inp.name in WORK_FILES and work in (inp.parent, inp.parent.parent):
+            raise InputError(inp, None, f"is an input, and the run writes its own {inp.name} in "
+                             f"the work folder {work}: choose another --work")
     _check_location(outputs.work, "work folder", outputs.source)
     if outputs.work.exists() and not outputs.work.is_dir():
         raise InputError(outputs.work, None, "is a file, not a folder (--work)")

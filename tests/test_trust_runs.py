@@ -231,6 +231,17 @@ def test_cmusen_script_honours_o_and_never_overwrites_its_scene(tmp_path):
     assert (tmp_path / "in" / "SingelParticle_text.txt").read_bytes() == scene
 
 
+def test_work_folder_may_hold_inputs_but_never_overwrites_one(tmp_path):
+    inp = fibre_case(tmp_path)
+    assert cli(["-q", "run", inp, "--work", "."], tmp_path).returncode == 0       # --work beside the input
+    shutil.copy(tmp_path / "model.txt", tmp_path / "data.lammps")
+    model = (tmp_path / "data.lammps").read_bytes()
+    inp.write_text(inp.read_text().replace("model_file\tmodel.txt", "model_file\tdata.lammps"))
+    res = cli(["-q", "run", inp, "--work", ".", "--force"], tmp_path)
+    assert res.returncode == 2 and "writes its own data.lammps" in res.stderr, res.stderr
+    assert (tmp_path / "data.lammps").read_bytes() == model
+
+
 # -- 6. every error before anything runs -----------------------------------------------------
 def test_error_in_a_later_cmusen_job_is_found_before_the_first_runs(tmp_path):
     job = musen_case(tmp_path, end_time="2e-3")

@@ -6,6 +6,10 @@ velocities, bonds, contact and bond history, per-atom fix data) and ``checkpoint
 and of every file the job reads, and the byte size of every dump the script appends to, so
 frames written after the checkpoint are dropped).
 
+``checkpoint.forces.npz`` holds the forces and torques the next step starts from (computed
+with half-step velocities; ``write_restart`` does not keep them), so a resumed run continues
+exactly as an uninterrupted one.
+
 Resuming replays the same rendered script: set-up commands run again (styles, fixes,
 variables must exist), ``read_data`` becomes ``read_restart``, and commands that change the
 state or write output (run, velocity, displace_atoms, write_dump, ...) are skipped up to the
@@ -27,6 +31,7 @@ from .errors import InputError
 
 RESTART = "checkpoint.restart"
 STATE = "checkpoint.json"
+FORCES = "checkpoint.forces.npz"       # the step's forces and torques (see runner.step_state)
 # commands that change the state or write output: done already when resuming
 ACTIONS = frozenset({"run", "minimize", "velocity", "displace_atoms", "reset_timestep", "write_dump",
                      "write_restart", "write_data", "set", "delete_atoms", "create_atoms",
@@ -80,12 +85,19 @@ class Checkpointing:
 
     # -- files -----------------------------------------------------------------------------
     def write(self, lmp, rank: int, commands: int, line: int, steps: int, frames: int,
-              script_text: str) -> None:
+              script_text: str, step_state: dict | None = None) -> None:
         tmp = self.folder / (RESTART + ".tmp")
         lmp.command(f"write_restart {tmp.name}")
         if rank != 0:
             return
         os.replace(tmp, self.folder / RESTART)
+        if step_state is not None:        # forces/torques: write_restart does not keep them
+            import numpy as np
+
+            part = self.folder / (FORCES + ".tmp")
+            with open(part, "wb") as fh:
+                np.savez(fh, **step_state)
+            os.replace(part, self.folder / FORCES)
         state = {"commands": commands, "line": line, "steps": steps, "frames": frames,
                  "script_sha256": _sha(script_text), "inputs_sha256": inputs_digest(self.inputs),
                  "sizes": {name: (self.folder / name).stat().st_size
@@ -94,9 +106,19 @@ class Checkpointing:
         part.write_text(json.dumps(state, indent=1))
         os.replace(part, self.folder / STATE)
 
+    def load_step_state(self) -> dict | None:
+        """The forces/torques saved with the checkpoint being resumed (None: not saved)."""
+        path = self.folder / FORCES
+        if self.resume is None or not path.exists():
+            return None
+        import numpy as np
+
+        with np.load(path) as data:
+            return {k: data[k] for k in data.files}
+
     def clear(self, rank: int) -> None:
         if rank == 0:
-            for name in (RESTART, STATE, RESTART + ".tmp", STATE + ".tmp"):
+            for name in (RESTART, STATE, FORCES, RESTART + ".tmp", STATE + ".tmp", FORCES + ".tmp"):
                 (self.folder / name).unlink(missing_ok=True)
 
 

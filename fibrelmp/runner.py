@@ -150,6 +150,8 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
     since = 0
     done = 0                         # commands executed (the position in the command stream)
     rebuild = False                  # a checkpoint re-exchanged the atoms: rebuild neighbours
+    saved_state: dict = {}           # the step state at the last checkpoint
+    resumed_state = checkpoints.load_step_state() if resume else None
     deferred: list[str] = []         # per-atom fixes: defined after read_restart to get their data
     lmp = None
     if resume:
@@ -187,8 +189,14 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
                 if words[0] == "read_data":
                     text = "read_restart checkpoint.restart"
             try:
+                if not replaying and resumed_state is not None:
+                    # the first command after the checkpoint: computes set up and the step's
+                    # forces back (a write_dump or set may come before any run)
+                    restore_step_state(lmp, resumed_state)
+                    resumed_state = None
+                    rebuild = False
                 if rebuild and words[0] == "run":
-                    _rebuild_neighbours(lmp)
+                    _rebuild_neighbours(lmp, saved_state)
                     rebuild = False
                 before = _timestep(lmp) if words[0] == "run" else 0
                 lmp.command(text)
@@ -213,7 +221,9 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
             if checkpoints is not None and words[0] == "run":
                 signum = checkpoints.stop_requested(size)
                 if signum or (checkpoints.every and since >= checkpoints.every):
-                    checkpoints.write(lmp, rank, done, cmd.number, steps, frames, script_text)
+                    saved_state = step_state(lmp)
+                    checkpoints.write(lmp, rank, done, cmd.number, steps, frames, script_text,
+                                      saved_state)
                     rebuild = True
                     since = 0
                     if signum:
@@ -233,14 +243,40 @@ def _timestep(lmp) -> int:
     return int(lmp.extract_global("ntimestep"))
 
 
-def _rebuild_neighbours(lmp) -> None:
-    """After ``write_restart`` (which re-exchanges atoms and rebuilds ghosts) a ``run … pre
-    no`` would use a stale neighbour list.  ``run 0`` rebuilds it; the forces it recomputes
-    are replaced by the ones the run would have started from (they include drag on half-step
-    velocities), so a checkpointed run continues exactly as an uninterrupted one."""
-    forces = lmp.gather_atoms("f", 1, 3)
+def step_state(lmp) -> dict:
+    """What a velocity-Verlet step starts from besides the restart file's contents: the
+    forces (and torques) of the last step, computed with half-step velocities in the drag
+    and contact damping.  By atom id (ids need not be consecutive after deletions)."""
+    import numpy as np
+
+    n = int(lmp.get_natoms())
+    state = {"id": np.array(lmp.gather_atoms_concat("id", 0, 1)[:n], dtype=np.int64)}
+    for name in ("f", "torque"):
+        if lmp.extract_atom(name) is not None:
+            state[name] = np.array(lmp.gather_atoms_concat(name, 1, 3)[:3 * n], dtype=np.float64)
+    return state
+
+
+def restore_step_state(lmp, state: dict) -> None:
+    """``run 0`` (neighbour lists, computes and fixes set up; forces recomputed), then the
+    forces of ``step_state`` put back, so the next step is the one an uninterrupted run takes."""
+    import ctypes
+
     lmp.command("run 0 post no")
-    lmp.scatter_atoms("f", 1, 3, forces)
+    ids = state["id"]
+    n = len(ids)
+    c_ids = (ctypes.c_int * n)(*ids.tolist()) if n else (ctypes.c_int * 1)()
+    for name in ("f", "torque"):
+        if name in state:
+            values = state[name]
+            data = (ctypes.c_double * len(values))(*values.tolist()) if n else (ctypes.c_double * 1)()
+            lmp.scatter_atoms_subset(name, 1, 3, n, c_ids, data)
+
+
+def _rebuild_neighbours(lmp, state: dict) -> None:
+    """After ``write_restart`` (which re-exchanges atoms and rebuilds ghosts) a ``run … pre
+    no`` would use a stale neighbour list: rebuild it, keeping the step's forces."""
+    restore_step_state(lmp, state)
 
 
 class RunAborted(Exception):

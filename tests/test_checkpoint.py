@@ -1,11 +1,11 @@
 """Checkpoints: a run killed with SIGTERM stops at a checkpoint; ``--resume`` finishes it with
 the same frames as an uninterrupted run (no duplicates, no gaps).
 
-Not bitwise: a resumed LAMMPS run re-evaluates the forces at its first step with full-step
-velocities, while the uninterrupted run used half-step ones in the velocity-dependent drag
-(LAMMPS documents the same for velocity-dependent pair styles).  Measured on this example:
-positions differ by < 3e-7 (box 7), velocities by < 3e-6 over the remaining 1760 steps; the
-FibreNet files (5 decimals) differ by at most one unit in the last digit.
+The checkpoint keeps the step's forces and torques besides LAMMPS's restart file (drag and
+contact damping were computed with half-step velocities, which write_restart does not keep),
+so the resumed run continues as the uninterrupted one did; the %.17g dump differs only by
+summation round-off (the neighbour lists are rebuilt).  The tolerances here are the earlier,
+looser ones; tests/test_trust_runs.py asserts byte-identical result files.
 """
 
 from __future__ import annotations

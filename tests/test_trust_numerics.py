@@ -21,7 +21,7 @@ from fibrelmp.post import to_fibrenet
 from fibrelmp.post.lammps_dump import Frame, iter_frames
 from fibrelmp.post.to_fibrenet import write_fibrenet
 from fibrelmp.translate import granular_job as gj
-from fibrelmp.translate.granular_walls import tile_triangles
+from fibrelmp.translate.granular_walls import tile_triangles, tile_triangles_within
 
 from . import granular_models as gm
 from .conftest import REPO
@@ -163,7 +163,7 @@ def test_clipped_tiling_is_the_full_tiling_inside_the_box():
             lo[k % 2], hi[k % 2] = -np.inf, np.inf
         p, o = tile_triangles(v, 0.0004)
         inside = ((p >= lo) & (p <= hi)).all(axis=1)
-        q, w = gj.tile_triangles_within(v, 0.0004, lo, hi)
+        q, w = tile_triangles_within(v, 0.0004, lo, hi)
         assert np.array_equal(p[inside], q) and np.array_equal(o[inside], w)
         assert gj.tile_estimate(v, 0.0004) >= len(p)
 

@@ -20,7 +20,8 @@ from ..sanity import close_pairs
 from ..textio import atomic_write
 from .granular_walls import (BoxShape, CylinderShape, Kinematics, detect_cylinder, detect_oriented_box,
                              geometry_kinematics, geometry_triangle_rows, particle_side,
-                             piecewise_expression, tile_triangles, triangle_normals)
+                             piecewise_expression, tile_triangles, tile_triangles_within,
+                             triangle_normals)
 from .lammps_job import _block, _fmt
 
 SCRIPT_NAME = "in.lammps"
@@ -440,52 +441,6 @@ def tile_estimate(v: np.ndarray, spacing: float) -> float:
         return 0.0
     n = _tile_counts(v, spacing)
     return float(np.sum((n + 1) * (n + 2) / 2))
-
-
-def tile_triangles_within(v: np.ndarray, spacing: float, lo: np.ndarray, hi: np.ndarray):
-    """``tile_triangles`` restricted to the points inside [lo, hi]: the same points in the same
-    order, without generating the others (a 1 m triangle tiled for 1 mm spheres has 4e6)."""
-    pts, owner = [], []
-    for k, tri in enumerate(v):
-        e = max(np.linalg.norm(tri[1] - tri[0]), np.linalg.norm(tri[2] - tri[0]),
-                np.linalg.norm(tri[2] - tri[1]))
-        n = max(1, int(math.ceil(e / spacing - 1e-9)))
-        if (tri.max(axis=0) < lo).any() or (tri.min(axis=0) > hi).any():
-            continue
-        i = np.arange(n + 1)
-        e1, e2 = tri[1] - tri[0], tri[2] - tri[0]
-        base = tri[0] + (i / n)[:, None] * e1
-        jlo, jhi = np.zeros(n + 1), (n - i).astype(float)
-        with np.errstate(all="ignore"):
-            for ax in range(3):
-                if e2[ax] != 0:
-                    t1 = (lo[ax] - base[:, ax]) / e2[ax] * n
-                    t2 = (hi[ax] - base[:, ax]) / e2[ax] * n
-                    jlo = np.maximum(jlo, np.minimum(t1, t2) - 1.0)
-                    jhi = np.minimum(jhi, np.maximum(t1, t2) + 1.0)
-                else:
-                    jhi[(base[:, ax] < lo[ax]) | (base[:, ax] > hi[ax])] = -1.0
-        jlo = np.ceil(np.clip(jlo, 0, n)).astype(np.int64)
-        jhi = np.floor(np.clip(jhi, -1, n)).astype(np.int64)
-        ok = jhi >= jlo
-        cnt = (jhi - jlo + 1)[ok]
-        if not cnt.sum():
-            continue
-        ii = np.repeat(i[ok], cnt)
-        start = np.repeat(np.cumsum(cnt) - cnt, cnt)
-        jj = np.repeat(jlo[ok], cnt) + (np.arange(int(cnt.sum())) - start)
-        p = tri[0] + (ii / n)[:, None] * (tri[1] - tri[0]) + (jj / n)[:, None] * (tri[2] - tri[0])
-        p = p[((p >= lo) & (p <= hi)).all(axis=1)]
-        pts.append(p)
-        owner.append(np.full(len(p), k))
-    if not pts:
-        return np.zeros((0, 3)), np.zeros(0, np.int64)
-    p = np.concatenate(pts)
-    o = np.concatenate(owner)
-    key = np.round(p / (spacing * 1e-6)).astype(np.int64)
-    _, first = np.unique(key, axis=0, return_index=True)
-    first.sort()
-    return p[first], o[first]
 
 
 # ----------------------------------------------------------------------------------------

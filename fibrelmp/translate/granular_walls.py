@@ -431,22 +431,16 @@ def piecewise_expression(kin: Kinematics, coeff, derivative: bool = False) -> st
 
 # ----------------------------------------------------------------------------------------
 # tiling
-def tile_triangles(v: np.ndarray, spacing: float) -> tuple[np.ndarray, np.ndarray]:
-    """Points covering each triangle on a barycentric grid whose sub-triangle edges are all
-    <= spacing; points shared by neighbouring triangles are kept once.
+def _grid_divisions(tri: np.ndarray, spacing: float) -> int:
+    """Barycentric grid divisions n of a triangle: every sub-triangle edge is <= spacing."""
+    e = max(np.linalg.norm(tri[1] - tri[0]), np.linalg.norm(tri[2] - tri[0]),
+            np.linalg.norm(tri[2] - tri[1]))
+    return max(1, int(math.ceil(e / spacing - 1e-9)))
 
-    Returns (points (p,3), triangle index (p,) of the first triangle that produced each)."""
-    pts, owner = [], []
-    for k, tri in enumerate(v):
-        e = max(np.linalg.norm(tri[1] - tri[0]), np.linalg.norm(tri[2] - tri[0]),
-                np.linalg.norm(tri[2] - tri[1]))
-        n = max(1, int(math.ceil(e / spacing - 1e-9)))
-        i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
-        keep = (i + j) <= n
-        a, b = i[keep] / n, j[keep] / n
-        p = tri[0] + a[:, None] * (tri[1] - tri[0]) + b[:, None] * (tri[2] - tri[0])
-        pts.append(p)
-        owner.append(np.full(len(p), k))
+
+def _unique_tiles(pts: list, owner: list, spacing: float) -> tuple[np.ndarray, np.ndarray]:
+    """The tiles of all triangles, a point shared by neighbouring triangles kept once (with
+    the first triangle that produced it)."""
     if not pts:
         return np.zeros((0, 3)), np.zeros(0, np.int64)
     p = np.concatenate(pts)
@@ -455,6 +449,60 @@ def tile_triangles(v: np.ndarray, spacing: float) -> tuple[np.ndarray, np.ndarra
     _, first = np.unique(key, axis=0, return_index=True)
     first.sort()
     return p[first], o[first]
+
+
+def tile_triangles(v: np.ndarray, spacing: float) -> tuple[np.ndarray, np.ndarray]:
+    """Points covering each triangle on a barycentric grid whose sub-triangle edges are all
+    <= spacing; points shared by neighbouring triangles are kept once.
+
+    Returns (points (p,3), triangle index (p,) of the first triangle that produced each)."""
+    pts, owner = [], []
+    for k, tri in enumerate(v):
+        n = _grid_divisions(tri, spacing)
+        i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
+        keep = (i + j) <= n
+        a, b = i[keep] / n, j[keep] / n
+        p = tri[0] + a[:, None] * (tri[1] - tri[0]) + b[:, None] * (tri[2] - tri[0])
+        pts.append(p)
+        owner.append(np.full(len(p), k))
+    return _unique_tiles(pts, owner, spacing)
+
+
+def tile_triangles_within(v: np.ndarray, spacing: float, lo: np.ndarray, hi: np.ndarray):
+    """``tile_triangles`` restricted to the points inside [lo, hi]: the same points in the same
+    order, without generating the others (a 1 m triangle tiled for 1 mm spheres has 4e6)."""
+    pts, owner = [], []
+    for k, tri in enumerate(v):
+        n = _grid_divisions(tri, spacing)
+        if (tri.max(axis=0) < lo).any() or (tri.min(axis=0) > hi).any():
+            continue
+        i = np.arange(n + 1)
+        e1, e2 = tri[1] - tri[0], tri[2] - tri[0]
+        base = tri[0] + (i / n)[:, None] * e1
+        jlo, jhi = np.zeros(n + 1), (n - i).astype(float)
+        with np.errstate(all="ignore"):
+            for ax in range(3):
+                if e2[ax] != 0:
+                    t1 = (lo[ax] - base[:, ax]) / e2[ax] * n
+                    t2 = (hi[ax] - base[:, ax]) / e2[ax] * n
+                    jlo = np.maximum(jlo, np.minimum(t1, t2) - 1.0)
+                    jhi = np.minimum(jhi, np.maximum(t1, t2) + 1.0)
+                else:
+                    jhi[(base[:, ax] < lo[ax]) | (base[:, ax] > hi[ax])] = -1.0
+        jlo = np.ceil(np.clip(jlo, 0, n)).astype(np.int64)
+        jhi = np.floor(np.clip(jhi, -1, n)).astype(np.int64)
+        ok = jhi >= jlo
+        cnt = (jhi - jlo + 1)[ok]
+        if not cnt.sum():
+            continue
+        ii = np.repeat(i[ok], cnt)
+        start = np.repeat(np.cumsum(cnt) - cnt, cnt)
+        jj = np.repeat(jlo[ok], cnt) + (np.arange(int(cnt.sum())) - start)
+        p = tri[0] + (ii / n)[:, None] * (tri[1] - tri[0]) + (jj / n)[:, None] * (tri[2] - tri[0])
+        p = p[((p >= lo) & (p <= hi)).all(axis=1)]
+        pts.append(p)
+        owner.append(np.full(len(p), k))
+    return _unique_tiles(pts, owner, spacing)
 
 
 def triangle_normals(v: np.ndarray) -> np.ndarray:

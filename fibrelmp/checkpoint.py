@@ -1,14 +1,16 @@
 """Checkpoints: stop a run cleanly (every N steps, or on SIGTERM/Ctrl-C) and resume it.
 
-A checkpoint sits in the job folder: ``checkpoint.restart`` (LAMMPS ``write_restart``: atoms,
-velocities, bonds, contact and bond history, per-atom fix data) and ``checkpoint.json``
+A checkpoint sits in the job folder: ``checkpoint-N.restart`` (LAMMPS ``write_restart``:
+atoms, velocities, bonds, contact and bond history, per-atom fix data; N counts the commands
+done) and ``checkpoint.json``
 (fibrelmp's own state: how many script commands were done, steps done, a hash of the script
 and of every file the job reads, and the byte size of every dump the script appends to, so
 frames written after the checkpoint are dropped).
 
-``checkpoint.forces.npz`` holds the forces and torques the next step starts from (computed
+``checkpoint-N.forces.npz`` holds the forces and torques the next step starts from (computed
 with half-step velocities; ``write_restart`` does not keep them), so a resumed run continues
-exactly as an uninterrupted one.
+exactly as an uninterrupted one.  ``checkpoint.json`` is written last, atomically, and names
+its two files: a run killed while writing a checkpoint leaves the previous one intact.
 
 Resuming replays the same rendered script: set-up commands run again (styles, fixes,
 variables must exist), ``read_data`` becomes ``read_restart``, and commands that change the
@@ -29,9 +31,9 @@ from pathlib import Path
 
 from .errors import InputError
 
-RESTART = "checkpoint.restart"
-STATE = "checkpoint.json"
-FORCES = "checkpoint.forces.npz"       # the step's forces and torques (see runner.step_state)
+STATE = "checkpoint.json"             # written last: names the files below
+RESTART = "checkpoint-{n}.restart"     # n: commands done (see runner.run_script)
+FORCES = "checkpoint-{n}.forces.npz"   # the step's forces and torques (see runner.step_state)
 # commands that change the state or write output: done already when resuming
 ACTIONS = frozenset({"run", "minimize", "velocity", "displace_atoms", "reset_timestep", "write_dump",
                      "write_restart", "write_data", "set", "delete_atoms", "create_atoms",
@@ -86,31 +88,30 @@ class Checkpointing:
     # -- files -----------------------------------------------------------------------------
     def write(self, lmp, rank: int, commands: int, line: int, steps: int, frames: int,
               script_text: str, step_state: dict | None = None) -> None:
-        tmp = self.folder / (RESTART + ".tmp")
-        lmp.command(f"write_restart {tmp.name}")
+        restart, forces = RESTART.format(n=commands), FORCES.format(n=commands)
+        lmp.command(f"write_restart {restart}")
         if rank != 0:
             return
-        os.replace(tmp, self.folder / RESTART)
         if step_state is not None:        # forces/torques: write_restart does not keep them
             import numpy as np
 
-            part = self.folder / (FORCES + ".tmp")
-            with open(part, "wb") as fh:
+            with open(self.folder / forces, "wb") as fh:
                 np.savez(fh, **step_state)
-            os.replace(part, self.folder / FORCES)
         state = {"commands": commands, "line": line, "steps": steps, "frames": frames,
+                 "restart": restart, "forces": forces if step_state is not None else None,
                  "script_sha256": _sha(script_text), "inputs_sha256": inputs_digest(self.inputs),
                  "sizes": {name: (self.folder / name).stat().st_size
                            for name in self.appended if (self.folder / name).exists()}}
         part = self.folder / (STATE + ".tmp")
         part.write_text(json.dumps(state, indent=1))
-        os.replace(part, self.folder / STATE)
+        os.replace(part, self.folder / STATE)      # the new checkpoint is complete from here
+        self._remove_files(keep={restart, forces})
 
     def load_step_state(self) -> dict | None:
         """The forces/torques saved with the checkpoint being resumed (None: not saved)."""
-        path = self.folder / FORCES
-        if self.resume is None or not path.exists():
+        if self.resume is None or not self.resume.get("forces"):
             return None
+        path = self.folder / self.resume["forces"]
         import numpy as np
 
         with np.load(path) as data:
@@ -118,20 +119,36 @@ class Checkpointing:
 
     def clear(self, rank: int) -> None:
         if rank == 0:
-            for name in (RESTART, STATE, FORCES, RESTART + ".tmp", STATE + ".tmp", FORCES + ".tmp"):
+            for name in (STATE, STATE + ".tmp"):
                 (self.folder / name).unlink(missing_ok=True)
+            self._remove_files(keep=set())
+
+    def _remove_files(self, keep: set) -> None:
+        """Restart and force files of other (earlier or unfinished) checkpoints."""
+        for path in self.folder.glob("checkpoint-*"):
+            if path.name not in keep:
+                path.unlink(missing_ok=True)
+
+
+def check_every(every: int | None) -> None:
+    """``--checkpoint-every`` must be a positive number of steps (None: only on signals)."""
+    if every is not None and every <= 0:
+        raise InputError(None, None, f"--checkpoint-every must be a positive number of steps, got {every}")
 
 
 def load(folder: Path, script_text: str, inputs: list[Path] = ()) -> dict:
     """The checkpoint state in ``folder``; an InputError when there is none or the job
     (script or any file it reads) changed since it was written."""
     path = Path(folder) / STATE
-    if not path.exists() or not (Path(folder) / RESTART).exists():
+    if not path.exists():
         raise InputError(path, None, "no checkpoint to resume from (run without --resume, or "
                          "give the same --work folder as the interrupted run)")
     try:
         state = json.loads(path.read_text())
         commands, line, steps = int(state["commands"]), int(state["line"]), int(state["steps"])
+        files = [state["restart"]] + ([state["forces"]] if state.get("forces") else [])
+        if not all(isinstance(name, str) and (Path(folder) / name).is_file() for name in files):
+            raise ValueError("a checkpoint file is missing")
     except (ValueError, KeyError, TypeError):
         raise InputError(path, None, "the checkpoint state is damaged; run again without --resume") from None
     if state.get("script_sha256") != _sha(script_text) or \

@@ -28,7 +28,7 @@ from .errors import InputError
 
 # what a run writes into its work folder (translate.lammps_job / granular_job, checkpoint)
 WORK_FILES = frozenset({"in.lammps", "data.lammps", "frames.dump", "bonds.dump", "walls.dump",
-                        "breaks.dump", "checkpoint.restart", "checkpoint.json", "log.lammps"})
+                        "breaks.dump", "checkpoint.json", "log.lammps"})
 
 
 @dataclass
@@ -54,15 +54,6 @@ class Outputs:
         return list(dict.fromkeys(found))
 
 
-def inside(path: Path, folder: Path) -> bool:
-    """Is ``path`` (resolved) ``folder`` or below it?"""
-    try:
-        Path(path).resolve().relative_to(Path(folder).resolve())
-        return True
-    except ValueError:
-        return False
-
-
 def _same_file(a: Path, b: Path) -> bool:
     try:
         return a.resolve() == b.resolve() or (a.exists() and b.exists() and os.path.samefile(a, b))
@@ -70,7 +61,7 @@ def _same_file(a: Path, b: Path) -> bool:
         return False
 
 
-def _check_location(path: Path, what: str, source: Path) -> None:
+def _check_location(path: Path, what: str) -> None:
     """``path`` can be created: its nearest existing ancestor is a writable folder."""
     if path.is_dir() and what == "output":
         raise InputError(path, None, "is a directory, but fibrelmp writes a result file there")
@@ -92,7 +83,7 @@ def check(outputs: Outputs, force: bool) -> None:
             if _same_file(out, inp):
                 raise InputError(out, None, f"is an input of this run ({outputs.source}) and would "
                                  "be overwritten by a result: choose another result name")
-        _check_location(out, "output", outputs.source)
+        _check_location(out, "output")
     for inp in outputs.inputs:
         # the job files a run writes into its work folder (cmusen scripts: one level down)
         inp = Path(inp).resolve()
@@ -100,7 +91,7 @@ def check(outputs: Outputs, force: bool) -> None:
         if inp.name in WORK_FILES and work in (inp.parent, inp.parent.parent):
             raise InputError(inp, None, f"is an input, and the run writes its own {inp.name} in "
                              f"the work folder {work}: choose another --work")
-    _check_location(outputs.work, "work folder", outputs.source)
+    _check_location(outputs.work, "work folder")
     if outputs.work.exists() and not outputs.work.is_dir():
         raise InputError(outputs.work, None, "is a file, not a folder (--work)")
     if not force:

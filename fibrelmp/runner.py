@@ -187,7 +187,7 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
                     deferred.append(text)
                     continue
                 if words[0] == "read_data":
-                    text = "read_restart checkpoint.restart"
+                    text = f"read_restart {resume['restart']}"
             try:
                 if not replaying and resumed_state is not None:
                     # the first command after the checkpoint: computes set up and the step's
@@ -196,7 +196,9 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
                     resumed_state = None
                     rebuild = False
                 if rebuild and words[0] == "run":
-                    _rebuild_neighbours(lmp, saved_state)
+                    # write_restart re-exchanged the atoms and rebuilt the ghosts: a "run …
+                    # pre no" would use a stale neighbour list
+                    restore_step_state(lmp, saved_state)
                     rebuild = False
                 before = _timestep(lmp) if words[0] == "run" else 0
                 lmp.command(text)
@@ -272,11 +274,6 @@ def restore_step_state(lmp, state: dict) -> None:
             data = (ctypes.c_double * len(values))(*values.tolist()) if n else (ctypes.c_double * 1)()
             lmp.scatter_atoms_subset(name, 1, 3, n, c_ids, data)
 
-
-def _rebuild_neighbours(lmp, state: dict) -> None:
-    """After ``write_restart`` (which re-exchanges atoms and rebuilds ghosts) a ``run … pre
-    no`` would use a stale neighbour list: rebuild it, keeping the step's forces."""
-    restore_step_state(lmp, state)
 
 
 class RunAborted(Exception):

@@ -443,3 +443,22 @@ def test_python_users_get_a_working_lammps_instance(tmp_path):
     env = {k: v for k, v in os.environ.items() if k != "LD_LIBRARY_PATH"}
     res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, cwd=tmp_path)
     assert res.returncode == 0 and res.stdout.strip().isdigit(), res.stderr
+
+
+def test_checkpoint_state_names_its_own_files(tmp_path):
+    """checkpoint.json is the commit point: a restart file of an unfinished later checkpoint
+    (killed before its state was written) is never picked up, and a state whose files are
+    gone is refused."""
+    from fibrelmp.checkpoint import STATE, load
+
+    (tmp_path / "checkpoint-10.restart").write_bytes(b"complete")
+    (tmp_path / "checkpoint-10.forces.npz").write_bytes(b"complete")
+    (tmp_path / "checkpoint-20.restart").write_bytes(b"half written")     # the killed one
+    state = {"commands": 10, "line": 5, "steps": 100, "frames": 1, "restart": "checkpoint-10.restart",
+             "forces": "checkpoint-10.forces.npz", "script_sha256": None, "inputs_sha256": None}
+    (tmp_path / STATE).write_text(json.dumps(state))
+    with pytest.raises(Exception, match="input changed"):      # hashes differ: found, then compared
+        load(tmp_path, "script")
+    (tmp_path / "checkpoint-10.forces.npz").unlink()
+    with pytest.raises(Exception, match="damaged"):
+        load(tmp_path, "script")

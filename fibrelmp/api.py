@@ -85,8 +85,6 @@ def run(model: Model, out: str | Path | None = None, work: str | Path | None = N
     outputs, out_folder, prefix = fibrenet_outputs(model, out, work)
     work_folder = outputs.work
     rank, size = mpi_rank_size()
-    if checkpoint_every is not None and checkpoint_every <= 0:
-        raise InputError(None, None, f"--checkpoint-every must be a positive number of steps, got {checkpoint_every}")
     # resuming continues this run's own (locked) work: its partial results are not "earlier" ones
     with locked(outputs, force or resume, rank):
         # every rank parses and renders identically; only rank 0 writes the job files
@@ -144,10 +142,9 @@ def prepare_checkpoints(folder: Path, text: str, every: int | None, resume: bool
     """Checkpointing for a job (always on: a SIGTERM/Ctrl-C leaves a checkpoint behind);
     when resuming, load the state (refused when the script or any of ``inputs``, the files
     the job reads, changed) and cut the dumps back to the checkpoint."""
-    from .checkpoint import Checkpointing, load, truncate_outputs
+    from .checkpoint import Checkpointing, check_every, load, truncate_outputs
 
-    if every is not None and every <= 0:
-        raise InputError(None, None, f"--checkpoint-every must be a positive number of steps, got {every}")
+    check_every(every)
     state = load(folder, text, inputs) if resume else None
     if state is not None and rank == 0:
         truncate_outputs(folder, state)

@@ -41,20 +41,34 @@ def read(path: str | Path):
     return read_granular(path, kind)[0]
 
 
-def translate_job(path: str | Path, folder: str | Path) -> Path:
+def translate_job(path: str | Path, folder: str | Path, warn: Warn | None = None) -> Path:
     """Write ``folder/in.lammps`` and its data file for the input at ``path`` (a cmusen
-    script: its first simulation); returns the script's path (replay: ``lmp -in in.lammps``)."""
+    script: its first simulation); returns the script's path (replay: ``lmp -in in.lammps``).
+    ``warn`` receives the input's warnings, then those the translation found."""
+    return write_job(path, folder, warn).script
+
+
+def write_job(path: str | Path, folder: str | Path, warn: Warn | None = None):
+    """``translate_job``, returning the job (``.script``, ``.data``)."""
     from .formats import detect
 
     kind = detect(path)
     if kind == "fibrenet":
         from .api import read_input, translate as write
 
-        return write(read_input(path), folder).script
-    from .granular_api import model_for_check
-    from .translate.granular_job import write_granular_job
+        model = read_input(path)
+    else:
+        from .granular_api import model_for_check
+        from .translate.granular_job import write_granular_job as write
 
-    return write_granular_job(model_for_check(path, kind), folder).script
+        model = model_for_check(path, kind)
+    said = len(model.warnings)
+    if warn is not None:
+        warn(model.warnings)
+    job = write(model, folder)
+    if warn is not None and model.warnings[said:]:
+        warn(model.warnings[said:])
+    return job
 
 
 @dataclass
@@ -93,11 +107,13 @@ def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | N
     ``force``.  ``end_time``/``step``/``save_step`` (MUSEN scene, DEMDF) and ``steps``
     (DEMDF) override the input.  ``say`` receives progress notes, ``warn`` lists of
     ``(kind, text)`` warnings as they are found (they are also in the result)."""
+    from .checkpoint import check_every
     from .formats import detect
     from .granular_api import Checkpoints
 
     path = Path(path)
     kind = detect(path)
+    check_every(checkpoint_every)         # before any folder is made
     result = RunResult()
 
     def warned(items: list[tuple[str, str]]) -> None:
@@ -136,15 +152,14 @@ def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | N
                         steps=steps, save_every=save_step, warn=warned, say=say,
                         checkpoints=checkpoints, force=force)
     else:
-        from .granular_api import read_granular, run_musen_scene
+        from .granular_api import read_granular, run_musen_scene, scene_result_path
 
         model, overrides = read_granular(path, kind, end_time, step, save_step, steps)
         for text in overrides:
             say(f"override: {text}")
         warned(model.warnings)
         said = len(model.warnings)
-        target = out if out is not None else path.with_name(f"{path.stem}_result.txt")
-        res = run_musen_scene(model, target, work=work, progress=progress, precision=precision,
+        res = run_musen_scene(model, scene_result_path(path, out), work=work, progress=progress, precision=precision,
                               checkpoints=checkpoints, force=force)
         warned(model.warnings[said:])            # found while translating or running
     result.outputs, result.notes = res.outputs, res.notes
@@ -165,7 +180,9 @@ def has_checkpoint(path: Path, kind: str, out: str | Path | None, work: str | Pa
     elif kind in ("musen-script", "demdf"):
         folders = [Path(out or path.resolve().parent) / f"{path.stem}_work"]
     else:
-        target = Path(out) if out is not None else path.with_name(f"{path.stem}_result.txt")
+        from .granular_api import scene_result_path
+
+        target = scene_result_path(path, out)
         folders = [target.resolve().parent / f"{target.stem}_work"]
     return any(next(f.rglob("checkpoint.json"), None) is not None for f in folders if f.exists())
 

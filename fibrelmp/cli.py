@@ -243,7 +243,7 @@ def check(input: Path = typer.Argument(..., help="Any supported input file.",
 
 def _granular_results(input: Path, kind: str, model) -> str:
     """Where ``run`` would write (without -o), as check reports it."""
-    from .granular_api import demdf_outputs, musen_result_path, plan_musen_script
+    from .granular_api import demdf_outputs, musen_result_path, plan_musen_script, scene_result_path
 
     if kind == "demdf":
         outputs, folder = demdf_outputs(model)
@@ -251,7 +251,7 @@ def _granular_results(input: Path, kind: str, model) -> str:
     if kind == "musen-script":
         written = [str(st.written) for st in plan_musen_script(input).steps if st.written is not None]
         return ", ".join(written) or "none (the script exports nothing)"
-    return f"{musen_result_path(input.resolve().with_name(f'{input.stem}_result.txt'))[0]} (or -o FILE)"
+    return f"{musen_result_path(scene_result_path(input.resolve()))[0]} (or -o FILE)"
 
 
 def _summary(lines: list[str]) -> None:
@@ -299,24 +299,10 @@ def translate(input: Path = typer.Argument(..., help="Any supported input file."
       fibrelmp translate examples/musen/single_particle_job.txt -o job/
       fibrelmp translate examples/demdf/head_on.json -o job/
     """
-    from .formats import detect
+    from .python_api import write_job
 
     _set_flags(quiet, verbose)
-    kind = detect(input)
-    if kind != "fibrenet":
-        from .granular_api import model_for_check
-        from .translate.granular_job import write_granular_job
-
-        model = model_for_check(input, kind)
-        _report_warnings(model.warnings)
-        job = write_granular_job(model, out)
-        _say(f"wrote {job.script} and {job.data}")
-        return
-    from .api import read_input, translate as do_translate
-
-    model = read_input(input)
-    _report_warnings(model.warnings)
-    job = do_translate(model, out)
+    job = write_job(input, out, warn=_report_warnings)
     _say(f"wrote {job.script} and {job.data}")
 
 

@@ -118,6 +118,12 @@ def run_demdf(path: str | Path, out: str | Path | None = None, work: str | Path 
     return result
 
 
+def scene_result_path(scene: str | Path, out: str | Path | None = None) -> Path:
+    """Where a bare MUSEN scene's result goes: ``out``, else ``<scene>_result.txt`` beside it."""
+    scene = Path(scene)
+    return Path(out) if out is not None else scene.with_name(f"{scene.stem}_result.txt")
+
+
 def musen_result_path(path: str | Path) -> tuple[Path, str | None]:
     """MUSEN result name: a ``.mdem`` name becomes ``.txt`` (fibrelmp writes text only)."""
     path = Path(path)

@@ -6,7 +6,6 @@ FibreNet file never imports the DEM code (and vice versa).
 
 from __future__ import annotations
 
-import os
 import re
 from pathlib import Path
 from types import ModuleType
@@ -35,18 +34,16 @@ DETECT_BYTES = 1 << 20          # detection reads at most this much of a file
 def check_regular_file(path: Path, what: str = "input") -> None:
     """A readable regular file: not missing, not a folder, not a device or FIFO (reading
     /dev/zero never ends, a FIFO blocks for ever)."""
-    import stat
+    from .textio import refuse_special_file
 
     try:
-        mode = os.stat(path).st_mode
+        refuse_special_file(path, what)
     except FileNotFoundError:
         raise InputError(path, None, f"{what} file not found") from None
     except OSError as exc:
         raise InputError(path, None, f"cannot read {what}: {exc.strerror or exc}") from None
-    if stat.S_ISDIR(mode):
+    if path.is_dir():
         raise InputError(path, None, f"{what} is a directory, expected a file")
-    if not stat.S_ISREG(mode):
-        raise InputError(path, None, f"{what} is not a regular file (a device, FIFO or socket)")
 
 
 def detect(path: str | Path) -> str:

@@ -30,6 +30,15 @@ def patched_reading() -> bool:
     return bool(_OVERLAY)
 
 
+def refuse_special_file(path: str | os.PathLike, what: str = "file") -> None:
+    """An InputError unless ``path`` is a regular file or a folder (whose read says so):
+    reading /dev/zero never ends, opening a FIFO blocks until someone writes to it.  The
+    OSError of a path that cannot be examined propagates."""
+    mode = os.stat(path).st_mode
+    if not stat.S_ISREG(mode) and not stat.S_ISDIR(mode):
+        raise InputError(path, None, f"{what} is not a regular file (a device, FIFO or socket)")
+
+
 def read_text(path: str | os.PathLike, what: str = "file") -> str:
     """Read a text file; every failure becomes an InputError naming the path.
 
@@ -42,10 +51,7 @@ def read_text(path: str | os.PathLike, what: str = "file") -> str:
         if patched is not None:
             return patched
     try:
-        mode = os.stat(p).st_mode
-        if not stat.S_ISREG(mode) and not stat.S_ISDIR(mode):
-            # /dev/zero never ends, opening a FIFO blocks until someone writes to it
-            raise InputError(p, None, f"{what} is not a regular file (a device, FIFO or socket)")
+        refuse_special_file(p, what)
         raw = p.read_bytes()
     except OSError as exc:
         raise InputError(p, None, read_failure(exc, what)) from None
@@ -86,9 +92,7 @@ def check_text_file(path: str | os.PathLike, what: str = "file") -> None:
     if _OVERLAY and _OVERLAY.get(_overlay_key(p)) is not None:
         return
     try:
-        mode = os.stat(p).st_mode
-        if not stat.S_ISREG(mode) and not stat.S_ISDIR(mode):
-            raise InputError(p, None, f"{what} is not a regular file (a device, FIFO or socket)")
+        refuse_special_file(p, what)
         with open(p, "rb") as fh:
             decoder = codecs.getincrementaldecoder("utf-8")()
             first, offset, lines = True, 0, 1

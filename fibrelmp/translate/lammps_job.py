@@ -17,6 +17,7 @@ from ..fastfmt import rows_text
 from ..lammps_text import comment_text, template_environment
 from ..model import Model
 from ..textio import atomic_write, format_rows
+from .steps import SaveSteps
 
 SCRIPT_NAME = "in.lammps"
 DATA_NAME = "data.lammps"
@@ -32,7 +33,7 @@ class Job:
     frames: Path
     total_steps: int
     type_of_ltype: np.ndarray            # LAMMPS type (1-based, index 0 unused) -> user type
-    output_steps: object = ()              # the steps of the frames (lazy: range-like)
+    output_steps: SaveSteps | tuple = ()   # the steps of the frames (lazy)
     text: str = ""                        # the script, also when only rank 0 wrote files
 
 
@@ -109,14 +110,14 @@ def angle_expression(c: float, theta0: float) -> str:
             f"-{_fmt(c)}*theta^2;phi={_fmt(u)}-theta")
 
 
-def _schedule(model: Model, general_lambda: bool) -> tuple[list[tuple], range, int]:
+def _schedule(model: Model, general_lambda: bool) -> tuple[list[tuple], SaveSteps, int]:
     """The sequence of actions the script performs (see the template for each action).
 
     FibreNet's first step of a fresh start (or after a velocity reset) uses a stored force
     instead of F(x): the "kick" action reproduces that step exactly.  Repeated identical
     chunks (relaxation chunks with resets, production chunks between frames) become one
     LAMMPS loop ("loop" ... "end"), so the script does not grow with the number of frames.
-    Returns the actions, the output steps (a lazy range) and the total number of steps.
+    Returns the actions, the output steps (lazy) and the total number of steps.
     """
     acts: list[tuple] = []
     total = sum(st.steps for st in model.plan.stages)
@@ -186,24 +187,7 @@ def _schedule(model: Model, general_lambda: bool) -> tuple[list[tuple], range, i
         repeat(full, lambda: frame_chunk(every))
         if rest:
             frame_chunk(rest)
-    out_steps = range(0, steps + every, every) if steps % every == 0 else None
-    if out_steps is None:
-        out_steps = _Steps(every, steps)
-    return acts, out_steps, total
-
-
-class _Steps:
-    """0, every, 2 every, ..., and ``last`` (a partial last chunk): lazily."""
-
-    def __init__(self, every: int, last: int):
-        self.every, self.last = every, last
-
-    def __iter__(self):
-        yield from range(0, self.last, self.every)
-        yield self.last
-
-    def __len__(self) -> int:
-        return len(range(0, self.last, self.every)) + 1
+    return acts, SaveSteps(steps, period=every), total
 
 
 def write_job(model: Model, folder: str | Path, write_files: bool = True) -> Job:

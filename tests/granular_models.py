@@ -112,3 +112,12 @@ def two_materials():
                 (0, 1): law_for(glass, steel, 0.8, 0.6, 0.05),
                 (1, 1): law_for(steel, steel, 0.6, 0.7, 0.05)}
     return mats, contacts
+
+
+def run(model: GranularModel, folder: Path, name: str = "job"):
+    """Run ``model`` in ``folder/name``: (job, every saved frame in order)."""
+    from fibrelmp.granular_run import run_granular
+
+    frames = []
+    job = run_granular(model, Path(folder) / name, frames.append, progress=False)
+    return job, frames

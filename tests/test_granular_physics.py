@@ -16,16 +16,13 @@ import pytest
 
 from fibrelmp.errors import InputError
 from fibrelmp.granmodel import ContactLaw, hertz_effective
-from fibrelmp.granular_run import quat_multiply, run_granular
+from fibrelmp.granular_run import quat_multiply
 from fibrelmp.translate.granular_job import law_args, write_granular_job
 
 from . import granular_models as gm
+from .granular_models import run
 
 
-def run(model, tmp_path, name="job"):
-    frames = []
-    job = run_granular(model, tmp_path / name, frames.append, progress=False)
-    return job, frames
 
 
 def hertz(e_star, r_star, delta):

@@ -16,7 +16,6 @@ import pytest
 
 from fibrelmp.errors import InputError
 from fibrelmp.granmodel import ContactLaw, hertz_effective
-from fibrelmp.granular_run import run_granular
 from fibrelmp.post.lammps_dump import iter_frames
 from fibrelmp.translate.granular_job import describe_walls
 from fibrelmp.translate.granular_walls import (detect_box, detect_cylinder, detect_oriented_box,
@@ -24,16 +23,13 @@ from fibrelmp.translate.granular_walls import (detect_box, detect_cylinder, dete
                                                nearest_triangle, closest_points, tile_triangles)
 
 from . import granular_models as gm
+from .granular_models import run
 from .conftest import REPO, data_path
 
 R = 0.0005
 G = 9.81
 
 
-def run(model, tmp_path, name="job"):
-    frames = []
-    job = run_granular(model, tmp_path / name, frames.append, progress=False)
-    return job, frames
 
 
 def static_overlap(mats, r=R):

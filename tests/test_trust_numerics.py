@@ -16,7 +16,6 @@ import pytest
 
 from fibrelmp import api
 from fibrelmp.errors import InputError, RunError
-from fibrelmp.granular_run import run_granular
 from fibrelmp.post import to_fibrenet
 from fibrelmp.post.lammps_dump import Frame, iter_frames
 from fibrelmp.post.to_fibrenet import write_fibrenet
@@ -24,16 +23,13 @@ from fibrelmp.translate import granular_job as gj
 from fibrelmp.translate.granular_walls import tile_triangles, tile_triangles_within
 
 from . import granular_models as gm
+from .granular_models import run
 from .conftest import REPO
 
 R = 0.0005
 G = 9.81
 
 
-def run(model, tmp_path, name="job"):
-    frames = []
-    job = run_granular(model, tmp_path / name, frames.append, progress=False)
-    return job, frames
 
 
 # ---------------------------------------------------------------------------------------

@@ -1,8 +1,8 @@
-"""Build step for the optional C helpers of ``fibrelmp.post`` (metadata is in pyproject.toml).
+"""Build step for the optional C helpers of ``fibrelmp.numtext`` (metadata is in pyproject.toml).
 
-``fibrelmp/post/_fastparse.c`` is compiled at install time into a plain shared library,
-``fibrelmp/post/_fastparse_c<EXT_SUFFIX>`` (e.g. ``_fastparse_c.cpython-311-x86_64-linux-gnu.so``),
-which ``fibrelmp.post.fastparse`` loads with ctypes.  It is declared as an Extension so that
+``fibrelmp/numtext/_fastparse.c`` is compiled at install time into a plain shared library,
+``fibrelmp/numtext/_fastparse_c<EXT_SUFFIX>`` (e.g. ``_fastparse_c.cpython-311-x86_64-linux-gnu.so``),
+which ``fibrelmp.numtext.fast`` loads with ctypes.  It is declared as an Extension so that
 setuptools compiles and links it with the interpreter's compiler settings, ships it in the
 wheel (tagged for this platform) and copies it into the source tree for editable installs;
 but it is not a Python module: it has no ``PyInit_`` function and is never imported.
@@ -21,8 +21,8 @@ from setuptools.command.build_ext import build_ext
 # fused multiply-add), the results must be bit-identical to the numpy paths.  These come after
 # the interpreter's and the user's CFLAGS on the command line, so they take precedence.
 FASTPARSE = Extension(
-    "fibrelmp.post._fastparse_c",
-    sources=["fibrelmp/post/_fastparse.c"],
+    "fibrelmp.numtext._fastparse_c",
+    sources=["fibrelmp/numtext/_fastparse.c"],
     extra_compile_args=["-O3", "-fno-fast-math", "-ffp-contract=off"],
     libraries=["m"],
     optional=True,
@@ -51,7 +51,7 @@ class OptionalBuildExt(build_ext):
             self._skip(exc)
 
     def _skip(self, exc):
-        self.warn(f"fibrelmp: the C fast path of fibrelmp.post was not built ({exc}); "
+        self.warn(f"fibrelmp: the C fast path of fibrelmp.numtext was not built ({exc}); "
                   "it will be compiled on first use if a C compiler is available then, "
                   "else the (slower) numpy path is used; see `fibrelmp --version`")
 

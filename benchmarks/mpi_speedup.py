@@ -69,7 +69,7 @@ def same_outputs(a: Path, b: Path) -> str | None:
     """None when b holds a's FibreNet outputs (within one unit of the last digit), else why not."""
     import numpy as np
 
-    from fibrelmp.post.fibrenet_out import read_restart, read_xyz
+    from fibrelmp.translate.fibrenet.writer import read_restart, read_xyz
 
     names_a = sorted(p.name for p in a.iterdir() if p.is_file())
     names_b = sorted(p.name for p in b.iterdir() if p.is_file())

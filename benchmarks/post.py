@@ -64,7 +64,7 @@ def run_fibrelmp(dump: Path, out: Path) -> float:
 
 def run_reader(dump: Path) -> float:
     """fibrelmp's reader alone (read + parse every frame), to show where the time goes."""
-    from fibrelmp.post.lammps_dump import iter_frames
+    from fibrelmp.post.lammps_dump.reader import iter_frames
 
     t = time.perf_counter()
     for _ in iter_frames(dump):

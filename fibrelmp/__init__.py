@@ -21,11 +21,11 @@ __all__ = ["read", "translate_job", "run", "convert", "RunResult", "InputError",
 def __getattr__(name: str):
     """Lazy exports: ``import fibrelmp`` stays light (LAMMPS, jinja2, MDAnalysis load on use)."""
     if name in ("read", "translate_job", "run", "convert", "RunResult"):
-        from . import python_api
+        from fibrelmp import python_api
 
         return getattr(python_api, name)
     if name in ("InputError", "RunError"):
-        from . import errors
+        from fibrelmp import errors
 
         return getattr(errors, name)
     raise AttributeError(f"module 'fibrelmp' has no attribute {name!r}")
@@ -34,7 +34,7 @@ def __getattr__(name: str):
 def lammps_module():
     """The ``lammps`` Python module with its MPI library loaded: ``lammps_module().lammps()``
     works without LD_LIBRARY_PATH."""
-    from ._lammps import load_lammps_module
+    from fibrelmp._lammps import load_lammps_module
 
     return load_lammps_module()
 
@@ -42,6 +42,6 @@ def lammps_module():
 def lammps_instance(cmdargs: list[str] | None = None):
     """A new ``lammps.lammps`` instance (e.g. ``lammps_instance(["-log", "none"])``); close it
     with ``.close()`` when done."""
-    from ._lammps import new_lammps
+    from fibrelmp._lammps import new_lammps
 
     return new_lammps(cmdargs)

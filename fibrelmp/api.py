@@ -8,20 +8,21 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from .errors import InputError
-from .formats import detect, reader
-from .model import Model
+from fibrelmp.errors import InputError
+from fibrelmp.model import Model
 
 if TYPE_CHECKING:
     import numpy as np
 
-    from .outputs import Outputs
-from .translate.lammps_job import Job, write_job
+    from fibrelmp.outputs import Outputs
+from fibrelmp.translate.lammps_job import Job, write_job
 
 
 def read_input(path: str | Path) -> Model:
     """Parse any supported input into the neutral Model."""
-    return reader(detect(path)).read(path)
+    from fibrelmp.translate.fibrenet.reader import read
+
+    return read(path)
 
 
 def translate(model: Model, folder: str | Path) -> Job:
@@ -42,8 +43,8 @@ def fibrenet_outputs(model: Model, out: str | Path | None = None,
     ``output_file`` is a name inside the output folder (``-o``, default the input's folder);
     one that leaves it (``..``) is refused, and an absolute one is honoured only without
     ``-o`` (as FibreNet would write it)."""
-    from .outputs import Outputs
-    from .post.fibrenet_out import RESTART_SUFFIX, XYZ_SUFFIX
+    from fibrelmp.outputs import Outputs
+    from fibrelmp.translate.fibrenet.writer import RESTART_SUFFIX, XYZ_SUFFIX
 
     spec = model.plan.output
     name = Path(spec.basename)
@@ -76,10 +77,10 @@ def run(model: Model, out: str | Path | None = None, work: str | Path | None = N
     Ctrl-C in any case); ``resume`` continues from the checkpoint in the work folder.
     Existing results are replaced (completely) only with ``force``; the output and work
     folders are locked for the run."""
-    from .outputs import finish, locked
-    from .post.lammps_dump import iter_frames
-    from .post.to_fibrenet import write_fibrenet
-    from .runner import mpi_rank_size, run_script
+    from fibrelmp.outputs import finish, locked
+    from fibrelmp.post.lammps_dump.reader import iter_frames
+    from fibrelmp.post.to_fibrenet import write_fibrenet
+    from fibrelmp.runner import mpi_rank_size, run_script
 
     spec = model.plan.output
     outputs, out_folder, prefix = fibrenet_outputs(model, out, work)
@@ -90,7 +91,7 @@ def run(model: Model, out: str | Path | None = None, work: str | Path | None = N
         # every rank parses and renders identically; only rank 0 writes the job files
         job = write_job(model, work_folder, write_files=rank == 0)
         if size > 1:
-            from ._lammps import mpi_barrier
+            from fibrelmp._lammps import mpi_barrier
             mpi_barrier()        # the data file is complete before any rank hashes it
         checkpoints = prepare_checkpoints(job.folder, job.text, checkpoint_every, resume,
                                           [job.frames.name], rank, [job.data])
@@ -124,7 +125,7 @@ def run(model: Model, out: str | Path | None = None, work: str | Path | None = N
 def _expected_frames(frames, job: Job):
     """``frames``, checked against the job's schedule: a missing, repeated or extra frame is
     a RunError, never a silently wrong output file."""
-    from .errors import RunError
+    from fibrelmp.errors import RunError
 
     expected = iter(job.output_steps)
     for frame in frames:
@@ -142,7 +143,7 @@ def prepare_checkpoints(folder: Path, text: str, every: int | None, resume: bool
     """Checkpointing for a job (always on: a SIGTERM/Ctrl-C leaves a checkpoint behind);
     when resuming, load the state (refused when the script or any of ``inputs``, the files
     the job reads, changed) and cut the dumps back to the checkpoint."""
-    from .checkpoint import Checkpointing, check_every, load, truncate_outputs
+    from fibrelmp.checkpoint import Checkpointing, check_every, load, truncate_outputs
 
     check_every(every)
     state = load(folder, text, inputs) if resume else None
@@ -152,8 +153,8 @@ def prepare_checkpoints(folder: Path, text: str, every: int | None, resume: bool
 
 
 def _run_with_converter(job: Job, progress: bool, convert, checkpoints=None) -> list[Path]:
-    from .post.lammps_dump import iter_frames
-    from .runner import run_overlapped
+    from fibrelmp.post.lammps_dump.reader import iter_frames
+    from fibrelmp.runner import run_overlapped
 
     def consume(tokens) -> list[Path]:
         frames = iter_frames(job.frames)
@@ -179,9 +180,9 @@ def evaluate(model: Model, folder: str | Path) -> Evaluation:
     """
     import numpy as np
 
-    from ._lammps import new_lammps
-    from .errors import RunError
-    from .lammps_text import input_lines
+    from fibrelmp._lammps import new_lammps
+    from fibrelmp.errors import RunError
+    from fibrelmp.lammps_text import input_lines
     import os
 
     job = translate(model, folder)

@@ -29,7 +29,7 @@ import signal
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .errors import InputError
+from fibrelmp.errors import InputError
 
 STATE = "checkpoint.json"             # written last: names the files below
 RESTART = "checkpoint-{n}.restart"     # n: commands done (see runner.run_script)

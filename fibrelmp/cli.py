@@ -11,19 +11,28 @@ from typing import Optional
 
 import typer
 
-from . import __version__
+from fibrelmp import __version__
+
+from fibrelmp.registry import INPUT, TARGET, formats, names
+
+_INPUTS = formats(INPUT)
+_TITLES = ", ".join(f.title for f in _INPUTS[:-1]) + " or " + _INPUTS[-1].title
+
+
+def _examples(command: str, tail: str = "", role: str = INPUT) -> str:
+    """Example command lines for a help text, one per registered format that has one."""
+    return "\n".join(f"  fibrelmp {command} {f.example}{tail}" for f in formats(role) if f.example)
+
 
 app = typer.Typer(add_completion=True, no_args_is_help=True, rich_markup_mode=None,
-                  help="""Run FibreNet, MUSEN and DEMDF inputs on LAMMPS and write the results in
-each code's own format; convert LAMMPS dumps into those formats.
+                  help=f"""Run simulation inputs ({_TITLES}) on LAMMPS and write the results in
+each code's own format; convert LAMMPS dumps into those formats ({", ".join(names(TARGET))}).
 
 \b
 Examples:
-  fibrelmp check examples/fibre_network/input.txt      # validate, list every error
-  fibrelmp run examples/musen/single_particle_job.txt
-  fibrelmp translate examples/demdf/head_on.json -o job/
-  fibrelmp post frames.dump --to vtk -o run/frames
-  fibrelmp --install-completion                        # tab completion for your shell
+{_examples("check")}
+  fibrelmp post frames.dump --to {names(TARGET)[-1]} -o run/frames
+  fibrelmp --install-completion          # tab completion for your shell
 
 \b
 Exit codes: 0 success, 1 the run failed (LAMMPS error), 2 bad input or
@@ -43,7 +52,7 @@ def _set_flags(quiet: bool, verbose: bool) -> None:
 
 
 def _rank0() -> bool:
-    from .runner import mpi_rank_size
+    from fibrelmp.runner import mpi_rank_size
 
     return mpi_rank_size()[0] == 0
 
@@ -69,8 +78,8 @@ def _report_warnings(warnings: list[tuple[str, str]]) -> None:
 
 def _fail(message: str, code: int) -> None:
     """Report and exit; under MPI a failure on any rank aborts all ranks (never a hang)."""
-    from ._lammps import mpi_abort
-    from .runner import mpi_rank_size
+    from fibrelmp._lammps import mpi_abort
+    from fibrelmp.runner import mpi_rank_size
 
     rank, size = mpi_rank_size()
     # input errors are found identically on every rank (all ranks parse): say them once
@@ -95,10 +104,10 @@ def _guard(func):
 
     @functools.wraps(func)
     def wrapper(*args, **kwargs):
-        from .errors import InputError, RunError
+        from fibrelmp.errors import InputError, RunError
 
-        from ._lammps import mpi_finalize, mpi_init
-        from .runner import mpi_rank_size
+        from fibrelmp._lammps import mpi_finalize, mpi_init
+        from fibrelmp.runner import mpi_rank_size
 
         size = mpi_rank_size()[1]
         if size > 1:
@@ -108,7 +117,7 @@ def _guard(func):
         except InputError as exc:
             _fail(f"error: {exc}", 2)
         except (RunError, OSError) as exc:
-            from .errors import visible
+            from fibrelmp.errors import visible
 
             _fail(f"run failed: {visible(str(exc), keep_newlines=True)}", 1)
         except MemoryError:
@@ -116,7 +125,7 @@ def _guard(func):
         except KeyboardInterrupt:
             _fail("interrupted", 130)
         except Exception as exc:
-            from .checkpoint import CheckpointStop
+            from fibrelmp.checkpoint import CheckpointStop
 
             if isinstance(exc, CheckpointStop):
                 _fail(str(exc), 128 + exc.signum)
@@ -151,7 +160,7 @@ def _version(value: bool) -> None:
     if value:
         typer.echo(f"fibrelmp {__version__}")
         try:
-            from ._lammps import load_lammps_module
+            from fibrelmp._lammps import load_lammps_module
 
             lmp = load_lammps_module().lammps(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
             typer.echo(f"LAMMPS {lmp.version()} (MPI support: {bool(lmp.has_mpi_support)})")
@@ -163,7 +172,7 @@ def _version(value: bool) -> None:
         except Exception as exc:  # no MPI library loaded (serial LAMMPS build)
             typer.echo(f"MPI unavailable: {exc}")
         try:
-            from .post.fastparse import active_path
+            from fibrelmp.numtext.fast import active_path
 
             typer.echo(f"post fast path: {active_path()}")
         except Exception as exc:  # version output must never crash
@@ -181,77 +190,27 @@ def main_options(
     _state["quiet"], _state["verbose"] = quiet, verbose
 
 
-@app.command()
+@app.command(help=f"""Parse and validate INPUT without running LAMMPS; print a summary, the unit
+system and the time step against the fastest spring / contact it has to resolve.
+
+Every error of a line-oriented input is listed (run stops at the first); exit code 2 on
+any error.
+
+\b
+Examples:
+{_examples("check")}
+""")
 @_guard
 def check(input: Path = typer.Argument(..., help="Any supported input file.",
                                        readable=False),    # fibrelmp says why, as path: message
           quiet: bool = _QUIET, verbose: bool = _VERBOSE) -> None:
-    """Parse and validate INPUT without running LAMMPS; print a summary, the unit system and
-    the time step against the fastest spring / contact it has to resolve.
-
-    For FibreNet inputs and models, MUSEN scenes and cmusen scripts every error is listed
-    (run stops at the first); for DEMDF files the first.  Exit code 2 on any error.
-
-    \b
-    Examples:
-      fibrelmp check examples/fibre_network/input.txt
-      fibrelmp check examples/musen/single_particle_job.txt
-      fibrelmp check examples/demdf/head_on.json --verbose   # every warning
-    """
-    from .formats import detect
+    from fibrelmp.python_api import check as check_input
 
     _set_flags(quiet, verbose)
-    kind = detect(input)
-    if kind != "fibrenet":
-        from .granular_api import model_for_check
-        from .granular_check import summary
-
-        model = _read_for_check(lambda: model_for_check(input, kind), kind, input)
-        _summary(summary(model) + [f"results      {_granular_results(input, kind, model)}"])
-        _report_warnings(model.warnings)
-        _summary([f"warnings     {len(model.warnings)}"])
-        return
-    from .api import read_input
-    from .sanity import spring_check, units_line
-
-    model = _read_for_check(lambda: read_input(input), kind, input)
-    p = model.particles
-    lines = [f"input        {model.source}",
-             units_line(model),
-             f"beads        {p.count}",
-             f"springs      {model.bonds.count}",
-             f"angles       {model.angles.count}",
-             f"types        {', '.join(p.type_names)}",
-             "pairs        " + "; ".join(f"{law.kind} {p.type_names[law.type_i]}-{p.type_names[law.type_j]}"
-                                         for law in model.pairs),
-             f"box          {' x '.join(f'{x:g}' for x in model.box.lengths)} "
-             f"({'periodic' if all(model.box.periodic) else 'finite, wall k = %g' % model.box.wall_stiffness})",
-             f"time step    {model.dynamics.dt:g}   lambda {model.dynamics.lambda_:g}   damping {model.dynamics.damping:g}"]
-    for st in model.plan.stages:
-        extra = f" in chunks of {st.chunk}" + (", velocities reset" if st.reset else "") if st.name == "relax" else \
-            f", output every {model.plan.output.every}"
-        lines.append(f"stage        {st.name}: {st.steps} steps{extra}")
-    lines += spring_check(model)
-    from .api import fibrenet_outputs
-
-    outputs, folder, prefix = fibrenet_outputs(model)
-    lines.append(f"results      {', '.join(str(p) for p in outputs.files)} (or in -o DIR)")
-    _summary(lines)
-    _report_warnings(model.warnings)
-    _summary([f"warnings     {len(model.warnings)}"])
-
-
-def _granular_results(input: Path, kind: str, model) -> str:
-    """Where ``run`` would write (without -o), as check reports it."""
-    from .granular_api import demdf_outputs, musen_result_path, plan_musen_script, scene_result_path
-
-    if kind == "demdf":
-        outputs, folder = demdf_outputs(model)
-        return f"{folder / model.passthrough['demdf']['filename']}_<n>.json (or in -o DIR)"
-    if kind == "musen-script":
-        written = [str(st.written) for st in plan_musen_script(input).steps if st.written is not None]
-        return ", ".join(written) or "none (the script exports nothing)"
-    return f"{musen_result_path(scene_result_path(input.resolve()))[0]} (or -o FILE)"
+    report = check_input(input)
+    _summary(report.lines)
+    _report_warnings(report.warnings)
+    _summary([f"warnings     {len(report.warnings)}"])
 
 
 def _summary(lines: list[str]) -> None:
@@ -260,68 +219,50 @@ def _summary(lines: list[str]) -> None:
         typer.echo("\n".join(lines))
 
 
-def _read_for_check(read, kind: str, input: Path):
-    """``read()``; on an input error in a line-oriented format, every error of the file (the
-    readers stop at the first: ``collect_errors`` re-reads with failing lines patched out)."""
-    from .errors import InputError
-    from .textio import MAX_ERRORS, collect_errors
+@app.command(help=f"""Write a stock-LAMMPS job (in.lammps + data file) for INPUT into a folder
+(replay: cd job && lmp -in in.lammps).
 
-    try:
-        return read()
-    except InputError as first:
-        if kind == "demdf":
-            raise
-        if kind == "fibrenet":
-            from .translate.fibrenet import check_patch
-
-            patch = check_patch(input)
-        else:
-            from .translate.musen_script import check_patch as patch
-        errors = collect_errors(read, first, patch)
-    if len(errors) == 1:
-        raise errors[0]
-    files = list(dict.fromkeys(e.path for e in errors))          # in the order they were met
-    errors.sort(key=lambda e: (files.index(e.path), e.line or 0))
-    more = " (the limit: fix these and check again)" if len(errors) >= MAX_ERRORS else ""
-    _fail("\n".join(f"error: {e}" for e in errors) + f"\n{len(errors)} errors{more}", 2)
-
-
-@app.command()
+\b
+Examples:
+{_examples("translate", " -o job/")}
+""")
 @_guard
 def translate(input: Path = typer.Argument(..., help="Any supported input file.", readable=False),
               out: Path = typer.Option(..., "-o", "--out", help="Folder for in.lammps and the data file."),
               quiet: bool = _QUIET, verbose: bool = _VERBOSE) -> None:
-    """Write a stock-LAMMPS job (in.lammps + data file) for INPUT into a folder.
-
-    \b
-    Examples:
-      fibrelmp translate input.txt -o job/ && cd job && lmp -in in.lammps
-      fibrelmp translate examples/musen/single_particle_job.txt -o job/
-      fibrelmp translate examples/demdf/head_on.json -o job/
-    """
-    from .python_api import write_job
+    from fibrelmp.python_api import write_job
 
     _set_flags(quiet, verbose)
     job = write_job(input, out, warn=_report_warnings)
     _say(f"wrote {job.script} and {job.data}")
 
 
-@app.command()
+@app.command(help=f"""Translate INPUT, run it on LAMMPS and write the results in the input's own
+format.
+
+Results are never overwritten silently: an existing result needs --force.  The output and
+work folders are locked while the run writes them.
+
+\b
+Examples:
+{_examples("run")}
+""")
 @_guard
-def run(input: Path = typer.Argument(..., help="FibreNet input, MUSEN text scene, cmusen job script "
-                                     "or DEMDF JSON file.", readable=False),
-        out: Optional[Path] = typer.Option(None, "--out", "-o", help="Where results go: a folder "
-                                           "(FibreNet, DEMDF) or the result file (MUSEN scene). "
+def run(input: Path = typer.Argument(..., help=f"{_TITLES[0].upper()}{_TITLES[1:]}.", readable=False),
+        out: Optional[Path] = typer.Option(None, "--out", "-o", help="Where results go: a folder, or "
+                                           "the result file for inputs with a single result. "
                                            "Default: next to the input."),
         work: Optional[Path] = typer.Option(None, "--work", help="Folder for the rendered LAMMPS job."),
         end_time: Optional[float] = typer.Option(None, "--end-time", "--time-end",
-                                                 help="MUSEN scene / DEMDF: simulated end time."),
-        step: Optional[float] = typer.Option(None, "--step", help="MUSEN scene: simulation time step."),
+                                                 help="Simulated end time (overrides the input's)."),
+        step: Optional[float] = typer.Option(None, "--step", help="Simulation time step, for inputs "
+                                             "that do not set one."),
         save_step: Optional[float] = typer.Option(None, "--save-step", "--save-every",
-                                                  help="MUSEN scene / DEMDF: time between saved states."),
-        steps: Optional[int] = typer.Option(None, "--steps", help="DEMDF: number of time steps to run."),
-        precision: int = typer.Option(6, "--precision", help="MUSEN result: significant digits "
-                                      "(6 as MUSEN; 17 for exact round trips)."),
+                                                  help="Time between saved states (overrides the input's)."),
+        steps: Optional[int] = typer.Option(None, "--steps", help="Number of time steps to run, "
+                                            "for inputs that count steps."),
+        precision: int = typer.Option(6, "--precision", help="Significant digits of text results "
+                                      "that take it (6 as the source code; 17 for exact round trips)."),
         checkpoint_every: Optional[int] = typer.Option(None, "--checkpoint-every", help="Write a "
                                                        "checkpoint every N steps (one is always "
                                                        "written on SIGTERM/Ctrl-C)."),
@@ -331,21 +272,9 @@ def run(input: Path = typer.Argument(..., help="FibreNet input, MUSEN text scene
                                    "(all of them: stale files are removed)."),
         quiet: bool = _QUIET, verbose: bool = _VERBOSE,
         ) -> None:
-    """Translate INPUT, run it on LAMMPS and write the results in the input's own format.
-
-    \b
-    Examples:
-      fibrelmp run examples/fibre_network/input.txt
-      fibrelmp run examples/musen/single_particle_job.txt
-      fibrelmp run scene.txt --end-time 0.1 --step 1e-6 --save-step 1e-3 -o result.txt
-      fibrelmp run examples/demdf/head_on.json --time-end 2
-
-    Results are never overwritten silently: an existing result needs --force.  The output
-    and work folders are locked while the run writes them.
-    """
     import time
 
-    from .python_api import run as run_any
+    from fibrelmp.python_api import run as run_any
 
     _set_flags(quiet, verbose)
     start = time.monotonic()
@@ -361,41 +290,41 @@ def run(input: Path = typer.Argument(..., help="FibreNet input, MUSEN text scene
     _say(f"done in {time.monotonic() - start:.1f} s (LAMMPS job: {script})")
 
 
-@app.command("post")
+@app.command("post", help=f"""Convert an existing dump into another code's files ({", ".join(
+    f"{f.name}: {f.title}" for f in formats(TARGET))}).
+
+Outputs are written only when the whole conversion succeeded; existing ones are kept unless
+--force is given.
+
+\b
+Examples:
+  fibrelmp post dump.lammpstrj --info
+""" + "\n".join(f"  fibrelmp post dump.lammpstrj --to {name} -o out/run" for name in names(TARGET)) + """
+  fibrelmp post frames.dump.gz --to NAME -o out/run --frames 0:100:10 --types 1
+  fibrelmp post traj.dcd --topology top.pdb --to NAME -o final
+""")
 @_guard
 def post(dump: Path = typer.Argument(..., help="LAMMPS text dump (.gz too), or any MDAnalysis trajectory.",
                                      readable=False),
-         to: Optional[str] = typer.Option(None, "--to", help="xyz, res, mercury, vtk, musen or demdf."),
+         to: Optional[str] = typer.Option(None, "--to", help=f"One of: {', '.join(names(TARGET))}.",
+                                          autocompletion=lambda: names(TARGET)),
          out: Optional[Path] = typer.Option(None, "-o", "--out", help="Output base name (folder/name)."),
          info: bool = typer.Option(False, "--info", help="Describe the dump (frames, atoms, columns, box)."),
          frames: Optional[str] = typer.Option(None, "--frames", help="Frames to convert: i, start:stop:step, "
-                                              "or a comma list (default all; res: the last)."),
+                                              "or a comma list (default all; single-frame targets: the last)."),
          types: Optional[list[str]] = typer.Option(None, "--types", help="Only these atom types (numbers "
                                                    "or names; repeat or comma-separate)."),
          data: Optional[Path] = typer.Option(None, "--data", help="LAMMPS data file: type names, radii, "
                                              "masses, bonds the dump lacks."),
          local: Optional[Path] = typer.Option(None, "--local", help="dump local file with per-contact data "
-                                              "(mercury .fstat and elastic energy)."),
+                                              "(for targets that write contacts)."),
          gravity: Optional[tuple[float, float, float]] = typer.Option(None, "--gravity", help="gx gy gz for "
                                                                       "the gravitational energy."),
          force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
          topology: Optional[Path] = typer.Option(None, "--topology", help="Topology for MDAnalysis "
                                                  "trajectory formats."),
          quiet: bool = _QUIET, verbose: bool = _VERBOSE) -> None:
-    """Convert an existing dump into FibreNet, MercuryDPM, ParaView, MUSEN or DEMDF files.
-
-    Outputs are written only when the whole conversion succeeded; existing ones are kept
-    unless --force is given.
-
-    \b
-    Examples:
-      fibrelmp post dump.lammpstrj --info
-      fibrelmp post dump.lammpstrj --to vtk -o run --data data.lammps
-      fibrelmp post frames.dump.gz --to xyz -o out/fibres --frames 0:100:10 --types F1
-      fibrelmp post atoms.dump --to mercury -o run --local contacts.dump --gravity 0 0 -9.81
-      fibrelmp post traj.dcd --topology top.pdb --to res -o final
-    """
-    from .post.cli_post import post_command
+    from fibrelmp.post.cli_post import post_command
 
     _set_flags(quiet, verbose)
     written = post_command(dump, to, out, info, frames, types, data, local, gravity, force, topology,

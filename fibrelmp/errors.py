@@ -63,3 +63,19 @@ class RunError(Exception):
 
     def __str__(self) -> str:
         return visible(super().__str__(), keep_newlines=True)
+
+
+class InputErrors(InputError):
+    """Several input errors of one check (``fibrelmp check`` lists them all); the first is
+    the one ``path``/``line``/``message`` describe."""
+
+    def __init__(self, errors: list[InputError], at_limit: bool = False):
+        self.errors = list(errors)
+        self.at_limit = at_limit
+        first = self.errors[0]
+        super().__init__(first.path, first.line, first.message)
+
+    def __str__(self) -> str:
+        more = " (the limit: fix these and check again)" if self.at_limit else ""
+        return ("\nerror: ".join(InputError.__str__(e) for e in self.errors)
+                + f"\n{len(self.errors)} errors{more}")

@@ -12,11 +12,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable
 
-from .errors import InputError
-from .granmodel import GranularModel
+from fibrelmp.errors import InputError
+from fibrelmp.granmodel import GranularModel
 
 if TYPE_CHECKING:
-    from .outputs import Outputs
+    from fibrelmp.outputs import Outputs
 
 
 @dataclass
@@ -27,7 +27,7 @@ class GranularResult:
 
 
 def _is_rank0() -> bool:
-    from .runner import mpi_rank_size
+    from fibrelmp.runner import mpi_rank_size
 
     return mpi_rank_size()[0] == 0
 
@@ -44,7 +44,7 @@ def simulate(model: GranularModel, work: Path, sinks: list, progress: bool = Tru
              checkpoints: Checkpoints = Checkpoints()):
     """Run ``model`` and feed every saved frame to each sink's ``add``; sinks are closed on
     success and aborted (temp files removed) on any failure."""
-    from .granular_run import run_granular
+    from fibrelmp.granular_run import run_granular
 
     def on_frame(frame) -> None:
         for sink in sinks:
@@ -74,7 +74,7 @@ def demdf_outputs(model: GranularModel, out: str | Path | None = None,
     a ``filename`` that leaves that folder is refused."""
     import re
 
-    from .outputs import Outputs
+    from fibrelmp.outputs import Outputs
 
     info = model.passthrough["demdf"]
     folder = (Path(out) if out is not None else Path(model.source).parent).resolve()
@@ -95,9 +95,9 @@ def run_demdf(path: str | Path, out: str | Path | None = None, work: str | Path 
               checkpoints: Checkpoints = Checkpoints(), force: bool = False) -> GranularResult:
     """DEMDF: snapshots ``<filename>_<saveCount>.json`` next to the input (or in ``out``);
     earlier snapshots of the same name are replaced, all of them, only with ``force``."""
-    from .outputs import finish, locked
-    from .post.demdf_out import DemdfSnapshotWriter
-    from .translate import demdf
+    from fibrelmp.outputs import finish, locked
+    from fibrelmp.translate.demdf.writer import DemdfSnapshotWriter
+    from fibrelmp.translate.demdf import reader as demdf
 
     model = demdf.read(path, time_end=time_end, steps=steps, save_every=save_every)
     if warn is not None:
@@ -137,8 +137,8 @@ def run_musen_scene(model: GranularModel, result: str | Path, work: str | Path |
                     progress: bool = True, precision: int = 6,
                     checkpoints: Checkpoints = Checkpoints(), force: bool = False) -> GranularResult:
     """Simulate a MUSEN scene whose plan (step, end, saves) is already set."""
-    from .outputs import Outputs, finish, locked
-    from .post.musen_out import MusenResultWriter
+    from fibrelmp.outputs import Outputs, finish, locked
+    from fibrelmp.translate.musen.writer import MusenResultWriter
 
     check_musen_runnable(model)
     target, note = musen_result_path(result)
@@ -178,10 +178,10 @@ def read_granular(path: str | Path, kind: str, end_time: float | None = None,
                   steps: int | None = None) -> tuple[GranularModel, list[str]]:
     """Read a MUSEN scene or DEMDF file and apply command-line overrides."""
     if kind == "demdf":
-        from .translate import demdf
+        from fibrelmp.translate.demdf import reader as demdf
 
         return demdf.read(path, time_end=end_time, steps=steps, save_every=save_step), []
-    from .translate import musen
+    from fibrelmp.translate.musen import scene as musen
 
     if steps is not None:
         raise InputError(path, None, "--steps is for DEMDF inputs; a MUSEN scene takes --end-time")
@@ -195,7 +195,7 @@ def bare_scene_settings(model: GranularModel, end_time: float | None, step: floa
     Hertz-Mindlin particle-particle and particle-wall, elastic solid bonds (breakage on),
     gravity (0, 0, -9.81); step, saving step and end time from the command line (MUSEN's
     defaults 1e-6 s, 1e-3 s and 1 s, with a warning, when not given)."""
-    from .translate.musen_script import (MUSEN_DEFAULTS, SUPPORTED_MODELS, MusenJob,
+    from fibrelmp.translate.musen.script import (MUSEN_DEFAULTS, SUPPORTED_MODELS, MusenJob,
                                          MusenModelSpec, apply_simulator_settings)
 
     for name, value in (("end-time", end_time), ("step", step), ("save-step", save_step)):
@@ -227,7 +227,7 @@ def _initial_frame(model: GranularModel):
     """The model's start state as a frame (exporting a scene that was never simulated)."""
     import numpy as np
 
-    from .granmodel import GranularFrame
+    from fibrelmp.granmodel import GranularFrame
 
     s = model.spheres
     t = model.plan.t_start
@@ -271,7 +271,7 @@ def _script_model(job, handles: dict, path_of) -> GranularModel:
 
 def _read_scene(source: Path, job, key: str) -> GranularModel:
     """A text scene named by a script line: a missing file is reported at that line."""
-    from .translate import musen
+    from fibrelmp.translate.musen import scene as musen
 
     if not source.exists():
         raise InputError(job.path, job.where(key), f"{key} {source}: file not found")
@@ -330,9 +330,9 @@ def plan_musen_script(path: str | Path, out: str | Path | None = None) -> Script
 
     Results go where RESULT_FILE says (relative to the script), or with ``out`` into that
     folder under their relative RESULT_FILE names (an absolute or ``..`` name is refused)."""
-    from .textio import patched_reading
-    from .translate.granular_job import build_granular_job
-    from .translate.musen_script import apply_simulator_settings, read_script
+    from fibrelmp.textio import patched_reading
+    from fibrelmp.translate.granular_job import build_granular_job
+    from fibrelmp.translate.musen.script import apply_simulator_settings, read_script
 
     script = Path(path).resolve()
     jobs = read_script(Path(path))          # messages name the script as the user did
@@ -418,9 +418,9 @@ def run_musen_script(path: str | Path, work: str | Path | None = None, progress:
     keeps the scene in memory, SIMULATOR keeps its frames in an on-disk spool, and
     EXPORT_TO_TEXT writes them as MUSEN text.  A SIMULATOR result nobody exports is written as
     text next to its ``.mdem`` name (said as a note)."""
-    from .outputs import Outputs, finish, locked
-    from .post.frame_spool import FrameSpool
-    from .post.musen_out import MusenResultWriter
+    from fibrelmp.outputs import Outputs, finish, locked
+    from fibrelmp.frame_spool import FrameSpool
+    from fibrelmp.translate.musen.writer import MusenResultWriter
 
     say = say or (lambda text: None)
     plan = plan_musen_script(path, out)

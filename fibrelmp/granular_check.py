@@ -3,8 +3,8 @@ the time-step check lives in ``sanity``."""
 
 from __future__ import annotations
 
-from .granmodel import GranularModel
-from .sanity import contact_check, units_line
+from fibrelmp.granmodel import GranularModel
+from fibrelmp.sanity import contact_check, units_line
 
 
 def summary(model: GranularModel) -> list[str]:
@@ -19,7 +19,7 @@ def summary(model: GranularModel) -> list[str]:
     if model.planes:
         lines.append(f"wall planes  {len(model.planes)}")
     try:
-        from .translate.granular_job import describe_walls
+        from fibrelmp.translate.granular_job import describe_walls
 
         for text in describe_walls(model):
             lines.append(f"wall         {text}")

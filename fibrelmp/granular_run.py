@@ -18,13 +18,13 @@ from typing import Callable, Iterator
 
 import numpy as np
 
-from .errors import InputError, RunError
-from .granmodel import GranularFrame, GranularModel
-from .post.lammps_dump import iter_frames
-from ._lammps import mpi_barrier
-from .runner import mpi_rank_size, run_script
-from .translate.granular_job import GranularJob, build_granular_job, write_granular_job
-from .translate.granular_walls import nearest_triangle
+from fibrelmp.errors import InputError, RunError
+from fibrelmp.granmodel import GranularFrame, GranularModel
+from fibrelmp.post.lammps_dump.reader import iter_frames
+from fibrelmp._lammps import mpi_barrier
+from fibrelmp.runner import mpi_rank_size, run_script
+from fibrelmp.translate.granular_job import GranularJob, build_granular_job, write_granular_job
+from fibrelmp.translate.granular_walls import nearest_triangle
 
 
 def quat_multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -273,7 +273,7 @@ def run_granular(model: GranularModel, work: str | Path,
     (rank 0 only), in time order, as soon as LAMMPS has written it.  ``checkpoint_every`` /
     ``resume``: see fibrelmp.checkpoint (a resumed run feeds the frames saved before the
     checkpoint to ``on_frame`` again, from the dumps, so writers see every frame once)."""
-    from .api import prepare_checkpoints
+    from fibrelmp.api import prepare_checkpoints
 
     work = Path(work).resolve()
     rank, size = mpi_rank_size()
@@ -321,7 +321,7 @@ def run_granular(model: GranularModel, work: str | Path,
 
 def _run_threaded(job, builder, steps, on_frame, progress, checkpoints=None) -> None:
     """Convert frames on a second thread while LAMMPS computes the next ones."""
-    from .runner import run_overlapped
+    from fibrelmp.runner import run_overlapped
 
     def consume(tokens) -> None:
         for step in tokens:

@@ -30,7 +30,7 @@ import string
 from os import PathLike
 from pathlib import Path
 
-from .errors import InputError, RunError
+from fibrelmp.errors import InputError, RunError
 
 # printable ASCII LAMMPS gives no meaning inside a comment or title; everything else is
 # replaced: quotes by a backquote, whitespace (every line separator) by a space, the rest

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Iterator
 
-from .errors import InputError
+from fibrelmp.errors import InputError
 
 
 # what a run writes into its work folder (translate.lammps_job / granular_job, checkpoint)

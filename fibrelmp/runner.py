@@ -19,12 +19,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable, Iterator
 
-from ._lammps import new_lammps
-from .errors import RunError
-from .lammps_text import input_lines, read_script
+from fibrelmp._lammps import new_lammps
+from fibrelmp.errors import RunError
+from fibrelmp.lammps_text import input_lines, read_script
 
 if TYPE_CHECKING:
-    from .checkpoint import Checkpointing  # noqa: F401
+    from fibrelmp.checkpoint import Checkpointing  # noqa: F401
 
 
 def mpi_rank_size() -> tuple[int, int]:
@@ -134,7 +134,7 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
     a resumed run skips: their frames are in the dump already).  ``checkpoints`` enables
     checkpoints and resuming (see fibrelmp.checkpoint).
     """
-    from .checkpoint import ACTIONS, CheckpointStop
+    from fibrelmp.checkpoint import ACTIONS, CheckpointStop
 
     script = Path(script)
     rank, size = mpi_rank_size()
@@ -161,7 +161,7 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
         if size > 1:
             # rank 0 wrote the job files before it got here; LAMMPS's read_data checks the
             # data file on every rank, so no rank may decide where to run before that
-            from ._lammps import mpi_barrier
+            from fibrelmp._lammps import mpi_barrier
             mpi_barrier()
         try:
             os.chdir(script.parent)

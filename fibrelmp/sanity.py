@@ -15,9 +15,9 @@ import math
 
 import numpy as np
 
-from .granmodel import GranularModel
-from .model import Model
-from .units import system
+from fibrelmp.granmodel import GranularModel
+from fibrelmp.model import Model
+from fibrelmp.units import system
 
 STEP_FRACTION = 0.1
 # 2 * integral_0^1 dx / sqrt(1 - x^(5/2)): the duration of an elastic Hertz impact in units of

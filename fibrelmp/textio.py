@@ -11,7 +11,7 @@ from typing import Callable
 
 import numpy as np
 
-from .errors import InputError, RunError
+from fibrelmp.errors import InputError, RunError
 
 
 # In-memory replacements of files, keyed by absolute path: ``collect_errors`` re-reads an

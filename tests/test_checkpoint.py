@@ -18,8 +18,8 @@ import time
 
 import numpy as np
 
-from fibrelmp.post.fibrenet_out import read_xyz
-from fibrelmp.post.lammps_dump import iter_frames
+from fibrelmp.translate.fibrenet.writer import read_xyz
+from fibrelmp.post.lammps_dump.reader import iter_frames
 
 from .conftest import REPO
 
@@ -79,7 +79,7 @@ def test_musen_script_sigterm_then_resume(tmp_path):
     """The same for a cmusen script (agglomerate, 2,000 steps): the resumed result has every
     saved time once and agrees with the uninterrupted one to the 6-digit export (positions),
     within 1e-4 m/s in velocity (the damped contacts restart with full-step velocities)."""
-    from fibrelmp.translate.musen import read_time_points
+    from fibrelmp.translate.musen.scene import read_time_points
 
     src = REPO / "examples" / "musen"
     job = (src / "agglomerate_short_job.txt").read_text()

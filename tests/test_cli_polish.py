@@ -15,7 +15,8 @@ from typer.testing import CliRunner
 
 from fibrelmp import sanity, units
 from fibrelmp.cli import app
-from fibrelmp.translate import demdf_contact, fibrenet
+from fibrelmp.translate.demdf import contact as demdf_contact
+from fibrelmp.translate.fibrenet import reader as fibrenet
 
 REPO = Path(__file__).resolve().parents[1]
 CORPUS = REPO / "tests" / "bad_inputs"
@@ -246,7 +247,8 @@ def test_templates_run_each_format_in_the_units_module_style():
 
 def test_readers_take_their_unit_system_from_units():
     assert fibrenet.read(CORPUS / "fibrenet" / "good.txt").units == units.LJ.name
-    from fibrelmp.translate import demdf, musen
+    from fibrelmp.translate.demdf import reader as demdf
+    from fibrelmp.translate.musen import scene as musen
 
     assert musen.read(CORPUS / "musen" / "good.txt").units == units.SI.name
     assert demdf.read(CORPUS / "demdf" / "good.json").units == units.DIMENSIONLESS.name

@@ -12,7 +12,7 @@ from typer.testing import CliRunner
 
 from fibrelmp.cli import app
 from fibrelmp.errors import InputError
-from fibrelmp.translate import demdf
+from fibrelmp.translate.demdf import reader as demdf
 
 GOOD = {
     "fileFormat": "demdf", "fileFormatVersion": 0.01, "dimensionality": 3, "time": 0.0,

@@ -15,8 +15,8 @@ import pytest
 
 from fibrelmp.errors import InputError
 from fibrelmp.granmodel import GranularFrame
-from fibrelmp.post.demdf_out import DemdfSnapshotWriter
-from fibrelmp.translate import demdf
+from fibrelmp.translate.demdf.writer import DemdfSnapshotWriter
+from fibrelmp.translate.demdf import reader as demdf
 
 from .conftest import shared_path
 

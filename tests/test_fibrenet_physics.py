@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from fibrelmp import api
-from fibrelmp.post.lammps_dump import iter_frames
+from fibrelmp.post.lammps_dump.reader import iter_frames
 
 from . import fibrenet_reference as ref
 

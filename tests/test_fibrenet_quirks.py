@@ -3,7 +3,7 @@
 import numpy as np
 
 from fibrelmp import api
-from fibrelmp.post.fibrenet_out import read_xyz
+from fibrelmp.translate.fibrenet.writer import read_xyz
 
 from .test_fibrenet_bad_input import INPUT, MODEL, write_case
 

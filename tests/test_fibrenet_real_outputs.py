@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from fibrelmp import api
-from fibrelmp.post.fibrenet_out import XYZ_SUFFIX, read_restart, read_xyz
+from fibrelmp.translate.fibrenet.writer import XYZ_SUFFIX, read_restart, read_xyz
 
 from .conftest import data_path
 

@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 from fibrelmp import api
-from fibrelmp.post.fibrenet_out import read_xyz
-from fibrelmp.post.lammps_dump import iter_frames
+from fibrelmp.translate.fibrenet.writer import read_xyz
+from fibrelmp.post.lammps_dump.reader import iter_frames
 
 from . import fibrenet_reference as ref
 

@@ -16,7 +16,7 @@ import pytest
 
 from fibrelmp.errors import InputError
 from fibrelmp.granmodel import ContactLaw, hertz_effective
-from fibrelmp.post.lammps_dump import iter_frames
+from fibrelmp.post.lammps_dump.reader import iter_frames
 from fibrelmp.translate.granular_job import describe_walls
 from fibrelmp.translate.granular_walls import (detect_box, detect_cylinder, detect_oriented_box,
                                                geometry_kinematics,

@@ -22,10 +22,12 @@ from hypothesis import strategies as st
 
 from fibrelmp.errors import InputError
 from fibrelmp.post.cli_post import Completer
-from fibrelmp.post.lammps_dump import iter_frames
+from fibrelmp.post.lammps_dump.reader import iter_frames
 from fibrelmp.textio import collect_errors
-from fibrelmp.translate import demdf, fibrenet, musen
-from fibrelmp.translate import musen_script as ms
+from fibrelmp.translate.demdf import reader as demdf
+from fibrelmp.translate.fibrenet import reader as fibrenet
+from fibrelmp.translate.musen import scene as musen
+from fibrelmp.translate.musen import script as ms
 
 PROFILE = settings(max_examples=int(os.environ.get("FIBRELMP_HYPOTHESIS_EXAMPLES", "300")),
                    deadline=None, database=None,

@@ -24,10 +24,12 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from fibrelmp.granmodel import GranularFrame
-from fibrelmp.post.demdf_out import DemdfSnapshotWriter
-from fibrelmp.post.lammps_dump import iter_frames
-from fibrelmp.post.musen_out import MusenResultWriter
-from fibrelmp.translate import demdf, fibrenet, musen
+from fibrelmp.translate.demdf.writer import DemdfSnapshotWriter
+from fibrelmp.post.lammps_dump.reader import iter_frames
+from fibrelmp.translate.musen.writer import MusenResultWriter
+from fibrelmp.translate.demdf import reader as demdf
+from fibrelmp.translate.fibrenet import reader as fibrenet
+from fibrelmp.translate.musen import scene as musen
 
 PROFILE = settings(max_examples=int(os.environ.get("FIBRELMP_HYPOTHESIS_EXAMPLES", "100")),
                    deadline=None, database=None,

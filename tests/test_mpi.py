@@ -116,8 +116,8 @@ def fibrenet_runs(tmp_path_factory):
 
 
 def test_fibrenet_mpi_matches_serial(fibrenet_runs):
-    from fibrelmp.post.fibrenet_out import read_restart, read_xyz
-    from fibrelmp.post.lammps_dump import iter_frames
+    from fibrelmp.translate.fibrenet.writer import read_restart, read_xyz
+    from fibrelmp.post.lammps_dump.reader import iter_frames
 
     assert_ran(fibrenet_runs)
     assert_same_files(fibrenet_runs)
@@ -155,7 +155,7 @@ def test_outputs_complete_when_conversion_outlasts_lammps(tmp_path):
     names = sorted(p.name for p in net.iterdir())
     assert names == ["input.txt", "model.txt", "network_coord.xyz", "network_force.xyz",
                      "network_restart.res", "network_vel.xyz", "network_work"], names
-    from fibrelmp.post.fibrenet_out import read_xyz
+    from fibrelmp.translate.fibrenet.writer import read_xyz
 
     frames = read_xyz(net / "network_force.xyz")
     assert [f.step for f in frames] == list(range(0, 101, 10))

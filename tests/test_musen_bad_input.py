@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from fibrelmp.errors import InputError
-from fibrelmp.translate import musen
-from fibrelmp.translate import musen_script as ms
+from fibrelmp.translate.musen import scene as musen
+from fibrelmp.translate.musen import script as ms
 
 BASE = """\
 0 0 1 14 5  23 STEEL 24 0 1e+300 2 0 44 0 0 0 1 0 0 0 1 0 15 0 0 0

@@ -9,7 +9,7 @@ import sys
 import numpy as np
 import pytest
 
-from fibrelmp.translate.musen import read, read_time_points
+from fibrelmp.translate.musen.scene import read, read_time_points
 
 from .conftest import REPO
 

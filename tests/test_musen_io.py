@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from fibrelmp.granmodel import GranularFrame
-from fibrelmp.post.musen_out import MusenResultWriter
-from fibrelmp.translate import musen
-from fibrelmp.translate import musen_script as ms
+from fibrelmp.translate.musen.writer import MusenResultWriter
+from fibrelmp.translate.musen import scene as musen
+from fibrelmp.translate.musen import script as ms
 
 from .conftest import REPO, data_path
 

@@ -25,7 +25,7 @@ import sys
 import numpy as np
 import pytest
 
-from fibrelmp.translate.musen import read_time_points
+from fibrelmp.translate.musen.scene import read_time_points
 
 from .conftest import data_path
 
@@ -98,7 +98,7 @@ def test_final_state_at_full_precision(agglomerate_run):
 
 
 def test_broken_bond_count(agglomerate_run):
-    from fibrelmp.translate.musen import read
+    from fibrelmp.translate.musen.scene import read
 
     for name in ("real_agglo_result.txt", "agglo_result.txt"):
         model = read(agglomerate_run / name)
@@ -120,7 +120,7 @@ def test_scene_domain_removes_what_musen_removed(tmp_path):
                           capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     assert "5695 of 5696 active spheres lie outside the simulation domain" in done.stderr
-    from fibrelmp.translate.musen import read
+    from fibrelmp.translate.musen.scene import read
 
     model = read(tmp_path / "agglo_domaintest.txt")
     removed = model.spheres.active_end == 0

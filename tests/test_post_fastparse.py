@@ -1,4 +1,4 @@
-"""The optional C parser/formatter (fibrelmp.post.fastparse) against numpy / printf."""
+"""The optional C parser/formatter (fibrelmp.numtext.fast) against numpy / printf."""
 
 from __future__ import annotations
 
@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from fibrelmp.errors import InputError
-from fibrelmp.post import fastparse
-from fibrelmp.post.fibrenet_out import xyz_frame_bytes
-from fibrelmp.post.lammps_dump import Header, parse_block
+from fibrelmp.numtext import fast as fastparse
+from fibrelmp.translate.fibrenet.writer import xyz_frame_bytes
+from fibrelmp.post.lammps_dump.reader import Header, parse_block
 
 needs_c = pytest.mark.skipif(fastparse.library() is None, reason="no C compiler: fast path unavailable")
 

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from fibrelmp.errors import InputError
-from fibrelmp.translate.demdf import read_snapshot
-from fibrelmp.translate.musen import read, read_time_points
+from fibrelmp.translate.demdf.reader import read_snapshot
+from fibrelmp.translate.musen.scene import read, read_time_points
 
 from .test_post_roundtrip import dump_frames, granular, post  # noqa: F401  (fixture)
 

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from fibrelmp.errors import InputError
-from fibrelmp.post.fibrenet_out import read_xyz
-from fibrelmp.post.lammps_dump import iter_frames
+from fibrelmp.translate.fibrenet.writer import read_xyz
+from fibrelmp.post.lammps_dump.reader import iter_frames
 
 from .test_post_roundtrip import post
 
@@ -232,7 +232,7 @@ def test_type_labels_in_the_dump(tmp_path):
 @pytest.mark.parametrize("chunk", [7, 64, 1000])
 def test_small_read_chunks_give_the_same_frames(tmp_path, monkeypatch, chunk):
     """Frames spanning many read chunks (and buffer compaction) parse as with one read."""
-    from fibrelmp.post import lammps_dump
+    from fibrelmp.post.lammps_dump import reader as lammps_dump
 
     rng = np.random.default_rng(chunk)
     text = "".join(frame(s, [(k + 1, 1 + k % 2, *rng.random(3).round(6)) for k in range(n)], time=s / 10)

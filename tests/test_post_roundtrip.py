@@ -15,10 +15,10 @@ import pytest
 
 from fibrelmp.errors import InputError
 from fibrelmp.post.cli_post import post_command
-from fibrelmp.post.fibrenet_out import read_restart, read_xyz
-from fibrelmp.post.lammps_dump import iter_frames
-from fibrelmp.post.mercury import ENE_HEADER, read_data_file, read_ene, read_fstat
-from fibrelmp.post.vtk import read_pvd, read_vtu
+from fibrelmp.translate.fibrenet.writer import read_restart, read_xyz
+from fibrelmp.post.lammps_dump.reader import iter_frames
+from fibrelmp.post.mercury.writer import ENE_HEADER, read_data_file, read_ene, read_fstat
+from fibrelmp.post.vtk.writer import read_pvd, read_vtu
 
 GRANULAR = """
 units si
@@ -245,7 +245,7 @@ def test_mercury_2d_layout(granular2d, tmp_path):
 # -- VTK -------------------------------------------------------------------------------------------
 @pytest.mark.parametrize("ascii_", [False, True])
 def test_vtk_round_trip(granular, tmp_path, ascii_):
-    from fibrelmp.post.vtk import VtkWriter
+    from fibrelmp.post.vtk.writer import VtkWriter
 
     frames = dump_frames(granular / "atoms.dump")
     if ascii_:

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fibrelmp.post.fibrenet_out import _rows, xyz_frame, xyz_frame_bytes
-from fibrelmp.post.textfmt import fixed_chars
+from fibrelmp.translate.fibrenet.writer import _rows, xyz_frame, xyz_frame_bytes
+from fibrelmp.numtext.printf import fixed_chars
 
 EDGES = [0.0, -0.0, 0.015625, -0.015625, 5e-6, -5e-6, 1.5e-5, 2.5e-5, 1e-6, -1e-6, 1000.000005,
          99999.999995, 0.000015, 123.456785, -7.5e-6, 0.5, 2.5, 1e10, -1e10 + 0.5, 12345678.123455,

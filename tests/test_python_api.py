@@ -34,7 +34,7 @@ def test_documented_example_runs(tmp_path):
 
 def test_run_returns_frames_raises_and_restores_signals(tmp_path):
     import fibrelmp
-    from fibrelmp.post.fibrenet_out import read_xyz
+    from fibrelmp.translate.fibrenet.writer import read_xyz
 
     before = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
     result = fibrelmp.run(REPO / "examples" / "fibre_network" / "input.txt", out=tmp_path)

@@ -274,7 +274,8 @@ def test_rendered_fibrenet_job_with_hostile_names_is_safe(tmp_path):
 def test_rendered_granular_job_with_hostile_names_is_safe(tmp_path, monkeypatch):
     """MUSEN scene with every name hostile; the plate is forced onto wall particles so the
     wall-particle type names are rendered too."""
-    from fibrelmp.translate import granular_job, musen
+    from fibrelmp.translate import granular_job
+    from fibrelmp.translate.musen import scene as musen
     from fibrelmp.granular_api import bare_scene_settings
 
     scene = _musen_scene(tmp_path, "scene.txt")

@@ -17,7 +17,7 @@ import pytest
 from fibrelmp import api
 from fibrelmp.errors import InputError, RunError
 from fibrelmp.post import to_fibrenet
-from fibrelmp.post.lammps_dump import Frame, iter_frames
+from fibrelmp.post.lammps_dump.reader import Frame, iter_frames
 from fibrelmp.post.to_fibrenet import write_fibrenet
 from fibrelmp.translate import granular_job as gj
 from fibrelmp.translate.granular_walls import tile_triangles, tile_triangles_within
@@ -227,7 +227,7 @@ def _demdf_doc(tmp_path, far: float, domain_hi: float):
 def test_demdf_huge_domain_and_coordinates(tmp_path):
     """A 1e300 domain with a particle at x = 1e200 used to end in a traceback (cKDTree:
     "Encountering floating point overflow"); now it reads and runs."""
-    from fibrelmp.translate import demdf
+    from fibrelmp.translate.demdf import reader as demdf
 
     path = _demdf_doc(tmp_path, 1e200, 1e300)
     model = demdf.read(path)
@@ -237,7 +237,7 @@ def test_demdf_huge_domain_and_coordinates(tmp_path):
 
 
 def test_demdf_huge_domain_normal_particles_run(tmp_path):
-    from fibrelmp.translate import demdf
+    from fibrelmp.translate.demdf import reader as demdf
 
     job, frames = run(demdf.read(_demdf_doc(tmp_path, 3.0, 1e300)), tmp_path)
     assert "boundary        m m m" in job.script.read_text()

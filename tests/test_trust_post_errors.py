@@ -17,8 +17,8 @@ from typer.testing import CliRunner
 from fibrelmp import textio
 from fibrelmp.cli import app
 from fibrelmp.errors import InputError, RunError
-from fibrelmp.post.fibrenet_out import XyzWriter, read_xyz
-from fibrelmp.post.lammps_dump import iter_frames, iter_headers
+from fibrelmp.translate.fibrenet.writer import XyzWriter, read_xyz
+from fibrelmp.post.lammps_dump.reader import iter_frames, iter_headers
 
 from .test_post_robust import ROWS, frame, write
 
@@ -275,7 +275,7 @@ def test_post_on_a_full_disk_names_the_output_and_leaves_nothing(tmp_path, full_
 
 def test_musen_result_writer_on_a_full_disk(tmp_path, monkeypatch):
     """The writer ``fibrelmp run`` uses: the temp file and the spool are removed."""
-    from fibrelmp.post import musen_out
+    from fibrelmp.translate.musen import writer as musen_out
 
     from .test_post_roundtrip import post
 

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from fibrelmp.post.fibrenet_out import read_xyz
+from fibrelmp.translate.fibrenet.writer import read_xyz
 
 from .conftest import REPO
 
@@ -407,7 +407,7 @@ def test_mpi_rank0_write_failure_always_prints(tmp_path):
     (hook / "sitecustomize.py").write_text(
         "import errno, os\n"
         "if os.environ.get('PMI_RANK') == '0':\n"
-        "    from fibrelmp.post import fibrenet_out\n"
+        "    from fibrelmp.translate.fibrenet import writer as fibrenet_out\n"
         "    def close(self):\n"
         "        self.abort()\n"
         "        raise OSError(errno.ENOSPC, 'No space left on device', str(self.path))\n"

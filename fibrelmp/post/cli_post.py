@@ -15,9 +15,9 @@ from typing import Callable, Iterator
 
 import numpy as np
 
-from ..errors import InputError, RunError
-from ..textio import write_failure
-from .lammps_dump import Frame, frame_from, iter_frames, iter_headers
+from fibrelmp.errors import InputError, RunError
+from fibrelmp.textio import write_failure
+from fibrelmp.post.lammps_dump.reader import Frame, frame_from, iter_frames, iter_headers
 
 FORMATS = ("xyz", "res", "mercury", "vtk", "musen", "demdf")
 
@@ -115,7 +115,7 @@ class Source:
         if self.native:
             # warnings come from the conversion pass itself; this pass only counts
             return sum(1 for _ in iter_headers(self.path, [], want=lambda i, h: False))
-        from .mda_bridge import open_universe
+        from fibrelmp.post.mdanalysis.reader import open_universe
         return len(open_universe(self.path, self.topology).trajectory)
 
     def frames(self, sel: Selection, last_only: bool = False) -> Iterator[Frame]:
@@ -123,7 +123,7 @@ class Source:
         want = sel.resolve(total)
         stop = sel.stop
         if not self.native:
-            from .mda_bridge import iter_mda_frames
+            from fibrelmp.post.mdanalysis.reader import iter_mda_frames
             it = iter_mda_frames(self.path, self.topology, self.type_names,
                                  want=lambda i, ts: want(i) if not last_only else True)
             if last_only:
@@ -195,7 +195,7 @@ class Completer:
         n = frame.count
         data = self.data
         if self.target_units is not None and frame.units is not None:
-            from ..units import mismatch_note
+            from fibrelmp.units import mismatch_note
 
             note = mismatch_note(frame.units, self.target_units[1], self.target_units[0])
             if note is not None:
@@ -283,10 +283,10 @@ def _outputs(to: str, out: Path, dump: Path) -> tuple[Path, list[Path]]:
     """(base path, files the conversion will write) for ``-o``."""
     base = out / dump.name.split(".")[0] if out.is_dir() else out
     if to == "xyz":
-        from .fibrenet_out import XYZ_SUFFIX
+        from fibrelmp.translate.fibrenet.writer import XYZ_SUFFIX
         files = [base.with_name(base.name + s) for s in XYZ_SUFFIX.values()]
     elif to == "res":
-        from .fibrenet_out import RESTART_SUFFIX
+        from fibrelmp.translate.fibrenet.writer import RESTART_SUFFIX
         files = [base.with_name(base.name + RESTART_SUFFIX)]
     elif to == "mercury":
         files = [base.with_name(base.name + s) for s in (".data", ".ene", ".fstat")]
@@ -363,7 +363,7 @@ def _report(warnings: list[tuple[str, str]], say) -> None:
 def _post(dump, to, out, info, frames, types, data, local, gravity, force, topology, say, warnings):
     source = Source(dump, topology, warnings)
     if info:
-        from .dump_info import describe_dump, describe_universe
+        from fibrelmp.post.lammps_dump.info import describe_dump, describe_universe
         lines = describe_dump(dump, warnings) if source.native else describe_universe(dump, topology)
         for ln in lines:
             say(ln)
@@ -402,10 +402,10 @@ def _convert(dump, to, base, source, data, types, frames, local, gravity, warnin
     """The conversion proper, once the output folder exists; returns the files written."""
     datafile = None
     if data is not None:
-        from .data_file import read_data
+        from fibrelmp.post.lammps_data.reader import read_data
         datafile = read_data(data)
     names: dict[int, str] = dict(datafile.type_names) if datafile else {}
-    from ..units import LJ, SI
+    from fibrelmp.units import LJ, SI
 
     # FibreNet files hold LAMMPS reduced numbers, MUSEN files SI; the others have no units
     targets = {"xyz": ("FibreNet", LJ), "res": ("FibreNet", LJ), "musen": ("MUSEN", SI)}
@@ -440,7 +440,7 @@ def _convert(dump, to, base, source, data, types, frames, local, gravity, warnin
         if not written:
             raise InputError(dump, None, "no complete frame was selected; nothing written")
         if to == "vtk":
-            from .vtk import remove_stale
+            from fibrelmp.post.vtk.writer import remove_stale
             remove_stale(base)    # frames of an earlier conversion (exist only with --force)
         final = []
         for path in written:
@@ -483,7 +483,7 @@ class _Names(dict):
 
 
 def _to_fibrenet(stream, base, datafile, names, source, local, gravity, warn, warnings, restart: bool):
-    from .to_fibrenet import write_fibrenet
+    from fibrelmp.post.to_fibrenet import write_fibrenet
 
     first, stream = _peek(stream, 2)
     if not first:
@@ -517,7 +517,7 @@ def _to_res(*args):
 
 
 def _to_mercury(stream, base, datafile, names, source, local, gravity, warn, warnings):
-    from .mercury import MercuryWriter, iter_matching
+    from fibrelmp.post.mercury.writer import MercuryWriter, iter_matching
 
     g = np.zeros(3) if gravity is None else np.asarray(gravity, float)
     bonds = {tuple(map(int, b)) for b in datafile.bonds} if datafile is not None else None
@@ -550,7 +550,7 @@ def _to_mercury(stream, base, datafile, names, source, local, gravity, warn, war
 
 
 def _to_vtk(stream, base, datafile, names, source, local, gravity, warn, warnings):
-    from .vtk import VtkWriter
+    from fibrelmp.post.vtk.writer import VtkWriter
 
     writer = VtkWriter(base, datafile.bonds if datafile is not None else None)
     try:
@@ -567,7 +567,7 @@ def _to_vtk(stream, base, datafile, names, source, local, gravity, warn, warning
 def _to_granular(kind: str, stream, base, source, names, warn):
     """MUSEN result / DEMDF snapshots through the neutral granular model and the same
     writers ``fibrelmp run`` uses."""
-    from .to_granular import demdf_document, granular_frames, model_from_frame
+    from fibrelmp.post.to_granular import demdf_document, granular_frames, model_from_frame
 
     first, stream = _peek(stream, 2)
     if not first:
@@ -578,12 +578,12 @@ def _to_granular(kind: str, stream, base, source, names, warn):
                              times[0], dt)
     frames = granular_frames(((f, _time_of(f, warn)) for f in stream), model)
     if kind == "musen":
-        from .musen_out import MusenResultWriter
+        from fibrelmp.translate.musen.writer import MusenResultWriter
 
         writer = MusenResultWriter(model, base)
         done = lambda: [writer.close()]                          # noqa: E731
     else:
-        from .demdf_out import DemdfSnapshotWriter
+        from fibrelmp.translate.demdf.writer import DemdfSnapshotWriter
 
         s = model.spheres
         model.passthrough["demdf"] = {

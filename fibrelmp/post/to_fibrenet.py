@@ -8,8 +8,8 @@ from typing import Callable, Iterable, Sequence
 
 import numpy as np
 
-from .fibrenet_out import RESTART_SUFFIX, XYZ_SUFFIX, XyzWriter, write_restart
-from .lammps_dump import Frame
+from fibrelmp.translate.fibrenet.writer import RESTART_SUFFIX, XYZ_SUFFIX, XyzWriter, write_restart
+from fibrelmp.post.lammps_dump.reader import Frame
 
 # dump column names for the velocity FibreNet writes (v~) and its total force
 VEL_COLUMNS = ("v_fn_vx", "v_fn_vy", "v_fn_vz")

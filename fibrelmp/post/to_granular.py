@@ -15,9 +15,9 @@ from typing import Iterable, Iterator
 
 import numpy as np
 
-from ..errors import InputError
-from ..granmodel import GranularFrame, GranularModel, GranularPlan, Material, Spheres
-from .lammps_dump import Frame
+from fibrelmp.errors import InputError
+from fibrelmp.granmodel import GranularFrame, GranularModel, GranularPlan, Material, Spheres
+from fibrelmp.post.lammps_dump.reader import Frame
 
 
 def _vector(frame: Frame, names: tuple[str, str, str], n: int) -> np.ndarray:

@@ -13,17 +13,17 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
-from ..granmodel import ContactLaw, Geometry, GranularModel
-from ..lammps_text import LammpsText, comment_text, template_environment
-from ..sanity import close_pairs
-from ..textio import atomic_write
-from .granular_walls import (BoxShape, CylinderShape, Kinematics, detect_cylinder, detect_oriented_box,
+from fibrelmp.errors import InputError
+from fibrelmp.granmodel import ContactLaw, Geometry, GranularModel
+from fibrelmp.lammps_text import LammpsText, comment_text, template_environment
+from fibrelmp.sanity import close_pairs
+from fibrelmp.textio import atomic_write
+from fibrelmp.translate.granular_walls import (BoxShape, CylinderShape, Kinematics, detect_cylinder, detect_oriented_box,
                              geometry_kinematics, geometry_triangle_rows, particle_side,
                              piecewise_expression, tile_triangles, tile_triangles_within,
                              triangle_normals)
-from .lammps_job import _block, _fmt
-from .steps import SaveSteps
+from fibrelmp.translate.lammps_job import _block, _fmt
+from fibrelmp.translate.steps import SaveSteps
 
 SCRIPT_NAME = "in.lammps"
 DATA_NAME = "data.lammps"

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..granmodel import Geometry, GranularModel
+from fibrelmp.granmodel import Geometry, GranularModel
 
 AREA_RTOL = 1e-6
 

@@ -12,12 +12,12 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
-from ..fastfmt import rows_text
-from ..lammps_text import comment_text, template_environment
-from ..model import Model
-from ..textio import atomic_write, format_rows
-from .steps import SaveSteps
+from fibrelmp.errors import InputError
+from fibrelmp.numtext.shortest import rows_text
+from fibrelmp.lammps_text import comment_text, template_environment
+from fibrelmp.model import Model
+from fibrelmp.textio import atomic_write, format_rows
+from fibrelmp.translate.steps import SaveSteps
 
 SCRIPT_NAME = "in.lammps"
 DATA_NAME = "data.lammps"
@@ -285,7 +285,7 @@ def _bonds_alive_at_first_step(model: Model):
     FibreNet tests the stress before the first force; fix bond/break acts only after the
     first integration, so such springs are left out of the data file instead.
     """
-    from ..model import Bonds
+    from fibrelmp.model import Bonds
 
     b, p = model.bonds, model.particles
     breakable = np.isfinite(b.break_length)

@@ -45,7 +45,7 @@ class Case:
 
 
 # a UTF-8 BOM is fine (read_text drops it), but format detection matches the first line
-# before it is dropped; fixing it belongs to fibrelmp/formats.py
+# before it is dropped; fixing it belongs to fibrelmp/registry.py
 def _c(fmt: str, folder: str, rows: list[tuple], ext: str = ".txt") -> list[Case]:
     out = []
     for row in rows:

@@ -19,12 +19,12 @@ from typing import Any
 
 import numpy as np
 
-from ..granmodel import ContactLaw, GranularModel, Material, Plane, Spheres
-from ..sanity import close_pairs
-from ..units import DIMENSIONLESS
-from . import demdf_contact as hertz
-from .demdf_json import JsonDoc, describe, load_json
-from .demdf_plan import Output, PlanMixin
+from fibrelmp.granmodel import ContactLaw, GranularModel, Material, Plane, Spheres
+from fibrelmp.sanity import close_pairs
+from fibrelmp.units import DIMENSIONLESS
+from fibrelmp.translate.demdf import contact as hertz
+from fibrelmp.translate.demdf.json_doc import JsonDoc, describe, load_json
+from fibrelmp.translate.demdf.plan import Output, PlanMixin
 
 DEFAULT_RADIUS = 0.5          # BOS hard-codes this radius
 DEFAULT_MASS = 1.0

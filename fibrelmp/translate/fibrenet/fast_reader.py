@@ -11,7 +11,7 @@ import io
 
 import numpy as np
 
-from ..model import Angles, Particles
+from fibrelmp.model import Angles, Particles
 
 _NCOLS = {"BEAD": 18, "SPRING": 7, "ANGLE": 10}
 # bytes that str.splitlines()/str.split() treat as line breaks / whitespace but loadtxt may not

@@ -31,9 +31,9 @@ from typing import Iterator
 
 import numpy as np
 
-from ..errors import InputError
-from ..textio import format_rows, read_text
-from .lammps_dump import Frame
+from fibrelmp.errors import InputError
+from fibrelmp.textio import format_rows, read_text
+from fibrelmp.post.lammps_dump.reader import Frame
 
 ENE_LABELS = ("time", "gravitEnergy", "traKineticEnergy", "rotKineticEnergy", "elasticEnergy",
               "centerOfMassX", "centerOfMassY", "centerOfMassZ")

@@ -14,8 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
-from ..textio import integer_column, parse_table, read_text
+from fibrelmp.errors import InputError
+from fibrelmp.textio import integer_column, parse_table, read_text
 
 SECTIONS = {
     "Atoms", "Velocities", "Masses", "Ellipsoids", "Lines", "Triangles", "Bodies", "Bonds",

@@ -14,8 +14,8 @@ from typing import Callable, Iterator
 
 import numpy as np
 
-from ..errors import InputError
-from .lammps_dump import Frame
+from fibrelmp.errors import InputError
+from fibrelmp.post.lammps_dump.reader import Frame
 
 
 def box_from_dimensions(dim) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:

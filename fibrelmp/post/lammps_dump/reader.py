@@ -23,8 +23,8 @@ from typing import Callable, Iterator
 
 import numpy as np
 
-from ..errors import InputError
-from .fastparse import nth_newline, parse_numbers
+from fibrelmp.errors import InputError
+from fibrelmp.numtext.fast import nth_newline, parse_numbers
 
 # columns that may hold text (type labels with ``dump_modify types labels``, element names)
 TEXT_COLUMNS = {"type", "element"}

@@ -14,11 +14,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
-from ..units import SI
-from ..granmodel import (ContactLaw, Geometry, GranularModel, GranularPlan, Material,
+from fibrelmp.errors import InputError
+from fibrelmp.units import SI
+from fibrelmp.granmodel import (ContactLaw, Geometry, GranularModel, GranularPlan, Material,
                          MotionInterval, SolidBonds, Spheres, Triangles, hertz_effective)
-from .musen_text import (LIQUID_BOND, SOLID_BOND, SPHERE, TD_SIZE, TYPE_NAMES, WALL,  # noqa: F401
+from fibrelmp.translate.musen.text import (LIQUID_BOND, SOLID_BOND, SPHERE, TD_SIZE, TYPE_NAMES, WALL,  # noqa: F401
                          TimePoints, _bool, _check_duplicate_ids, _fill, _int, _num, _scan, _Scan,
                          _state, read_time_points)
 
@@ -452,7 +452,7 @@ def check_simulable(model: GranularModel) -> None:
 
 # --------------------------------------------------------------------------- fibrelmp check
 def _first_material_key(path: str | Path) -> str | None:
-    from ..textio import read_text
+    from fibrelmp.textio import read_text
 
     try:
         text = read_text(path, "MUSEN text file")

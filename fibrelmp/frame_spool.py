@@ -14,7 +14,7 @@ from typing import Iterator
 
 import numpy as np
 
-from ..granmodel import GranularFrame
+from fibrelmp.granmodel import GranularFrame
 
 _FIELDS = [f.name for f in dataclasses.fields(GranularFrame)]
 

@@ -13,11 +13,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
-from ..model import (Angles, Bonds, Box, Dynamics, Model, OutputSpec, PairLaw, Particles,
+from fibrelmp.errors import InputError
+from fibrelmp.model import (Angles, Bonds, Box, Dynamics, Model, OutputSpec, PairLaw, Particles,
                      RunPlan, Stage)
-from ..textio import check_text_file, integer_column, parse_table, read_bytes, read_text, to_float, to_int
-from ..units import LJ
+from fibrelmp.textio import check_text_file, integer_column, parse_table, read_bytes, read_text, to_float, to_int
+from fibrelmp.units import LJ
 
 EXTENSIONS = (".txt", ".in", ".inp")
 
@@ -247,7 +247,7 @@ def read(path: str | Path) -> Model:
         rpath = folder / rline.tokens[1]
         if not rpath.exists():
             raise InputError(path, rline.number, f"restart file '{rline.tokens[1]}' not found")
-        from ..post.fibrenet_out import read_restart
+        from fibrelmp.translate.fibrenet.writer import read_restart
 
         rtypes, rdata = read_restart(rpath)
         if len(rtypes) != n:
@@ -357,7 +357,7 @@ def _pair_law(path: Path, line: _Line, i: int, j: int, cutoff: float) -> PairLaw
 
 def _read_model(path: Path, type_index: dict[str, int], type_names: list[str], size: np.ndarray,
                 notes: list) -> tuple[Particles, "_Springs", Angles]:
-    from .fibrenet_fast import fast_read_model
+    from fibrelmp.translate.fibrenet.fast_reader import fast_read_model
 
     check_text_file(path, "FibreNet model file")    # encoding / binary checks, streamed
     fast = fast_read_model(read_bytes(path), type_index, type_names, size, _Springs)

@@ -12,11 +12,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
-from ..textio import (atomic_write, discard, format_rows, parse_table, read_text, temp_name,
+from fibrelmp.errors import InputError
+from fibrelmp.textio import (atomic_write, discard, format_rows, parse_table, read_text, temp_name,
                       write_failure)
-from .fastparse import format_xyz_parts
-from .textfmt import fixed_chars, join_fields, name_chars
+from fibrelmp.numtext.fast import format_xyz_parts
+from fibrelmp.numtext.printf import fixed_chars, join_fields, name_chars
 
 XYZ_SUFFIX = {"position": "_coord.xyz", "velocity": "_vel.xyz", "force": "_force.xyz"}
 RESTART_SUFFIX = "_restart.res"

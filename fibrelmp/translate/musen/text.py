@@ -15,8 +15,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..errors import InputError
-from ..textio import read_text
+from fibrelmp.errors import InputError
+from fibrelmp.textio import read_text
 
 SPHERE, SOLID_BOND, LIQUID_BOND, WALL = 1, 9, 13, 14
 TYPE_NAMES = {SPHERE: "sphere", SOLID_BOND: "solid bond", LIQUID_BOND: "liquid bond",

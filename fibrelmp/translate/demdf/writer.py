@@ -22,10 +22,10 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import RunError
-from ..granmodel import GranularFrame, GranularModel
-from ..textio import discard, write_failure
-from ..translate.demdf import read_snapshot
+from fibrelmp.errors import RunError
+from fibrelmp.granmodel import GranularFrame, GranularModel
+from fibrelmp.textio import discard, write_failure
+from fibrelmp.translate.demdf.reader import read_snapshot
 
 __all__ = ["DemdfSnapshotWriter", "read_snapshot"]
 

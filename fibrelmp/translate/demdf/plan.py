@@ -14,9 +14,9 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InputError
-from ..granmodel import GranularPlan
-from .demdf_json import describe
+from fibrelmp.errors import InputError
+from fibrelmp.granmodel import GranularPlan
+from fibrelmp.translate.demdf.json_doc import describe
 
 LONG_RUN_STEPS = 20_000_000
 

@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 
 _SRC = Path(__file__).with_name("_fastparse.c")
-# built by setup.py (Extension "fibrelmp.post._fastparse_c"); loaded with ctypes, never imported
+# built by setup.py (Extension "fibrelmp.numtext._fastparse_c"); loaded with ctypes, never imported
 _INSTALLED = Path(__file__).with_name("_fastparse_c" + (sysconfig.get_config_var("EXT_SUFFIX") or ".so"))
 _FLAGS = ["-O3", "-shared", "-fPIC", "-fno-fast-math", "-ffp-contract=off"]
 _lock = threading.Lock()

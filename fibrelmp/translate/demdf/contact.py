@@ -24,8 +24,8 @@ from dataclasses import dataclass
 import numpy as np
 
 # the Hertz impact formulas live in fibrelmp.sanity (``fibrelmp check`` uses them too)
-from ..sanity import hertz_contact_time as contact_time  # noqa: F401
-from ..sanity import hertz_peak_overlap as peak_overlap  # noqa: F401
+from fibrelmp.sanity import hertz_contact_time as contact_time  # noqa: F401
+from fibrelmp.sanity import hertz_peak_overlap as peak_overlap  # noqa: F401
 
 
 def modulus_for_overlap(m_eff: float, r_eff: float, speed: float, overlap: float) -> float:

@@ -13,8 +13,8 @@ from typing import Any, NoReturn
 
 import numpy as np
 
-from ..errors import InputError
-from ..textio import read_text
+from fibrelmp.errors import InputError
+from fibrelmp.textio import read_text
 
 
 class _JsonValueError(ValueError):

@@ -22,9 +22,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..granmodel import GranularFrame, GranularModel
-from ..textio import temp_name, write_failure
-from ..translate.musen import (ACTIVE_INTERACTIONS, ACTIVE_PROPERTIES, DEFAULT_ACTIVITY_END,
+from fibrelmp.granmodel import GranularFrame, GranularModel
+from fibrelmp.textio import temp_name, write_failure
+from fibrelmp.translate.musen.scene import (ACTIVE_INTERACTIONS, ACTIVE_PROPERTIES, DEFAULT_ACTIVITY_END,
                                PROPERTY_DEFAULTS)
 
 # MUSEN's export selector groups and flags, in ExportAsText.h order (cmusen TEXT_EXPORT_*).

@@ -18,9 +18,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
-from ..textio import atomic_write
-from .lammps_dump import Frame
+from fibrelmp.errors import InputError
+from fibrelmp.textio import atomic_write
+from fibrelmp.post.lammps_dump.reader import Frame
 
 VTK_VERTEX, VTK_LINE = 1, 3
 _TYPES = {np.dtype(np.float64): "Float64", np.dtype(np.float32): "Float32", np.dtype(np.int64): "Int64",

@@ -17,11 +17,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
-from ..granmodel import GranularModel, MotionInterval
-from ..post.musen_out import EXPORT_FLAGS, all_on
-from ..textio import read_text
-from .musen import (INTERACTION_DEFAULTS, _check_material, check_simulable, contact_law,
+from fibrelmp.errors import InputError
+from fibrelmp.granmodel import GranularModel, MotionInterval
+from fibrelmp.translate.musen.writer import EXPORT_FLAGS, all_on
+from fibrelmp.textio import read_text
+from fibrelmp.translate.musen.scene import (INTERACTION_DEFAULTS, _check_material, check_simulable, contact_law,
                     domain_warning)
 
 COMPONENTS = {"SIMULATOR": "SIMULATOR", "IMPORT_FROM_TEXT": "IMPORT_FROM_TEXT",
@@ -697,7 +697,7 @@ def check_patch(err: InputError, line: str | None, attempt: int) -> str | None:
     if key in ("JOB", "NEW_JOB"):
         return None
     if key[:1].isdigit():
-        from .musen import check_patch as scene_patch
+        from fibrelmp.translate.musen.scene import check_patch as scene_patch
 
         return scene_patch(err, line, attempt)
     candidates: list[str] = []

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .lammps_dump import iter_headers
+from fibrelmp.post.lammps_dump.reader import iter_headers
 
 POSITION_KINDS = (("x y z", ("x", "y", "z")), ("scaled xs ys zs", ("xs", "ys", "zs")),
                   ("unwrapped xu yu zu", ("xu", "yu", "zu")),
@@ -68,7 +68,7 @@ def describe_dump(path: Path, warnings: list[tuple[str, str]]) -> list[str]:
 
 
 def describe_universe(path: Path, topology: Path | None) -> list[str]:
-    from .mda_bridge import open_universe
+    from fibrelmp.post.mdanalysis.reader import open_universe
 
     u = open_universe(path, topology)
     ts = u.trajectory.ts

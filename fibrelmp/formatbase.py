@@ -1,0 +1,170 @@
+"""The abstract Reader and Writer every format derives from (see docs/architecture.md).
+
+What all formats share is implemented here once:
+
+* ``Reader``: the file it reads is checked first (exists, a regular file: a FIFO or
+  /dev/zero would block or never end), and every error it raises is ``path:line: message``
+  through ``Reader.error`` (one exception type, ``InputError``).
+* ``Writer``: streaming ``add(frame)`` ... ``close()`` (or ``abort()``); every file goes to a
+  temp name beside its final name and is renamed into place only by ``close``, so a failure
+  at any point leaves no half-written output and earlier outputs untouched; existing outputs
+  are replaced only with ``force``; an ``OSError`` (a full disk...) becomes an error naming
+  the output, never the temp file.  ``with Writer(...) as w:`` closes on success and aborts
+  on an exception.
+
+A derived reader implements ``read`` (whole-file formats) or ``__iter__`` (frame formats);
+a derived writer implements ``write(frame)`` and, if it writes at the end, ``finish``.
+(Modelled on MDAnalysis's ReaderBase/WriterBase and meshio's one reader/writer per format.)
+"""
+
+from __future__ import annotations
+
+import os
+from abc import ABC, abstractmethod
+from pathlib import Path
+from typing import IO, Any, ClassVar, Iterator
+
+from .errors import InputError
+from .textio import discard, temp_name, write_failure
+
+
+class Reader(ABC):
+    """Reads one file of one format."""
+
+    format: ClassVar[str] = ""           # the registry name (fibrelmp.registry)
+    what: ClassVar[str] = "input"        # how messages call the file
+
+    def __init__(self, path: str | os.PathLike):
+        from .registry import check_regular_file
+
+        self.path = Path(path)
+        check_regular_file(self.path, self.what)
+
+    def error(self, line: int | None, message: str) -> InputError:
+        """The error to raise for a problem at ``line`` (1-based, or None) of this file."""
+        return InputError(self.path, line, message)
+
+    def read(self) -> Any:
+        """The whole file as the format's neutral object (model, table...)."""
+        raise NotImplementedError(f"{type(self).__name__} reads frames: iterate over it")
+
+    def __iter__(self) -> Iterator[Any]:
+        """Frames, one at a time (memory does not grow with their number)."""
+        raise NotImplementedError(f"{type(self).__name__} is not a frame format: call read()")
+
+
+class Writer(ABC):
+    """Writes one output (one or several files) from a stream of frames."""
+
+    format: ClassVar[str] = ""
+
+    def __init__(self, target: str | os.PathLike, *, force: bool = True):
+        """``target``: the output's path (or base name, for multi-file formats).  Without
+        ``force`` an existing output (any file ``outputs()`` names) is an error, raised here,
+        before anything is written."""
+        self.target = Path(target)
+        self.count = 0                      # frames added
+        self.closed = False
+        self._staged: dict[Path, Path] = {}        # final path -> temp path
+        self._handles: dict[Path, IO] = {}         # final path -> open temp file
+        if not force:
+            existing = [p for p in self.outputs() if p.exists()]
+            if existing:
+                raise InputError(existing[0], None, "output exists; use --force to overwrite")
+
+    # -- what derived writers implement ------------------------------------------------
+    def outputs(self) -> list[Path]:
+        """The files this output consists of (what ``force`` protects); default the target."""
+        return [self.target]
+
+    @abstractmethod
+    def write(self, frame: Any) -> None:
+        """Write (or stage) one frame."""
+
+    def finish(self) -> None:
+        """Write what comes at the end (an index file, a header that needs every frame...)."""
+
+    def discard(self) -> None:
+        """Drop the writer's own scratch data (spools...) on abort and after close."""
+
+    # -- shared machinery ---------------------------------------------------------------
+    def stage(self, final: str | os.PathLike) -> Path:
+        """The temp path a file is written to until ``close`` renames it to ``final``."""
+        final = Path(final)
+        if final not in self._staged:
+            self._staged[final] = temp_name(final)
+        return self._staged[final]
+
+    def open(self, final: str | os.PathLike, mode: str = "wb") -> IO:
+        """An open temp file for ``final`` (kept open until close/abort; opened once)."""
+        final = Path(final)
+        fh = self._handles.get(final)
+        if fh is None:
+            try:
+                fh = open(self.stage(final), mode)
+            except OSError as exc:
+                self.abort()
+                raise write_failure(final, exc) from None
+            self._handles[final] = fh
+        return fh
+
+    def add(self, frame: Any) -> None:
+        if self.closed:
+            raise ValueError(f"{type(self).__name__} for {self.target} is closed")
+        try:
+            self.write(frame)
+        except OSError as exc:
+            self.abort()
+            raise write_failure(getattr(exc, "output", None) or self.target, exc) from None
+        except BaseException:
+            self.abort()
+            raise
+        self.count += 1
+
+    def close(self) -> list[Path]:
+        """Finish, then rename every staged file into place; returns the final paths."""
+        if self.closed:
+            return []
+        current = self.target
+        try:
+            self.finish()
+            for final, fh in list(self._handles.items()):
+                current = final
+                fh.close()
+            self._handles.clear()
+            done = []
+            for final, tmp in list(self._staged.items()):
+                current = final
+                os.replace(tmp, final)
+                done.append(final)
+                del self._staged[final]
+        except OSError as exc:
+            self.abort()
+            raise write_failure(current, exc) from None
+        except BaseException:
+            self.abort()
+            raise
+        self.closed = True
+        self.discard()
+        return done
+
+    def abort(self) -> None:
+        """Remove everything not yet in place; never raises."""
+        for final, tmp in list(self._staged.items()):
+            discard(tmp, self._handles.pop(final, None))
+        self._staged.clear()
+        self._handles.clear()
+        self.closed = True
+        try:
+            self.discard()
+        except OSError:
+            pass
+
+    def __enter__(self) -> "Writer":
+        return self
+
+    def __exit__(self, kind, exc, tb) -> None:
+        if kind is None:
+            self.close()
+        else:
+            self.abort()

@@ -1,0 +1,196 @@
+"""The format registry: every file format fibrelmp reads or writes, in one table.
+
+Each ``Format`` record says what a format is (name, extensions, content magic, units), which
+roles it has and where its code lives.  The CLI and the Python API take every format choice
+from here (``fibrelmp run/check/translate`` detect the input, ``post --to`` lists and loads
+targets, help texts list names); no other module names formats.  Code is imported lazily
+(``Format.load``): ``fibrelmp check`` on a FibreNet file never imports the DEM code.
+
+Roles
+  ``input``   a simulation input ``run``/``check``/``translate`` accept; its hook is an
+              ``InputFormat`` (fibrelmp.pipeline) that turns the file into run requests.
+  ``result``  written by ``run`` as the input's native results (its hook is a ``Writer``).
+  ``target``  a ``post --to`` output; its hook is a ``post.target.DumpTarget`` (a ``Writer``
+              of LAMMPS dump frames).
+  ``frames``  a trajectory ``post`` reads; its hook is a frame ``Reader``.
+
+Adding a format: one module with its Reader/Writer subclass, one ``register_format`` call
+below (docs/architecture.md shows an example).  Like meshio's ``register_format`` and ASE's
+``ioformats`` table.
+"""
+
+from __future__ import annotations
+
+import importlib
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from .errors import InputError
+
+INPUT, RESULT, TARGET, FRAMES = "input", "result", "target", "frames"
+ROLES = (INPUT, RESULT, TARGET, FRAMES)
+
+
+@dataclass(frozen=True)
+class Format:
+    name: str                              # as the CLI and the API spell it
+    title: str                             # one line for help texts
+    units: str                             # "lj" (LAMMPS reduced), "si", "dimensionless", "any"
+    hooks: dict[str, str]                  # role -> "module:attribute"
+    extensions: tuple[str, ...] = ()       # lower case, with the dot
+    magic: re.Pattern | None = None        # content test on the first MiB (inputs)
+    example: str = ""                      # a command line for help texts
+    home: str = ""                         # the format's package (docs)
+    roles: tuple[str, ...] = field(init=False)
+
+    def __post_init__(self) -> None:
+        unknown = set(self.hooks) - set(ROLES)
+        if unknown:
+            raise ValueError(f"format {self.name}: unknown roles {sorted(unknown)}")
+        object.__setattr__(self, "roles", tuple(r for r in ROLES if r in self.hooks))
+
+    def load(self, role: str) -> Any:
+        """The class/object implementing ``role`` (imported now, not before)."""
+        module, _, attribute = self.hooks[role].partition(":")
+        return getattr(importlib.import_module(module), attribute)
+
+
+_FORMATS: dict[str, Format] = {}
+
+
+def register_format(fmt: Format) -> Format:
+    """Add (or replace) a format; returns it."""
+    _FORMATS[fmt.name] = fmt
+    return fmt
+
+
+def get(name: str) -> Format:
+    return _FORMATS[name]
+
+
+def formats(role: str | None = None) -> list[Format]:
+    """Registered formats (with ``role``), in registration order."""
+    return [f for f in _FORMATS.values() if role is None or role in f.roles]
+
+
+def names(role: str) -> list[str]:
+    return [f.name for f in formats(role)]
+
+
+def choose(role: str, name: str, option: str) -> Format:
+    """The format ``name`` given to ``option`` (e.g. ``--to``), or an error listing choices."""
+    fmt = _FORMATS.get(name.lower())
+    if fmt is None or role not in fmt.roles:
+        raise InputError(None, None, f"{option} {name!r}: unknown format (choose from "
+                         f"{', '.join(names(role))})")
+    return fmt
+
+
+# -- input detection -------------------------------------------------------------------------
+DETECT_BYTES = 1 << 20          # detection reads at most this much of a file
+
+
+def check_regular_file(path: Path, what: str = "input") -> None:
+    """A readable regular file: not missing, not a folder, not a device or FIFO (reading
+    /dev/zero never ends, a FIFO blocks for ever)."""
+    from .textio import refuse_special_file
+
+    try:
+        refuse_special_file(path, what)
+    except FileNotFoundError:
+        raise InputError(path, None, f"{what} file not found") from None
+    except OSError as exc:
+        raise InputError(path, None, f"cannot read {what}: {exc.strerror or exc}") from None
+    if path.is_dir():
+        raise InputError(path, None, f"{what} is a directory, expected a file")
+
+
+def input_hint() -> str:
+    titles = [f.title for f in formats(INPUT)]
+    return "expected " + ", ".join(titles[:-1]) + " or " + titles[-1]
+
+
+def detect(path: str | Path) -> Format:
+    """The input format of ``path``: by content first, then by extension (so that format's
+    reader explains what is wrong inside)."""
+    path = Path(path)
+    check_regular_file(path)
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(DETECT_BYTES)
+    except OSError as exc:
+        raise InputError(path, None, f"cannot read input: {exc.strerror or exc}") from None
+    if path.suffix.lower() == ".mdem":
+        raise InputError(path, None, "binary MUSEN .mdem files cannot be read: export the scene "
+                         "as text (MUSEN: File > Export > Text, or a cmusen job with "
+                         "'COMPONENT EXPORT_TO_TEXT') and run that file")
+    if head.startswith((b"\xff\xfe", b"\xfe\xff")):
+        raise InputError(path, None, "the file is UTF-16 encoded; save it as UTF-8 (or ASCII) text")
+    if head.startswith(b"\xef\xbb\xbf"):        # UTF-8 byte-order mark: the readers accept it
+        head = head[3:]
+    inputs = formats(INPUT)
+    for fmt in inputs:
+        if fmt.magic is not None and fmt.magic.search(head):
+            return fmt
+    for fmt in inputs:
+        if path.suffix.lower() in fmt.extensions:
+            return fmt
+    raise InputError(path, None, f"cannot tell the input format: {input_hint()}")
+
+
+# -- the formats ---------------------------------------------------------------------------
+register_format(Format(
+    "fibrenet", "a FibreNet input (with a 'model_file' line)", "lj",
+    {INPUT: "fibrelmp.translate.fibrenet:FibreNetInput"},
+    magic=re.compile(rb"^[ \t]*model_file\s", re.M),
+    example="examples/fibre_network/input.txt", home="fibrelmp.translate.fibrenet"))
+register_format(Format(
+    "musen-script", "a cmusen job script", "si",
+    {INPUT: "fibrelmp.translate.musen:ScriptInput"},
+    magic=re.compile(rb"^[ \t]*(JOB|SOURCE_FILE|COMPONENT)\b", re.M),
+    example="examples/musen/single_particle_job.txt", home="fibrelmp.translate.musen"))
+register_format(Format(
+    # an object line "0 ID 1 TYPE 5 ...", or a scene line (22 domain / 32 material) of an
+    # object-less scene; ".txt" is too common to mean MUSEN
+    "musen", "a MUSEN text scene or result", "si",
+    {INPUT: "fibrelmp.translate.musen:SceneInput",
+     RESULT: "fibrelmp.translate.musen.writer:MusenResultWriter",
+     TARGET: "fibrelmp.post.to_granular:MusenTarget"},
+    magic=re.compile(rb"\A\s*(0\s+\d+\s+1\s+\d+\s+5\b|(22|32)\s+\S)"),
+    example="examples/musen/SingelParticle_text.txt", home="fibrelmp.translate.musen"))
+register_format(Format(
+    "demdf", "a DEMDF JSON file (input or snapshot)", "dimensionless",
+    {INPUT: "fibrelmp.translate.demdf:DemdfInput",
+     RESULT: "fibrelmp.translate.demdf.writer:DemdfSnapshotWriter",
+     TARGET: "fibrelmp.post.to_granular:DemdfTarget"},
+    extensions=(".json",), magic=re.compile(rb"\A\s*\{"),
+    example="examples/demdf/head_on.json", home="fibrelmp.translate.demdf"))
+register_format(Format(
+    "xyz", "FibreNet trajectories (_coord/_vel/_force.xyz)", "lj",
+    {RESULT: "fibrelmp.translate.fibrenet.writer:XyzWriter",
+     TARGET: "fibrelmp.post.to_fibrenet:XyzTarget"},
+    extensions=(".xyz",), home="fibrelmp.translate.fibrenet"))
+register_format(Format(
+    "res", "a FibreNet restart (_restart.res)", "lj",
+    {RESULT: "fibrelmp.translate.fibrenet.writer:RestartWriter",
+     TARGET: "fibrelmp.post.to_fibrenet:RestartTarget"},
+    extensions=(".res",), home="fibrelmp.translate.fibrenet"))
+register_format(Format(
+    "mercury", "MercuryDPM .data/.ene/.fstat", "any",
+    {TARGET: "fibrelmp.post.mercury:MercuryTarget"},
+    extensions=(".data", ".ene", ".fstat"), home="fibrelmp.post.mercury"))
+register_format(Format(
+    "vtk", "VTK .vtu frames with a ParaView .pvd index", "any",
+    {TARGET: "fibrelmp.post.vtk:VtkTarget"},
+    extensions=(".vtu", ".pvd"), home="fibrelmp.post.vtk"))
+register_format(Format(
+    "lammps-dump", "a LAMMPS text dump (plain or .gz)", "any",
+    {FRAMES: "fibrelmp.post.lammps_dump:DumpReader"},
+    extensions=(".dump", ".lammpstrj", ".gz"), magic=re.compile(rb"\A\s*ITEM:"),
+    home="fibrelmp.post.lammps_dump"))
+register_format(Format(
+    "mdanalysis", "any trajectory MDAnalysis reads (with --topology)", "any",
+    {FRAMES: "fibrelmp.post.mdanalysis:UniverseReader"},
+    home="fibrelmp.post.mdanalysis"))

@@ -48,7 +48,7 @@ class _Line:
 class _InputFile:
     """FibreNet input: first token is the keyword; single keywords keep the first line."""
 
-    def __init__(self, path: Path, model: list[tuple[str, str]]):
+    def __init__(self, path: Path, notes: list[tuple[str, str]]):
         self.path = path
         self.lines: dict[str, list[_Line]] = {}
         for number, raw in enumerate(read_text(path, "FibreNet input file").splitlines(), 1):
@@ -57,7 +57,7 @@ class _InputFile:
                 continue
             key = tokens[0]
             if key == "box_wall_re":
-                model.append(("keyword alias", f"{path}:{number}: 'box_wall_re' (as in FibreNet's "
+                notes.append(("keyword alias", f"{path}:{number}: 'box_wall_re' (as in FibreNet's "
                               "README) is read as 'box_wall_rep'; real FibreNet ignores it and "
                               "leaves the wall stiffness uninitialised"))
                 key = "box_wall_rep"
@@ -72,7 +72,7 @@ class _InputFile:
             self.lines.setdefault(key, []).append(_Line(number, tokens))
         for key, found in self.lines.items():
             if not KEYWORDS[key][1] and len(found) > 1:
-                model.append(("repeated keyword", f"{path}:{found[1].number}: '{key}' repeated; "
+                notes.append(("repeated keyword", f"{path}:{found[1].number}: '{key}' repeated; "
                               f"FibreNet uses the first one (line {found[0].number})"))
 
     def first(self, key: str) -> _Line | None:
@@ -138,7 +138,10 @@ def _stoi(token: str) -> int | None:
 
 
 def read(path: str | Path) -> Model:
-    """Read a FibreNet input file (and the files it names) into a Model."""
+    """Read a FibreNet input file (and the files it names) into a Model.
+
+    The steps run in FibreNet's order, so the first error reported is the one FibreNet
+    would meet first."""
     path = Path(path)
     notes: list[tuple[str, str]] = []
     inp = _InputFile(path, notes)
@@ -146,8 +149,49 @@ def read(path: str | Path) -> Model:
         if key != "box_wall_rep":
             inp.require(key)
     folder = path.parent
+    type_names, type_index, cutoff, pairs = _types_and_pairs(inp)
+    box = _box(inp, notes)
+    settings = _run_settings(inp)
 
-    # ---- types and pairs -------------------------------------------------------------
+    model_line = inp.require("model_file")
+    model_path = folder / model_line.tokens[1]
+    if not model_path.exists():
+        raise InputError(path, model_line.number, f"model file '{model_line.tokens[1]}' not found "
+                         f"(looked in {folder})")
+    particles, springs, angles = _read_model(model_path, type_index, type_names, box.lengths, notes)
+
+    # restart, modif_bead, modif_spring: FibreNet's order
+    restart = _apply_restart(inp, particles, type_names, notes)
+    _apply_modif_bead(inp, particles, type_index, notes)
+    quirk = (particles.velocities != particles.display_velocities).any(axis=1)
+    if quirk.any():
+        row = int(np.flatnonzero(quirk)[0])
+        notes.append(("velocity quirk", f"{model_path}: bead {row}: FibreNet starts beads from "
+                      "v = (vx, vx, vx) (a bug in its model reader); fibrelmp reproduces it. "
+                      "Use 'modif_bead ... velocity' to set other velocities"))
+    _apply_modif_spring(inp, springs, notes)
+    bonds = springs.to_bonds()
+    periodic = all(box.periodic)
+    _check_positions(particles, box, periodic, model_path, notes)
+    _check_lengths(particles, bonds, angles, model_path)
+    _check_periodic_extent(particles, bonds, angles, box, model_path)
+    exclusion = _exclusion_rule(particles, bonds, model_path)
+
+    output = _output_spec(inp, type_index, settings.out_freq)
+    stages = _stages(inp, settings, notes)
+    dyn = Dynamics(dt=settings.dt, damping=settings.damping, lambda_=settings.lam,
+                   gravity=settings.gravity, pair_cutoff=cutoff, exclusion=exclusion)
+    _note_quirks(particles, bonds, angles, pairs, dyn, notes, model_path)
+    model = Model(path, particles, bonds, angles, pairs, box, dyn, RunPlan(stages, output),
+                  units=LJ.name)
+    model.warnings.extend(notes)
+    model.inputs = [path, model_path] + ([restart] if restart is not None else [])
+    return model
+
+
+def _types_and_pairs(inp: _InputFile) -> tuple[list[str], dict[str, int], float, list[PairLaw]]:
+    """The bead types, the pair cutoff and one pair law per type pair (all must be given)."""
+    path = inp.path
     type_names: list[str] = []
     for line in inp.all("type"):
         if line.tokens[1] in type_names:
@@ -173,8 +217,11 @@ def read(path: str | Path) -> Model:
             if (i, j) not in pair_lines:
                 raise InputError(path, None, f"no 'pair' line for types {type_names[i]} "
                                  f"{type_names[j]}: FibreNet needs every type pair defined")
+    return type_names, type_index, cutoff, pairs
 
-    # ---- box -----------------------------------------------------------------------------
+
+def _box(inp: _InputFile, notes: list) -> Box:
+    path = inp.path
     size_line = inp.require("box_size")
     size = np.array([to_float(v, path, size_line.number, "box_size") for v in size_line.tokens[1:]])
     if (size <= 0).any():
@@ -195,9 +242,25 @@ def read(path: str | Path) -> Model:
                       "does not, so this input runs here but not in FibreNet"))
     if inp.first("grid_update_freq") is not None:
         inp.integer("grid_update_freq", minimum=1)
-    box = Box(np.zeros(3), size, (periodic,) * 3, None if periodic else wall_k)
+    return Box(np.zeros(3), size, (periodic,) * 3, None if periodic else wall_k)
 
-    # ---- dynamics ------------------------------------------------------------------------
+
+@dataclass
+class _RunSettings:
+    dt: float
+    lam: float
+    damping: float
+    gravity: np.ndarray
+    run_steps: int
+    min_steps: int
+    min_sub: int
+    reset: bool
+    out_freq: int
+
+
+def _run_settings(inp: _InputFile) -> _RunSettings:
+    """Time step, damping, gravity, relaxation and production lengths, output frequency."""
+    path = inp.path
     dt = inp.number("step", positive=True)
     lam = inp.number("lambda", positive=True)
     damping = inp.number("damping", default=0.0)
@@ -223,17 +286,13 @@ def read(path: str | Path) -> Model:
     if out_freq > run_steps:
         raise InputError(path, inp.first("output_freq").number,
                          f"output_freq ({out_freq}) must not exceed run ({run_steps})")
+    return _RunSettings(dt, lam, damping, gravity, run_steps, min_steps, min_sub, reset, out_freq)
 
-    # ---- model file ----------------------------------------------------------------------
-    model_line = inp.require("model_file")
-    model_path = folder / model_line.tokens[1]
-    if not model_path.exists():
-        raise InputError(path, model_line.number, f"model file '{model_line.tokens[1]}' not found "
-                         f"(looked in {folder})")
-    particles, springs, angles = _read_model(model_path, type_index, type_names, size, notes)
-    n = particles.count
 
-    # ---- restart, modif_bead, modif_spring (FibreNet's order) ------------------------------
+def _apply_restart(inp: _InputFile, particles: Particles, type_names: list[str],
+                   notes: list) -> Path | None:
+    """Apply ``restart_file``/``restart_data``; the restart file read, if any."""
+    path, folder, n = inp.path, inp.path.parent, particles.count
     restart_lines = inp.all("restart_file")
     restart_fields: set[str] = set()
     for line in inp.all("restart_data"):
@@ -242,50 +301,39 @@ def read(path: str | Path) -> Model:
             raise InputError(path, line.number, f"restart_data must be position, velocity, force "
                              f"or all, got '{value}'")
         restart_fields |= {"position", "velocity", "force"} if value == "all" else {value}
-    if restart_lines:
-        rline = restart_lines[-1]           # the last restart_file line wins
-        rpath = folder / rline.tokens[1]
-        if not rpath.exists():
-            raise InputError(path, rline.number, f"restart file '{rline.tokens[1]}' not found")
-        from fibrelmp.translate.fibrenet.writer import read_restart
+    if not restart_lines:
+        return None
+    rline = restart_lines[-1]           # the last restart_file line wins
+    rpath = folder / rline.tokens[1]
+    if not rpath.exists():
+        raise InputError(path, rline.number, f"restart file '{rline.tokens[1]}' not found")
+    from fibrelmp.translate.fibrenet.writer import read_restart
 
-        rtypes, rdata = read_restart(rpath)
-        if len(rtypes) != n:
-            raise InputError(rpath, None, f"restart file has {len(rtypes)} bead rows, the model has {n}")
-        mismatch = np.flatnonzero(np.asarray(rtypes, dtype=object) !=
-                                  np.asarray(type_names, dtype=object)[particles.types])
-        if mismatch.size:
-            b = int(mismatch[0])
-            raise InputError(rpath, None, f"bead {b}: restart type '{rtypes[b]}' differs from the "
-                             f"model type '{type_names[particles.types[b]]}'")
-        if "position" in restart_fields:
-            particles.positions = rdata[:, 0:3].copy()
-            particles.unwrapped = rdata[:, 3:6].copy()
-        if "velocity" in restart_fields:
-            particles.velocities = rdata[:, 6:9].copy()
-            particles.display_velocities = rdata[:, 6:9].copy()
-        if "force" in restart_fields:
-            particles.initial_forces = rdata[:, 9:12].copy()
-        if not restart_fields:
-            notes.append(("restart ignored", f"{path}:{rline.number}: restart_file without "
-                          "restart_data: FibreNet only validates the file and applies nothing"))
-    _apply_modif_bead(inp, particles, type_index, notes)
-    quirk = (particles.velocities != particles.display_velocities).any(axis=1)
-    if quirk.any():
-        row = int(np.flatnonzero(quirk)[0])
-        notes.append(("velocity quirk", f"{model_path}: bead {row}: FibreNet starts beads from "
-                      "v = (vx, vx, vx) (a bug in its model reader); fibrelmp reproduces it. "
-                      "Use 'modif_bead ... velocity' to set other velocities"))
-    _apply_modif_spring(inp, springs, notes)
-    bonds = springs.to_bonds()
-    _check_positions(particles, box, periodic, model_path, notes)
-    _check_lengths(particles, bonds, angles, model_path)
-    _check_periodic_extent(particles, bonds, angles, box, model_path)
+    rtypes, rdata = read_restart(rpath)
+    if len(rtypes) != n:
+        raise InputError(rpath, None, f"restart file has {len(rtypes)} bead rows, the model has {n}")
+    mismatch = np.flatnonzero(np.asarray(rtypes, dtype=object) !=
+                              np.asarray(type_names, dtype=object)[particles.types])
+    if mismatch.size:
+        b = int(mismatch[0])
+        raise InputError(rpath, None, f"bead {b}: restart type '{rtypes[b]}' differs from the "
+                         f"model type '{type_names[particles.types[b]]}'")
+    if "position" in restart_fields:
+        particles.positions = rdata[:, 0:3].copy()
+        particles.unwrapped = rdata[:, 3:6].copy()
+    if "velocity" in restart_fields:
+        particles.velocities = rdata[:, 6:9].copy()
+        particles.display_velocities = rdata[:, 6:9].copy()
+    if "force" in restart_fields:
+        particles.initial_forces = rdata[:, 9:12].copy()
+    if not restart_fields:
+        notes.append(("restart ignored", f"{path}:{rline.number}: restart_file without "
+                      "restart_data: FibreNet only validates the file and applies nothing"))
+    return rpath
 
-    # ---- exclusion rule ------------------------------------------------------------------
-    exclusion = _exclusion_rule(particles, bonds, model_path)
 
-    # ---- outputs ---------------------------------------------------------------------------
+def _output_spec(inp: _InputFile, type_index: dict[str, int], out_freq: int) -> OutputSpec:
+    path = inp.path
     fields: set[str] = set()
     for line in inp.all("output_data"):
         value = line.tokens[1]
@@ -302,29 +350,24 @@ def read(path: str | Path) -> Model:
             raise InputError(path, line.number, f"output_type refers to undefined type "
                              f"'{line.tokens[1]}'")
         out_types.add(type_index[line.tokens[1]])
-    output = OutputSpec("fibrenet", inp.require("output_file").tokens[1], folder,
-                        tuple(f for f in ("position", "velocity", "force") if f in fields),
-                        None if out_types is None else tuple(sorted(out_types)), out_freq,
-                        inp.require("output_file").number)
+    return OutputSpec("fibrenet", inp.require("output_file").tokens[1], path.parent,
+                      tuple(f for f in ("position", "velocity", "force") if f in fields),
+                      None if out_types is None else tuple(sorted(out_types)), out_freq,
+                      inp.require("output_file").number)
 
+
+def _stages(inp: _InputFile, s: _RunSettings, notes: list) -> list[Stage]:
+    """Relaxation in chunks (FibreNet drops a remainder), then production with output."""
     stages: list[Stage] = []
-    if min_steps > 0:
-        chunks = min_steps // min_sub
-        if chunks * min_sub != min_steps:
-            notes.append(("minimize remainder", f"{path}: minimize_steps {min_steps} is not a "
-                          f"multiple of minimize_substeps {min_sub}; FibreNet drops the last "
-                          f"{min_steps - chunks * min_sub} steps, so does fibrelmp"))
-        stages.append(Stage("relax", chunks * min_sub, min_sub, reset=reset))
-    stages.append(Stage("production", run_steps, out_freq, output=True))
-
-    dyn = Dynamics(dt=dt, damping=damping, lambda_=lam, gravity=gravity, pair_cutoff=cutoff,
-                   exclusion=exclusion)
-    _note_quirks(particles, bonds, angles, pairs, dyn, notes, model_path)
-    model = Model(path, particles, bonds, angles, pairs, box, dyn, RunPlan(stages, output),
-                  units=LJ.name)
-    model.warnings.extend(notes)
-    model.inputs = [path, model_path] + ([folder / restart_lines[-1].tokens[1]] if restart_lines else [])
-    return model
+    if s.min_steps > 0:
+        chunks = s.min_steps // s.min_sub
+        if chunks * s.min_sub != s.min_steps:
+            notes.append(("minimize remainder", f"{inp.path}: minimize_steps {s.min_steps} is not a "
+                          f"multiple of minimize_substeps {s.min_sub}; FibreNet drops the last "
+                          f"{s.min_steps - chunks * s.min_sub} steps, so does fibrelmp"))
+        stages.append(Stage("relax", chunks * s.min_sub, s.min_sub, reset=s.reset))
+    stages.append(Stage("production", s.run_steps, s.out_freq, output=True))
+    return stages
 
 
 def _pair_law(path: Path, line: _Line, i: int, j: int, cutoff: float) -> PairLaw:

@@ -1,6 +1,7 @@
 """fibrelmp: run FibreNet, MUSEN and DEMDF inputs on LAMMPS.
 
-The Python API (docs/python.md): ``read``, ``translate_job``, ``run``, ``convert``; errors are
+The Python API (docs/python.md): ``read``, ``check``, ``translate`` (= ``translate_job``),
+``run``, ``convert``, ``describe``; errors are
 ``InputError`` (bad input, ``path:line: message``) and ``RunError`` (LAMMPS or the machine);
 nothing here exits the interpreter.
 
@@ -14,16 +15,21 @@ from __future__ import annotations
 
 __version__ = "0.1.0"
 
-__all__ = ["read", "translate_job", "run", "convert", "RunResult", "InputError", "RunError",
-           "lammps_instance", "lammps_module", "__version__"]
+_API = ("read", "check", "translate_job", "run", "convert", "describe", "RunResult", "CheckReport")
+__all__ = [*_API, "translate", "InputError", "RunError", "lammps_instance", "lammps_module",
+           "__version__"]
 
 
 def __getattr__(name: str):
     """Lazy exports: ``import fibrelmp`` stays light (LAMMPS, jinja2, MDAnalysis load on use)."""
-    if name in ("read", "translate_job", "run", "convert", "RunResult"):
+    if name in _API:
         from fibrelmp import python_api
 
         return getattr(python_api, name)
+    if name == "translate":      # the subpackage, callable as translate(path, folder)
+        import importlib
+
+        return importlib.import_module("fibrelmp.translate")
     if name in ("InputError", "RunError"):
         from fibrelmp import errors
 

@@ -29,7 +29,8 @@ def test_documented_example_runs(tmp_path):
                           "fibre_network_force.xyz", "fibre_network_restart.res"])
     assert out[1].startswith("2000 ")
     assert out[2].startswith("refused:") and "--force" in out[2]
-    assert out[3] == "7 ParaView files" and out[4] == "2 spheres" and out[5] == "in.lammps"
+    assert out[3] == "7 ParaView files" and out[4] == "2 spheres"
+    assert out[5] == "input        examples/demdf/head_on.json (demdf)" and out[6] == "in.lammps"
 
 
 def test_run_returns_frames_raises_and_restores_signals(tmp_path):

@@ -4,8 +4,8 @@
 Generates a random ~50,000-bead FibreNet network (examples/generate_network.py; 1000 steps,
 a frame every 250 steps) in a temporary folder, then in the same process measures:
 
-  (a) fibrelmp = fibrelmp.api.read_input(input.txt) + fibrelmp.api.run(model, out=...,
-      progress=False): translation, LAMMPS run (line by line, as the CLI does) and writing
+  (a) fibrelmp = fibrelmp.translate.fibrenet.reader.read(input.txt) +
+      fibrelmp.pipeline.fibrenet.run_fibrenet(model, out=..., progress=False): translation, LAMMPS run (line by line, as the CLI does) and writing
       FibreNet's output files from the dump;
   (b) bare     = new_lammps([...]); chdir(job folder); lmp.file('in.lammps'); close, on the
       job folder (a) rendered, i.e. the same LAMMPS work (including its write_dump frames)
@@ -66,22 +66,24 @@ class Timers:
 
 
 def run_fibrelmp(input_path: Path, out: Path) -> tuple[float, dict[str, float], object]:
-    import fibrelmp.api as api
     import fibrelmp.post.to_fibrenet as to_fibrenet
     import fibrelmp.runner as runner
+    import fibrelmp.translate.lammps_job as lammps_job
+    from fibrelmp.pipeline.fibrenet import run_fibrenet
+    from fibrelmp.translate.fibrenet.reader import read
 
     timers = Timers()
-    # api.run imports run_script / write_fibrenet from their modules at call time and calls
-    # the module-level translate, so wrapping the module attributes times exactly those parts
-    timers.wrap(api, "translate", "translate")
+    # the pipeline looks up write_job / run_script / write_fibrenet in their modules at call
+    # time, so wrapping the module attributes times exactly those parts
+    timers.wrap(lammps_job, "write_job", "translate")
     timers.wrap(runner, "run_script", "LAMMPS (run_script)")
     timers.wrap(to_fibrenet, "write_fibrenet", "output conversion (worker thread, overlaps LAMMPS)")
     try:
         gc.collect()
         t0 = time.perf_counter()
-        model = api.read_input(input_path)
+        model = read(input_path)
         t1 = time.perf_counter()
-        result = api.run(model, out=out, progress=False)
+        result = run_fibrenet(model, out=out, progress=False)
         t2 = time.perf_counter()
     finally:
         timers.restore()

@@ -4,7 +4,8 @@
 Generates a random ~260,000-bead FibreNet network (examples/generate_network.py) in a
 temporary folder, then in the same process measures, best of --repeat:
 
-  (a) translate = fibrelmp.api.read_input(input.txt) + fibrelmp.api.translate(model, job)
+  (a) translate = fibrelmp.translate.fibrenet.reader.read(input.txt) +
+      fibrelmp.translate.lammps_job.write_job(model, job)
       (parse the FibreNet input and model, write data.lammps and in.lammps);
   (b) read_data = LAMMPS executing the ``read_data`` line of that in.lammps (the set-up
       commands before it are issued first, untimed, in a fresh instance).
@@ -44,7 +45,8 @@ def setup_and_read_data(script: Path) -> tuple[list[str], str]:
 
 
 def time_translate(input_path: Path, job_dir: Path) -> tuple[float, float, object]:
-    from fibrelmp.api import read_input, translate
+    from fibrelmp.translate.fibrenet.reader import read as read_input
+    from fibrelmp.translate.lammps_job import write_job as translate
 
     shutil.rmtree(job_dir, ignore_errors=True)     # a fresh folder, as in a real first translate
     gc.collect()
@@ -120,7 +122,8 @@ def main() -> int:
             import cProfile
             import pstats
 
-            from fibrelmp.api import read_input, translate
+            from fibrelmp.translate.fibrenet.reader import read as read_input
+            from fibrelmp.translate.lammps_job import write_job as translate
 
             prof = cProfile.Profile()
             prof.enable()

@@ -22,23 +22,18 @@ def _quiet(_: object) -> None:
     pass
 
 
+def _input(path: Path):
+    """The INPUT hook of the input's format (``fibrelmp.pipeline.inputs.InputFormat``)."""
+    from fibrelmp.registry import INPUT, detect
+
+    return detect(path).load(INPUT)()
+
+
 def read(path: str | Path):
     """The neutral model of any supported input: a ``Model`` (FibreNet), a ``GranularModel``
     (MUSEN scene, DEMDF) or, for a cmusen job script, its checked ``ScriptPlan``."""
-    from fibrelmp.registry import detect
-
-    kind = detect(path).name
-    if kind == "fibrenet":
-        from fibrelmp.api import read_input
-
-        return read_input(path)
-    if kind == "musen-script":
-        from fibrelmp.granular_api import plan_musen_script
-
-        return plan_musen_script(path)
-    from fibrelmp.granular_api import read_granular
-
-    return read_granular(path, kind)[0]
+    path = Path(path)
+    return _input(path).read(path)
 
 
 def translate_job(path: str | Path, folder: str | Path, warn: Warn | None = None) -> Path:
@@ -50,22 +45,13 @@ def translate_job(path: str | Path, folder: str | Path, warn: Warn | None = None
 
 def write_job(path: str | Path, folder: str | Path, warn: Warn | None = None):
     """``translate_job``, returning the job (``.script``, ``.data``)."""
-    from fibrelmp.registry import detect
-
-    kind = detect(path).name
-    if kind == "fibrenet":
-        from fibrelmp.api import read_input, translate as write
-
-        model = read_input(path)
-    else:
-        from fibrelmp.granular_api import model_for_check
-        from fibrelmp.translate.granular_job import write_granular_job as write
-
-        model = model_for_check(path, kind)
+    path = Path(path)
+    hook = _input(path)
+    model = hook.model(path)
     said = len(model.warnings)
     if warn is not None:
         warn(model.warnings)
-    job = write(model, folder)
+    job = hook.write_job(model, Path(folder))
     if warn is not None and model.warnings[said:]:
         warn(model.warnings[said:])
     return job
@@ -108,11 +94,11 @@ def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | N
     (DEMDF) override the input.  ``say`` receives progress notes, ``warn`` lists of
     ``(kind, text)`` warnings as they are found (they are also in the result)."""
     from fibrelmp.checkpoint import check_every
-    from fibrelmp.registry import detect
-    from fibrelmp.granular_api import Checkpoints
+    from fibrelmp.pipeline import RunOptions, run as run_plan
+    from fibrelmp.pipeline.inputs import RunSettings
 
     path = Path(path)
-    kind = detect(path).name
+    hook = _input(path)
     check_every(checkpoint_every)         # before any folder is made
     result = RunResult()
 
@@ -121,70 +107,17 @@ def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | N
         if warn is not None and items:
             warn(list(items))
 
-    if kind == "fibrenet":
-        from fibrelmp.api import read_input, run as run_fibrenet
-
-        _no_overrides(path, (end_time, step, save_step, steps), "FibreNet inputs set their own "
-                      "steps: --end-time/--step/--save-step/--steps are for MUSEN and DEMDF inputs")
-        model = read_input(path)
-        warned(model.warnings)
-        said = len(model.warnings)
-        done = run_fibrenet(model, out=out, work=work, progress=progress,
-                            checkpoint_every=checkpoint_every, resume=resume, force=force)
-        warned(model.warnings[said:])            # found while running (beads outside the box)
-        result.outputs, result.scripts, result.dumps = done.outputs, [done.job.script], [done.job.frames]
-        return result
-    if resume and not has_checkpoint(path, kind, out, work):
+    if resume and not hook.has_checkpoint(path, out, work):
         raise InputError(path, None, "no checkpoint to resume from (run without --resume, or "
                          "give the same --work folder as the interrupted run)")
-    checkpoints = Checkpoints(checkpoint_every, resume)
-    if kind == "musen-script":
-        from fibrelmp.granular_api import run_musen_script
-
-        _no_overrides(path, (end_time, step, save_step, steps), "a cmusen job script sets "
-                      "END_TIME, SIMULATION_STEP and SAVING_STEP itself; edit the script instead")
-        res = run_musen_script(path, work=work, progress=progress, say=say, warn=warned,
-                               checkpoints=checkpoints, out=out, force=force)
-    elif kind == "demdf":
-        from fibrelmp.granular_api import run_demdf
-
-        res = run_demdf(path, out=out, work=work, progress=progress, time_end=end_time,
-                        steps=steps, save_every=save_step, warn=warned, say=say,
-                        checkpoints=checkpoints, force=force)
-    else:
-        from fibrelmp.granular_api import read_granular, run_musen_scene, scene_result_path
-
-        model, overrides = read_granular(path, kind, end_time, step, save_step, steps)
-        for text in overrides:
-            say(f"override: {text}")
-        warned(model.warnings)
-        said = len(model.warnings)
-        res = run_musen_scene(model, scene_result_path(path, out), work=work, progress=progress, precision=precision,
-                              checkpoints=checkpoints, force=force)
-        warned(model.warnings[said:])            # found while translating or running
-    result.outputs, result.notes = res.outputs, res.notes
-    result.scripts = [job.script for job in res.jobs]
-    result.dumps = [job.frames for job in res.jobs]
+    settings = RunSettings(None if out is None else Path(out), None if work is None else Path(work),
+                           end_time, step, save_step, steps, precision)
+    plan = hook.plan(path, settings, RunOptions(progress, force, checkpoint_every, resume), say, warned)
+    outcome = run_plan(plan, warn=warned)
+    result.outputs, result.notes = outcome.outputs, list(plan.notes)
+    result.scripts = [job.script for job in outcome.jobs]
+    result.dumps = [job.job.frames for job in outcome.jobs]
     return result
-
-
-def _no_overrides(path: Path, values: tuple, message: str) -> None:
-    if any(v is not None for v in values):
-        raise InputError(path, None, message)
-
-
-def has_checkpoint(path: Path, kind: str, out: str | Path | None, work: str | Path | None) -> bool:
-    """Is there a checkpoint for this granular input's work folder(s)?"""
-    if work is not None:
-        folders = [Path(work)]
-    elif kind in ("musen-script", "demdf"):
-        folders = [Path(out or path.resolve().parent) / f"{path.stem}_work"]
-    else:
-        from fibrelmp.granular_api import scene_result_path
-
-        target = scene_result_path(path, out)
-        folders = [target.resolve().parent / f"{target.stem}_work"]
-    return any(next(f.rglob("checkpoint.json"), None) is not None for f in folders if f.exists())
 
 
 def convert(dump: str | Path, to: str, out: str | Path, *, frames: str | None = None,
@@ -211,74 +144,29 @@ class CheckReport:
 def check(path: str | Path) -> CheckReport:
     """Parse and validate an input without running LAMMPS.  For line-oriented formats every
     error is collected: several raise ``InputErrors`` (an ``InputError`` listing them)."""
-    from .registry import detect
+    from .registry import INPUT, detect
 
     path = Path(path)
-    kind = detect(path).name
-    if kind != "fibrenet":
-        from .granular_api import model_for_check
-        from .granular_check import summary
-
-        model = _read_for_check(lambda: model_for_check(path, kind), kind, path)
-        lines = summary(model) + [f"results      {_granular_results(path, kind, model)}"]
-        return CheckReport(kind, lines, list(model.warnings))
-    from .api import fibrenet_outputs, read_input
-    from .sanity import spring_check, units_line
-
-    model = _read_for_check(lambda: read_input(path), kind, path)
-    p = model.particles
-    lines = [f"input        {model.source}",
-             units_line(model),
-             f"beads        {p.count}",
-             f"springs      {model.bonds.count}",
-             f"angles       {model.angles.count}",
-             f"types        {', '.join(p.type_names)}",
-             "pairs        " + "; ".join(f"{law.kind} {p.type_names[law.type_i]}-{p.type_names[law.type_j]}"
-                                         for law in model.pairs),
-             f"box          {' x '.join(f'{x:g}' for x in model.box.lengths)} "
-             f"({'periodic' if all(model.box.periodic) else 'finite, wall k = %g' % model.box.wall_stiffness})",
-             f"time step    {model.dynamics.dt:g}   lambda {model.dynamics.lambda_:g}   damping {model.dynamics.damping:g}"]
-    for st in model.plan.stages:
-        extra = f" in chunks of {st.chunk}" + (", velocities reset" if st.reset else "") if st.name == "relax" else \
-            f", output every {model.plan.output.every}"
-        lines.append(f"stage        {st.name}: {st.steps} steps{extra}")
-    lines += spring_check(model)
-    outputs, folder, prefix = fibrenet_outputs(model)
-    lines.append(f"results      {', '.join(str(p) for p in outputs.files)} (or in -o DIR)")
-    return CheckReport(kind, lines, list(model.warnings))
+    fmt = detect(path)
+    hook = fmt.load(INPUT)()
+    model = _read_for_check(lambda: hook.model(path), lambda: hook.check_patch(path))
+    return CheckReport(fmt.name, hook.check_lines(path, model), list(model.warnings))
 
 
-def _granular_results(input: Path, kind: str, model) -> str:
-    """Where ``run`` would write (without -o), as check reports it."""
-    from .granular_api import demdf_outputs, musen_result_path, plan_musen_script, scene_result_path
-
-    if kind == "demdf":
-        outputs, folder = demdf_outputs(model)
-        return f"{folder / model.passthrough['demdf']['filename']}_<n>.json (or in -o DIR)"
-    if kind == "musen-script":
-        written = [str(st.written) for st in plan_musen_script(input).steps if st.written is not None]
-        return ", ".join(written) or "none (the script exports nothing)"
-    return f"{musen_result_path(scene_result_path(input.resolve()))[0]} (or -o FILE)"
-
-
-def _read_for_check(read, kind: str, input: Path):
-    """``read()``; on an input error in a line-oriented format, every error of the file (the
-    readers stop at the first: ``collect_errors`` re-reads with failing lines patched out)."""
+def _read_for_check(read, patch):
+    """``read()``; on an input error in a line-oriented format (``patch()`` is not None),
+    every error of the file (the readers stop at the first: ``collect_errors`` re-reads with
+    failing lines patched out)."""
     from .errors import InputErrors
     from .textio import MAX_ERRORS, collect_errors
 
     try:
         return read()
     except InputError as first:
-        if kind == "demdf":
+        fix = patch()
+        if fix is None:
             raise
-        if kind == "fibrenet":
-            from .translate.fibrenet.reader import check_patch
-
-            patch = check_patch(input)
-        else:
-            from .translate.musen.script import check_patch as patch
-        errors = collect_errors(read, first, patch)
+        errors = collect_errors(read, first, fix)
     if len(errors) == 1:
         raise errors[0]
     files = list(dict.fromkeys(e.path for e in errors))          # in the order they were met

@@ -8,7 +8,11 @@ targets, help texts list names); no other module names formats.  Code is importe
 
 Roles
   ``input``   a simulation input ``run``/``check``/``translate`` accept; its hook is an
-              ``InputFormat`` (fibrelmp.pipeline) that turns the file into run requests.
+              ``InputFormat`` (``fibrelmp.pipeline.inputs``): read, check, translate, and
+              the ``RunPlan`` of a run.  The hooks live in the pipeline, not in the
+              format's ``translate`` home, because a run plan joins translate (job),
+              post (frame conversion) and pipeline objects, and translate never imports
+              post or the pipeline.
   ``result``  written by ``run`` as the input's native results (its hook is a ``Writer``).
   ``target``  a ``post --to`` output; its hook is a ``post.target.DumpTarget`` (a ``Writer``
               of LAMMPS dump frames).
@@ -143,26 +147,26 @@ def detect(path: str | Path) -> Format:
 # -- the formats ---------------------------------------------------------------------------
 register_format(Format(
     "fibrenet", "a FibreNet input (with a 'model_file' line)", "lj",
-    {INPUT: "fibrelmp.translate.fibrenet:FibreNetInput"},
+    {INPUT: "fibrelmp.pipeline.inputs.fibrenet:FibreNetInput"},
     magic=re.compile(rb"^[ \t]*model_file\s", re.M),
     example="examples/fibre_network/input.txt", home="fibrelmp.translate.fibrenet"))
 register_format(Format(
     "musen-script", "a cmusen job script", "si",
-    {INPUT: "fibrelmp.translate.musen:ScriptInput"},
+    {INPUT: "fibrelmp.pipeline.inputs.musen_script:ScriptInput"},
     magic=re.compile(rb"^[ \t]*(JOB|SOURCE_FILE|COMPONENT)\b", re.M),
     example="examples/musen/single_particle_job.txt", home="fibrelmp.translate.musen"))
 register_format(Format(
     # an object line "0 ID 1 TYPE 5 ...", or a scene line (22 domain / 32 material) of an
     # object-less scene; ".txt" is too common to mean MUSEN
     "musen", "a MUSEN text scene or result", "si",
-    {INPUT: "fibrelmp.translate.musen:SceneInput",
+    {INPUT: "fibrelmp.pipeline.inputs.musen:SceneInput",
      RESULT: "fibrelmp.translate.musen.writer:MusenResultWriter",
      TARGET: "fibrelmp.post.to_granular:MusenTarget"},
     magic=re.compile(rb"\A\s*(0\s+\d+\s+1\s+\d+\s+5\b|(22|32)\s+\S)"),
     example="examples/musen/SingelParticle_text.txt", home="fibrelmp.translate.musen"))
 register_format(Format(
     "demdf", "a DEMDF JSON file (input or snapshot)", "dimensionless",
-    {INPUT: "fibrelmp.translate.demdf:DemdfInput",
+    {INPUT: "fibrelmp.pipeline.inputs.demdf:DemdfInput",
      RESULT: "fibrelmp.translate.demdf.writer:DemdfSnapshotWriter",
      TARGET: "fibrelmp.post.to_granular:DemdfTarget"},
     extensions=(".json",), magic=re.compile(rb"\A\s*\{"),

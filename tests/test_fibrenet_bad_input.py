@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from fibrelmp import api
+from fibrelmp.translate.fibrenet.reader import read as read_fibrenet
 from fibrelmp.errors import InputError
 
 MODEL = """BEAD\tA\t1\t0\t0.3\t1.0\t1.0\t1.0\t1.0\t0\t0\t0\t0\t0\t0\t1.0\t1.0\t1.0
@@ -70,7 +70,7 @@ def test_reader_reports_location(name, tmp_path):
     model, inp, where, what = CASES[name]
     path = write_case(tmp_path, model, inp)
     with pytest.raises(InputError) as info:
-        api.read_input(path)
+        read_fibrenet(path)
     message = str(info.value)
     assert where in message and what in message, message
 

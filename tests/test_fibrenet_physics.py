@@ -1,7 +1,7 @@
 """Each FibreNet force law, as translated to LAMMPS, against an independent numpy reference.
 
-The inputs are written in FibreNet's own text formats, read with ``fibrelmp.api.read_input``
-and evaluated by LAMMPS (``fibrelmp.api.evaluate``: one force evaluation, ``run 0``).  The
+The inputs are written in FibreNet's own text formats, read with ``fibrelmp.translate.fibrenet.reader.read``
+and evaluated by LAMMPS (``fibrelmp.pipeline.evaluate.evaluate``: one force evaluation, ``run 0``).  The
 reference (tests/fibrenet_reference.py) is written from shared/research/fibrenet.md only.
 Forces must agree to 1e-8 of the largest force component and energies to 1e-8 relative.
 """
@@ -13,7 +13,9 @@ import math
 import numpy as np
 import pytest
 
-from fibrelmp import api
+from fibrelmp.pipeline.evaluate import evaluate
+from fibrelmp.pipeline.fibrenet import run_fibrenet
+from fibrelmp.translate.fibrenet.reader import read as read_fibrenet
 from fibrelmp.post.lammps_dump.reader import iter_frames
 
 from . import fibrenet_reference as ref
@@ -23,11 +25,11 @@ TOL = 1e-8
 
 def _evaluate(net: ref.Net, tmp_path, name: str, mutate=None, **options):
     """Write the case, evaluate it with fibrelmp, and compute the reference."""
-    model = api.read_input(net.write(tmp_path / name, name=name, **options))
+    model = read_fibrenet(net.write(tmp_path / name, name=name, **options))
     sys_, st = net.system(), net.state()
     if mutate is not None:
         mutate(model, st)
-    ev = api.evaluate(model, tmp_path / f"{name}_job")
+    ev = evaluate(model, tmp_path / f"{name}_job")
     F, E = ref.total_forces(sys_, st.x, st.xu, st.v_old)
     return ev, F, E
 
@@ -145,8 +147,8 @@ def _dump_frames(job_folder):
 
 def _run_and_compare(net: ref.Net, tmp_path, name, run, every):
     """Run with fibrelmp and compare every frame of frames.dump with the reference."""
-    model = api.read_input(net.write(tmp_path / name, name=name, run=run, output_freq=every))
-    result = api.run(model, out=tmp_path / f"{name}_out", work=tmp_path / f"{name}_work", progress=False)
+    model = read_fibrenet(net.write(tmp_path / name, name=name, run=run, output_freq=every))
+    result = run_fibrenet(model, out=tmp_path / f"{name}_out", work=tmp_path / f"{name}_work", progress=False)
     got = _dump_frames(result.job.folder)
     want = ref.simulate(net.system(), net.state(), run, every)
     assert [g[0] for g in got] == [w.step for w in want]

@@ -8,7 +8,8 @@ significant digits (restart).
 import numpy as np
 import pytest
 
-from fibrelmp import api
+from fibrelmp.pipeline.fibrenet import run_fibrenet
+from fibrelmp.translate.fibrenet.reader import read as read_fibrenet
 from fibrelmp.translate.fibrenet.writer import XYZ_SUFFIX, read_restart, read_xyz
 
 from .conftest import data_path
@@ -21,9 +22,9 @@ TOL = {"position": 2e-5, "velocity": 3e-5, "force": 1e-3}
 @pytest.mark.parametrize("case", CASES)
 def test_matches_real_fibrenet(case, tmp_path):
     folder = data_path("real-outputs", "fibrenet", case)
-    model = api.read_input(folder / "input.txt")
+    model = read_fibrenet(folder / "input.txt")
     base = model.plan.output.basename
-    api.run(model, out=tmp_path, progress=False)
+    run_fibrenet(model, out=tmp_path, progress=False)
     for field, suffix in XYZ_SUFFIX.items():
         mine, ref = read_xyz(tmp_path / f"{base}{suffix}"), read_xyz(folder / f"{base}{suffix}")
         assert [f.step for f in mine] == [f.step for f in ref]

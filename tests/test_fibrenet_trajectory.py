@@ -1,4 +1,4 @@
-"""A small damped fibre network run through ``fibrelmp.api.run`` against the reference
+"""A small damped fibre network run through ``fibrelmp.pipeline.fibrenet.run_fibrenet`` against the reference
 integrator (tests/fibrenet_reference.py, FibreNet's modified velocity-Verlet).
 
 Compared frame by frame: the full-precision LAMMPS dump (``<work>/frames.dump``) to 1e-6 in
@@ -12,7 +12,8 @@ import math
 import numpy as np
 import pytest
 
-from fibrelmp import api
+from fibrelmp.pipeline.fibrenet import run_fibrenet
+from fibrelmp.translate.fibrenet.reader import read as read_fibrenet
 from fibrelmp.translate.fibrenet.writer import read_xyz
 from fibrelmp.post.lammps_dump.reader import iter_frames
 
@@ -77,10 +78,10 @@ def _dump(job_folder):
 
 
 def _compare(net: ref.Net, tmp_path, name: str, run=1000, every=250, floor=True, **minimize):
-    model = api.read_input(net.write(tmp_path / name, name=name, run=run, output_freq=every,
+    model = read_fibrenet(net.write(tmp_path / name, name=name, run=run, output_freq=every,
                                      **minimize))
     out, work = tmp_path / f"{name}_out", tmp_path / f"{name}_work"
-    api.run(model, out=out, work=work, progress=False)
+    run_fibrenet(model, out=out, work=work, progress=False)
     want = ref.simulate(net.system(), net.state(), run, every, **minimize)
     got = _dump(work)
     assert [g[0] for g in got] == [w.step for w in want] == list(range(0, run + 1, every))

@@ -141,7 +141,8 @@ def test_res_round_trip_last_and_chosen_frame(granular, tmp_path):
 def test_res_restores_a_fibrenet_run(tmp_path):
     """FibreNet run -> dump -> post --to res -> restart_file of a new FibreNet run: the new
     run starts from the converted state."""
-    from fibrelmp import api
+    from fibrelmp.pipeline.fibrenet import run_fibrenet
+    from fibrelmp.translate.fibrenet.reader import read as read_fibrenet
 
     from . import fibrenet_reference as ref
 
@@ -157,8 +158,8 @@ def test_res_restores_a_fibrenet_run(tmp_path):
         net.spring(a, b, 0.4, 800.0, tag=1)
     net.modif_bead("tag", 1, "velocity", 0.2, 0.1, 0.3)
     first = tmp_path / "first"
-    model = api.read_input(net.write(first, name="first", run=200, output_freq=100))
-    api.run(model, out=first / "out", work=first / "work", progress=False)
+    model = read_fibrenet(net.write(first, name="first", run=200, output_freq=100))
+    run_fibrenet(model, out=first / "out", work=first / "work", progress=False)
     post(first / "work" / "frames.dump", "res", first / "conv", data=first / "work" / "data.lammps")
     names, state = read_restart(first / "conv_restart.res")
     assert names == ["B" if k % 2 == 0 else "A" for k in range(8)]
@@ -166,9 +167,9 @@ def test_res_restores_a_fibrenet_run(tmp_path):
     second = tmp_path / "second"
     second.mkdir()
     (second / "prev_restart.res").write_text((first / "conv_restart.res").read_text())
-    model2 = api.read_input(net.write(second, name="second", run=10, output_freq=10,
+    model2 = read_fibrenet(net.write(second, name="second", run=10, output_freq=10,
                                       extra=("restart_file\tprev_restart.res", "restart_data\tall")))
-    api.run(model2, out=second / "out", work=second / "work", progress=False)
+    run_fibrenet(model2, out=second / "out", work=second / "work", progress=False)
     start = read_xyz(second / "out" / "second_coord.xyz")[0]
     np.testing.assert_allclose(start.values, state[:, 0:3], rtol=0, atol=1e-5)
     last = dump_frames(first / "work" / "frames.dump")[-1]

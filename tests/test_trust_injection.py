@@ -253,10 +253,10 @@ def test_template_environment_prints_numbers_and_safe_fragments():
 
 
 def _hostile_fibrenet_model(tmp_path):
-    from fibrelmp import api
+    from fibrelmp.translate.fibrenet.reader import read as read_fibrenet
 
     inp = _fibrenet_case(tmp_path / "in", "input.txt")
-    model = api.read_input(inp)
+    model = read_fibrenet(inp)
     model.source = tmp_path / HOSTILE
     model.particles.type_names = [HOSTILE + str(k) for k in range(len(model.particles.type_names))]
     return model
@@ -276,7 +276,7 @@ def test_rendered_granular_job_with_hostile_names_is_safe(tmp_path, monkeypatch)
     wall-particle type names are rendered too."""
     from fibrelmp.translate import granular_job
     from fibrelmp.translate.musen import scene as musen
-    from fibrelmp.granular_api import bare_scene_settings
+    from fibrelmp.pipeline.inputs.musen import bare_scene_settings
 
     scene = _musen_scene(tmp_path, "scene.txt")
     model = musen.read(scene)

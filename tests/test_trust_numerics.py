@@ -14,7 +14,8 @@ import warnings
 import numpy as np
 import pytest
 
-from fibrelmp import api
+from fibrelmp.pipeline.fibrenet import run_fibrenet
+from fibrelmp.translate.fibrenet.reader import read as read_fibrenet
 from fibrelmp.errors import InputError, RunError
 from fibrelmp.post import to_fibrenet
 from fibrelmp.post.lammps_dump.reader import Frame, iter_frames
@@ -300,7 +301,7 @@ def test_fibrenet_spring_longer_than_half_the_periodic_box_is_refused(tmp_path):
     the nearest image (length 4: force 200).  Refused with the model line."""
     path = _fibrenet_case(tmp_path, _bead(1.0) + _bead(7.0, tag=2) + "SPRING\tHR\t0\t0\t1\t6.0\t100\n")
     with pytest.raises(InputError) as info:
-        api.read_input(path)
+        read_fibrenet(path)
     msg = str(info.value)
     assert "model.txt:3:" in msg and "beads 0 and 1" in msg and "nearest periodic image (length 4)" in msg
 
@@ -309,13 +310,13 @@ def test_fibrenet_angle_leg_longer_than_half_the_box_is_refused(tmp_path):
     model = (_bead(1.0) + _bead(2.0) + _bead(2.0, y=7.5) + "SPRING\tHR\t0\t0\t1\t1.0\t100\n"
              + "ANGLE\tHR\t0\t0\t1\t2\t0\t0\t1.5708\t10\n")
     with pytest.raises(InputError, match=r"model.txt:5: ANGLE: the angle leg between beads 1 and 2"):
-        api.read_input(_fibrenet_case(tmp_path, model))
+        read_fibrenet(_fibrenet_case(tmp_path, model))
 
 
 def test_fibrenet_long_spring_in_a_finite_box_is_fine(tmp_path):
     path = _fibrenet_case(tmp_path, _bead(1.0) + _bead(7.0, tag=2) + "SPRING\tHR\t0\t0\t1\t6.0\t100\n",
                           FN_INPUT.replace("box_type pbc", "box_type finite"))
-    assert api.read_input(path).bonds.count == 1
+    assert read_fibrenet(path).bonds.count == 1
 
 
 # ---------------------------------------------------------------------------------------
@@ -361,9 +362,9 @@ def test_fibrenet_run_warns_when_a_bead_is_pressed_into_a_wall(tmp_path):
            .replace("output_freq 10", "output_freq 100")
            + "modif_bead id 0 velocity -20 0 0\n")
     path = _fibrenet_case(tmp_path, model, inp)
-    m = api.read_input(path)
+    m = read_fibrenet(path)
     said = len(m.warnings)
-    api.run(m, out=tmp_path / "out", progress=False)   # run warnings join the model's (the CLI prints them)
+    run_fibrenet(m, out=tmp_path / "out", progress=False)   # run warnings join the model's (the CLI prints them)
     assert any("outside the finite box" in text for _, text in m.warnings[said:]), m.warnings
     import subprocess
     import sys

@@ -1,29 +1,22 @@
-"""Run a GranularModel on LAMMPS and stream every saved frame as a ``GranularFrame``.
+"""Granular frames: a ``GranularFrame`` per saved step, built from a running job's dumps.
 
-The job is rendered to disk (``translate.granular_job``) and executed line by line by
-``runner.run_script``, so ``lmp -in in.lammps`` replays it identically.  Each saved frame is
-read back from the dumps as soon as LAMMPS has written it and handed to ``on_frame``; only
-one frame (plus per-bond/per-sphere end times) is held in memory.
-
-MPI: LAMMPS runs on every rank; the job files, the frame conversion and ``on_frame`` happen on
-rank 0 only (other ranks render the same script text in memory and hand it to the runner).
+The job (``translate.granular_job``) dumps the spheres, the alive bonds (a local dump) and the
+wall tiles at every saved step, and appends every bond break to ``breaks.dump``.  A
+``FrameBuilder`` reads them back (``post.lammps_dump``'s reader, local dumps included) as
+soon as LAMMPS has written them and keeps only one frame plus the per-bond/per-sphere end
+times in memory.  It is the pipeline's frame source for granular jobs.
 """
 
 from __future__ import annotations
 
-import os
-from itertools import islice
 from pathlib import Path
-from typing import Callable, Iterator
 
 import numpy as np
 
-from fibrelmp.errors import InputError, RunError
 from fibrelmp.granmodel import GranularFrame, GranularModel
+from fibrelmp.pipeline.run import wrong_frame
 from fibrelmp.post.lammps_dump.reader import iter_frames
-from fibrelmp._lammps import mpi_barrier
-from fibrelmp.runner import mpi_rank_size, run_script
-from fibrelmp.translate.granular_job import GranularJob, build_granular_job, write_granular_job
+from fibrelmp.translate.granular_job import GranularJob
 from fibrelmp.translate.granular_walls import nearest_triangle
 
 
@@ -34,25 +27,6 @@ def quat_multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     w = w1 * w2 - (v1 * v2).sum(1, keepdims=True)
     v = w1 * v2 + w2 * v1 + np.cross(v1, v2)
     return np.hstack([w, v])
-
-
-def iter_local(path: Path) -> Iterator[tuple[int, dict[str, np.ndarray]]]:
-    """Frames of a LAMMPS local dump (``write_dump ... local``): (step, columns)."""
-    with open(path, "rb") as fh:
-        while True:
-            line = fh.readline()
-            if not line:
-                return
-            if not line.strip():
-                continue
-            header = list(islice(fh, 8))
-            if not line.startswith(b"ITEM: TIMESTEP") or len(header) < 8:
-                raise InputError(path, None, "malformed local dump")
-            step, n = int(header[0]), int(header[2])
-            names = [w.decode() for w in header[7].split()[2:]]
-            rows = list(islice(fh, n))
-            data = np.array(b" ".join(rows).split(), dtype=np.float64).reshape(n, len(names))
-            yield step, {name: data[:, k] for k, name in enumerate(names)}
 
 
 class _BreakLog:
@@ -94,7 +68,7 @@ class FrameBuilder:
         sp = model.spheres
         self.q0 = np.asarray(sp.quaternion, float)
         self.frames = iter_frames(job.frames)
-        self.bonds = iter_local(job.bond_dump) if job.bond_dump is not None else None
+        self.bonds = iter_frames(job.bond_dump) if job.bond_dump is not None else None
         self.tiles = iter_frames(job.tile_dump) if job.tile_dump is not None else None
         self.breaks = _BreakLog(job.breaks)
         self.sphere_end = np.full(sp.count, np.inf)
@@ -137,12 +111,16 @@ class FrameBuilder:
         ok = self.bkeys[pos] == key if len(self.bkeys) else np.zeros(len(key), bool)
         return np.where(ok, self.brows[pos], -1)
 
-    def next(self, step: int) -> GranularFrame:
+    def is_frame(self, words: list[str]) -> bool:
+        """The sphere dump's ``write_dump`` saves a frame (bonds and walls are dumped with it)."""
+        return words[:3] == ["write_dump", "spheres", "custom"]
+
+    def read(self, step: int) -> GranularFrame:
         job = self.job
         t = job.t_start + step * job.dt
-        f = next(self.frames)
-        if f.step != step:
-            raise RunError(f"{job.frames}: expected frame at step {step}, found step {f.step}")
+        f = next(self.frames, None)
+        if f is None or f.step != step:
+            raise wrong_frame(job.frames, step, None if f is None else f.step)
         c = f.columns
         rows = c["id"].astype(np.int64) - 1
         pos = np.column_stack([c["x"], c["y"], c["z"]])
@@ -196,7 +174,7 @@ class FrameBuilder:
             frame.bond_end_time = self.bond_end.copy()
             bf = np.full((self.nb, 3), np.nan)
             # no bond dump when no bond survives the start (e.g. all left the domain at t = 0)
-            cols = next(self.bonds)[1] if self.bonds is not None else {}
+            cols = next(self.bonds).columns if self.bonds is not None else {}
             if len(cols.get("c_fl_bpair[1]", [])):
                 i1 = cols["c_fl_bpair[1]"].astype(np.int64)
                 i2 = cols["c_fl_bpair[2]"].astype(np.int64)
@@ -264,69 +242,6 @@ class FrameBuilder:
 
     def close(self) -> None:
         self.breaks.close()
-
-
-def run_granular(model: GranularModel, work: str | Path,
-                 on_frame: Callable[[GranularFrame], None], progress: bool = True,
-                 checkpoint_every: int | None = None, resume: bool = False) -> GranularJob:
-    """Translate ``model`` into ``work``, run it and call ``on_frame`` for every saved frame
-    (rank 0 only), in time order, as soon as LAMMPS has written it.  ``checkpoint_every`` /
-    ``resume``: see fibrelmp.checkpoint (a resumed run feeds the frames saved before the
-    checkpoint to ``on_frame`` again, from the dumps, so writers see every frame once)."""
-    from fibrelmp.api import prepare_checkpoints
-
-    work = Path(work).resolve()
-    rank, size = mpi_rank_size()
-    if rank == 0:
-        job = write_granular_job(model, work)
-        text = job.script.read_text()
-    else:
-        job, text, _ = build_granular_job(model, work)
-    dumps = [p for p in (job.frames, job.bond_dump, job.tile_dump, job.breaks) if p is not None]
-    if size > 1:
-        mpi_barrier()        # the data file is complete before any rank hashes it
-    checkpoints = prepare_checkpoints(work, text, checkpoint_every, resume,
-                                      [p.name for p in dumps], rank, [job.data])
-    if rank == 0 and not resume:
-        for p in dumps:
-            if p.exists():
-                p.unlink()
-    if rank != 0:       # the same script text; LAMMPS reads the data file on rank 0 only
-        run_script(job.script, job.total_steps, progress=False, text=text, checkpoints=checkpoints)
-        mpi_barrier()
-        return job
-
-    builder = FrameBuilder(model, job)
-    steps = iter(job.save_steps)
-    threaded = size == 1 and (os.cpu_count() or 1) > 1
-    try:
-        if not threaded:
-            def hook(words: list[str]) -> None:
-                if words[:3] == ["write_dump", "spheres", "custom"]:
-                    on_frame(builder.next(next(steps)))
-            run_script(job.script, job.total_steps, progress=progress, on_command=hook,
-                       checkpoints=checkpoints)
-        else:
-            _run_threaded(job, builder, steps, on_frame, progress, checkpoints)
-        missing = next(steps, None)
-        if missing is not None:     # never a result with frames silently missing
-            raise RunError(f"{job.script}: the run ended without the frame of step {missing} "
-                           f"({len(job.save_steps)} were scheduled)")
-    finally:
-        builder.close()
-    if size > 1:
-        mpi_barrier()
-    return job
-
-
-def _run_threaded(job, builder, steps, on_frame, progress, checkpoints=None) -> None:
-    """Convert frames on a second thread while LAMMPS computes the next ones."""
-    from fibrelmp.runner import run_overlapped
-
-    def consume(tokens) -> None:
-        for step in tokens:
-            on_frame(builder.next(step))
-
-    run_overlapped(job.script, job.total_steps,
-                   lambda words: next(steps) if words[:3] == ["write_dump", "spheres", "custom"] else None,
-                   consume, progress=progress, checkpoints=checkpoints)
+        for dump in (self.frames, self.bonds, self.tiles):
+            if dump is not None:
+                dump.close()

@@ -35,6 +35,12 @@ class FrameSpool:
         tmp.rename(self.folder / f"frame_{self.count:06d}.npz")
         self.count += 1
 
+    def close(self) -> None:
+        """Nothing to finish: every frame is on disk once added (a writer of the pipeline)."""
+
+    def abort(self) -> None:
+        """Kept until ``remove`` (the run plan's clean-up)."""
+
     def __len__(self) -> int:
         return self.count
 

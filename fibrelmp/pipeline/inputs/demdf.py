@@ -1,0 +1,75 @@
+"""DEMDF JSON documents (an input, or a snapshot to continue from)."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from fibrelmp.errors import InputError
+from fibrelmp.pipeline.inputs import InputFormat, RunSettings, Say, Warn
+
+if TYPE_CHECKING:
+    from fibrelmp.granmodel import GranularModel
+    from fibrelmp.outputs import Outputs
+    from fibrelmp.pipeline.request import RunOptions, RunPlan
+    from fibrelmp.translate.granular_job import GranularJob
+
+
+class DemdfInput(InputFormat):
+    name = "demdf"
+
+    def read(self, path: Path, settings: RunSettings = RunSettings()) -> "GranularModel":
+        """The document; ``settings``' --end-time, --steps and --save-step override its own."""
+        from fibrelmp.translate.demdf import reader as demdf
+
+        return demdf.read(path, time_end=settings.end_time, steps=settings.steps,
+                          save_every=settings.save_step)
+
+    def check_lines(self, path: Path, model: "GranularModel") -> list[str]:
+        from fibrelmp.granular_check import summary
+
+        folder = demdf_outputs(model)[1]
+        return summary(model) + [f"results      {folder / model.passthrough['demdf']['filename']}"
+                                 "_<n>.json (or in -o DIR)"]
+
+    def write_job(self, model: "GranularModel", folder: Path) -> "GranularJob":
+        from fibrelmp.translate.granular_job import write_granular_job
+
+        return write_granular_job(model, folder)
+
+    def plan(self, path: Path, settings: RunSettings, options: "RunOptions", say: Say,
+             warn: Warn) -> "RunPlan":
+        """Snapshots ``<filename>_<saveCount>.json`` next to the input (or in ``out``);
+        earlier snapshots of the same name are replaced, all of them, only with ``force``."""
+        from fibrelmp.pipeline.granular import granular_request
+        from fibrelmp.pipeline.request import RunPlan
+        from fibrelmp.translate.demdf.writer import DemdfSnapshotWriter
+
+        model = self.read(path, settings)
+        warn(model.warnings)
+        outputs, folder = demdf_outputs(model, settings.out, settings.work)
+        request = granular_request(model, outputs.work, lambda: [DemdfSnapshotWriter(model, folder)])
+        return RunPlan(outputs, [request], options)
+
+    def work_folder(self, path: Path, out: Path | None, work: Path | None) -> Path:
+        return Path(work) if work is not None else \
+            Path(out or Path(path).resolve().parent) / f"{Path(path).stem}_work"
+
+
+def demdf_outputs(model: "GranularModel", out: str | Path | None = None,
+                  work: str | Path | None = None) -> tuple["Outputs", Path]:
+    """Where a DEMDF run writes: ``<filename>_<n>.json`` in the input's folder (or ``-o``);
+    a ``filename`` that leaves that folder is refused."""
+    from fibrelmp.outputs import Outputs
+
+    info = model.passthrough["demdf"]
+    folder = (Path(out) if out is not None else Path(model.source).parent).resolve()
+    name = str(info["filename"])
+    if Path(name).is_absolute() or ".." in Path(name).parts or "/" in name or "\\" in name:
+        raise InputError(model.source, None, f"output filename {name!r} must be a plain file name: "
+                         f"snapshots are written into {folder}")
+    work_folder = (Path(work) if work is not None else folder / f"{Path(model.source).stem}_work").resolve()
+    inputs = [Path(model.source)] + ([Path(info["particles_file"])] if info.get("particles_file") else [])
+    pattern = re.compile(re.escape(name) + r"_\d+\.json")
+    return Outputs(Path(model.source), work_folder, patterns=[(folder, pattern)], inputs=inputs), folder

@@ -1,0 +1,75 @@
+"""FibreNet inputs (``input.txt`` with a ``model_file`` line)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from fibrelmp.pipeline.inputs import InputFormat, RunSettings, Say, Warn, no_overrides
+
+if TYPE_CHECKING:
+    from fibrelmp.model import Model
+    from fibrelmp.pipeline.request import RunOptions, RunPlan
+    from fibrelmp.textio import Patch
+    from fibrelmp.translate.lammps_job import Job
+
+
+class FibreNetInput(InputFormat):
+    name = "fibrenet"
+
+    def read(self, path: Path) -> "Model":
+        from fibrelmp.translate.fibrenet.reader import read
+
+        return read(path)
+
+    def check_patch(self, path: Path) -> "Patch":
+        from fibrelmp.translate.fibrenet.reader import check_patch
+
+        return check_patch(path)
+
+    def check_lines(self, path: Path, model: "Model") -> list[str]:
+        from fibrelmp.pipeline.fibrenet import fibrenet_outputs
+        from fibrelmp.sanity import spring_check, units_line
+
+        p = model.particles
+        lines = [f"input        {model.source}",
+                 units_line(model),
+                 f"beads        {p.count}",
+                 f"springs      {model.bonds.count}",
+                 f"angles       {model.angles.count}",
+                 f"types        {', '.join(p.type_names)}",
+                 "pairs        " + "; ".join(f"{law.kind} {p.type_names[law.type_i]}-{p.type_names[law.type_j]}"
+                                             for law in model.pairs),
+                 f"box          {' x '.join(f'{x:g}' for x in model.box.lengths)} "
+                 f"({'periodic' if all(model.box.periodic) else 'finite, wall k = %g' % model.box.wall_stiffness})",
+                 f"time step    {model.dynamics.dt:g}   lambda {model.dynamics.lambda_:g}   damping {model.dynamics.damping:g}"]
+        for st in model.plan.stages:
+            extra = f" in chunks of {st.chunk}" + (", velocities reset" if st.reset else "") if st.name == "relax" else \
+                f", output every {model.plan.output.every}"
+            lines.append(f"stage        {st.name}: {st.steps} steps{extra}")
+        lines += spring_check(model)
+        outputs = fibrenet_outputs(model)[0]
+        lines.append(f"results      {', '.join(str(p) for p in outputs.files)} (or in -o DIR)")
+        return lines
+
+    def write_job(self, model: "Model", folder: Path) -> "Job":
+        from fibrelmp.translate.lammps_job import write_job
+
+        return write_job(model, folder)
+
+    def plan(self, path: Path, settings: RunSettings, options: "RunOptions", say: Say,
+             warn: Warn) -> "RunPlan":
+        from fibrelmp.pipeline.fibrenet import fibrenet_plan
+
+        no_overrides(path, settings, "FibreNet inputs set their own steps: --end-time/--step/"
+                     "--save-step/--steps are for MUSEN and DEMDF inputs")
+        model = self.read(path)
+        warn(model.warnings)
+        return fibrenet_plan(model, settings.out, settings.work, options)
+
+    def work_folder(self, path: Path, out: Path | None, work: Path | None) -> Path:
+        from fibrelmp.pipeline.fibrenet import fibrenet_outputs
+
+        if work is not None:
+            return Path(work)
+        return fibrenet_outputs(self.read(path), out)[0].work

@@ -1,0 +1,148 @@
+"""MUSEN text scenes (and results), run as cmusen runs a scene after IMPORT_FROM_TEXT."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from fibrelmp.errors import InputError
+from fibrelmp.pipeline.inputs import InputFormat, RunSettings, Say, Warn
+
+if TYPE_CHECKING:
+    from fibrelmp.granmodel import GranularModel
+    from fibrelmp.pipeline.request import RunOptions, RunPlan
+    from fibrelmp.textio import Patch
+    from fibrelmp.translate.granular_job import GranularJob
+
+
+class SceneInput(InputFormat):
+    name = "musen"
+
+    def read(self, path: Path) -> "GranularModel":
+        """The scene with MUSEN's settings for a bare scene (``bare_scene_settings``)."""
+        return self.read_with(path, RunSettings())[0]
+
+    def read_with(self, path: Path, settings: RunSettings) -> tuple["GranularModel", list[str]]:
+        """The scene with the command line's settings, and what they set (to say)."""
+        from fibrelmp.translate.musen import scene as musen
+
+        if settings.steps is not None:
+            raise InputError(path, None, "--steps is for DEMDF inputs; a MUSEN scene takes --end-time")
+        model = musen.read(path)
+        return model, bare_scene_settings(model, settings.end_time, settings.step, settings.save_step)
+
+    def check_patch(self, path: Path) -> "Patch":
+        from fibrelmp.translate.musen.script import check_patch
+
+        return check_patch
+
+    def check_lines(self, path: Path, model: "GranularModel") -> list[str]:
+        from fibrelmp.granular_check import summary
+
+        where = musen_result_path(scene_result_path(Path(path).resolve()))[0]
+        return summary(model) + [f"results      {where} (or -o FILE)"]
+
+    def write_job(self, model: "GranularModel", folder: Path) -> "GranularJob":
+        from fibrelmp.translate.granular_job import write_granular_job
+
+        return write_granular_job(model, folder)
+
+    def plan(self, path: Path, settings: RunSettings, options: "RunOptions", say: Say,
+             warn: Warn) -> "RunPlan":
+        model, overrides = self.read_with(path, settings)
+        for text in overrides:
+            say(f"override: {text}")
+        warn(model.warnings)
+        return scene_plan(model, scene_result_path(path, settings.out), settings.work,
+                          settings.precision, options)
+
+    def work_folder(self, path: Path, out: Path | None, work: Path | None) -> Path:
+        return _work_folder(musen_result_path(scene_result_path(path, out))[0], work)
+
+
+def scene_plan(model: "GranularModel", result: str | Path, work: str | Path | None = None,
+               precision: int = 6, options: "RunOptions | None" = None) -> "RunPlan":
+    """The run of a MUSEN scene whose plan (step, end, saves) is set: one simulation, its
+    result in MUSEN text at ``result`` (a ``.mdem`` name becomes ``.txt``, with a note)."""
+    from fibrelmp.outputs import Outputs
+    from fibrelmp.pipeline.granular import granular_request
+    from fibrelmp.pipeline.request import RunOptions, RunPlan
+    from fibrelmp.translate.musen.writer import MusenResultWriter
+
+    check_musen_runnable(model)
+    target, note = musen_result_path(result)
+    target = target.resolve()
+    outputs = Outputs(Path(model.source), _work_folder(target, work), [target],
+                      inputs=[Path(model.source)])
+    request = granular_request(model, outputs.work,
+                               lambda: [MusenResultWriter(model, target, precision=precision)])
+    return RunPlan(outputs, [request], options or RunOptions(), notes=[note] if note else [])
+
+
+def _work_folder(target: Path, work: str | Path | None) -> Path:
+    return (Path(work) if work is not None else target.resolve().parent / f"{target.stem}_work").resolve()
+
+
+def scene_result_path(scene: str | Path, out: str | Path | None = None) -> Path:
+    """Where a bare MUSEN scene's result goes: ``out``, else ``<scene>_result.txt`` beside it."""
+    scene = Path(scene)
+    return Path(out) if out is not None else scene.with_name(f"{scene.stem}_result.txt")
+
+
+def musen_result_path(path: str | Path) -> tuple[Path, str | None]:
+    """MUSEN result name: a ``.mdem`` name becomes ``.txt`` (fibrelmp writes text only)."""
+    path = Path(path)
+    if path.suffix.lower() == ".mdem":
+        new = path.with_suffix(".txt")
+        return new, f"MUSEN binary results are not written: {path} becomes {new} (MUSEN text format)"
+    return path, None
+
+
+def check_musen_runnable(model: GranularModel) -> None:
+    if model.passthrough.get("liquid_bonds"):
+        raise InputError(model.source, None, "the scene has liquid bonds (type 13), which need a "
+                         "liquid-bridge model fibrelmp does not translate; remove them or export "
+                         "the scene without them")
+    plan = model.plan
+    for name, value in (("simulation step", plan.dt), ("end time", plan.t_end)):
+        if not math.isfinite(value) or value <= 0:
+            raise InputError(model.source, None, f"no {name}: MUSEN text scenes do not carry one; "
+                             "give it in a cmusen job script or with --step/--end-time/--save-step")
+    if plan.save_every_time is None and plan.save_every_steps is None:
+        raise InputError(model.source, None, "no saving step: give SAVING_STEP in the job script "
+                         "or --save-step")
+
+
+def bare_scene_settings(model: GranularModel, end_time: float | None, step: float | None,
+                        save_step: float | None) -> list[str]:
+    """Settings for a bare MUSEN scene, as cmusen would simulate it after IMPORT_FROM_TEXT:
+    Hertz-Mindlin particle-particle and particle-wall, elastic solid bonds (breakage on),
+    gravity (0, 0, -9.81); step, saving step and end time from the command line (MUSEN's
+    defaults 1e-6 s, 1e-3 s and 1 s, with a warning, when not given)."""
+    from fibrelmp.translate.musen.script import (MUSEN_DEFAULTS, SUPPORTED_MODELS, MusenJob,
+                                         MusenModelSpec, apply_simulator_settings)
+
+    for name, value in (("end-time", end_time), ("step", step), ("save-step", save_step)):
+        if value is not None and not value > 0:
+            raise InputError(model.source, None, f"--{name} must be positive, got {value:g}")
+    job = MusenJob(path=model.source, index=0, line=0, component="SIMULATOR",
+                   simulation_step=step or 0.0, saving_step=save_step or 0.0,
+                   end_time=end_time or 0.0, ext_accel=tuple(MUSEN_DEFAULTS["gravity"]))
+    job.models = [MusenModelSpec(name=SUPPORTED_MODELS["PP"], params="", kind="PP", line=0)]
+    if model.triangles is not None and model.triangles.count:
+        job.models.append(MusenModelSpec(name=SUPPORTED_MODELS["PW"], params="", kind="PW", line=0))
+    if model.bonds is not None and model.bonds.count:
+        job.models.append(MusenModelSpec(name=SUPPORTED_MODELS["SB"], params="", kind="SB", line=0))
+    apply_simulator_settings(model, job)
+    plan = model.plan
+    model.warnings = [(kind, f"no --step/--save-step/--end-time given: MUSEN's defaults are used "
+                              f"(step {plan.dt:g} s, saving step {plan.save_every_time:g} s, end "
+                              f"{plan.t_end:g} s)") if kind == "musen-default-settings" else (kind, text)
+                      for kind, text in model.warnings]
+    said = [f"models {', '.join(spec.name for spec in job.models)} (MUSEN's for a bare scene)",
+            "gravity 0 0 -9.81 m/s^2 (MUSEN's default)"]
+    for name, value in (("end time", end_time), ("simulation step", step), ("saving step", save_step)):
+        if value is not None:
+            said.append(f"{name} {value:g} s")
+    return said

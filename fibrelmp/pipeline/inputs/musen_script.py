@@ -1,0 +1,308 @@
+"""cmusen job scripts: IMPORT_FROM_TEXT, SIMULATOR and EXPORT_TO_TEXT jobs, run unchanged.
+
+The whole script is checked first (``plan_musen_script``: every scene read, every job's
+settings applied and its LAMMPS job built, every result located), then it becomes one
+``RunPlan``: a ``RunRequest`` per SIMULATOR job and an ``Action`` per import/export, whose
+results are locked together.  ``.mdem`` files produced by an earlier job are handles:
+IMPORT_FROM_TEXT keeps the scene in memory, SIMULATOR keeps its frames in an on-disk spool
+(``pipeline.spool``), and EXPORT_TO_TEXT writes them as MUSEN text.  A SIMULATOR result
+nobody exports is written as text next to its ``.mdem`` name (said as a note).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import partial
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from fibrelmp.errors import InputError
+from fibrelmp.granmodel import GranularModel
+from fibrelmp.pipeline.inputs import InputFormat, RunSettings, Say, Warn, no_overrides
+from fibrelmp.pipeline.inputs.musen import check_musen_runnable, musen_result_path
+
+if TYPE_CHECKING:
+    from fibrelmp.pipeline.request import RunOptions, RunPlan, Step
+    from fibrelmp.pipeline.spool import FrameSpool
+    from fibrelmp.textio import Patch
+    from fibrelmp.translate.granular_job import GranularJob
+
+
+class ScriptInput(InputFormat):
+    name = "musen-script"
+
+    def read(self, path: Path) -> "ScriptPlan":
+        """The checked plan of the script (``fibrelmp.read`` gives it for a script)."""
+        return plan_musen_script(path)
+
+    def model(self, path: Path) -> GranularModel:
+        """The scene of the first SIMULATOR job with that job's settings applied (after
+        checking every job of the script, as ``run`` does before it starts)."""
+        for step in plan_musen_script(path).steps:
+            if step.kind == "simulate":
+                return step.model
+        raise InputError(path, None, "the script has no SIMULATOR job")
+
+    def check_patch(self, path: Path) -> "Patch":
+        from fibrelmp.translate.musen.script import check_patch
+
+        return check_patch
+
+    def check_lines(self, path: Path, model: GranularModel) -> list[str]:
+        from fibrelmp.granular_check import summary
+
+        written = [str(st.written) for st in plan_musen_script(path).steps if st.written is not None]
+        return summary(model) + [f"results      {', '.join(written) or 'none (the script exports nothing)'}"]
+
+    def write_job(self, model: GranularModel, folder: Path) -> "GranularJob":
+        from fibrelmp.translate.granular_job import write_granular_job
+
+        return write_granular_job(model, folder)
+
+    def plan(self, path: Path, settings: RunSettings, options: "RunOptions", say: Say,
+             warn: Warn) -> "RunPlan":
+        from fibrelmp.outputs import Outputs
+        from fibrelmp.pipeline.request import Action, RunPlan
+
+        no_overrides(path, settings, "a cmusen job script sets END_TIME, SIMULATION_STEP and "
+                     "SAVING_STEP itself; edit the script instead")
+        plan = plan_musen_script(path, settings.out)
+        work = self.work_folder(plan.script, settings.out, settings.work).resolve()
+        files = [st.written for st in plan.steps if st.written is not None]
+        outputs = Outputs(plan.script, work, list(dict.fromkeys(files)), inputs=plan.inputs)
+        spools: dict[Path, "FrameSpool"] = {}
+        steps: list["Step"] = []
+        for st in plan.steps:
+            if st.kind == "simulate":
+                steps.append(Action(partial(_announce, st, say, warn)))
+                steps.append(_simulation(st, work / f"job{st.job.index}", spools))
+            else:
+                steps.append(Action(partial(_import if st.kind == "import" else _export, st, spools, say)))
+
+        def remove_spools() -> None:
+            for spool in spools.values():
+                spool.remove()
+        return RunPlan(outputs, steps, options, notes=[n for st in plan.steps for n in st.notes],
+                       cleanup=[remove_spools])
+
+    def work_folder(self, path: Path, out: Path | None, work: Path | None) -> Path:
+        return Path(work) if work is not None else \
+            Path(out or Path(path).resolve().parent) / f"{Path(path).stem}_work"
+
+
+def _announce(step: "ScriptStep", say: Say, warn: Warn, rank0: bool) -> list[Path]:
+    warn(step.model.warnings)
+    say(f"job {step.job.index}: simulating {step.job.source_file} to t = {step.model.plan.t_end:g} s")
+    return []
+
+
+def _simulation(step: "ScriptStep", work: Path, spools: dict):
+    """A SIMULATOR job: its frames go to a spool (exported later) and/or its MUSEN result."""
+    from fibrelmp.pipeline.granular import granular_request
+    from fibrelmp.pipeline.spool import FrameSpool
+    from fibrelmp.translate.musen.writer import MusenResultWriter
+
+    def writers() -> list:
+        made: list = []
+        if step.spool:
+            spools[step.handle] = FrameSpool(work / "frames")
+            made.append(spools[step.handle])
+        if step.written is not None:
+            made.append(MusenResultWriter(step.model, step.written))
+        return made
+    return granular_request(step.model, work, writers)
+
+
+def _import(step: "ScriptStep", spools: dict, say: Say, rank0: bool) -> list[Path]:
+    job = step.job
+    say(f"job {job.index}: imported {job.source_file} ({step.model.spheres.count} spheres) as "
+        f"{job.result_file} (kept in memory)")
+    return []
+
+
+def _export(step: "ScriptStep", spools: dict, say: Say, rank0: bool) -> list[Path]:
+    """EXPORT_TO_TEXT: the spooled frames of an earlier simulation (or, for a scene that was
+    never simulated, its start state) as MUSEN text."""
+    from fibrelmp.pipeline.run import feed
+    from fibrelmp.translate.musen.writer import MusenResultWriter
+
+    job = step.job
+    written: list[Path] = []
+    if rank0:
+        spool = spools.get(step.source)
+        writer = MusenResultWriter(step.model, step.written, precision=job.precision,
+                                   time_interval=job.time_interval, selectors=job.text_export)
+        written = feed([writer])(iter(spool if spool is not None else [_initial_frame(step.model)]))
+    say(f"job {job.index}: exported {job.source_file} as {step.written.name}")
+    return written
+
+
+def _initial_frame(model: GranularModel):
+    """The model's start state as a frame (exporting a scene that was never simulated)."""
+    import numpy as np
+
+    from fibrelmp.granmodel import GranularFrame
+
+    s = model.spheres
+    t = model.plan.t_start
+    alive = (s.active_start <= t) & (s.active_end > t)
+    rows = np.flatnonzero(alive)
+    frame = GranularFrame(time=t, step=0, sphere_rows=rows, position=s.position[rows],
+                          velocity=s.velocity[rows], omega=s.omega[rows],
+                          force=np.zeros((rows.size, 3)), quaternion=s.quaternion[rows])
+    if model.bonds is not None:
+        b = model.bonds
+        frame.bond_alive = (b.active_start <= t) & (b.active_end > t)
+        frame.bond_end_time = np.where(frame.bond_alive, np.inf, b.active_end)
+        frame.bond_force = np.zeros((b.count, 3)) if b.force is None else b.force
+    if model.triangles is not None:
+        tr = model.triangles
+        frame.triangle_vertices = tr.vertices
+        frame.triangle_velocity = tr.velocity
+        frame.triangle_force = np.zeros((tr.count, 3))
+    return frame
+
+
+def _script_model(job, handles: dict, path_of) -> GranularModel:
+    """The scene a SIMULATOR job starts from (a copy): a handle made earlier, or a text scene."""
+    import copy
+
+    source = path_of(job.source_file, job, "SOURCE_FILE")
+    if source in handles:
+        kind, value = handles[source]
+        if kind == "result":
+            raise InputError(job.path, job.where("SOURCE_FILE"), f"{job.source_file} is a simulation "
+                             "result of an earlier job; continuing a result is not supported: "
+                             "simulate the scene with a later END_TIME instead")
+        return copy.deepcopy(value)
+    if source.suffix.lower() == ".mdem":
+        raise InputError(job.path, job.where("SOURCE_FILE"), f"{job.source_file}: no earlier job of "
+                         "this script produced this .mdem and fibrelmp cannot read binary MUSEN "
+                         "files: export it as text (COMPONENT EXPORT_TO_TEXT) or import a text scene "
+                         "first (COMPONENT IMPORT_FROM_TEXT)")
+    return _read_scene(source, job, "SOURCE_FILE")
+
+
+def _read_scene(source: Path, job, key: str) -> GranularModel:
+    """A text scene named by a script line: a missing file is reported at that line."""
+    from fibrelmp.translate.musen import scene as musen
+
+    if not source.exists():
+        raise InputError(job.path, job.where(key), f"{key} {source}: file not found")
+    return musen.read(source)
+
+
+def _path_resolver(script: Path):
+    base = script.resolve().parent
+
+    def path_of(name: str | None, job, key: str) -> Path:
+        if not name:
+            # no line: the job is named instead (and check's line patching stays quiet about it)
+            raise InputError(job.path, None, f"job {job.index} ({job.component}, line {job.line}) "
+                             f"has no '{key}'")
+        p = Path(name)
+        return (p if p.is_absolute() else base / p).resolve()
+    return path_of
+
+
+@dataclass
+class ScriptStep:
+    """One job of a cmusen script, resolved and checked before anything runs."""
+    job: object                          # MusenJob
+    kind: str                            # "import" | "simulate" | "export"
+    handle: Path | None = None           # the .mdem name it makes (import/simulate)
+    source: Path | None = None           # the handle it reads (export)
+    model: GranularModel | None = None   # import: the scene; simulate: scene + settings
+    written: Path | None = None          # the MUSEN text file it writes, if any
+    spool: bool = False                  # simulate: keep the frames for a later export
+    notes: list[str] = field(default_factory=list)
+
+
+@dataclass
+class ScriptPlan:
+    script: Path
+    steps: list[ScriptStep]
+    inputs: list[Path]                   # the script and every text scene it reads
+
+
+def plan_musen_script(path: str | Path, out: str | Path | None = None) -> ScriptPlan:
+    """Check every job of a cmusen script before any of them runs: scenes read, settings
+    applied, the LAMMPS job of every simulation built (in memory), every result located.
+
+    Results go where RESULT_FILE says (relative to the script), or with ``out`` into that
+    folder under their relative RESULT_FILE names (an absolute or ``..`` name is refused)."""
+    from fibrelmp.textio import patched_reading
+    from fibrelmp.translate.granular_job import build_granular_job
+    from fibrelmp.translate.musen.script import apply_simulator_settings, read_script
+
+    script = Path(path).resolve()
+    jobs = read_script(Path(path))          # messages name the script as the user did
+    path_of = _path_resolver(script)
+    out_folder = Path(out).resolve() if out is not None else None
+
+    def written_path(job) -> tuple[Path, str | None]:
+        name = job.result_file
+        if out_folder is None:
+            return musen_result_path(path_of(name, job, "RESULT_FILE"))
+        if not name:
+            path_of(name, job, "RESULT_FILE")       # the usual message
+        rel = Path(name)
+        if rel.is_absolute() or ".." in rel.parts:
+            raise InputError(job.path, job.where("RESULT_FILE"), f"RESULT_FILE {name} cannot be "
+                             f"placed in -o {out_folder}: use a relative name without '..', or leave out -o")
+        return musen_result_path(out_folder / rel)
+
+    exported = {path_of(j.source_file, j, "SOURCE_FILE") for j in jobs
+                if j.component == "EXPORT_TO_TEXT" and j.source_file}
+    handles: dict[Path, tuple[str, GranularModel]] = {}
+    inputs: list[Path] = [script]
+    steps: list[ScriptStep] = []
+    for job in jobs:
+        if job.component == "IMPORT_FROM_TEXT":
+            source = path_of(job.source_file, job, "SOURCE_FILE")
+            model = _read_scene(source, job, "SOURCE_FILE")
+            inputs.append(source)
+            handle = path_of(job.result_file, job, "RESULT_FILE")
+            handles[handle] = ("scene", model)
+            steps.append(ScriptStep(job, "import", handle=handle, model=model))
+        elif job.component == "SIMULATOR":
+            source = path_of(job.source_file, job, "SOURCE_FILE")
+            if source not in handles and source.suffix.lower() != ".mdem":
+                inputs.append(source)
+            model = _script_model(job, handles, path_of)
+            apply_simulator_settings(model, job)
+            check_musen_runnable(model)
+            if not patched_reading():        # (check re-reading with placeholder values)
+                build_granular_job(model, script.parent)  # translation errors now, not mid-script
+            handle = path_of(job.result_file, job, "RESULT_FILE")
+            step = ScriptStep(job, "simulate", handle=handle, model=model, spool=handle in exported)
+            if not (handle.suffix.lower() == ".mdem" and handle in exported):
+                # nobody exports this result: it is written as MUSEN text right away
+                step.written, note = written_path(job)
+                if note:
+                    step.notes.append(note)
+            handles[handle] = ("result", model)
+            steps.append(step)
+        elif job.component == "EXPORT_TO_TEXT":
+            source = path_of(job.source_file, job, "SOURCE_FILE")
+            if source not in handles:
+                raise InputError(job.path, job.where("SOURCE_FILE"),
+                                 f"{job.source_file}: no earlier job of this script produced it"
+                                 + (" and fibrelmp cannot read binary MUSEN files"
+                                    if source.suffix.lower() == ".mdem" else ""))
+            step = ScriptStep(job, "export", source=source, model=handles[source][1])
+            step.written, note = written_path(job)
+            if note:
+                step.notes.append(note)
+            steps.append(step)
+        else:
+            raise InputError(job.path, job.where("COMPONENT"), f"COMPONENT {job.component} is "
+                             "not supported (fibrelmp runs SIMULATOR, IMPORT_FROM_TEXT and "
+                             "EXPORT_TO_TEXT jobs)")
+    inputs = list(dict.fromkeys(inputs))
+    for step in steps:
+        if step.written is not None and step.written in inputs:
+            raise InputError(step.job.path, step.job.where("RESULT_FILE"), f"RESULT_FILE "
+                             f"{step.job.result_file} is an input of this script ({step.written}): "
+                             "the result would overwrite it; choose another name")
+    return ScriptPlan(script, steps, inputs)

@@ -1,0 +1,110 @@
+"""What a run is made of: ``RunRequest`` (one LAMMPS simulation) and ``RunPlan`` (the
+requests of one input, with the import/export ``Action``\\ s of a cmusen script between them,
+and the outputs they lock together).
+
+The pieces are plain callables, so a request says *what* to run and the pipeline
+(``fibrelmp.pipeline.run``) alone decides *how*: rendering, checkpoints, the converter
+thread, frame scheduling, locking and finishing outputs.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Callable, Iterable, Iterator, Protocol, Union
+
+if TYPE_CHECKING:
+    from fibrelmp.granmodel import GranularModel
+    from fibrelmp.model import Model
+    from fibrelmp.outputs import Outputs
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """How to run (the same for every simulation of a plan)."""
+    progress: bool = True              # a progress bar on a terminal
+    force: bool = False                # replace the results of an earlier run
+    checkpoint_every: int | None = None   # steps between checkpoints (None: on signals only)
+    resume: bool = False               # continue from the checkpoint in the work folder
+
+
+@dataclass
+class Rendered:
+    """A job rendered for LAMMPS: ``job.script`` replays with ``lmp -in in.lammps``."""
+    job: Any                           # translate.lammps_job.Job or granular_job.GranularJob
+    text: str                          # the script (also on MPI ranks that wrote no file)
+    schedule: Iterable[int]            # the steps of the saved frames, in order (lazy)
+    dumps: list[Path]                  # files the script appends to (cut back on resume)
+
+    @property
+    def folder(self) -> Path:
+        return Path(self.job.folder)
+
+    @property
+    def script(self) -> Path:
+        return Path(self.job.script)
+
+    @property
+    def data(self) -> Path:
+        return Path(self.job.data)
+
+    @property
+    def total_steps(self) -> int:
+        return int(self.job.total_steps)
+
+
+class FrameSource(Protocol):
+    """Reads the saved frames back from a running job's dumps, one at a time, in order."""
+
+    def is_frame(self, words: list[str]) -> bool:
+        """Did this script command (split in words) write a frame?"""
+
+    def read(self, step: int) -> Any:
+        """The next frame, which must be the one of ``step`` (else a RunError)."""
+
+    def close(self) -> None:
+        """Release open files."""
+
+
+# the rendered-job builder: (job folder, write the files: rank 0) -> Rendered
+JobBuilder = Callable[[Path, bool], Rendered]
+# frames in, result files out: the writers are closed when the frames end, aborted on an error
+Consumer = Callable[[Iterator[Any]], list[Path]]
+
+
+@dataclass
+class RunRequest:
+    """One simulation: a neutral model, how to render and read it, and what its frames feed."""
+    model: "Model | GranularModel"
+    build: JobBuilder                                  # renders the LAMMPS job
+    frames: Callable[[Rendered], FrameSource]          # reads the frames the job saves
+    results: Callable[[Rendered], Consumer]            # the native writers (rank 0 only)
+    work: Path                                         # the job folder
+
+
+@dataclass
+class Action:
+    """A step of a multi-job script that runs no simulation (cmusen import, export):
+    ``run(rank0)`` returns the result files it wrote."""
+    run: Callable[[bool], list[Path]]
+
+
+Step = Union[RunRequest, Action]
+
+
+@dataclass
+class RunPlan:
+    """Everything one input runs: its outputs (checked and locked together, before anything
+    runs) and its steps, in order."""
+    outputs: "Outputs"
+    steps: list[Step]
+    options: RunOptions = RunOptions()
+    notes: list[str] = field(default_factory=list)        # for the user (renamed results...)
+    cleanup: list[Callable[[], None]] = field(default_factory=list)   # run after, always
+
+
+@dataclass
+class Outcome:
+    """What a plan wrote, and the jobs it ran (their scripts and dumps stay in the work folder)."""
+    outputs: list[Path] = field(default_factory=list)
+    jobs: list[Rendered] = field(default_factory=list)

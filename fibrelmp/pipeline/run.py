@@ -1,0 +1,220 @@
+"""The one run pipeline: every input (FibreNet, MUSEN scene, cmusen script, DEMDF) runs here.
+
+``run(plan)`` locks the plan's outputs, then for each simulation: renders the job to disk on
+rank 0 (the LAMMPS script first: ``lmp -in in.lammps`` replays it), prepares checkpoints (or
+resumes), runs LAMMPS serially or with the frame conversion overlapped on a second core,
+feeds every saved frame to the result writers (closed on success, aborted on any failure)
+and checks the frame schedule (a missing or extra frame is a RunError, never a silently
+wrong result).  Finally it removes earlier results this run did not write again.
+
+MPI: LAMMPS runs on every rank; files, frames and writers are rank 0's.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any, Callable, Iterator
+
+from fibrelmp.errors import InputError, RunError
+from fibrelmp.pipeline.request import (Action, Consumer, Outcome, Rendered, RunOptions, RunPlan,
+                                       RunRequest)
+
+Warn = Callable[[list[tuple[str, str]]], None]
+_EXTRA = object()            # the token of a frame beyond the schedule
+
+
+def run(plan: RunPlan, warn: Warn | None = None) -> Outcome:
+    """Run every step of ``plan``; ``warn`` receives the warnings each simulation adds to
+    its model while it is translated and run."""
+    from fibrelmp.outputs import finish, locked
+    from fibrelmp.runner import mpi_rank_size
+
+    rank, size = mpi_rank_size()
+    options = plan.options
+    if options.resume and not has_checkpoint(plan.outputs.work):
+        raise InputError(plan.outputs.source, None, "no checkpoint to resume from (run without "
+                         "--resume, or give the same --work folder as the interrupted run)")
+    outcome = Outcome()
+    # resuming continues this run's own (locked) work: its partial results are not "earlier" ones
+    with locked(plan.outputs, options.force or options.resume, rank):
+        try:
+            for step in plan.steps:
+                if isinstance(step, Action):
+                    outcome.outputs += step.run(rank == 0)
+                    continue
+                said = len(step.model.warnings)
+                rendered, written = simulate(step, options, rank, size)
+                outcome.jobs.append(rendered)
+                outcome.outputs += written
+                if warn is not None and step.model.warnings[said:]:
+                    warn(step.model.warnings[said:])    # found while translating or running
+            if rank == 0:
+                finish(plan.outputs, outcome.outputs)
+        finally:
+            for cleanup in plan.cleanup:
+                cleanup()
+    return outcome
+
+
+def has_checkpoint(work: Path) -> bool:
+    """Is there a checkpoint in the work folder (a cmusen script's: in a job's sub-folder)?"""
+    from fibrelmp.checkpoint import STATE
+
+    work = Path(work)
+    return work.is_dir() and next(work.rglob(STATE), None) is not None
+
+
+def simulate(request: RunRequest, options: RunOptions, rank: int = 0,
+             size: int = 1) -> tuple[Rendered, list[Path]]:
+    """Render, run and convert one simulation; (the rendered job, the result files)."""
+    from fibrelmp._lammps import mpi_barrier
+    from fibrelmp.checkpoint import STATE
+    from fibrelmp.runner import run_script
+
+    # every rank renders identically; only rank 0 writes the job files
+    rendered = request.build(Path(request.work).resolve(), rank == 0)
+    if size > 1:
+        mpi_barrier()        # the data file is complete before any rank hashes it
+    # a cmusen script resumes the simulation that was interrupted; finished ones run again
+    resume = options.resume and (rendered.folder / STATE).exists()
+    checkpoints = prepare_checkpoints(rendered.folder, rendered.text, options.checkpoint_every,
+                                      resume, [p.name for p in rendered.dumps], rank, [rendered.data])
+    if rank == 0 and not resume:
+        for dump in rendered.dumps:
+            dump.unlink(missing_ok=True)
+    if rank != 0:            # the same script text; LAMMPS reads the data file on rank 0 only
+        run_script(rendered.script, rendered.total_steps, progress=False, text=rendered.text,
+                   checkpoints=checkpoints)
+        mpi_barrier()
+        return rendered, []
+
+    source = request.frames(rendered)
+    try:
+        consume = request.results(rendered)
+        schedule = iter(rendered.schedule)
+
+        def token(words: list[str]) -> Any:
+            return next(schedule, _EXTRA) if source.is_frame(words) else None
+
+        def convert(tokens: Iterator[Any]) -> list[Path]:
+            return consume(_scheduled(tokens, source, schedule, rendered))
+
+        if size == 1 and (os.cpu_count() or 1) > 1:
+            from fibrelmp.runner import run_overlapped
+
+            # convert each frame on a second core while LAMMPS computes the next ones (the
+            # lammps module releases the GIL inside the library)
+            written = run_overlapped(rendered.script, rendered.total_steps, token, convert,
+                                     progress=options.progress, checkpoints=checkpoints)
+        else:
+            written = _run_serial(rendered, token, convert, options.progress, checkpoints)
+    finally:
+        source.close()
+    if size > 1:
+        mpi_barrier()
+    return rendered, list(written)
+
+
+def _run_serial(rendered: Rendered, token: Callable, convert: Consumer, progress: bool,
+                checkpoints) -> list[Path]:
+    """Run LAMMPS to the end, then convert the frames it saved (MPI, or a single core)."""
+    from fibrelmp.runner import RunAborted, run_script
+
+    tokens: list[Any] = []
+
+    def hook(words: list[str]) -> None:
+        t = token(words)
+        if t is not None:
+            tokens.append(t)
+
+    def aborted() -> Iterator[Any]:
+        raise RunAborted()
+        yield
+
+    try:
+        run_script(rendered.script, rendered.total_steps, progress=progress, on_command=hook,
+                   text=rendered.text, checkpoints=checkpoints)
+    except BaseException:
+        try:
+            convert(aborted())      # the writers discard what they staged
+        except RunAborted:
+            pass
+        raise
+    return convert(iter(tokens))
+
+
+def _scheduled(tokens: Iterator[Any], source, schedule: Iterator[int], rendered: Rendered) -> Iterator[Any]:
+    """The frames of ``tokens``, checked against the job's schedule: a frame the schedule
+    does not have, or one it has but the run did not write, is a RunError (raised inside the
+    writers' loop, so they discard their partial results)."""
+    for step in tokens:
+        if step is _EXTRA:
+            raise RunError(f"{rendered.script}: the run wrote more frames than the "
+                           f"{_count(rendered.schedule)} scheduled")
+        yield source.read(step)
+    missing = next(schedule, None)
+    if missing is not None:
+        raise RunError(f"{rendered.script}: the run ended without the frame of step {missing} "
+                       f"({_count(rendered.schedule)} were scheduled)")
+
+
+def _count(schedule) -> str:
+    try:
+        return str(len(schedule))
+    except TypeError:
+        return "frames"
+
+
+def wrong_frame(path: Path, step: int, found: int | None) -> RunError:
+    """The error of a frame source that found another frame (or none) than the scheduled one."""
+    what = "no more frames" if found is None else f"step {found}"
+    return RunError(f"{path}: expected the frame of step {step}, found {what}")
+
+
+def prepare_checkpoints(folder: Path, text: str, every: int | None, resume: bool,
+                        appended: list[str], rank: int, inputs: list[Path] = ()):
+    """Checkpointing for a job (always on: a SIGTERM/Ctrl-C leaves a checkpoint behind);
+    when resuming, load the state (refused when the script or any of ``inputs``, the files
+    the job reads, changed) and cut the dumps back to the checkpoint."""
+    from fibrelmp.checkpoint import Checkpointing, check_every, load, truncate_outputs
+
+    check_every(every)
+    state = load(folder, text, inputs) if resume else None
+    if state is not None and rank == 0:
+        truncate_outputs(folder, state)
+    return Checkpointing(Path(folder), every, state, list(appended), list(inputs))
+
+
+def feed(writers: list) -> Consumer:
+    """A consumer that adds every frame to each writer (``add``/``close``/``abort``): all are
+    closed when the frames end and aborted (their temp files removed) on any failure.  It
+    returns the files the writers report (``close()``'s paths, or their ``written`` list)."""
+    def consume(frames: Iterator[Any]) -> list[Path]:
+        try:
+            for frame in frames:
+                for writer in writers:
+                    writer.add(frame)
+        except BaseException:
+            for writer in writers:
+                writer.abort()
+            raise
+        written: list[Path] = []
+        for k, writer in enumerate(writers):
+            try:
+                done = writer.close()
+            except BaseException:
+                for rest in writers[k + 1:]:
+                    rest.abort()
+                raise
+            written += _files(writer, done)
+        return written
+    return consume
+
+
+def _files(writer, closed) -> list[Path]:
+    if isinstance(closed, (str, os.PathLike)):
+        return [Path(closed)]
+    if closed:
+        return [Path(p) for p in closed]
+    return [Path(p) for p in getattr(writer, "written", [])]

@@ -107,11 +107,11 @@ def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | N
         if warn is not None and items:
             warn(list(items))
 
-    if resume and not hook.has_checkpoint(path, out, work):
-        raise InputError(path, None, "no checkpoint to resume from (run without --resume, or "
-                         "give the same --work folder as the interrupted run)")
     settings = RunSettings(None if out is None else Path(out), None if work is None else Path(work),
                            end_time, step, save_step, steps, precision)
+    if resume and not hook.has_checkpoint(path, settings.out, settings.work):    # before reading
+        raise InputError(path, None, "no checkpoint to resume from (run without --resume, or "
+                         "give the same --work folder as the interrupted run)")
     plan = hook.plan(path, settings, RunOptions(progress, force, checkpoint_every, resume), say, warned)
     outcome = run_plan(plan, warn=warned)
     result.outputs, result.notes = outcome.outputs, list(plan.notes)

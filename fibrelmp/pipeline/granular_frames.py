@@ -154,42 +154,48 @@ class FrameBuilder:
         frame = GranularFrame(time=t, step=step, sphere_rows=rows, position=pos, velocity=vel,
                               omega=omega, force=force, quaternion=quat)
         if self.nb:
-            broken = np.array(self.breaks.upto(step), np.int64).reshape(-1, 3)
-            if len(broken):
-                broken = broken[np.argsort(broken[:, 0], kind="stable")]
-                r = self._bond_lookup(broken[:, 1], broken[:, 2])
-                ok = r >= 0
-                r, bsteps = r[ok], broken[ok, 0]
-                r, first = np.unique(r, return_index=True)     # earliest record per bond (MPI
-                bsteps = bsteps[first]                          # ranks may both report it)
-                live = self.bond_alive[r]
-                self.bond_alive[r[live]] = False
-                self.bond_end[r[live]] = job.t_start + bsteps[live] * job.dt
-            pair = self.model.bonds.pair
-            end = np.minimum(self.sphere_end[pair[:, 0]], self.sphere_end[pair[:, 1]])
-            dead = self.bond_alive & np.isfinite(end)
-            self.bond_alive[dead] = False
-            self.bond_end[dead] = end[dead]
-            frame.bond_alive = self.bond_alive.copy()
-            frame.bond_end_time = self.bond_end.copy()
-            bf = np.full((self.nb, 3), np.nan)
-            # no bond dump when no bond survives the start (e.g. all left the domain at t = 0)
-            cols = next(self.bonds).columns if self.bonds is not None else {}
-            if len(cols.get("c_fl_bpair[1]", [])):
-                i1 = cols["c_fl_bpair[1]"].astype(np.int64)
-                i2 = cols["c_fl_bpair[2]"].astype(np.int64)
-                fb = np.column_stack([cols[f"c_fl_bforce[{k}]"] for k in range(1, 4)])
-                br = self._bond_lookup(i1, i2)
-                ok = br >= 0
-                # b5..b7 is the force on batom1; report the force on the bond's first sphere
-                sign = np.where(i1[ok] == self.first_id[br[ok]], 1.0, -1.0)
-                bf[br[ok]] = fb[ok] * sign[:, None]
-            bf[~self.bond_alive] = 0.0
-            frame.bond_force = bf
+            self._bonds(frame, step)
         if self.v0 is not None:
             self._triangles(frame, t, c)
         self.prev_t, self.prev_x[rows], self.prev_v[rows] = t, pos, vel
         return frame
+
+    def _bonds(self, frame: GranularFrame, step: int) -> None:
+        """Bond states at ``step``: breaks logged since the last frame, bonds of removed
+        spheres ended, forces from the bond dump (zero for broken bonds)."""
+        job = self.job
+        broken = np.array(self.breaks.upto(step), np.int64).reshape(-1, 3)
+        if len(broken):
+            broken = broken[np.argsort(broken[:, 0], kind="stable")]
+            r = self._bond_lookup(broken[:, 1], broken[:, 2])
+            ok = r >= 0
+            r, bsteps = r[ok], broken[ok, 0]
+            r, first = np.unique(r, return_index=True)     # earliest record per bond (MPI
+            bsteps = bsteps[first]                          # ranks may both report it)
+            live = self.bond_alive[r]
+            self.bond_alive[r[live]] = False
+            self.bond_end[r[live]] = job.t_start + bsteps[live] * job.dt
+        pair = self.model.bonds.pair
+        end = np.minimum(self.sphere_end[pair[:, 0]], self.sphere_end[pair[:, 1]])
+        dead = self.bond_alive & np.isfinite(end)
+        self.bond_alive[dead] = False
+        self.bond_end[dead] = end[dead]
+        frame.bond_alive = self.bond_alive.copy()
+        frame.bond_end_time = self.bond_end.copy()
+        bf = np.full((self.nb, 3), np.nan)
+        # no bond dump when no bond survives the start (e.g. all left the domain at t = 0)
+        cols = next(self.bonds).columns if self.bonds is not None else {}
+        if len(cols.get("c_fl_bpair[1]", [])):
+            i1 = cols["c_fl_bpair[1]"].astype(np.int64)
+            i2 = cols["c_fl_bpair[2]"].astype(np.int64)
+            fb = np.column_stack([cols[f"c_fl_bforce[{k}]"] for k in range(1, 4)])
+            br = self._bond_lookup(i1, i2)
+            ok = br >= 0
+            # b5..b7 is the force on batom1; report the force on the bond's first sphere
+            sign = np.where(i1[ok] == self.first_id[br[ok]], 1.0, -1.0)
+            bf[br[ok]] = fb[ok] * sign[:, None]
+        bf[~self.bond_alive] = 0.0
+        frame.bond_force = bf
 
     def _exit_time(self, r: int, t: float) -> float:
         """Ballistic estimate of when sphere r crossed the domain, from the previous frame."""

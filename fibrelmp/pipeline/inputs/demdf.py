@@ -53,8 +53,14 @@ class DemdfInput(InputFormat):
         return RunPlan(outputs, [request], options)
 
     def work_folder(self, path: Path, out: Path | None, work: Path | None) -> Path:
-        return Path(work) if work is not None else \
-            Path(out or Path(path).resolve().parent) / f"{Path(path).stem}_work"
+        return _folders(path, out, work)[1]
+
+
+def _folders(source: str | Path, out: str | Path | None, work: str | Path | None) -> tuple[Path, Path]:
+    """(the snapshots' folder: the input's or ``out``; the work folder: ``work``, default
+    ``<input stem>_work`` in the snapshots' folder)."""
+    folder = (Path(out) if out is not None else Path(source).parent).resolve()
+    return folder, (Path(work) if work is not None else folder / f"{Path(source).stem}_work").resolve()
 
 
 def demdf_outputs(model: "GranularModel", out: str | Path | None = None,
@@ -64,12 +70,11 @@ def demdf_outputs(model: "GranularModel", out: str | Path | None = None,
     from fibrelmp.outputs import Outputs
 
     info = model.passthrough["demdf"]
-    folder = (Path(out) if out is not None else Path(model.source).parent).resolve()
+    folder, work_folder = _folders(model.source, out, work)
     name = str(info["filename"])
     if Path(name).is_absolute() or ".." in Path(name).parts or "/" in name or "\\" in name:
         raise InputError(model.source, None, f"output filename {name!r} must be a plain file name: "
                          f"snapshots are written into {folder}")
-    work_folder = (Path(work) if work is not None else folder / f"{Path(model.source).stem}_work").resolve()
     inputs = [Path(model.source)] + ([Path(info["particles_file"])] if info.get("particles_file") else [])
     pattern = re.compile(re.escape(name) + r"_\d+\.json")
     return Outputs(Path(model.source), work_folder, patterns=[(folder, pattern)], inputs=inputs), folder

@@ -231,78 +231,96 @@ def plan_musen_script(path: str | Path, out: str | Path | None = None) -> Script
 
     Results go where RESULT_FILE says (relative to the script), or with ``out`` into that
     folder under their relative RESULT_FILE names (an absolute or ``..`` name is refused)."""
-    from fibrelmp.textio import patched_reading
-    from fibrelmp.translate.granular_job import build_granular_job
-    from fibrelmp.translate.musen.script import apply_simulator_settings, read_script
+    from fibrelmp.translate.musen.script import read_script
 
-    script = Path(path).resolve()
     jobs = read_script(Path(path))          # messages name the script as the user did
-    path_of = _path_resolver(script)
-    out_folder = Path(out).resolve() if out is not None else None
-
-    def written_path(job) -> tuple[Path, str | None]:
-        name = job.result_file
-        if out_folder is None:
-            return musen_result_path(path_of(name, job, "RESULT_FILE"))
-        if not name:
-            path_of(name, job, "RESULT_FILE")       # the usual message
-        rel = Path(name)
-        if rel.is_absolute() or ".." in rel.parts:
-            raise InputError(job.path, job.where("RESULT_FILE"), f"RESULT_FILE {name} cannot be "
-                             f"placed in -o {out_folder}: use a relative name without '..', or leave out -o")
-        return musen_result_path(out_folder / rel)
-
-    exported = {path_of(j.source_file, j, "SOURCE_FILE") for j in jobs
-                if j.component == "EXPORT_TO_TEXT" and j.source_file}
-    handles: dict[Path, tuple[str, GranularModel]] = {}
-    inputs: list[Path] = [script]
-    steps: list[ScriptStep] = []
-    for job in jobs:
-        if job.component == "IMPORT_FROM_TEXT":
-            source = path_of(job.source_file, job, "SOURCE_FILE")
-            model = _read_scene(source, job, "SOURCE_FILE")
-            inputs.append(source)
-            handle = path_of(job.result_file, job, "RESULT_FILE")
-            handles[handle] = ("scene", model)
-            steps.append(ScriptStep(job, "import", handle=handle, model=model))
-        elif job.component == "SIMULATOR":
-            source = path_of(job.source_file, job, "SOURCE_FILE")
-            if source not in handles and source.suffix.lower() != ".mdem":
-                inputs.append(source)
-            model = _script_model(job, handles, path_of)
-            apply_simulator_settings(model, job)
-            check_musen_runnable(model)
-            if not patched_reading():        # (check re-reading with placeholder values)
-                build_granular_job(model, script.parent)  # translation errors now, not mid-script
-            handle = path_of(job.result_file, job, "RESULT_FILE")
-            step = ScriptStep(job, "simulate", handle=handle, model=model, spool=handle in exported)
-            if not (handle.suffix.lower() == ".mdem" and handle in exported):
-                # nobody exports this result: it is written as MUSEN text right away
-                step.written, note = written_path(job)
-                if note:
-                    step.notes.append(note)
-            handles[handle] = ("result", model)
-            steps.append(step)
-        elif job.component == "EXPORT_TO_TEXT":
-            source = path_of(job.source_file, job, "SOURCE_FILE")
-            if source not in handles:
-                raise InputError(job.path, job.where("SOURCE_FILE"),
-                                 f"{job.source_file}: no earlier job of this script produced it"
-                                 + (" and fibrelmp cannot read binary MUSEN files"
-                                    if source.suffix.lower() == ".mdem" else ""))
-            step = ScriptStep(job, "export", source=source, model=handles[source][1])
-            step.written, note = written_path(job)
-            if note:
-                step.notes.append(note)
-            steps.append(step)
-        else:
-            raise InputError(job.path, job.where("COMPONENT"), f"COMPONENT {job.component} is "
-                             "not supported (fibrelmp runs SIMULATOR, IMPORT_FROM_TEXT and "
-                             "EXPORT_TO_TEXT jobs)")
-    inputs = list(dict.fromkeys(inputs))
+    planner = _Planner(Path(path).resolve(), jobs, out)
+    steps = [planner.step(job) for job in jobs]
+    inputs = list(dict.fromkeys(planner.inputs))
     for step in steps:
         if step.written is not None and step.written in inputs:
             raise InputError(step.job.path, step.job.where("RESULT_FILE"), f"RESULT_FILE "
                              f"{step.job.result_file} is an input of this script ({step.written}): "
                              "the result would overwrite it; choose another name")
-    return ScriptPlan(script, steps, inputs)
+    return ScriptPlan(planner.script, steps, inputs)
+
+
+class _Planner:
+    """Plans the jobs of one script in order; ``handles`` are the .mdem names made so far."""
+
+    def __init__(self, script: Path, jobs: list, out: str | Path | None):
+        self.script = script
+        self.path_of = _path_resolver(script)
+        self.out = Path(out).resolve() if out is not None else None
+        self.exported = {self.path_of(j.source_file, j, "SOURCE_FILE") for j in jobs
+                         if j.component == "EXPORT_TO_TEXT" and j.source_file}
+        self.handles: dict[Path, tuple[str, GranularModel]] = {}
+        self.inputs: list[Path] = [script]
+
+    def step(self, job) -> ScriptStep:
+        if job.component == "IMPORT_FROM_TEXT":
+            return self.import_(job)
+        if job.component == "SIMULATOR":
+            return self.simulate(job)
+        if job.component == "EXPORT_TO_TEXT":
+            return self.export(job)
+        raise InputError(job.path, job.where("COMPONENT"), f"COMPONENT {job.component} is "
+                         "not supported (fibrelmp runs SIMULATOR, IMPORT_FROM_TEXT and "
+                         "EXPORT_TO_TEXT jobs)")
+
+    def import_(self, job) -> ScriptStep:
+        source = self.path_of(job.source_file, job, "SOURCE_FILE")
+        model = _read_scene(source, job, "SOURCE_FILE")
+        self.inputs.append(source)
+        handle = self.path_of(job.result_file, job, "RESULT_FILE")
+        self.handles[handle] = ("scene", model)
+        return ScriptStep(job, "import", handle=handle, model=model)
+
+    def simulate(self, job) -> ScriptStep:
+        from fibrelmp.textio import patched_reading
+        from fibrelmp.translate.granular_job import build_granular_job
+        from fibrelmp.translate.musen.script import apply_simulator_settings
+
+        source = self.path_of(job.source_file, job, "SOURCE_FILE")
+        if source not in self.handles and source.suffix.lower() != ".mdem":
+            self.inputs.append(source)
+        model = _script_model(job, self.handles, self.path_of)
+        apply_simulator_settings(model, job)
+        check_musen_runnable(model)
+        if not patched_reading():        # (check re-reading with placeholder values)
+            build_granular_job(model, self.script.parent)  # translation errors now, not mid-script
+        handle = self.path_of(job.result_file, job, "RESULT_FILE")
+        step = ScriptStep(job, "simulate", handle=handle, model=model, spool=handle in self.exported)
+        if not (handle.suffix.lower() == ".mdem" and handle in self.exported):
+            # nobody exports this result: it is written as MUSEN text right away
+            self.result(step)
+        self.handles[handle] = ("result", model)
+        return step
+
+    def export(self, job) -> ScriptStep:
+        source = self.path_of(job.source_file, job, "SOURCE_FILE")
+        if source not in self.handles:
+            raise InputError(job.path, job.where("SOURCE_FILE"),
+                             f"{job.source_file}: no earlier job of this script produced it"
+                             + (" and fibrelmp cannot read binary MUSEN files"
+                                if source.suffix.lower() == ".mdem" else ""))
+        step = ScriptStep(job, "export", source=source, model=self.handles[source][1])
+        self.result(step)
+        return step
+
+    def result(self, step: ScriptStep) -> None:
+        """Where the job's MUSEN text result goes (a renamed .mdem: with a note)."""
+        job = step.job
+        name = job.result_file
+        if self.out is None:
+            step.written, note = musen_result_path(self.path_of(name, job, "RESULT_FILE"))
+        else:
+            if not name:
+                self.path_of(name, job, "RESULT_FILE")       # the usual message
+            rel = Path(name)
+            if rel.is_absolute() or ".." in rel.parts:
+                raise InputError(job.path, job.where("RESULT_FILE"), f"RESULT_FILE {name} cannot be "
+                                 f"placed in -o {self.out}: use a relative name without '..', or leave out -o")
+            step.written, note = musen_result_path(self.out / rel)
+        if note:
+            step.notes.append(note)

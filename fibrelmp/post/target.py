@@ -74,13 +74,15 @@ class PostContext:
 @dataclass
 class ReadBack:
     """One frame of a target's output as read back (conformance tests): positions in dump
-    atom-id order, ``atol`` the format's printed precision; ``values`` other per-atom vectors
-    the format keeps (dump column names -> (n, k))."""
+    atom-id order, to within ``rtol``/``atol`` (the format's printed precision); ``values``
+    other per-atom vectors it keeps (dump column names -> (n, k)), to within ``value_tol``
+    ((rtol, atol); None: the positions')."""
 
     positions: np.ndarray
-    atol: float = 0.0
     rtol: float = 0.0
-    values: dict[str, np.ndarray] = field(default_factory=dict)
+    atol: float = 0.0
+    values: dict[tuple[str, ...], np.ndarray] = field(default_factory=dict)
+    value_tol: tuple[float, float] | None = None
 
 
 class DumpTarget(Writer):

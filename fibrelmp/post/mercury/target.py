@@ -69,7 +69,7 @@ class MercuryTarget(DumpTarget):
         out = []
         for f in read_data_file(data):
             if f.rows.shape[1] == 14:        # %.15g positions, %.10g the rest
-                out.append(ReadBack(f.rows[:, 0:3], rtol=1e-14,
+                out.append(ReadBack(f.rows[:, 0:3], rtol=1e-14, value_tol=(1e-9, 1e-300),
                                     values={("vx", "vy", "vz"): f.rows[:, 3:6], ("radius",): f.rows[:, 6:7]}))
             else:
                 out.append(ReadBack(np.column_stack([f.rows[:, 0:2], np.zeros(len(f.rows))]), rtol=1e-14))

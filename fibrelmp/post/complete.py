@@ -44,15 +44,31 @@ class Completer:
             self.warnings.append((key, text))
 
     def __call__(self, frame: Frame) -> Frame:
-        cols = dict(frame.columns)
-        n = frame.count
-        data = self.data
         if self.target_units is not None and frame.units is not None:
             from fibrelmp.units import mismatch_note
 
             note = mismatch_note(frame.units, self.target_units[1], self.target_units[0])
             if note is not None:
                 self._warn("units", f"{frame.source}: {note}")
+        cols = self._by_id(frame)
+        self._facts(frame, cols)
+        out = Frame(frame.step, frame.lo, frame.hi, frame.boundary, cols, frame.tilt, frame.time,
+                    frame.line, frame.units, frame.source)
+        self._positions(out)
+        if self.keep is not None:
+            codes = cols["type"].astype(np.int64)
+            mask = np.isin(codes, list(self.keep))
+            if not self.kept_any:
+                self.kept_any = bool(mask.any())
+                if not self.kept_any:
+                    self.present.update(np.unique(codes).tolist())
+            out = out.select(mask)
+        return out
+
+    def _by_id(self, frame: Frame) -> dict[str, np.ndarray]:
+        """The frame's columns with atoms in id order (numbered 1..N without ids)."""
+        cols = dict(frame.columns)
+        n = frame.count
         if "id" not in cols:
             cols["id"] = np.arange(1, n + 1, dtype=np.float64)
             self._warn("no ids", f"{frame.source}: the dump has no 'id' column; atoms are numbered "
@@ -66,9 +82,12 @@ class Completer:
             if len(twice):        # every writer keys atoms by id: two would be merged or doubled
                 raise InputError(frame.source, frame.line, f"atom id {ids[twice[0]]:.0f} appears "
                                  f"twice in the frame of step {frame.step}")
-        rows = None
-        if data is not None and n:
-            rows = data.rows(ids, "--data facts")
+        return cols
+
+    def _facts(self, frame: Frame, cols: dict[str, np.ndarray]) -> None:
+        """Types (numbered labels), radii and masses the dump lacks, from --data."""
+        n, data = frame.count, self.data
+        rows = data.rows(cols["id"], "--data facts") if data is not None and n else None
         if "type" not in cols:
             if rows is not None:
                 cols["type"] = data.types[rows].astype(np.float64)
@@ -91,8 +110,11 @@ class Completer:
                 cols["radius"] = data.radius[rows]
         if "mass" not in cols and rows is not None and data.mass is not None:
             cols["mass"] = data.mass[rows]
-        out = Frame(frame.step, frame.lo, frame.hi, frame.boundary, cols, frame.tilt, frame.time,
-                    frame.line, frame.units, frame.source)
+
+    @staticmethod
+    def _positions(out: Frame) -> None:
+        """Cartesian positions (x y z, else xu yu zu) in ``out``, all finite."""
+        cols = out.columns
         if not out.has("x", "y", "z"):
             x = out.positions()
             if x is not None:
@@ -107,18 +129,9 @@ class Completer:
                 bad = ~np.isfinite(out.vector(*names)).all(axis=1)
                 if bad.any():     # a blown-up run: no output format can hold these
                     k = int(np.flatnonzero(bad)[0])
-                    raise InputError(frame.source, frame.line, f"atom id {ids[k]:.0f} has position "
+                    raise InputError(out.source, out.line, f"atom id {cols['id'][k]:.0f} has position "
                                      f"{out.vector(*names)[k].tolist()} in the frame of step "
-                                     f"{frame.step} (did the simulation blow up?)")
-        if self.keep is not None:
-            codes = cols["type"].astype(np.int64)
-            mask = np.isin(codes, list(self.keep))
-            if not self.kept_any:
-                self.kept_any = bool(mask.any())
-                if not self.kept_any:
-                    self.present.update(np.unique(codes).tolist())
-            out = out.select(mask)
-        return out
+                                     f"{out.step} (did the simulation blow up?)")
 
     def check_types(self, source) -> None:
         """``--types`` selecting no atom of any frame read is an error, not empty frames."""

@@ -135,9 +135,9 @@ def wall_commands(model: GranularModel, wall_plans: list[WallPlan], spheres, dt:
     return wall_cmds, var_cmds, frame_columns
 
 
-def _region_wall(model, wp: WallPlan, tag: str, mat_groups, xs, smat, m_min, dt, wall_cmds,
-                 var_cmds, frame_columns) -> None:
-    """Region (+ wall/gran/region fixes).  LAMMPS places a dynamic region at
+def _region_motion(wp: WallPlan, tag: str, var_cmds) -> str:
+    """The move/rotate keywords of a region following its geometry (variables into
+    ``var_cmds``), "" for a static axis-aligned one.  LAMMPS places a dynamic region at
     P + R_n(theta) (x_region - P) + d: with the geometry's motion x = R(t) x0 + b(t) and a
     region frame E (x0 = P + E (x_region - P)), R_n(theta) = R(t) E and d = R(t) P + b - P."""
     sh = wp.shape
@@ -163,6 +163,17 @@ def _region_wall(model, wp: WallPlan, tag: str, mat_groups, xs, smat, m_min, dt,
                 f"{float_text(n[0])} {float_text(n[1])} {float_text(n[2])}")
     if dyn:
         dyn += " units box"
+    return dyn
+
+
+def _region_wall(model, wp: WallPlan, tag: str, mat_groups, xs, smat, m_min, dt, wall_cmds,
+                 var_cmds, frame_columns) -> None:
+    """Region (+ wall/gran/region fixes per sphere type; spheres on both sides of a closed
+    region get one region each, side in and side out, found with a static probe region)."""
+    sh = wp.shape
+    frame = isinstance(sh, BoxShape) and sh.frame is not None
+    P = sh.pivot if frame else np.zeros(3)
+    dyn = _region_motion(wp, tag, var_cmds)
     if isinstance(sh, BoxShape):
         geo = "block " + " ".join(f"{float_text(sh.lo[a])} {float_text(sh.hi[a])}" for a in range(3))
         opened = " ".join(f"open {f}" for f in sh.open_faces)
@@ -173,7 +184,8 @@ def _region_wall(model, wp: WallPlan, tag: str, mat_groups, xs, smat, m_min, dt,
             inside = ((xl > sh.lo) & (xl < sh.hi)).all(1)
     else:
         ax = "xyz"[sh.axis]
-        geo = f"cylinder {ax} {float_text(sh.c1)} {float_text(sh.c2)} {float_text(sh.radius)} {float_text(sh.lo)} {float_text(sh.hi)}"
+        geo = (f"cylinder {ax} {float_text(sh.c1)} {float_text(sh.c2)} {float_text(sh.radius)} "
+               f"{float_text(sh.lo)} {float_text(sh.hi)}")
         opened = " ".join(f"open {f}" for f in sh.open_faces)
         b, c = [k for k in range(3) if k != sh.axis]
         rho = np.hypot(xs[:, b] - sh.c1, xs[:, c] - sh.c2)

@@ -52,7 +52,7 @@ def generate(path: Path, atoms: int, frames: int, seed: int = 1) -> None:
 
 
 def run_fibrelmp(dump: Path, out: Path) -> float:
-    from fibrelmp.post.cli_post import post_command
+    from fibrelmp.post.convert import post_command
 
     if out.exists():
         shutil.rmtree(out)

@@ -324,7 +324,7 @@ def post(dump: Path = typer.Argument(..., help="LAMMPS text dump (.gz too), or a
          topology: Optional[Path] = typer.Option(None, "--topology", help="Topology for MDAnalysis "
                                                  "trajectory formats."),
          quiet: bool = _QUIET, verbose: bool = _VERBOSE) -> None:
-    from fibrelmp.post.cli_post import post_command
+    from fibrelmp.post.convert import post_command
 
     _set_flags(quiet, verbose)
     written = post_command(dump, to, out, info, frames, types, data, local, gravity, force, topology,

@@ -13,7 +13,9 @@ What all formats share is implemented here once:
   on an exception.
 
 A derived reader implements ``read`` (whole-file formats) or ``__iter__`` (frame formats);
-a derived writer implements ``write(frame)`` and, if it writes at the end, ``finish``.
+a derived writer implements ``write(frame)`` and, if it writes at the end, ``finish``; it
+writes through ``open``/``put`` (files written frame by frame) or ``write_file`` (a file per
+frame), and may ``adopt`` other writers whose files belong to the same output.
 (Modelled on MDAnalysis's ReaderBase/WriterBase and meshio's one reader/writer per format.)
 """
 
@@ -67,6 +69,7 @@ class Writer(ABC):
         self.closed = False
         self._staged: dict[Path, Path] = {}        # final path -> temp path
         self._handles: dict[Path, IO] = {}         # final path -> open temp file
+        self._parts: list[Writer] = []             # writers whose files belong to this output
         if not force:
             existing = [p for p in self.outputs() if p.exists()]
             if existing:
@@ -95,18 +98,45 @@ class Writer(ABC):
             self._staged[final] = temp_name(final)
         return self._staged[final]
 
-    def open(self, final: str | os.PathLike, mode: str = "wb") -> IO:
+    def open(self, final: str | os.PathLike, mode: str = "wb", **kwargs) -> IO:
         """An open temp file for ``final`` (kept open until close/abort; opened once)."""
         final = Path(final)
         fh = self._handles.get(final)
         if fh is None:
             try:
-                fh = open(self.stage(final), mode)
+                fh = open(self.stage(final), mode, **kwargs)
             except OSError as exc:
                 self.abort()
                 raise write_failure(final, exc) from None
             self._handles[final] = fh
         return fh
+
+    def put(self, final: str | os.PathLike, *chunks: bytes) -> None:
+        """Append ``chunks`` to the staged ``final`` (a failure names ``final``)."""
+        fh = self.open(final)
+        try:
+            for chunk in chunks:
+                fh.write(chunk)
+        except OSError as exc:
+            exc.output = Path(final)
+            raise
+
+    def write_file(self, final: str | os.PathLike, data: bytes) -> None:
+        """Stage the whole file ``final`` now, closed at once (formats with a file per
+        frame: no open file per frame until ``close``); a failure names ``final``."""
+        tmp = self.stage(final)
+        try:
+            with open(tmp, "wb") as fh:
+                fh.write(data)
+        except OSError as exc:
+            exc.output = Path(final)
+            raise
+
+    def adopt(self, part: "Writer") -> "Writer":
+        """A writer whose files belong to this output: its files are renamed into place with
+        this writer's (after every file of both was written), and aborted with it."""
+        self._parts.append(part)
+        return part
 
     def add(self, frame: Any) -> None:
         if self.closed:
@@ -125,31 +155,53 @@ class Writer(ABC):
         """Finish, then rename every staged file into place; returns the final paths."""
         if self.closed:
             return []
-        current = self.target
         try:
-            self.finish()
-            for final, fh in list(self._handles.items()):
-                current = final
-                fh.close()
-            self._handles.clear()
-            done = []
-            for final, tmp in list(self._staged.items()):
-                current = final
-                os.replace(tmp, final)
-                done.append(final)
-                del self._staged[final]
-        except OSError as exc:
+            self._settle()
+            done = self._commit()
+        except OSError as exc:            # from finish(): it names no file
             self.abort()
-            raise write_failure(current, exc) from None
+            raise write_failure(getattr(exc, "output", None) or self.target, exc) from None
         except BaseException:
             self.abort()
             raise
+        self._closed()
+        return done
+
+    def _settle(self) -> None:
+        """Write everything (finish) and close the temp files, parts first."""
+        self.finish()
+        for part in self._parts:
+            part._settle()
+        for final, fh in list(self._handles.items()):
+            try:
+                fh.close()
+            except OSError as exc:
+                raise write_failure(final, exc) from None
+            del self._handles[final]
+
+    def _commit(self) -> list[Path]:
+        done = []
+        for part in self._parts:
+            done += part._commit()
+        for final, tmp in list(self._staged.items()):
+            try:
+                os.replace(tmp, final)
+            except OSError as exc:
+                raise write_failure(final, exc) from None
+            done.append(final)
+            del self._staged[final]
+        return done
+
+    def _closed(self) -> None:
+        for part in self._parts:
+            part._closed()
         self.closed = True
         self.discard()
-        return done
 
     def abort(self) -> None:
         """Remove everything not yet in place; never raises."""
+        for part in self._parts:
+            part.abort()
         for final, tmp in list(self._staged.items()):
             discard(tmp, self._handles.pop(final, None))
         self._staged.clear()

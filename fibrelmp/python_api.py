@@ -126,7 +126,7 @@ def convert(dump: str | Path, to: str, out: str | Path, *, frames: str | None = 
             force: bool = False, topology: str | Path | None = None, say: Say = _quiet) -> list[Path]:
     """Convert a LAMMPS dump (or an MDAnalysis trajectory with ``topology``) into ``to``
     (xyz, res, musen, demdf, mercury, vtk); returns the files written (docs/post.md)."""
-    from fibrelmp.post.cli_post import post_command
+    from fibrelmp.post.convert import post_command
 
     return post_command(Path(dump), to, Path(out), False, frames, types,
                         None if data is None else Path(data), None if local is None else Path(local),
@@ -176,7 +176,7 @@ def _read_for_check(read, patch):
 
 def describe(dump: str | Path, topology: str | Path | None = None, say: Say = print) -> None:
     """``fibrelmp post --info``: frames, atoms, columns and box of a trajectory."""
-    from .post.cli_post import post_command
+    from .post.convert import post_command
 
     post_command(Path(dump), None, None, True, None, None, None, None, None, False,
                  None if topology is None else Path(topology), say)

@@ -70,6 +70,11 @@ def register_format(fmt: Format) -> Format:
     return fmt
 
 
+def unregister_format(name: str) -> None:
+    """Remove a format (tests that register a toy one)."""
+    _FORMATS.pop(name, None)
+
+
 def get(name: str) -> Format:
     return _FORMATS[name]
 

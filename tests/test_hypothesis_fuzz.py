@@ -21,7 +21,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from fibrelmp.errors import InputError
-from fibrelmp.post.cli_post import Completer
+from fibrelmp.post.complete import Completer
 from fibrelmp.post.lammps_dump.reader import iter_frames
 from fibrelmp.textio import collect_errors
 from fibrelmp.translate.demdf import reader as demdf

@@ -7,7 +7,7 @@ import re
 
 import numpy as np
 
-from fibrelmp.post.mercury.writer import ENE_HEADER, g10, read_data_file, read_ene, read_fstat
+from fibrelmp.post.mercury import ENE_HEADER, g10, read_data_file, read_ene, read_fstat
 
 from .conftest import data_path
 from .test_post_roundtrip import granular, granular2d, post  # noqa: F401  (fixtures)

@@ -14,11 +14,11 @@ import numpy as np
 import pytest
 
 from fibrelmp.errors import InputError
-from fibrelmp.post.cli_post import post_command
+from fibrelmp.post.convert import post_command
 from fibrelmp.translate.fibrenet.writer import read_restart, read_xyz
 from fibrelmp.post.lammps_dump.reader import iter_frames
-from fibrelmp.post.mercury.writer import ENE_HEADER, read_data_file, read_ene, read_fstat
-from fibrelmp.post.vtk.writer import read_pvd, read_vtu
+from fibrelmp.post.mercury import ENE_HEADER, read_data_file, read_ene, read_fstat
+from fibrelmp.post.vtk import read_pvd, read_vtu
 
 GRANULAR = """
 units si
@@ -246,13 +246,13 @@ def test_mercury_2d_layout(granular2d, tmp_path):
 # -- VTK -------------------------------------------------------------------------------------------
 @pytest.mark.parametrize("ascii_", [False, True])
 def test_vtk_round_trip(granular, tmp_path, ascii_):
-    from fibrelmp.post.vtk.writer import VtkWriter
+    from fibrelmp.post.vtk import VtkWriter
 
     frames = dump_frames(granular / "atoms.dump")
     if ascii_:
         w = VtkWriter(tmp_path / "run", ascii_=True)
         for f in frames:
-            w.write(f, f.time)
+            w.add(f)
         w.close()
     else:
         post(granular / "atoms.dump", "vtk", tmp_path / "run")

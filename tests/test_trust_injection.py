@@ -275,6 +275,7 @@ def test_rendered_granular_job_with_hostile_names_is_safe(tmp_path, monkeypatch)
     """MUSEN scene with every name hostile; the plate is forced onto wall particles so the
     wall-particle type names are rendered too."""
     from fibrelmp.translate import granular_job
+    from fibrelmp.translate.granular import walls
     from fibrelmp.translate.musen import scene as musen
     from fibrelmp.pipeline.inputs.musen import bare_scene_settings
 
@@ -288,8 +289,8 @@ def test_rendered_granular_job_with_hostile_names_is_safe(tmp_path, monkeypatch)
         g.name = HOSTILE
     for kind in ("box", "tiles"):
         if kind == "tiles":
-            monkeypatch.setattr(granular_job, "detect_oriented_box", lambda v: None)
-            monkeypatch.setattr(granular_job, "detect_cylinder", lambda v: None)
+            monkeypatch.setattr(walls, "detect_oriented_box", lambda v: None)
+            monkeypatch.setattr(walls, "detect_cylinder", lambda v: None)
         job = granular_job.write_granular_job(model, tmp_path / kind)
         assert [wp.kind for wp in job.wall_plans] == [kind]
         _assert_safe_job(job.folder)

@@ -21,7 +21,8 @@ from fibrelmp.post import to_fibrenet
 from fibrelmp.post.lammps_dump.reader import Frame, iter_frames
 from fibrelmp.post.to_fibrenet import write_fibrenet
 from fibrelmp.translate import granular_job as gj
-from fibrelmp.translate.granular_walls import tile_triangles, tile_triangles_within
+from fibrelmp.translate.granular import reach, tiles
+from fibrelmp.translate.granular.geometry import tile_triangles, tile_triangles_within
 
 from . import granular_models as gm
 from .granular_models import run
@@ -176,7 +177,7 @@ def _drop_on_triangle():
 
 def test_tiles_within_reach_give_the_same_bounce(tmp_path, monkeypatch):
     full_job, full = run(_drop_on_triangle(), tmp_path, "full")
-    monkeypatch.setattr(gj, "TILE_CLIP_MIN", 0)
+    monkeypatch.setattr(tiles, "TILE_CLIP_MIN", 0)
     clip_job, clipped = run(_drop_on_triangle(), tmp_path, "clipped")
     n_full = len(full_job.wall_plans[0].tile_ids)
     n_clip = len(clip_job.wall_plans[0].tile_ids)
@@ -190,8 +191,8 @@ def test_tiles_within_reach_give_the_same_bounce(tmp_path, monkeypatch):
 
 
 def test_sphere_leaving_the_tiled_region_stops_the_run(tmp_path, monkeypatch):
-    monkeypatch.setattr(gj, "TILE_CLIP_MIN", 0)
-    monkeypatch.setattr(gj, "REACH_SAFETY", 1e-6)       # a wrong reach estimate
+    monkeypatch.setattr(tiles, "TILE_CLIP_MIN", 0)
+    monkeypatch.setattr(reach, "REACH_SAFETY", 1e-6)       # a wrong reach estimate
     m = _drop_on_triangle()
     m.spheres.velocity[0] = [2.0, 0, 0]
     with pytest.raises(RunError, match="fl_sphere_beyond_wall_particles"):

@@ -240,18 +240,20 @@ def test_atomic_write_failing_rename_leaves_no_temp_file(tmp_path, monkeypatch):
     assert files(tmp_path) == []
 
 
-def test_xyz_writer_on_a_full_disk(tmp_path, monkeypatch):
+def test_xyz_writer_on_a_full_disk(tmp_path, monkeypatch, full_disk):
     import numpy as np
 
-    w = XyzWriter(tmp_path / "o_coord.xyz")
-    w.fh = _FullDisk(w.fh)
+    from fibrelmp.translate.fibrenet.writer import XyzFrame
+
+    w = XyzWriter(tmp_path / "o", fields=("position",))
     with pytest.raises(RunError) as err:
-        w.write(0, 0.1, np.ones(3), np.array(["a"]), np.zeros((1, 3)))
+        w.add(XyzFrame(0, 0.1, np.ones(3), ["a"], np.zeros((1, 3))))
     assert str(err.value) == f"{tmp_path / 'o_coord.xyz'}: cannot write output: {ENOSPC}"
     w.abort()                               # what the callers do next: harmless
     assert files(tmp_path) == []
-    # the rename failing at close
-    w = XyzWriter(tmp_path / "o_vel.xyz")
+    monkeypatch.undo()                      # a working disk again ...
+    # ... and the rename failing at close
+    w = XyzWriter(tmp_path / "o", fields=("velocity",))
     monkeypatch.setattr(os, "replace", lambda a, b: (_ for _ in ()).throw(OSError(errno.ENOSPC, ENOSPC)))
     with pytest.raises(RunError, match=f"o_vel.xyz: cannot write output: {ENOSPC}"):
         w.close()
@@ -283,14 +285,14 @@ def test_musen_result_writer_on_a_full_disk(tmp_path, monkeypatch):
     cols = "id type x y z vx vy vz fx fy fz radius mass"
     p = write(tmp_path, frame(0, rows, cols=cols, time=0.0) + frame(10, rows, cols=cols, time=0.1))
     made = []
-    real_close = musen_out.MusenResultWriter.close
+    real_finish = musen_out.MusenResultWriter.finish
 
-    def close(self):
+    def finish(self):                       # the result is written at close, then renamed
         made.append(self)
         monkeypatch.setattr(os, "replace", lambda a, b: (_ for _ in ()).throw(
             OSError(errno.ENOSPC, ENOSPC)))
-        return real_close(self)
-    monkeypatch.setattr(musen_out.MusenResultWriter, "close", close)
+        return real_finish(self)
+    monkeypatch.setattr(musen_out.MusenResultWriter, "finish", finish)
     with pytest.raises(RunError, match=f"/o: cannot write output: {ENOSPC}$"):
         post(p, "musen", tmp_path / "o")
     assert made and not made[0].tmp.exists() and not made[0].spool.exists()

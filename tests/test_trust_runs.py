@@ -408,10 +408,9 @@ def test_mpi_rank0_write_failure_always_prints(tmp_path):
         "import errno, os\n"
         "if os.environ.get('PMI_RANK') == '0':\n"
         "    from fibrelmp.translate.fibrenet import writer as fibrenet_out\n"
-        "    def close(self):\n"
-        "        self.abort()\n"
+        "    def finish(self):\n"
         "        raise OSError(errno.ENOSPC, 'No space left on device', str(self.path))\n"
-        "    fibrenet_out.XyzWriter.close = close\n")
+        "    fibrenet_out.XyzWriter.finish = finish\n")
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(hook), str(REPO)]))
     inp = fibre_case(tmp_path / "in", run="200", output_freq="100")
     for k in range(6):

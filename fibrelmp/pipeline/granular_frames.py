@@ -17,7 +17,7 @@ from fibrelmp.granmodel import GranularFrame, GranularModel
 from fibrelmp.pipeline.run import wrong_frame
 from fibrelmp.post.lammps_dump.reader import iter_frames
 from fibrelmp.translate.granular_job import GranularJob
-from fibrelmp.translate.granular_walls import nearest_triangle
+from fibrelmp.translate.granular.geometry import nearest_triangle
 
 
 def quat_multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:

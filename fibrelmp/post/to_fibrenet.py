@@ -1,15 +1,20 @@
-"""Convert LAMMPS dump frames into FibreNet's own output files."""
+"""LAMMPS dump frames -> FibreNet's own output files: ``write_fibrenet`` (``fibrelmp run``)
+and the ``post --to xyz|res`` targets."""
 
 from __future__ import annotations
 
 import warnings
 from pathlib import Path
-from typing import Callable, Iterable, Sequence
+from typing import Callable, ClassVar, Iterable, Mapping, Sequence
 
 import numpy as np
 
-from fibrelmp.translate.fibrenet.writer import RESTART_SUFFIX, XYZ_SUFFIX, XyzWriter, write_restart
+from fibrelmp.errors import InputError
 from fibrelmp.post.lammps_dump.reader import Frame
+from fibrelmp.post.target import DumpTarget, ReadBack
+from fibrelmp.translate.fibrenet.writer import (RESTART_SUFFIX, XYZ_SUFFIX, FibreNetWriter, RestartState,
+                                                XyzRows, read_restart, read_xyz)
+from fibrelmp.units import LJ
 
 # dump column names for the velocity FibreNet writes (v~) and its total force
 VEL_COLUMNS = ("v_fn_vx", "v_fn_vy", "v_fn_vz")
@@ -82,69 +87,157 @@ def _small_unique(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.flatnonzero(present) + lo, remap[t - lo]
 
 
-def write_fibrenet(frames: Iterable[Frame], basename: str, folder: Path, fields: Sequence[str],
-                   names_of_type: dict[int, str], dt: float, box_lengths: np.ndarray | None,
-                   output_types: set[str] | None, restart: bool = True,
-                   warn: Callable[[str, str], None] | None = None) -> list[Path]:
-    """Write ``<basename>_coord/_vel/_force.xyz`` (every frame) and ``_restart.res`` (last).
+class FibreNetFrames:
+    """Dump frames -> (XyzRows, RestartState) for ``FibreNetWriter``: atoms in id order,
+    positions wrapped, FibreNet's velocity/force columns when dumped.
 
     ``box_lengths`` None: each frame's own box (post-processing of dumps whose box changes).
-
     With ``box_lengths`` (FibreNet's box [0, L]) the first frame with a bead centre outside
     [0, L) on a finite axis triggers one warning (``outside_message``): ``warn(kind, text)``
     when given (e.g. ``model.warn``), otherwise a ``FibreNetDivergenceWarning`` through Python's
-    ``warnings`` module (printed on stderr by default).
-    """
-    folder = Path(folder)
-    writers = {f: XyzWriter(folder / f"{basename}{XYZ_SUFFIX[f]}") for f in fields}
-    last = None
-    warned = box_lengths is None
+    ``warnings`` module (printed on stderr by default)."""
+
+    def __init__(self, fields: Sequence[str], names_of_type: Mapping[int, str], dt: float,
+                 restart: bool, box_lengths: np.ndarray | None = None,
+                 output_types: set[str] | None = None,
+                 warn: Callable[[str, str], None] | None = None):
+        self.fields, self.names, self.dt, self.restart = tuple(fields), names_of_type, dt, restart
+        self.box_lengths, self.output_types, self.warn = box_lengths, output_types, warn
+        self.warned = box_lengths is None
+
+    def __call__(self, frame: Frame) -> tuple[XyzRows, RestartState]:
+        ids = frame.column("id")
+        # dumps written with "modify sort id" need no reordering (saves a sort per frame)
+        order = slice(None) if bool(np.all(ids[1:] > ids[:-1])) else np.argsort(ids, kind="stable")
+        codes, table = type_codes(frame.column("type")[order], self.names)
+        keep = slice(None) if self.output_types is None else \
+            np.isin(codes, [k for k, name in enumerate(table) if name in self.output_types])
+        wrapped, unwrapped = wrapped_and_unwrapped(frame)
+        if not self.warned:
+            self._check_box(frame, wrapped)
+        data = {"position": wrapped[order]}
+        if "velocity" in self.fields or self.restart:
+            data["velocity"] = _pick(frame, VEL_COLUMNS, ("vx", "vy", "vz"))[order]
+        if "force" in self.fields or self.restart:
+            data["force"] = _pick(frame, FORCE_COLUMNS, ("fx", "fy", "fz"))[order]
+        lengths = self.box_lengths if self.box_lengths is not None else frame.hi - frame.lo
+        rows = XyzRows(frame.step, self.dt, lengths, codes[keep], table,
+                       {f: data[f][keep] for f in self.fields})
+        state = RestartState(frame.step, self.dt, lengths, codes, table, data["position"],
+                             unwrapped[order], data.get("velocity"), data.get("force"))
+        return rows, state
+
+    def _check_box(self, frame: Frame, wrapped: np.ndarray) -> None:
+        out = outside_finite_box(wrapped, frame.periodic, self.box_lengths)
+        if out.any():
+            self.warned = True
+            text = outside_message(frame.step, int(out.sum()), np.asarray(self.box_lengths, float))
+            if self.warn is not None:
+                self.warn(OUTSIDE_KIND, text)
+            else:
+                warnings.warn(f"[{OUTSIDE_KIND}] {text}", FibreNetDivergenceWarning, stacklevel=4)
+
+
+def write_fibrenet(frames: Iterable[Frame], basename: str, folder: Path, fields: Sequence[str],
+                   names_of_type: Mapping[int, str], dt: float, box_lengths: np.ndarray | None,
+                   output_types: set[str] | None, restart: bool = True,
+                   warn: Callable[[str, str], None] | None = None) -> list[Path]:
+    """Write ``<basename>_coord/_vel/_force.xyz`` (every frame) and ``_restart.res`` (last);
+    see ``FibreNetFrames`` for ``box_lengths``, ``output_types`` and ``warn``."""
+    writer = FibreNetWriter(Path(folder) / basename, fields, restart)
+    convert = FibreNetFrames(fields, names_of_type, dt, restart, box_lengths, output_types, warn)
     try:
         for frame in frames:
-            ids = frame.column("id")
-            # dumps written with "modify sort id" need no reordering (saves a sort per frame)
-            order = slice(None) if bool(np.all(ids[1:] > ids[:-1])) else np.argsort(ids, kind="stable")
-            codes, table = type_codes(frame.column("type")[order], names_of_type)
-            keep = slice(None) if output_types is None else \
-                np.isin(codes, [k for k, name in enumerate(table) if name in output_types])
-            wrapped, unwrapped = wrapped_and_unwrapped(frame)
-            if not warned:
-                out = outside_finite_box(wrapped, frame.periodic, box_lengths)
-                if out.any():
-                    warned = True
-                    text = outside_message(frame.step, int(out.sum()), np.asarray(box_lengths, float))
-                    if warn is not None:
-                        warn(OUTSIDE_KIND, text)
-                    else:
-                        warnings.warn(f"[{OUTSIDE_KIND}] {text}", FibreNetDivergenceWarning, stacklevel=2)
-            data = {"position": wrapped[order]}
-            if "velocity" in fields or restart:
-                data["velocity"] = _pick(frame, VEL_COLUMNS, ("vx", "vy", "vz"))[order]
-            if "force" in fields or restart:
-                data["force"] = _pick(frame, FORCE_COLUMNS, ("fx", "fy", "fz"))[order]
-            lengths = box_lengths if box_lengths is not None else frame.hi - frame.lo
-            for f, w in writers.items():
-                w.write_codes(frame.step, dt, lengths, codes[keep], table, data[f][keep])
-            last = (frame.step, (codes, table), data["position"], unwrapped[order], data.get("velocity"),
-                    data.get("force"), lengths)
+            writer.add(convert(frame))
     except BaseException:
-        for w in writers.values():
-            w.abort()
+        writer.abort()
         raise
-    pending = list(writers.values())
-    try:
-        while pending:
-            pending[0].close()
-            pending.pop(0)
-    except BaseException:            # e.g. a full disk: no temp file of the others stays
-        for w in pending[1:]:
-            w.abort()
-        raise
-    written = [w.path for w in writers.values()]
-    if restart and last is not None:
-        path = folder / f"{basename}{RESTART_SUFFIX}"
-        step, (codes, table), x, xu, v, f, lengths = last
-        names = np.array(table, dtype=object)[codes]
-        write_restart(path, step, dt, lengths, names, x, xu, v, f)
-        written.append(path)
-    return written
+    return writer.close()
+
+
+def dt_from(first: list[Frame], warn: Callable[[str, str], None]) -> float:
+    """The MD time step for FibreNet's FRAME lines: from ITEM: TIME values when present."""
+    for f in first:
+        if f.time is not None and f.step:
+            return f.time / f.step
+    if len(first) == 2 and all(f.time is not None for f in first) and first[1].step != first[0].step:
+        return (first[1].time - first[0].time) / (first[1].step - first[0].step)
+    warn("no time step", "the dump does not give the time step (no ITEM: TIME); FRAME lines carry dt 0")
+    return 0.0
+
+
+class _FibreNetTarget(DumpTarget):
+    """``--to xyz`` / ``--to res``: FibreNet's files through ``FibreNetWriter``."""
+
+    units = ("FibreNet", LJ)
+    lookahead = 2                  # the time step comes from the first two frames
+    restart: ClassVar[bool]
+
+    def fields(self, first: Frame) -> tuple[str, ...]:
+        return ()
+
+    def start(self, first: list[Frame]) -> None:
+        ctx = self.context
+        fields = self.fields(first[0])
+        self.convert = FibreNetFrames(fields, ctx.type_names, dt_from(first, ctx.warn), self.restart)
+        self.out = self.adopt(FibreNetWriter(self.target, fields, self.restart))
+
+    def write_frame(self, frame: Frame) -> None:
+        self.out.add(self.convert(frame))
+
+
+class XyzTarget(_FibreNetTarget):
+    """``<base>_coord.xyz`` and, when dumped, ``_vel.xyz`` / ``_force.xyz``: every frame."""
+
+    restart = False
+
+    @classmethod
+    def files(cls, base: Path) -> list[Path]:
+        return [base.with_name(base.name + s) for s in XYZ_SUFFIX.values()]
+
+    def fields(self, first: Frame) -> tuple[str, ...]:
+        have = first.columns
+        fields = tuple(f for f, cols in (("position", ("x",)), ("velocity", ("vx", "v_fn_vx")),
+                                         ("force", ("fx", "v_fn_fx")))
+                       if f == "position" or any(c in have for c in cols))
+        missing = sorted({"velocity", "force"} - set(fields))
+        if missing:
+            self.context.warn("missing fields", f"{self.context.source}: no {' or '.join(missing)} "
+                              "columns; only " + ", ".join(f"_{'coord' if f == 'position' else f[:3]}.xyz"
+                                                           for f in fields) + " written")
+        return fields
+
+    @classmethod
+    def read_back(cls, files: list[Path]) -> list[ReadBack]:
+        frames = {p.name.rsplit("_", 1)[-1]: read_xyz(p) for p in files}
+        out = []
+        for k, f in enumerate(frames["coord.xyz"]):
+            values = {cols: frames[name][k].values for name, cols in
+                      (("vel.xyz", ("vx", "vy", "vz")), ("force.xyz", ("fx", "fy", "fz")))
+                      if name in frames}
+            out.append(ReadBack(f.values, atol=0.5e-5 + 1e-12, values=values))      # %.5f
+        return out
+
+
+class RestartTarget(_FibreNetTarget):
+    """``<base>_restart.res``: one frame, the last unless ``--frames`` says otherwise."""
+
+    restart = True
+    last_frame_by_default = True
+
+    @classmethod
+    def files(cls, base: Path) -> list[Path]:
+        return [base.with_name(base.name + RESTART_SUFFIX)]
+
+    def start(self, first: list[Frame]) -> None:
+        for need, cols in (("velocity", ("vx", "vy", "vz")), ("force", ("fx", "fy", "fz"))):
+            if not (first[0].has(*cols) or first[0].has(*("v_fn_" + c[0] + c[1] for c in cols))):
+                raise InputError(self.context.source, first[0].line, f"a FibreNet restart needs {need}: "
+                                 f"the dump has no {' '.join(cols)} columns")
+        super().start(first)
+
+    @classmethod
+    def read_back(cls, files: list[Path]) -> list[ReadBack]:
+        names, rows = read_restart(files[0])
+        return [ReadBack(rows[:, 0:3], rtol=6e-6, atol=1e-300,       # %g: 6 significant digits
+                         values={("vx", "vy", "vz"): rows[:, 6:9], ("fx", "fy", "fz"): rows[:, 9:12]})]

@@ -11,20 +11,23 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Iterable, Iterator
+from typing import ClassVar, Mapping
 
 import numpy as np
 
 from fibrelmp.errors import InputError
+from fibrelmp.formatbase import Writer
 from fibrelmp.granmodel import GranularFrame, GranularModel, GranularPlan, Material, Spheres
 from fibrelmp.post.lammps_dump.reader import Frame
+from fibrelmp.post.target import DumpTarget, ReadBack
+from fibrelmp.units import SI
 
 
 def _vector(frame: Frame, names: tuple[str, str, str], n: int) -> np.ndarray:
     return frame.vector(*names) if frame.has(*names) else np.zeros((n, 3))
 
 
-def model_from_frame(first: Frame, source: Path, names: dict[int, str], kind: str,
+def model_from_frame(first: Frame, source: Path, names: Mapping[int, str], kind: str,
                      time: float, dt: float) -> GranularModel:
     n = first.count
     if not first.has("radius"):
@@ -63,27 +66,26 @@ def model_from_frame(first: Frame, source: Path, names: dict[int, str], kind: st
     return model
 
 
-def granular_frames(frames: Iterable[tuple[Frame, float]], model: GranularModel) -> Iterator[GranularFrame]:
-    """Each dump frame as a GranularFrame; atoms missing from a frame count as removed,
-    atoms the first frame did not have are an error (a model cannot grow)."""
+def granular_frame(frame: Frame, time: float, model: GranularModel) -> GranularFrame:
+    """A dump frame as a GranularFrame; atoms missing from it count as removed, atoms the
+    first frame did not have are an error (a model cannot grow)."""
     ids = model.passthrough["atom_ids"]
-    order = np.argsort(ids)
-    for frame, time in frames:
-        fid = frame.column("id").astype(np.int64)
-        pos = np.searchsorted(ids, fid, sorter=order)
-        pos = np.minimum(pos, len(ids) - 1)
-        rows = order[pos]
-        if len(fid) and not np.array_equal(ids[rows], fid):
-            new = fid[ids[rows] != fid][0]
-            raise InputError(frame.source, frame.line, f"atom {new} appears after the first frame: "
-                             "MUSEN/DEMDF results need every object present from the start")
-        n = frame.count
-        quat = (frame.vector("quatw", "quati", "quatj", "quatk") if frame.has("quatw", "quati", "quatj", "quatk")
-                else np.tile([1.0, 0.0, 0.0, 0.0], (n, 1)))
-        yield GranularFrame(time=time, step=frame.step, sphere_rows=rows, position=frame.wrapped(),
-                            velocity=_vector(frame, ("vx", "vy", "vz"), n),
-                            omega=_vector(frame, ("omegax", "omegay", "omegaz"), n),
-                            force=_vector(frame, ("fx", "fy", "fz"), n), quaternion=quat)
+    order = model.passthrough.setdefault("atom_order", np.argsort(ids))
+    fid = frame.column("id").astype(np.int64)
+    pos = np.searchsorted(ids, fid, sorter=order)
+    pos = np.minimum(pos, len(ids) - 1)
+    rows = order[pos]
+    if len(fid) and not np.array_equal(ids[rows], fid):
+        new = fid[ids[rows] != fid][0]
+        raise InputError(frame.source, frame.line, f"atom {new} appears after the first frame: "
+                         "MUSEN/DEMDF results need every object present from the start")
+    n = frame.count
+    quat = (frame.vector("quatw", "quati", "quatj", "quatk") if frame.has("quatw", "quati", "quatj", "quatk")
+            else np.tile([1.0, 0.0, 0.0, 0.0], (n, 1)))
+    return GranularFrame(time=time, step=frame.step, sphere_rows=rows, position=frame.wrapped(),
+                         velocity=_vector(frame, ("vx", "vy", "vz"), n),
+                         omega=_vector(frame, ("omegax", "omegay", "omegaz"), n),
+                         force=_vector(frame, ("fx", "fy", "fz"), n), quaternion=quat)
 
 
 def demdf_document(model: GranularModel, filename: str) -> dict:
@@ -107,3 +109,81 @@ def demdf_document(model: GranularModel, filename: str) -> dict:
             "domain": [lo.tolist(), hi.tolist()], "objectTypes": object_types,
             "objects": {"particles": particles},
             "output": {"snapshot": {"filename": filename, "saveCount": 0}}}
+
+
+class _GranularTarget(DumpTarget):
+    """MUSEN result / DEMDF snapshots through the neutral granular model and the same
+    writers ``fibrelmp run`` uses (``result_writer``)."""
+
+    lookahead = 2                 # the save interval comes from the first two frames
+    kind: ClassVar[str]
+
+    def start(self, first: list[Frame]) -> None:
+        times = [self.time_of(f) for f in first]
+        dt = times[1] - times[0] if len(times) > 1 else 1.0
+        self.model = model_from_frame(first[0], Path(self.context.source), self.context.type_names,
+                                      self.kind, times[0], dt)
+        self.out = self.adopt(self.result_writer(self.model, dt))
+
+    def result_writer(self, model: GranularModel, dt: float) -> Writer:
+        raise NotImplementedError
+
+    def write_frame(self, frame: Frame) -> None:
+        self.out.add(granular_frame(frame, self.time_of(frame), self.model))
+
+    def end(self) -> None:
+        if self.count:
+            for kind, text in self.model.warnings:
+                self.context.warn(kind, text)
+
+
+class MusenTarget(_GranularTarget):
+    """``<base>``: a MUSEN text result (SI units)."""
+
+    kind = "musen"
+    units = ("MUSEN", SI)
+
+    def result_writer(self, model: GranularModel, dt: float) -> Writer:
+        from fibrelmp.translate.musen.writer import MusenResultWriter
+
+        return MusenResultWriter(model, self.target)
+
+    @classmethod
+    def read_back(cls, files: list[Path]) -> list[ReadBack]:
+        from fibrelmp.translate.musen.scene import read_time_points
+
+        tp = read_time_points(files[0], tags=(12, 15, 20))       # objects in id order
+        return [ReadBack(tp.fields[12][k], rtol=6e-6, atol=1e-12,      # %g: 6 significant digits
+                         values={("vx", "vy", "vz"): tp.fields[15][k], ("fx", "fy", "fz"): tp.fields[20][k]})
+                for k in range(len(tp.times))]
+
+
+class DemdfTarget(_GranularTarget):
+    """``<base>_<n>.json``: a DEMDF snapshot per frame."""
+
+    kind = "demdf"
+
+    @classmethod
+    def files(cls, base: Path) -> list[Path]:
+        return sorted(p for p in base.parent.glob(f"{base.name}_*.json")
+                      if p.stem[len(base.name) + 1:].isdigit())
+
+    def result_writer(self, model: GranularModel, dt: float) -> Writer:
+        from fibrelmp.translate.demdf.writer import DemdfSnapshotWriter
+
+        name = self.target.name
+        model.passthrough["demdf"] = {
+            "document": demdf_document(model, name), "dimensionality": 3,
+            "particle_rows": [[0.0] * 6 + [int(t)] for t in model.spheres.material],
+            "particles_file": None, "output_location": ("output", "snapshot"),
+            "filename": name, "save_count": 0, "file_time_step": dt, "substeps": 1,
+            "time_step_count": 0}
+        return DemdfSnapshotWriter(model, self.target.parent)
+
+    @classmethod
+    def read_back(cls, files: list[Path]) -> list[ReadBack]:
+        from fibrelmp.translate.demdf.reader import read_snapshot
+
+        snaps = sorted(files, key=lambda p: int(p.stem.rsplit("_", 1)[-1]))
+        return [ReadBack(s.spheres.position, values={("vx", "vy", "vz"): s.spheres.velocity})
+                for s in map(read_snapshot, snaps)]

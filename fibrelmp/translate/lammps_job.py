@@ -13,10 +13,10 @@ from pathlib import Path
 import numpy as np
 
 from fibrelmp.errors import InputError
-from fibrelmp.numtext.shortest import rows_text
 from fibrelmp.lammps_text import comment_text, template_environment
 from fibrelmp.model import Model
-from fibrelmp.textio import atomic_write, format_rows
+from fibrelmp.textio import atomic_write
+from fibrelmp.translate.lammps_format import data_rows, float_text
 from fibrelmp.translate.steps import SaveSteps
 
 SCRIPT_NAME = "in.lammps"
@@ -35,10 +35,6 @@ class Job:
     type_of_ltype: np.ndarray            # LAMMPS type (1-based, index 0 unused) -> user type
     output_steps: SaveSteps | tuple = ()   # the steps of the frames (lazy)
     text: str = ""                        # the script, also when only rank 0 wrote files
-
-
-def _fmt(x: float) -> str:
-    return repr(float(x))
 
 
 def _unique_rows(*cols: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -70,20 +66,20 @@ def _pair_coeffs(model: Model, ltypes: np.ndarray) -> tuple[list[str], list[str]
                     lines.append(f"pair_coeff {a + 1} {b + 1} none")
                     continue
                 # harmonic/cut: E = k (rc - r)^2, so k = K/2 gives F = K (Ri + Rj - r)
-                lines.append(f"pair_coeff {a + 1} {b + 1} harmonic/cut {_fmt(p['K'] / 2)} {_fmt(rc)}")
+                lines.append(f"pair_coeff {a + 1} {b + 1} harmonic/cut {float_text(p['K'] / 2)} {float_text(rc)}")
                 styles.add("harmonic/cut")
                 max_cut = max(max_cut, rc)
             elif law.kind == "st":
-                expr = f"0.5*{_fmt(p['B'])}*(r-{_fmt(p['rstar'])})^2"
-                lines.append(f'pair_coeff {a + 1} {b + 1} lepton "{expr}" {_fmt(p["cutoff"])}')
+                expr = f"0.5*{float_text(p['B'])}*(r-{float_text(p['rstar'])})^2"
+                lines.append(f'pair_coeff {a + 1} {b + 1} lepton "{expr}" {float_text(p["cutoff"])}')
                 styles.add("lepton")
                 max_cut = max(max_cut, p["cutoff"])
             else:  # FibreNet lj: F = 48 eps (s/r)^6 ((s/r)^6 - 1/2) / r^2 - Fc, shifted to 0 at c3
                 s, e, c3 = p["sigma"], p["epsilon"], p["shift"]
                 fc = 48 * e * (s / c3) ** 6 * ((s / c3) ** 6 - 0.5) / c3 ** 2
-                expr = (f"{_fmt(48 * e * s ** 12 / 13)}/r^13-{_fmt(24 * e * s ** 6 / 7)}/r^7"
-                        f"+{_fmt(fc)}*r")
-                lines.append(f'pair_coeff {a + 1} {b + 1} lepton "{expr}" {_fmt(p["cutoff"])}')
+                expr = (f"{float_text(48 * e * s ** 12 / 13)}/r^13-{float_text(24 * e * s ** 6 / 7)}/r^7"
+                        f"+{float_text(fc)}*r")
+                lines.append(f'pair_coeff {a + 1} {b + 1} lepton "{expr}" {float_text(p["cutoff"])}')
                 styles.add("lepton")
                 max_cut = max(max_cut, p["cutoff"])
     return lines, sorted(styles), max_cut
@@ -105,9 +101,9 @@ def angle_expression(c: float, theta0: float) -> str:
     u = math.pi - theta0
     q = 2.0 ** 60
     s = ANGLE_CLAMP
-    return (f"{_fmt(c)}*theta^2+select(step({_fmt(s)}-sin(phi)),D-floor(D*{_fmt(q)})/{_fmt(q)},0);"
-            f"D={_fmt(2 * c * s)}*(phi+phi^3/18-{_fmt(u)}*log(tan(max(abs(phi),1e-300)/2)))"
-            f"-{_fmt(c)}*theta^2;phi={_fmt(u)}-theta")
+    return (f"{float_text(c)}*theta^2+select(step({float_text(s)}-sin(phi)),D-floor(D*{float_text(q)})/{float_text(q)},0);"
+            f"D={float_text(2 * c * s)}*(phi+phi^3/18-{float_text(u)}*log(tan(max(abs(phi),1e-300)/2)))"
+            f"-{float_text(c)}*theta^2;phi={float_text(u)}-theta")
 
 
 def _schedule(model: Model, general_lambda: bool) -> tuple[list[tuple], SaveSteps, int]:
@@ -235,7 +231,7 @@ def write_job(model: Model, folder: str | Path, write_files: bool = True) -> Job
     if write_files:
         _write_data(model, bonds, data_path, ltypes, atype, btypes, btype, atypes, antype, use_mvv)
     script = template_environment().get_template("bead_spring.lammps.j2").render(
-        model=model, dyn=dyn, box=box, fmt=_fmt, use_mvv=use_mvv,
+        model=model, dyn=dyn, box=box, fmt=float_text, use_mvv=use_mvv,
         frozen_types=frozen_types, mobile_types=mobile_types,
         bond_types=btypes, angle_types=atypes, pair_lines=pair_lines, pair_styles=pair_styles,
         max_cut=max(max_cut, 1e-6), skin=skin, comm_cut=comm_cut, acts=acts,
@@ -263,20 +259,6 @@ def _extra_packages(pair_styles, btypes: np.ndarray, use_mvv: bool) -> list[str]
     if use_mvv:
         packages += ["DPD-MESO", "DPD-BASIC"]
     return packages
-
-
-def _block(fmt_row: str, columns: list[np.ndarray]) -> str:
-    """Data-file rows: digit-wise numpy formatting when possible, else one % operation."""
-    n = len(columns[0])
-    if n == 0:
-        return ""
-    # fast path: "%d"/"%.17g" columns and literal tokens, formatted digit-column-wise
-    tokens, it = fmt_row.split(), iter(columns)
-    if fmt_row.endswith("\n") and fmt_row.count("%") == len(columns):
-        text = rows_text([next(it) if tok.startswith("%") else tok for tok in tokens])
-        if text is not None:
-            return text.decode("ascii")
-    return format_rows(fmt_row, columns)
 
 
 def _bonds_alive_at_first_step(model: Model):
@@ -328,33 +310,33 @@ def _write_data(model: Model, bonds, path: Path, ltypes, atype, btypes, btype, a
             margin = 1e-6 * (hi - lo)
             lo = min(lo, float(x[:, axis].min()) - margin)
             hi = max(hi, float(x[:, axis].max()) + margin)
-        parts.append(f"{_fmt(lo)} {_fmt(hi)} {name}lo {name}hi\n")
+        parts.append(f"{float_text(lo)} {float_text(hi)} {name}lo {name}hi\n")
     parts.append("\nMasses\n\n")
     for i, row in enumerate(ltypes):
         mass = row[1] if row[1] > 0 else 1.0      # mass-0 beads are not integrated: placeholder
-        parts.append(f"{i + 1} {_fmt(mass)}  # {comment_text(p.type_names[int(row[0])])} m={row[1]:g} R={row[2]:g}\n")
+        parts.append(f"{i + 1} {float_text(mass)}  # {comment_text(p.type_names[int(row[0])])} m={row[1]:g} R={row[2]:g}\n")
     # unwrapped coordinates: read_data wraps them into periodic boxes and sets image flags
     cols = [ids, p.molecules, atype + 1, x[:, 0], x[:, 1], x[:, 2]]
     if use_mvv:
         parts.append("\nAtoms # hybrid\n\n")
-        parts.append(_block("%d %d %.17g %.17g %.17g %d 0\n", [ids, atype + 1, x[:, 0], x[:, 1], x[:, 2], p.molecules]))
+        parts.append(data_rows("%d %d %.17g %.17g %.17g %d 0\n", [ids, atype + 1, x[:, 0], x[:, 1], x[:, 2], p.molecules]))
     else:
         parts.append("\nAtoms # angle\n\n")
-        parts.append(_block("%d %d %d %.17g %.17g %.17g\n", cols))
+        parts.append(data_rows("%d %d %d %.17g %.17g %.17g\n", cols))
     v = p.velocities
     parts.append("\nVelocities\n\n")
-    parts.append(_block("%d %.17g %.17g %.17g\n", [ids, v[:, 0], v[:, 1], v[:, 2]]))
+    parts.append(data_rows("%d %.17g %.17g %.17g\n", [ids, v[:, 0], v[:, 1], v[:, 2]]))
     if bonds.count:
         b = bonds.atoms + 1
         parts.append("\nBonds\n\n")
-        parts.append(_block("%d %d %d %d\n", [np.arange(1, len(b) + 1), btype + 1, b[:, 0], b[:, 1]]))
+        parts.append(data_rows("%d %d %d %d\n", [np.arange(1, len(b) + 1), btype + 1, b[:, 0], b[:, 1]]))
     if model.angles.count:
         a = model.angles.atoms + 1
         parts.append("\nAngles\n\n")
-        parts.append(_block("%d %d %d %d %d\n", [np.arange(1, len(a) + 1), antype + 1, a[:, 0], a[:, 1], a[:, 2]]))
+        parts.append(data_rows("%d %d %d %d %d\n", [np.arange(1, len(a) + 1), antype + 1, a[:, 0], a[:, 1], a[:, 2]]))
     f0 = p.initial_forces if p.initial_forces is not None else np.zeros((n, 3))
     vt = p.display_velocities if p.display_velocities is not None else p.velocities
     parts.append(f"\n{STATE_SECTION}\n\n")
-    parts.append(_block("%d %.17g %.17g %.17g %.17g %.17g %.17g\n",
+    parts.append(data_rows("%d %.17g %.17g %.17g %.17g %.17g %.17g\n",
                         [ids, f0[:, 0], f0[:, 1], f0[:, 2], vt[:, 0], vt[:, 1], vt[:, 2]]))
     atomic_write(path, "".join(parts))

@@ -8,6 +8,7 @@ when they all are, else labels numbered in order of appearance).
 from __future__ import annotations
 
 import math
+import os
 import warnings as _warnings
 from pathlib import Path
 from typing import Callable, Iterator
@@ -15,6 +16,7 @@ from typing import Callable, Iterator
 import numpy as np
 
 from fibrelmp.errors import InputError
+from fibrelmp.formatbase import Reader
 from fibrelmp.post.lammps_dump.reader import Frame
 
 
@@ -103,3 +105,53 @@ def iter_mda_frames(trajectory: Path, topology: Path | None, type_names: dict[in
         raise
     except Exception as exc:
         raise InputError(trajectory, None, f"MDAnalysis failed reading a frame: {type(exc).__name__}: {exc}") from None
+
+
+def mda_format(path: Path) -> bool:
+    """Does MDAnalysis have a reader for the file's extension (other than LAMMPS dumps)?"""
+    try:
+        from MDAnalysis import _READERS
+    except ImportError:
+        return False
+    ext = path.suffix.lstrip(".").upper()
+    return bool(ext) and ext in _READERS and ext not in ("LAMMPSDUMP", "LAMMPSTRJ")
+
+
+class UniverseReader(Reader):
+    """Frames of any trajectory MDAnalysis reads (``topology`` for formats without one)."""
+
+    format = "mdanalysis"
+    what = "trajectory"
+
+    def __init__(self, path: str | os.PathLike, topology: Path | None = None,
+                 warnings: list[tuple[str, str]] | None = None):
+        self.path = Path(path)
+        self.topology = topology
+        self.warnings = warnings if warnings is not None else []
+        self.type_names: dict[int, str] = {}     # filled with label types while reading
+
+    @classmethod
+    def claims(cls, path: Path, topology: Path | None) -> bool:
+        return topology is not None or mda_format(path)
+
+    def count(self) -> int:
+        return len(open_universe(self.path, self.topology).trajectory)
+
+    def frames(self, want: Callable[[int], bool] | None = None,
+               stop: int | None = None) -> Iterator[Frame]:
+        return iter_mda_frames(self.path, self.topology, self.type_names,
+                               want=None if want is None else (lambda i, ts: want(i)))
+
+    def last(self) -> Frame | None:
+        last = None
+        for last in self.frames():
+            pass
+        return last
+
+    def __iter__(self) -> Iterator[Frame]:
+        return self.frames()
+
+    def describe(self) -> list[str]:
+        from fibrelmp.post.lammps_dump.info import describe_universe
+
+        return describe_universe(self.path, self.topology)

@@ -24,16 +24,15 @@ Numbers use C++ iostream default formatting at precision 10, which is printf ``%
 from __future__ import annotations
 
 import math
-import os
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Iterator
 
 import numpy as np
 
 from fibrelmp.errors import InputError
-from fibrelmp.textio import format_rows, read_text
+from fibrelmp.formatbase import Writer
 from fibrelmp.post.lammps_dump.reader import Frame
+from fibrelmp.textio import format_rows
 
 ENE_LABELS = ("time", "gravitEnergy", "traKineticEnergy", "rotKineticEnergy", "elasticEnergy",
               "centerOfMassX", "centerOfMassY", "centerOfMassZ")
@@ -285,169 +284,55 @@ def fstat_frame_text(time: float, p: Particles, c: Contacts | None) -> str:
 
 
 # -- writer --------------------------------------------------------------------------------
-class _Out:
-    """A text output written through a temp file and renamed into place on close."""
+@dataclass
+class MercuryFrame:
+    """One frame for ``MercuryWriter``: the dump frame, its time and its contacts (a frame of
+    a local dump, or None)."""
 
-    def __init__(self, path: Path):
-        self.path = path
-        self.tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
-        try:
-            self.fh = open(self.tmp, "w")
-        except OSError as exc:
-            raise InputError(path, None, f"cannot write output: {exc.strerror or exc}") from None
-
-    def close(self) -> Path:
-        self.fh.close()
-        os.replace(self.tmp, self.path)
-        return self.path
-
-    def abort(self) -> None:
-        self.fh.close()
-        self.tmp.unlink(missing_ok=True)
+    frame: Frame
+    time: float
+    local: Frame | None = None
 
 
-class MercuryWriter:
+class MercuryWriter(Writer):
     """``<base>.data`` + ``<base>.ene`` (+ ``<base>.fstat`` when contacts are given)."""
 
+    format = "mercury"
+
     def __init__(self, base: Path, gravity: np.ndarray, fstat: bool, dim: int | None = None,
-                 bonds: set[tuple[int, int]] | None = None):
-        self.base = Path(base)
+                 bonds: set[tuple[int, int]] | None = None, *, force: bool = True):
+        self.fstat = fstat
+        super().__init__(base, force=force)
         self.gravity = np.asarray(gravity, float)
         self.dim = dim
         self.bonds = bonds
-        self.outs = {"data": _Out(self.base.with_name(self.base.name + ".data")),
-                     "ene": _Out(self.base.with_name(self.base.name + ".ene"))}
-        if fstat:
-            self.outs["fstat"] = _Out(self.base.with_name(self.base.name + ".fstat"))
-        self.outs["ene"].fh.write(ENE_HEADER)
         self.no_elastic = False
 
-    def write(self, frame: Frame, time: float, local: Frame | None) -> None:
+    def file(self, ext: str) -> Path:
+        return self.target.with_name(self.target.name + ext)
+
+    def outputs(self) -> list[Path]:
+        return [self.file(e) for e in (".data", ".ene", ".fstat")[:3 if self.fstat else 2]]
+
+    def write(self, item: MercuryFrame) -> None:
+        frame, time = item.frame, item.time
+        if self.count == 0:
+            self.open(self.file(".data"), "w")
+            self.open(self.file(".ene"), "w").write(ENE_HEADER)
         if self.dim is None:
             self.dim = 2 if is_2d(frame) else 3
         p = particles(frame, time)
-        self.outs["data"].fh.write(data_frame_text(p, self.dim))
+        self.open(self.file(".data"), "w").write(data_frame_text(p, self.dim))
         c = None
-        if local is not None:
-            c = contacts(local, p, self.bonds, frame.periodic, frame.cell)
+        if item.local is not None:
+            c = contacts(item.local, p, self.bonds, frame.periodic, frame.cell)
         elastic = c.energy if c is not None and c.energy is not None else 0.0
         if c is None or c.energy is None:
             self.no_elastic = True
         try:
-            self.outs["ene"].fh.write(ene_line(energies(p, self.gravity, elastic)))
+            line = ene_line(energies(p, self.gravity, elastic))
         except InputError as exc:
             raise InputError(frame.source, frame.line, exc.message) from None
-        if "fstat" in self.outs:
-            self.outs["fstat"].fh.write(fstat_frame_text(time, p, c))
-
-    def close(self) -> list[Path]:
-        return [o.close() for o in self.outs.values()]
-
-    def abort(self) -> None:
-        for o in self.outs.values():
-            o.abort()
-
-
-# -- readers (tests, and checking files against MercuryDPM's own) ------------------------------
-@dataclass
-class DataFrame:
-    count: int
-    time: float
-    box: np.ndarray          # (4,) 2D or (6,) 3D
-    rows: np.ndarray         # (count, 8 | 14)
-
-
-def read_data_file(path: str | Path, dim: int | None = None) -> list[DataFrame]:
-    """Frames of a ``.data`` file; the dimension comes from the first header's length."""
-    path = Path(path)
-    lines = read_text(path, "MercuryDPM .data file").splitlines()
-    frames, k = [], 0
-    while k < len(lines):
-        head = lines[k].split()
-        if not head:
-            k += 1
-            continue
-        if dim is None:
-            if len(head) not in (6, 8):
-                raise InputError(path, k + 1, f"header needs 6 (2D) or 8 (3D) values, found {len(head)}")
-            dim = 2 if len(head) == 6 else 3
-        if len(head) != (6 if dim == 2 else 8):
-            raise InputError(path, k + 1, f"{dim}D header needs {6 if dim == 2 else 8} values, found {len(head)}")
-        n = int(head[0])
-        ncol = 8 if dim == 2 else 14
-        body = lines[k + 1:k + 1 + n]
-        if len(body) < n:
-            raise InputError(path, k + 2 + len(body), f"frame has {len(body)} of {n} particle lines")
-        rows = np.array(" ".join(body).split(), dtype=float)
-        if rows.size != n * ncol:
-            bad = next(b for b, ln in enumerate(body) if len(ln.split()) != ncol)
-            raise InputError(path, k + 2 + bad, f"particle line needs {ncol} values")
-        frames.append(DataFrame(n, float(head[1]), np.array(head[2:], float), rows.reshape(n, ncol)))
-        k += 1 + n
-    return frames
-
-
-def read_ene(path: str | Path) -> tuple[list[str], np.ndarray]:
-    path = Path(path)
-    lines = [ln for ln in read_text(path, "MercuryDPM .ene file").splitlines() if ln.strip()]
-    if not lines:
-        raise InputError(path, None, "empty .ene file")
-    labels = lines[0].split()
-    rows = np.array([ln.split() for ln in lines[1:]], dtype=float).reshape(len(lines) - 1, -1)
-    if rows.size and rows.shape[1] != len(labels):
-        raise InputError(path, 2, f"rows have {rows.shape[1]} values, header {len(labels)} labels")
-    return labels, rows
-
-
-@dataclass
-class FstatFrame:
-    time: float
-    version: int
-    box: np.ndarray          # (6,)
-    radii: np.ndarray        # (6,) rmin rmax 0 0 0 0
-    rows: np.ndarray         # (m, 16)
-
-
-def read_fstat(path: str | Path) -> list[FstatFrame]:
-    path = Path(path)
-    lines = read_text(path, "MercuryDPM .fstat file").splitlines()
-    frames: list[FstatFrame] = []
-    k = 0
-    while k < len(lines):
-        if not lines[k].startswith("#"):
-            raise InputError(path, k + 1, "expected the '# time version' line of a frame")
-        if k + 2 >= len(lines) or not (lines[k + 1].startswith("#") and lines[k + 2].startswith("#")):
-            raise InputError(path, k + 1, "a frame starts with three '#' lines")
-        t = lines[k][1:].split()
-        body = []
-        j = k + 3
-        while j < len(lines) and not lines[j].startswith("#"):
-            if lines[j].strip():
-                body.append(lines[j])
-            j += 1
-        rows = np.array(" ".join(body).split(), dtype=float)
-        if rows.size % 16:
-            bad = next(b for b, ln in enumerate(body) if len(ln.split()) != 16)
-            raise InputError(path, k + 4 + bad, "contact line needs 16 values")
-        frames.append(FstatFrame(float(t[0]), int(t[1]), np.array(lines[k + 1][1:].split(), float),
-                                 np.array(lines[k + 2][1:].split(), float), rows.reshape(-1, 16)))
-        k = j
-    return frames
-
-
-def iter_matching(frames: Iterator[Frame], step: int, pending: list) -> Frame | None:
-    """The local-dump frame with ``step`` from a step-ordered stream (None if it has none)."""
-    while True:
-        if pending:
-            f = pending[0]
-            if f.step == step:
-                pending.pop(0)
-                return f
-            if f.step > step:
-                return None
-            pending.pop(0)
-            continue
-        nxt = next(frames, None)
-        if nxt is None:
-            return None
-        pending.append(nxt)
+        self.open(self.file(".ene"), "w").write(line)
+        if self.fstat:
+            self.open(self.file(".fstat"), "w").write(fstat_frame_text(time, p, c))

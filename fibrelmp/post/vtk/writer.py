@@ -11,15 +11,11 @@ UInt64 headers) or ascii.  The ``.pvd`` lists every ``.vtu`` with its time.
 from __future__ import annotations
 
 import base64
-import os
-import xml.etree.ElementTree as ET
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from fibrelmp.errors import InputError
-from fibrelmp.textio import atomic_write
+from fibrelmp.formatbase import Writer
 from fibrelmp.post.lammps_dump.reader import Frame
 
 VTK_VERTEX, VTK_LINE = 1, 3
@@ -99,96 +95,42 @@ def vtu_text(frame: Frame, bonds: np.ndarray | None = None, ascii_: bool = False
     return "".join(parts)
 
 
-class VtkWriter:
-    """``<base>_NNNNNN.vtu`` per frame (renamed into place one by one), ``<base>.pvd`` at close."""
+class VtkWriter(Writer):
+    """``<base>_NNNNNN.vtu`` per frame and the ``<base>.pvd`` index (at close), all renamed
+    into place by ``close``.  A frame's time is its ITEM: TIME, else its step."""
 
-    def __init__(self, base: Path, bonds: np.ndarray | None = None, ascii_: bool = False):
-        self.base = Path(base)
+    format = "vtk"
+
+    def __init__(self, base: Path, bonds: np.ndarray | None = None, ascii_: bool = False, *,
+                 force: bool = True):
+        super().__init__(base, force=force)
         self.bonds = bonds
         self.ascii = ascii_
         self.entries: list[tuple[float, Path]] = []
+        self.stage(self.pvd_path)             # listed first, written at close
+
+    @property
+    def base(self) -> Path:
+        return self.target
+
+    @property
+    def pvd_path(self) -> Path:
+        return self.target.with_name(self.target.name + ".pvd")
+
+    def outputs(self) -> list[Path]:
+        return [self.pvd_path]
 
     def vtu_path(self, index: int) -> Path:
-        return self.base.with_name(f"{self.base.name}_{index:06d}.vtu")
+        return self.target.with_name(f"{self.target.name}_{index:06d}.vtu")
 
-    def write(self, frame: Frame, time: float) -> None:
+    def write(self, frame: Frame) -> None:
         path = self.vtu_path(len(self.entries))
-        atomic_write(path, vtu_text(frame, self.bonds, self.ascii))
-        self.entries.append((time, path))
+        self.write_file(path, vtu_text(frame, self.bonds, self.ascii).encode())
+        self.entries.append((float(frame.step) if frame.time is None else frame.time, path))
 
-    def close(self) -> list[Path]:
-        pvd = self.base.with_name(self.base.name + ".pvd")
+    def finish(self) -> None:
         rows = "".join(f'<DataSet timestep="{t!r}" group="" part="0" file="{p.name}"/>\n'
                        for t, p in self.entries)
-        atomic_write(pvd, '<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1" '
-                     'byte_order="LittleEndian">\n<Collection>\n' + rows + "</Collection>\n</VTKFile>\n")
-        return [pvd] + [p for _, p in self.entries]
-
-    def abort(self) -> None:
-        for _, p in self.entries:
-            p.unlink(missing_ok=True)
-
-
-# -- reading back (tests; structure checks without VTK installed) ----------------------------
-@dataclass
-class Vtu:
-    points: np.ndarray
-    point_data: dict[str, np.ndarray]
-    connectivity: np.ndarray
-    offsets: np.ndarray
-    types: np.ndarray
-    step: int | None
-
-
-_NP = {"Float64": np.float64, "Float32": np.float32, "Int64": np.int64, "Int32": np.int32,
-       "UInt8": np.uint8, "UInt64": np.uint64}
-
-
-def _decode_array(el: ET.Element, header: type) -> np.ndarray:
-    dtype = np.dtype(_NP[el.get("type")]).newbyteorder("<")
-    ncomp = int(el.get("NumberOfComponents", "1"))
-    text = (el.text or "").strip()
-    if el.get("format") == "ascii":
-        data = np.array(text.split(), dtype=dtype) if text else np.zeros(0, dtype)
-    else:
-        raw = base64.b64decode(text)
-        hsize = np.dtype(header).itemsize
-        nbytes = int(np.frombuffer(raw[:hsize], header)[0])
-        if nbytes != len(raw) - hsize:
-            raise ValueError(f"DataArray {el.get('Name')}: header says {nbytes} bytes, has {len(raw) - hsize}")
-        data = np.frombuffer(raw[hsize:], dtype)
-    return data.reshape(-1, ncomp) if ncomp > 1 else data
-
-
-def read_vtu(path: str | Path) -> Vtu:
-    root = ET.parse(path).getroot()
-    if root.get("type") != "UnstructuredGrid":
-        raise ValueError(f"{path}: not an UnstructuredGrid")
-    header = np.uint64 if root.get("header_type") == "UInt64" else np.uint32
-    piece = root.find("UnstructuredGrid/Piece")
-    arrays = {}
-    pd = {el.get("Name"): _decode_array(el, header) for el in piece.findall("PointData/DataArray")}
-    for el in piece.findall("Cells/DataArray"):
-        arrays[el.get("Name")] = _decode_array(el, header)
-    pts = _decode_array(piece.find("Points/DataArray"), header).reshape(-1, 3)
-    npts, ncells = int(piece.get("NumberOfPoints")), int(piece.get("NumberOfCells"))
-    if len(pts) != npts or len(arrays["types"]) != ncells or len(arrays["offsets"]) != ncells:
-        raise ValueError(f"{path}: array sizes do not match NumberOfPoints/NumberOfCells")
-    step_el = root.find("UnstructuredGrid/FieldData/DataArray")
-    step = int(_decode_array(step_el, header)[0]) if step_el is not None else None
-    return Vtu(pts, pd, arrays["connectivity"], arrays["offsets"], arrays["types"], step)
-
-
-def read_pvd(path: str | Path) -> list[tuple[float, Path]]:
-    root = ET.parse(path).getroot()
-    folder = Path(path).parent
-    return [(float(ds.get("timestep")), folder / ds.get("file")) for ds in root.iter("DataSet")]
-
-
-def remove_stale(base: Path) -> None:
-    """Delete ``<base>_*.vtu`` of an earlier conversion (called only with --force)."""
-    for p in base.parent.glob(f"{base.name}_[0-9][0-9][0-9][0-9][0-9][0-9].vtu"):
-        try:
-            os.unlink(p)
-        except OSError as exc:
-            raise InputError(p, None, f"cannot remove old output: {exc.strerror or exc}") from None
+        self.write_file(self.pvd_path, ('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1" '
+                                        'byte_order="LittleEndian">\n<Collection>\n' + rows +
+                                        "</Collection>\n</VTKFile>\n").encode())

@@ -15,8 +15,6 @@ from __future__ import annotations
 import copy
 import json
 import math
-import shutil
-import os
 from pathlib import Path
 from typing import Any
 
@@ -24,7 +22,7 @@ import numpy as np
 
 from fibrelmp.errors import RunError
 from fibrelmp.granmodel import GranularFrame, GranularModel
-from fibrelmp.textio import discard, write_failure
+from fibrelmp.formatbase import Writer
 from fibrelmp.translate.demdf.reader import read_snapshot
 
 __all__ = ["DemdfSnapshotWriter", "read_snapshot"]
@@ -32,16 +30,23 @@ __all__ = ["DemdfSnapshotWriter", "read_snapshot"]
 _MARK = "@@fibrelmp-particles@@"
 
 
-class DemdfSnapshotWriter:
-    def __init__(self, model: GranularModel, folder: str | Path):
+class DemdfSnapshotWriter(Writer):
+    """A snapshot per frame added; snapshots are staged and renamed into place by ``close``
+    (``written`` lists them then): a failed run leaves the folder as it was, an earlier run's
+    snapshots untouched."""
+
+    format = "demdf"
+
+    def __init__(self, model: GranularModel, folder: str | Path, *, force: bool = True):
         info = model.passthrough["demdf"]
+        super().__init__(folder, force=force)
         self.model = model
-        self.folder = Path(folder)
+        self.folder = self.target
         self.doc = copy.deepcopy(info["document"])
         self.dim: int = info["dimensionality"]
         self.types = [row[-1] for row in info["particle_rows"]]
         self.filename: str = info["filename"]
-        self.count: int = info["save_count"]
+        self.save_count: int = info["save_count"]
         self.location = info["output_location"]
         self.file_dt: float = info["file_time_step"]
         self.step0: int = info["time_step_count"]
@@ -49,16 +54,20 @@ class DemdfSnapshotWriter:
         self.position = model.spheres.position.copy()
         self.velocity = model.spheres.velocity.copy()
         self.written: list[Path] = []
-        # snapshots are staged and moved into place by close(): a failed run leaves the
-        # folder as it was (an earlier run's snapshots untouched); the run holds the folder's
-        # lock, so a staging folder found here is a killed run's
-        self.staging = self.folder / f".{self.filename}.fibrelmp-staging"
-        self.staged: list[Path] = []
+        self.last: Path | None = None            # the snapshot the last add() staged
         self.removed: dict[int, float] = {}      # particle index -> time it was first missing
         self.doc.setdefault("objects", {})
         self.doc["objects"]["particles"] = _MARK
 
+    def outputs(self) -> list[Path]:
+        return []            # any earlier snapshots are the run's business (outputs.Outputs)
+
     def add(self, frame: GranularFrame) -> Path:
+        """Stage the frame's snapshot; returns the path it gets at ``close``."""
+        super().add(frame)
+        return self.last
+
+    def write(self, frame: GranularFrame) -> None:
         rows = np.asarray(frame.sphere_rows, dtype=np.int64)
         self.position[rows] = frame.position
         self.velocity[rows] = frame.velocity
@@ -73,20 +82,20 @@ class DemdfSnapshotWriter:
             raise RunError(f"non-finite particle positions or velocities at time {frame.time:g}; "
                            "the run became unstable")
         self._set_counters(frame.time)
-        name = f"{self.filename}_{self.count}.json"
-        staged = self.staging / name
+        self.last = self.folder / f"{self.filename}_{self.save_count}.json"
         try:
-            if not self.staged:
-                shutil.rmtree(self.staging, ignore_errors=True)
-                self.staging.mkdir(parents=True)
-            with open(staged, "wb") as fh:
-                fh.write(self.render().encode("utf-8"))
-        except OSError as exc:        # the message names the snapshot, not the staging copy
-            discard(staged)
-            raise write_failure(self.folder / name, exc) from None
-        self.staged.append(staged)
-        self.count += 1
-        return self.folder / name
+            self.folder.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            exc.output = self.last
+            raise
+        self.write_file(self.last, self.render().encode("utf-8"))
+        self.save_count += 1
+
+    def close(self) -> list[Path]:
+        """Move the staged snapshots into place."""
+        done = super().close()
+        self.written.extend(done)
+        return done
 
     def _set_counters(self, time: float) -> None:
         doc = self.doc
@@ -102,7 +111,7 @@ class DemdfSnapshotWriter:
         target: Any = doc
         for key in self.location:
             target = target[key]
-        target["saveCount"] = self.count
+        target["saveCount"] = self.save_count
 
     def render(self) -> str:
         text = json.dumps(self.doc, indent=4, ensure_ascii=False, allow_nan=False)
@@ -120,24 +129,6 @@ class DemdfSnapshotWriter:
         rows = [f"{pad}[{', '.join(map(_num, p + v))}, {json.dumps(t)}]"
                 for p, v, t in zip(pos, vel, self.types)]
         return "[\n" + ",\n".join(rows) + "\n" + " " * indent + "]"
-
-    def close(self) -> None:
-        """Move the staged snapshots into place."""
-        for path in self.staged:
-            target = self.folder / path.name
-            try:
-                os.replace(path, target)
-            except OSError as exc:
-                self.abort()
-                raise write_failure(target, exc) from None
-            self.written.append(target)
-        self.staged = []
-        shutil.rmtree(self.staging, ignore_errors=True)
-
-    def abort(self) -> None:
-        """Drop the staged snapshots: the folder stays as it was."""
-        self.staged = []
-        shutil.rmtree(self.staging, ignore_errors=True)
 
 
 def _num(x: float) -> str:

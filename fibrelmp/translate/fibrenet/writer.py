@@ -6,15 +6,15 @@ xyz files, default ostream precision -- 6 significant digits -- for the restart 
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 from pathlib import Path
+from typing import NamedTuple, Sequence
 
 import numpy as np
 
 from fibrelmp.errors import InputError
-from fibrelmp.textio import (atomic_write, discard, format_rows, parse_table, read_text, temp_name,
-                      write_failure)
+from fibrelmp.formatbase import Writer
+from fibrelmp.textio import format_rows, parse_table, read_text
 from fibrelmp.numtext.fast import format_xyz_parts
 from fibrelmp.numtext.printf import fixed_chars, join_fields, name_chars
 
@@ -63,48 +63,48 @@ def xyz_frame(step: int, dt: float, lengths: np.ndarray, names: np.ndarray, valu
     return xyz_frame_bytes(step, dt, lengths, codes.ravel(), list(table), values).decode()
 
 
-class XyzWriter:
-    """Append frames to a temp file; ``close`` renames it into place (no half outputs).
+class XyzRows(NamedTuple):
+    """One frame for ``XyzWriter``: row i is ``table[codes[i]]`` and, per field, its values."""
+    step: int
+    dt: float
+    lengths: np.ndarray
+    codes: np.ndarray
+    table: list[str]
+    values: dict[str, np.ndarray]          # field ("position", "velocity", "force") -> (n, 3)
 
-    Any OSError (a full disk...) removes the temp file and raises ``write_failure``'s
-    error naming the output."""
 
-    def __init__(self, path: str | Path):
-        self.path = Path(path)
-        self.tmp = temp_name(self.path)
-        self.fh = None
-        try:
-            self.fh = open(self.tmp, "wb")
-        except OSError as exc:
-            self._fail(exc)
+class XyzWriter(Writer):
+    """FibreNet trajectories ``<base>_coord.xyz`` / ``_vel.xyz`` / ``_force.xyz``, one file
+    per field in ``fields``, every frame added (``XyzRows``, or an ``XyzFrame`` of names and
+    values for a one-field writer)."""
 
-    def _fail(self, exc: OSError):
-        self.abort()
-        raise write_failure(self.path, exc) from None
+    format = "xyz"
 
-    def write(self, step: int, dt: float, lengths: np.ndarray, names: np.ndarray, values: np.ndarray) -> None:
-        try:
-            self.fh.write(xyz_frame(step, dt, lengths, names, values).encode())
-        except OSError as exc:
-            self._fail(exc)
+    def __init__(self, base: str | Path, fields: Sequence[str] = tuple(XYZ_SUFFIX), *,
+                 force: bool = True):
+        self.fields = tuple(fields)
+        super().__init__(base, force=force)
+        for f in self.fields:               # the files exist (empty) even without frames
+            self.open(self.file(f))
 
-    def write_codes(self, step: int, dt: float, lengths: np.ndarray, codes: np.ndarray, table: list[str],
-                    values: np.ndarray) -> None:
-        try:
-            for part in xyz_frame_parts(step, dt, lengths, codes, table, values):
-                self.fh.write(part)
-        except OSError as exc:
-            self._fail(exc)
+    @property
+    def path(self) -> Path:
+        return self.target
 
-    def close(self) -> None:
-        try:
-            self.fh.close()
-            os.replace(self.tmp, self.path)
-        except OSError as exc:
-            self._fail(exc)
+    def file(self, field: str) -> Path:
+        return self.target.with_name(self.target.name + XYZ_SUFFIX[field])
 
-    def abort(self) -> None:
-        discard(self.tmp, self.fh)
+    def outputs(self) -> list[Path]:
+        return [self.file(f) for f in self.fields]
+
+    def write(self, frame: "XyzRows | XyzFrame") -> None:
+        if isinstance(frame, XyzFrame):
+            table, codes = np.unique(np.asarray(frame.names, dtype=str), return_inverse=True)
+            frame = XyzRows(frame.step, frame.dt, frame.lengths, codes.ravel(), list(table),
+                            {f: frame.values for f in self.fields})
+        for f in self.fields:
+            self.put(self.file(f), *xyz_frame_parts(frame.step, frame.dt, frame.lengths, frame.codes,
+                                                    frame.table, frame.values[f]))
 
 
 def _g(x: float) -> str:
@@ -119,8 +119,73 @@ def restart_text(step: int, dt: float, lengths: np.ndarray, names: np.ndarray, x
     return head + _rows("\t%s" + "\t%g" * 12 + "\n", names, values)
 
 
-def write_restart(path: str | Path, *args) -> None:
-    atomic_write(path, restart_text(*args))
+class RestartState(NamedTuple):
+    """One frame for ``RestartWriter``: bead i has type ``table[codes[i]]``, wrapped and
+    unwrapped positions, v~ and F."""
+    step: int
+    dt: float
+    lengths: np.ndarray
+    codes: np.ndarray
+    table: list[str]
+    x: np.ndarray
+    unwrapped: np.ndarray
+    v_tilde: np.ndarray
+    force: np.ndarray
+
+
+class RestartWriter(Writer):
+    """A FibreNet restart ``_restart.res`` (the path given) of the last frame added."""
+
+    format = "res"
+
+    def __init__(self, path: str | Path, *, force: bool = True):
+        super().__init__(path, force=force)
+        self.last: RestartState | None = None
+
+    def write(self, frame: RestartState) -> None:
+        self.last = frame                 # only the last frame is written, at close
+
+    def finish(self) -> None:
+        if self.last is not None:
+            s = self.last
+            names = np.array(s.table, dtype=object)[s.codes]
+            self.put(self.target, restart_text(s.step, s.dt, s.lengths, names, s.x, s.unwrapped,
+                                               s.v_tilde, s.force).encode())
+
+
+def write_restart(path: str | Path, step: int, dt: float, lengths: np.ndarray, names: np.ndarray,
+                  x: np.ndarray, unwrapped: np.ndarray, v_tilde: np.ndarray, force: np.ndarray) -> None:
+    """Write one restart file (atomically)."""
+    table, codes = np.unique(np.asarray(names, dtype=str), return_inverse=True)
+    with RestartWriter(path) as w:
+        w.add(RestartState(step, dt, lengths, codes.ravel(), list(table), x, unwrapped, v_tilde, force))
+
+
+class FibreNetWriter(Writer):
+    """What a FibreNet run writes: the xyz trajectories of ``fields`` and (``restart``) the
+    restart file of the last frame, all renamed into place together.  Frames are
+    ``(XyzRows, RestartState)`` pairs."""
+
+    def __init__(self, base: str | Path, fields: Sequence[str], restart: bool = True, *,
+                 force: bool = True):
+        self.fields, self.restart = tuple(fields), restart
+        super().__init__(base, force=force)
+        self.xyz = self.adopt(XyzWriter(base, self.fields))
+        self.res = self.adopt(RestartWriter(self.restart_path)) if restart else None
+
+    @property
+    def restart_path(self) -> Path:
+        return self.target.with_name(self.target.name + RESTART_SUFFIX)
+
+    def outputs(self) -> list[Path]:
+        xyz = [self.target.with_name(self.target.name + XYZ_SUFFIX[f]) for f in self.fields]
+        return xyz + ([self.restart_path] if self.restart else [])
+
+    def write(self, frame: tuple[XyzRows, RestartState]) -> None:
+        rows, state = frame
+        self.xyz.add(rows)
+        if self.res is not None:
+            self.res.add(state)
 
 
 @dataclass

@@ -10,7 +10,7 @@ Memory stays bounded: ``add`` appends each frame's per-type value block to one r
 file per object type in a temporary folder beside the output (laid out saves x objects x
 columns); ``close`` reads back chunks of objects for all saves and formats them (one C-level
 ``%`` per chunk and object type), a chunk holding about a million numbers whatever the number
-of saves, writes a temp file and renames it.
+of saves, writes a temp file and renames it (formatbase.Writer).
 """
 
 from __future__ import annotations
@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from fibrelmp.formatbase import Writer
 from fibrelmp.granmodel import GranularFrame, GranularModel
 from fibrelmp.textio import temp_name, write_failure
 from fibrelmp.translate.musen.scene import (ACTIVE_INTERACTIONS, ACTIVE_PROPERTIES, DEFAULT_ACTIVITY_END,
@@ -83,14 +84,17 @@ def _g(x: float) -> str:
     return "%g" % (DEFAULT_ACTIVITY_END if x == np.inf else x)
 
 
-class MusenResultWriter:
+class MusenResultWriter(Writer):
     """``add`` every frame, then ``close`` (or ``abort`` on failure)."""
+
+    format = "musen"
 
     def __init__(self, model: GranularModel, path: str | os.PathLike, precision: int = 6,
                  time_interval: tuple[float, float] | None = None,
-                 selectors: dict[str, dict[str, bool]] | None = None):
+                 selectors: dict[str, dict[str, bool]] | None = None, *, force: bool = True):
+        super().__init__(path, force=force)
         self.model = model
-        self.path = Path(path)
+        self.path = self.target
         self.precision = int(precision)
         self.time_interval = time_interval
         self.sel = all_on()
@@ -106,10 +110,14 @@ class MusenResultWriter:
                                                dir=self.path.parent))
         except OSError as exc:
             raise write_failure(self.path, exc) from None
-        self.tmp = temp_name(self.path)
+
+    @property
+    def tmp(self) -> Path:
+        """The temp file the result is written to until it is complete."""
+        return temp_name(self.path)
 
     # ------------------------------------------------------------------ frames
-    def add(self, frame: GranularFrame) -> None:
+    def write(self, frame: GranularFrame) -> None:
         m = self.model
         sp = m.spheres
         t = float(frame.time)
@@ -134,13 +142,9 @@ class MusenResultWriter:
             blocks["b"] = self._bond_block(frame, blocks["s"])
         if m.triangles is not None:
             blocks["w"] = self._wall_block(frame)
-        try:
-            for name, block in blocks.items():        # one growing (T, n, K) file per type
-                with open(self.spool / f"{name}.bin", "ab") as fh:
-                    fh.write(np.ascontiguousarray(block, np.float64).tobytes())
-        except OSError as exc:          # the spool is part of the output being written
-            self.abort()
-            raise write_failure(self.path, exc) from None
+        for name, block in blocks.items():        # one growing (T, n, K) file per type
+            with open(self.spool / f"{name}.bin", "ab") as fh:    # (a failure names the output)
+                fh.write(np.ascontiguousarray(block, np.float64).tobytes())
         self.times.append(t)
 
     def _sphere_block(self, f: GranularFrame, rows: np.ndarray) -> np.ndarray:
@@ -187,27 +191,13 @@ class MusenResultWriter:
         return b
 
     # ------------------------------------------------------------------ output
-    def close(self) -> Path:
-        try:
-            with open(self.tmp, "w", newline="\n") as out:
-                self._write_objects(out)
-                out.write(self._scene_text())
-            os.replace(self.tmp, self.path)
-        except OSError as exc:
-            self.abort()
-            raise write_failure(self.path, exc) from None
-        except BaseException:
-            self.abort()
-            raise
-        shutil.rmtree(self.spool, ignore_errors=True)
-        return self.path
+    def finish(self) -> None:
+        out = self.open(self.path, "w", newline="\n")
+        self._write_objects(out)
+        out.write(self._scene_text())
 
-    def abort(self) -> None:
+    def discard(self) -> None:
         shutil.rmtree(self.spool, ignore_errors=True)
-        try:
-            self.tmp.unlink()
-        except OSError:
-            pass
 
     def _objects(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(ids, type, row) of every object to write, ascending id."""

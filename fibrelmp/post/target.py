@@ -1,0 +1,155 @@
+"""What every ``fibrelmp post --to`` target shares: ``DumpTarget``, a ``Writer`` of completed
+LAMMPS dump frames, and the ``PostContext`` it gets from the command line.
+
+A target is one class (registered with ``registry.register_format(..., {TARGET: ...})``):
+``files(base)`` names what a conversion to ``base`` writes, ``write_frame`` writes one frame
+(``start`` first sees the first ``lookahead`` frames, e.g. to find the time step), ``end``
+writes what comes last, and ``read_back(files)`` reads the output back (the conformance
+tests, tests/test_conformance.py).  Class attributes tell the conversion (post/convert.py)
+what it needs: ``units`` (for the unit-mismatch warning), ``last_frame_by_default``,
+``uses_local``.  Files are staged and renamed into place by ``close`` (formatbase.Writer).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, ClassVar, Iterator, Mapping
+
+import numpy as np
+
+from fibrelmp.formatbase import Writer
+from fibrelmp.post.lammps_dump.reader import Frame
+
+
+class TypeNames(Mapping):
+    """Type number -> name, looked up in live tables (labels met later in the stream are
+    added to them), first table first; ``names[t]`` of a type without a name is its number,
+    ``names.get(t, default)`` the default."""
+
+    def __init__(self, *live: dict[int, str]):
+        self.live = live
+
+    def _find(self, key: int) -> str | None:
+        for table in self.live:
+            if key in table:
+                return table[key]
+        return None
+
+    def __getitem__(self, key: int) -> str:
+        name = self._find(key)
+        return str(key) if name is None else name
+
+    def get(self, key: int, default: Any = None) -> Any:
+        name = self._find(key)
+        return default if name is None else name
+
+    def __contains__(self, key: object) -> bool:
+        return any(key in table for table in self.live)
+
+    def __iter__(self) -> Iterator[int]:
+        return iter(dict.fromkeys(k for table in self.live for k in table))
+
+    def __len__(self) -> int:
+        return sum(1 for _ in self)
+
+
+@dataclass
+class PostContext:
+    """What a target may use besides the frames (from ``fibrelmp post``'s options)."""
+
+    source: Path                                   # the trajectory (for messages)
+    datafile: Any = None                           # --data (lammps_data.reader.DataFile)
+    type_names: Mapping[int, str] = field(default_factory=TypeNames)
+    local: Path | None = None                      # --local contact dump
+    gravity: tuple[float, float, float] | None = None
+    warnings: list[tuple[str, str]] = field(default_factory=list)
+
+    def warn(self, kind: str, text: str) -> None:
+        """One warning per kind."""
+        if kind not in {k for k, _ in self.warnings}:
+            self.warnings.append((kind, text))
+
+
+@dataclass
+class ReadBack:
+    """One frame of a target's output as read back (conformance tests): positions in dump
+    atom-id order, to within ``rtol``/``atol`` (the format's printed precision); ``values``
+    other per-atom vectors it keeps (dump column names -> (n, k)), to within ``value_tol``
+    ((rtol, atol); None: the positions')."""
+
+    positions: np.ndarray
+    rtol: float = 0.0
+    atol: float = 0.0
+    values: dict[tuple[str, ...], np.ndarray] = field(default_factory=dict)
+    value_tol: tuple[float, float] | None = None
+
+
+class DumpTarget(Writer):
+    """A ``post --to`` output, written from completed dump frames (``add(frame)``)."""
+
+    units: ClassVar[tuple[str, Any] | None] = None    # (format title, units.UnitSystem) of its numbers
+    last_frame_by_default: ClassVar[bool] = False     # without --frames: the last frame only
+    uses_local: ClassVar[bool] = False                # reads --local contact dumps
+    lookahead: ClassVar[int] = 1                      # frames ``start`` sees
+
+    def __init__(self, base: str | Path, context: PostContext | None = None, *,
+                 force: bool = True):
+        self.context = context if context is not None else PostContext(Path(base))
+        self._head: list[Frame] | None = []
+        super().__init__(base, force=force)
+
+    @property
+    def base(self) -> Path:
+        return self.target
+
+    # -- what targets implement -------------------------------------------------------------
+    @classmethod
+    def files(cls, base: Path) -> list[Path]:
+        """The files a conversion to ``base`` writes (and ``--force`` replaces)."""
+        return [base]
+
+    def start(self, first: list[Frame]) -> None:
+        """See the first ``lookahead`` frames (fewer if the dump has fewer) before any is written."""
+
+    def write_frame(self, frame: Frame) -> None:
+        raise NotImplementedError
+
+    def end(self) -> None:
+        """Write what comes after the last frame."""
+
+    @classmethod
+    def read_back(cls, files: list[Path]) -> list[ReadBack]:
+        """The frames of a written output (tests/test_conformance.py)."""
+        raise NotImplementedError
+
+    # -- shared ------------------------------------------------------------------------------
+    def outputs(self) -> list[Path]:
+        return self.files(self.target)
+
+    def write(self, frame: Frame) -> None:
+        if self._head is None:
+            self.write_frame(frame)
+            return
+        self._head.append(frame)
+        if len(self._head) >= self.lookahead:
+            self._release()
+
+    def _release(self) -> None:
+        head, self._head = self._head, None
+        self.start(head)
+        for frame in head:
+            self.write_frame(frame)
+
+    def finish(self) -> None:
+        if self._head:
+            self._release()
+        self.end()
+
+    def time_of(self, frame: Frame) -> float:
+        """The frame's time (ITEM: TIME), else its step, with a warning."""
+        if frame.time is not None:
+            return frame.time
+        self.context.warn("no times", f"{frame.source}: no ITEM: TIME in the dump (dump_modify time "
+                          "yes); the step number is written as the time")
+        return float(frame.step)

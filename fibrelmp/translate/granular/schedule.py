@@ -1,0 +1,142 @@
+"""Time in a granular job: the run's length in steps, the steps a frame is saved at, and the
+sequence of actions (runs, activity-end deletions, frames, loops) the script performs."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from fibrelmp.errors import InputError
+from fibrelmp.granmodel import GranularModel
+from fibrelmp.translate.steps import SaveSteps
+
+MAX_STEPS = 2.0 ** 63 - 1   # LAMMPS counts time steps in a 64-bit integer
+# explicit (irregular) save schedules longer than this are refused: regular ones are loops
+MAX_IRREGULAR_SAVES = 100_000
+
+
+@dataclass
+class RunTime:
+    dim: int                 # 2 or 3
+    dt: float
+    total: int               # time steps of the run
+    t_start: float
+    t_end: float             # t_start + total * dt
+
+
+def run_time(model: GranularModel) -> RunTime:
+    """Dimension, time step and number of steps of the run (checked)."""
+    plan = model.plan
+    dim = int(plan.dimension)
+    if dim not in (2, 3):
+        raise InputError(model.source, None, f"dimension must be 2 or 3, got {dim}")
+    dt = float(plan.dt)
+    if not (dt > 0 and math.isfinite(dt)):
+        raise InputError(model.source, None, f"time step must be > 0, got {plan.dt!r}")
+    span = float(plan.t_end) - float(plan.t_start)
+    if not span >= 0:
+        raise InputError(model.source, None, f"end time {plan.t_end!r} is before start time {plan.t_start!r}")
+    steps = span / dt
+    if not steps <= MAX_STEPS:
+        raise InputError(model.source, None, f"time step {dt:g} is too small: {span:g} time units "
+                         f"take {steps:.3g} steps, more than LAMMPS can count ({MAX_STEPS:.3g})")
+    total = int(round(steps))
+    t_start = float(plan.t_start)
+    t_end = t_start + total * dt
+    return RunTime(dim, dt, total, t_start, t_end)
+
+
+def schedule(total: int, saves: SaveSteps, deletions: list[tuple[int, np.ndarray]]):
+    """Actions of the script: runs (in pieces of at most 1/50 of the run, for progress),
+    activity-end deletions and frames.  A stretch of regular saves with no deletion in it is
+    one LAMMPS loop ("loop" ... "end"), so the script does not grow with the number of frames."""
+    piece = max(1, min(math.ceil(total / 50), 2 ** 31 - 1))     # LAMMPS: run N <= 2^31-1
+    acts: list[tuple] = [("run0",), ("frame", 0)]
+    dels = {s: rows for s, rows in deletions}
+    step, pre = 0, False
+
+    def event(ev: int) -> None:
+        nonlocal step, pre
+        while step < ev:
+            n = min(piece, ev - step)
+            acts.append(("run", n, pre))
+            pre = False
+            step += n
+        if ev in dels:
+            acts.append(("delete", ev, dels[ev]))
+            pre = True
+        if ev in saves:
+            acts.append(("frame", ev))
+
+    if saves.explicit is not None:
+        for ev in sorted(set(saves.explicit) | set(dels)):
+            if ev > 0:
+                event(ev)
+        return acts
+    k = saves.period
+    last_regular = (total // k) * k
+    for stop in sorted(d for d in dels if d > 0) + [None]:
+        limit = min(stop - 1 if stop is not None else total, last_regular)
+        first = (step // k + 1) * k
+        if first <= limit:
+            event(first)                  # its gap (or pre) may differ from the regular ones
+            more = (limit - first) // k
+            if more == 1:
+                event(first + k)
+            elif more > 1:
+                name = f"fl_loop{sum(1 for a in acts if a[0] == 'loop') + 1}"
+                acts.append(("loop", name, more))
+                body_step, n_left = step, k
+                while n_left > 0:
+                    n = min(piece, n_left)
+                    acts.append(("run", n, False))
+                    n_left -= n
+                acts.append(("frame", None))
+                acts.append(("end", name))
+                step = body_step + more * k
+        if stop is not None:
+            event(stop)
+    if step < total:
+        event(total)
+    return acts
+
+
+def save_steps(model: GranularModel, total: int, dt: float) -> SaveSteps:
+    plan = model.plan
+    if plan.save_every_steps:
+        k = int(plan.save_every_steps)
+        if k <= 0:
+            raise InputError(model.source, None, f"save interval must be > 0 steps, got {k}")
+        return SaveSteps(total, period=k)
+    if plan.save_every_time:
+        dts = float(plan.save_every_time)
+        if not dts > 0:
+            raise InputError(model.source, None, f"save interval must be > 0, got {dts!r}")
+        count = int(math.floor(total * dt / dts * (1 + 1e-12)))     # saves after the first
+        ratio = dts / dt
+        k = int(round(ratio))
+        # j * ratio rounds to j * k for every j <= count: the saves are regular
+        if k >= 1 and abs(ratio - k) * count + 1e-15 * ratio * count < 0.25:
+            return SaveSteps(total, period=k)
+        if count > MAX_IRREGULAR_SAVES:
+            raise InputError(model.source, None, f"the saving step {dts:g} s is not a multiple of "
+                             f"the simulation step {dt:g} s and the run saves {count + 1} times: "
+                             "make the saving step a multiple of the simulation step")
+        j = np.arange(0, count + 1)
+        steps = {0, total}
+        steps.update(int(s) for s in np.rint(j * dts / dt) if 0 <= s <= total)
+        return SaveSteps(total, explicit=sorted(steps))
+    return SaveSteps(total, explicit=[0, total])
+
+
+def compress_ids(ids: np.ndarray) -> str:
+    """LAMMPS id list of a group: runs of consecutive ids as a:b."""
+    ids = np.sort(np.asarray(ids, np.int64))
+    if not len(ids):
+        return ""
+    breaks = np.flatnonzero(np.diff(ids) != 1)
+    starts = np.r_[ids[0], ids[breaks + 1]]
+    ends = np.r_[ids[breaks], ids[-1]]
+    return " ".join(str(a) if a == b else f"{a}:{b}" for a, b in zip(starts, ends))

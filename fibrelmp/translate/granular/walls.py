@@ -1,0 +1,301 @@
+"""Walls of a granular job: how each geometry (triangle group) or plane is represented in
+LAMMPS (``plan_walls``: a region box / cylinder, wall particles, or a wall/gran plane) and the
+region, fix and variable commands of the regions, planes and moving wall particles
+(``wall_commands``)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from fibrelmp.errors import InputError
+from fibrelmp.granmodel import Geometry, GranularModel
+from fibrelmp.translate.granular.contacts import check_law, law_args, rolling_spring
+from fibrelmp.translate.granular.geometry import (BoxShape, CylinderShape, Kinematics, detect_cylinder,
+                                                  detect_oriented_box, geometry_kinematics,
+                                                  geometry_triangle_rows, piecewise_expression)
+from fibrelmp.translate.lammps_format import float_text
+
+
+@dataclass
+class WallPlan:
+    """How one geometry (group of triangles) or plane is represented."""
+
+    name: str
+    kind: str                        # box | cylinder | tiles | plane
+    description: str
+    triangle_rows: np.ndarray        # rows into model.triangles (empty for planes)
+    kinematics: Kinematics
+    material: int
+    shape: BoxShape | CylinderShape | None = None
+    region: str | None = None        # LAMMPS region id
+    fixes: list[str] = field(default_factory=list)
+    contact_vars: list[str] = field(default_factory=list)   # 6 dump columns (fx fy fz cx cy cz)
+    tile_ids: np.ndarray | None = None       # LAMMPS ids of its wall tiles
+    tile_owner: np.ndarray | None = None     # triangle row of each tile
+    plane_index: int | None = None           # index into model.planes
+
+
+def plan_walls(model: GranularModel, dt: float, t_end: float) -> list[WallPlan]:
+    """Representation of every geometry / plane (no files, used by ``fibrelmp check`` too)."""
+    plans: list[WallPlan] = []
+    tris = model.triangles
+    t0 = model.plan.t_start
+    for name, geom, rows in geometry_triangle_rows(model):
+        v = tris.vertices[rows]
+        if geom is not None:
+            _check_motion(model, geom)
+            kin = geometry_kinematics(geom, v, t0, t_end)
+        else:
+            kin = Kinematics()
+        mats, counts = np.unique(tris.material[rows], return_counts=True)
+        material = int(mats[np.argmax(counts)])
+        shape = detect_oriented_box(v) or detect_cylinder(v) if len(rows) else None
+        if shape is not None and kin.rotating and not _region_can_rotate(shape, kin):
+            shape = None        # a region rotates about one fixed axis direction only
+        if isinstance(shape, BoxShape):
+            kind = "box"
+        elif isinstance(shape, CylinderShape):
+            kind = "cylinder"
+        else:
+            kind = "tiles"
+        desc = shape.describe() if shape is not None else "tiled with frozen wall particles"
+        if kin.moving:
+            desc += ", moving (time-dependent motion)"
+        if len(mats) > 1:
+            desc += f"; mixed wall materials, uses '{model.materials[material].name}' for all"
+        plans.append(WallPlan(name, kind, desc, rows, kin, material, shape))
+    for k, pl in enumerate(model.planes):
+        n = np.asarray(pl.normal, float)
+        n = n / np.linalg.norm(n)
+        axis = int(np.argmax(np.abs(n)))
+        aligned = abs(abs(n[axis]) - 1) < 1e-12
+        if aligned:
+            ax = "xyz"[axis]
+            sign = "+" if n[axis] > 0 else "-"
+            desc = f"plane {ax} = {pl.point[axis]:.6g} (normal {sign}{ax}) -> fix wall/gran {ax}plane"
+        else:
+            desc = "plane through " + ", ".join(f"{c:.6g}" for c in pl.point) + " -> LAMMPS region plane"
+        plans.append(WallPlan(f"plane {k + 1}", "plane", desc, np.zeros(0, np.int64), Kinematics(),
+                              int(pl.material), plane_index=k))
+    return plans
+
+
+def _region_can_rotate(shape, kin: Kinematics) -> bool:
+    if kin.single_axis is None:
+        return False
+    if isinstance(shape, BoxShape) and shape.frame is not None:
+        ax, th = shape.rotation()
+        return th == 0.0 or abs(abs(float(ax @ kin.single_axis)) - 1) < 1e-9
+    return True
+
+
+def _check_motion(model: GranularModel, geom: Geometry) -> None:
+    if geom.motion_type in (2, 3):
+        raise InputError(model.source, None, f"geometry '{geom.name}': force-dependent geometry "
+                         "motion is not supported yet")
+    if geom.motion_type not in (0, 1):
+        raise InputError(model.source, None, f"geometry '{geom.name}': unknown motion type "
+                         f"{geom.motion_type}")
+    if any(geom.free) and geom.mass > 0:
+        raise InputError(model.source, None, f"geometry '{geom.name}': free (force-driven) geometry "
+                         "motion is not supported yet")
+
+
+def describe_walls(model: GranularModel) -> list[str]:
+    """One line per geometry / plane: how LAMMPS represents it."""
+    plan = model.plan
+    out = []
+    for wp in plan_walls(model, plan.dt, plan.t_end):
+        out.append(f"{wp.name}: {wp.description}" + (f" ({len(wp.triangle_rows)} triangles)"
+                                                     if len(wp.triangle_rows) else ""))
+    return out
+
+
+def wall_commands(model: GranularModel, wall_plans: list[WallPlan], spheres, dt: float):
+    """(region/fix commands, variable commands, extra frame columns) of every wall: regions and
+    planes get wall/gran fixes per sphere type, moving wall particles a fix move.  Each plan
+    gets the tag w1, w2, ... in its order; ``spheres`` is a ``SimulatedSpheres``."""
+    wall_cmds: list[str] = []
+    var_cmds: list[str] = []
+    frame_columns: list[str] = []
+    mat_groups = spheres.material_groups()
+    xs = spheres.x[spheres.rows]
+    for gi, wp in enumerate(wall_plans):
+        tag = f"w{gi + 1}"
+        if wp.kind in ("box", "cylinder"):
+            _region_wall(model, wp, tag, mat_groups, xs, spheres.smat, spheres.m_min, dt, wall_cmds,
+                         var_cmds, frame_columns)
+        elif wp.kind == "plane":
+            _plane_wall(model, model.planes[wp.plane_index], wp, tag, mat_groups, spheres.m_min, dt,
+                        wall_cmds)
+        elif wp.kind == "tiles" and wp.kinematics.moving:
+            _tile_motion(wp, tag, var_cmds, wall_cmds)
+    return wall_cmds, var_cmds, frame_columns
+
+
+def _region_motion(wp: WallPlan, tag: str, var_cmds) -> str:
+    """The move/rotate keywords of a region following its geometry (variables into
+    ``var_cmds``), "" for a static axis-aligned one.  LAMMPS places a dynamic region at
+    P + R_n(theta) (x_region - P) + d: with the geometry's motion x = R(t) x0 + b(t) and a
+    region frame E (x0 = P + E (x_region - P)), R_n(theta) = R(t) E and d = R(t) P + b - P."""
+    sh = wp.shape
+    kin = wp.kinematics
+    frame = isinstance(sh, BoxShape) and sh.frame is not None
+    P = sh.pivot if frame else np.zeros(3)
+    dyn = ""
+    if kin.moving:
+        for i, ax in enumerate("xyz"):
+            def coeff(s, i=i):
+                k = np.einsum("kij,j->ki", s.kr, P)[:, i] + s.kb[:, i]
+                k[0] -= P[i]
+                return k
+            var_cmds.append(f"variable        {tag}_b{ax} equal \"{piecewise_expression(kin, coeff)}\"")
+        dyn = f" move v_{tag}_bx v_{tag}_by v_{tag}_bz"
+    if kin.rotating or frame:
+        ax0, th0 = sh.rotation() if frame else (np.array([0.0, 0.0, 1.0]), 0.0)
+        n = kin.single_axis if kin.rotating else ax0
+        th0 = th0 * (1.0 if float(ax0 @ n) >= 0 else -1.0)
+        expr = _angle_expression(kin, th0) if kin.rotating else float_text(th0)
+        var_cmds.append(f"variable        {tag}_th equal \"{expr}\"")
+        dyn += (f" rotate v_{tag}_th {float_text(P[0])} {float_text(P[1])} {float_text(P[2])} "
+                f"{float_text(n[0])} {float_text(n[1])} {float_text(n[2])}")
+    if dyn:
+        dyn += " units box"
+    return dyn
+
+
+def _region_wall(model, wp: WallPlan, tag: str, mat_groups, xs, smat, m_min, dt, wall_cmds,
+                 var_cmds, frame_columns) -> None:
+    """Region (+ wall/gran/region fixes per sphere type; spheres on both sides of a closed
+    region get one region each, side in and side out, found with a static probe region)."""
+    sh = wp.shape
+    frame = isinstance(sh, BoxShape) and sh.frame is not None
+    P = sh.pivot if frame else np.zeros(3)
+    dyn = _region_motion(wp, tag, var_cmds)
+    if isinstance(sh, BoxShape):
+        geo = "block " + " ".join(f"{float_text(sh.lo[a])} {float_text(sh.hi[a])}" for a in range(3))
+        opened = " ".join(f"open {f}" for f in sh.open_faces)
+        if sh.flat_axis is not None:
+            inside = np.zeros(len(xs), bool)
+        else:
+            xl = sh.to_local(xs)
+            inside = ((xl > sh.lo) & (xl < sh.hi)).all(1)
+    else:
+        ax = "xyz"[sh.axis]
+        geo = (f"cylinder {ax} {float_text(sh.c1)} {float_text(sh.c2)} {float_text(sh.radius)} "
+               f"{float_text(sh.lo)} {float_text(sh.hi)}")
+        opened = " ".join(f"open {f}" for f in sh.open_faces)
+        b, c = [k for k in range(3) if k != sh.axis]
+        rho = np.hypot(xs[:, b] - sh.c1, xs[:, c] - sh.c2)
+        inside = (rho < sh.radius) & (xs[:, sh.axis] > sh.lo) & (xs[:, sh.axis] < sh.hi)
+    sides = []
+    if inside.any():
+        sides.append("in")
+    if (~inside).any() or not len(xs):
+        sides.append("out")
+    fx, cx = [[] for _ in range(3)], [[] for _ in range(3)]
+    for side in sides:
+        rid = f"{tag}{side}"
+        wall_cmds.append(f"region          {rid} {geo} side {side} {opened}{dyn}".rstrip())
+        grp = "spheres"
+        if len(sides) == 2:
+            static = ""
+            if frame:
+                ax0, th0 = sh.rotation()
+                wall_cmds.append(f"variable        {rid}_th0 equal {float_text(th0)}")
+                static = (f" rotate v_{rid}_th0 {float_text(P[0])} {float_text(P[1])} {float_text(P[2])} "
+                          f"{float_text(ax0[0])} {float_text(ax0[1])} {float_text(ax0[2])} units box")
+            wall_cmds.append(f"region          {rid}_probe {geo} side {side} {opened}{static}".rstrip())
+            wall_cmds.append(f"group           {rid} region {rid}_probe")
+            grp = rid
+        for t, m in mat_groups:
+            if not ((smat == m) & (inside if side == "in" else ~inside)).any():
+                continue
+            law = check_law(model, m, wp.material)
+            k, g = rolling_spring(m_min[m], dt)
+            fid = f"{rid}_m{t}"
+            g_use = f"m{t}" if grp == "spheres" else f"{rid}_m{t}"
+            if grp != "spheres":
+                wall_cmds.append(f"group           {rid}_m{t} intersect {rid} m{t}")
+            wall_cmds.append(f"fix             {fid} {g_use} wall/gran/region granular "
+                             f"{law_args(law, law.rolling_friction, k, g)} region {rid} contacts")
+            wp.fixes.append(fid)
+            for i in range(3):
+                fx[i].append(f"f_{fid}[{2 + i}]")
+                cx[i].append(f"f_{fid}[{5 + i}]")
+        wp.region = rid
+    if wp.fixes:
+        for i, ax in enumerate("xyz"):
+            wall_cmds.append(f"variable        {tag}_f{ax} atom \"{'+'.join(fx[i])}\"")
+        for i, ax in enumerate("xyz"):
+            wall_cmds.append(f"variable        {tag}_c{ax} atom \"{'+'.join(cx[i])}\"")
+        wp.contact_vars = [f"v_{tag}_f{a}" for a in "xyz"] + [f"v_{tag}_c{a}" for a in "xyz"]
+        frame_columns.extend(wp.contact_vars)
+
+
+def _angle_expression(kin: Kinematics, th0: float = 0.0) -> str:
+    """th0 + rotation angle theta(t) about kin.single_axis (all segments share the axis)."""
+    n = kin.single_axis
+
+    def coeff(s):
+        ws = float(s.axis @ n) * s.w if s.w else 0.0
+        return np.array([th0 + kin.angle(s.t0), ws, 0.0, 0.0])
+    return piecewise_expression(kin, coeff)
+
+
+def _plane_wall(model, pl, wp: WallPlan, tag: str, mat_groups, m_min, dt, wall_cmds) -> None:
+    n = np.asarray(pl.normal, float)
+    n = n / np.linalg.norm(n)
+    axis = int(np.argmax(np.abs(n)))
+    aligned = abs(abs(n[axis]) - 1) < 1e-12
+    if not aligned:
+        p = pl.point
+        wall_cmds.append(f"region          {tag} plane {float_text(p[0])} {float_text(p[1])} {float_text(p[2])} "
+                         f"{float_text(n[0])} {float_text(n[1])} {float_text(n[2])} side in units box")
+    for t, m in mat_groups:
+        law = check_law(model, m, wp.material)
+        k, g = rolling_spring(m_min[m], dt)
+        fid = f"{tag}_m{t}"
+        if aligned:
+            pos = float_text(pl.point[axis])
+            lohi = f"{pos} NULL" if n[axis] > 0 else f"NULL {pos}"
+            where = f"{'xyz'[axis]}plane {lohi}"
+            wall_cmds.append(f"fix             {fid} m{t} wall/gran granular "
+                             f"{law_args(law, law.rolling_friction, k, g)} {where}")
+        else:
+            wall_cmds.append(f"fix             {fid} m{t} wall/gran/region granular "
+                             f"{law_args(law, law.rolling_friction, k, g)} region {tag}")
+        wp.fixes.append(fid)
+
+
+def _tile_motion(wp: WallPlan, tag: str, var_cmds, wall_cmds) -> None:
+    """fix move variable: x = R(t) x0 + b(t) for every tile (x0 kept in d_x0 d_y0 d_z0)."""
+    if wp.tile_ids is None or not len(wp.tile_ids):
+        return
+    kin = wp.kinematics
+
+    def var(name: str, pick, rate: bool = False) -> None:
+        var_cmds.append(f"variable        {tag}_{name} equal \"{piecewise_expression(kin, pick, rate)}\"")
+
+    for i, ax in enumerate("xyz"):
+        var(f"b{ax}", lambda s, i=i: s.kb[:, i])
+        var(f"vb{ax}", lambda s, i=i: s.kb[:, i], True)
+    move = f"fix             {tag}_move {tag}_tiles move variable "
+    if not kin.rotating:
+        wall_cmds.append(move + " ".join(f"v_{tag}_b{a}" for a in "xyz") + " "
+                         + " ".join(f"v_{tag}_vb{a}" for a in "xyz"))
+        return
+    for i in range(3):
+        for j in range(3):
+            var(f"R{i}{j}", lambda s, i=i, j=j: s.kr[:, i, j])
+            var(f"dR{i}{j}", lambda s, i=i, j=j: s.kr[:, i, j], True)
+    x0 = ["d_x0", "d_y0", "d_z0"]
+    for i, ax in enumerate("xyz"):
+        disp = "+".join(f"(v_{tag}_R{i}{j}{'-1' if i == j else ''})*{x0[j]}" for j in range(3))
+        vel = "+".join(f"v_{tag}_dR{i}{j}*{x0[j]}" for j in range(3))
+        var_cmds.append(f"variable        {tag}_dx{ax} atom \"{disp}+v_{tag}_b{ax}\"")
+        var_cmds.append(f"variable        {tag}_vx{ax} atom \"{vel}+v_{tag}_vb{ax}\"")
+    wall_cmds.append(move + " ".join(f"v_{tag}_dx{a}" for a in "xyz") + " "
+                     + " ".join(f"v_{tag}_vx{a}" for a in "xyz"))

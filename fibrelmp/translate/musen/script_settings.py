@@ -1,0 +1,270 @@
+"""Apply a SIMULATOR job of a cmusen script (``script_parse.MusenJob``) to a GranularModel:
+materials, scene (domain, PBC, bonds, motion), models and times, in cmusen's order
+(``apply_simulator_settings``), with MUSEN's defaults where the job and the scene say nothing.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+
+import numpy as np
+
+from fibrelmp.errors import InputError
+from fibrelmp.granmodel import GranularModel
+from fibrelmp.translate.musen.scene import (INTERACTION_DEFAULTS, _check_material, check_simulable, contact_law,
+                    domain_warning)
+from fibrelmp.translate.musen.script_parse import MUSEN_MODELS, SUPPORTED_MODELS, MusenJob, model_kind
+
+MODEL_PARAMETERS = {"ModelSBElastic": {"CONSIDER_BREAKAGE": 1.0}}   # AddParameter(...) defaults
+MUSEN_DEFAULTS = {"dt": 1e-6, "save": 1e-3, "t_end": 1.0, "gravity": (0.0, 0.0, -9.81)}
+
+
+def _resolve_models(model: GranularModel, job: MusenJob) -> dict[str, tuple[str, dict]]:
+    chosen: dict[str, tuple[str, dict]] = dict(model.passthrough.get("musen_models", {}))
+    for spec in job.models:
+        kind = model_kind(spec)
+        known = [n for names in MUSEN_MODELS.values() for n in names]
+        if spec.name not in known:
+            near = difflib.get_close_matches(spec.name, known, n=1)
+            raise InputError(job.path, spec.line, f"unknown MUSEN model {spec.name!r}"
+                             + (f"; did you mean {near[0]}?" if near else ""))
+        if spec.kind and spec.kind != kind:
+            raise InputError(job.path, spec.line, f"{spec.name} is a {kind} model, given as "
+                             f"MODEL_{spec.kind}")
+        if SUPPORTED_MODELS.get(kind) != spec.name:
+            what = {"PP": "particle-particle", "PW": "particle-wall", "SB": "solid-bond",
+                    "LB": "liquid-bond", "EF": "external-force"}[kind]
+            ok = SUPPORTED_MODELS.get(kind)
+            raise InputError(job.path, spec.line, f"{spec.name}: this {what} model is not "
+                             "supported" + (f"; fibrelmp translates {ok} only" if ok else ""))
+        params = dict(MODEL_PARAMETERS.get(spec.name, {}))
+        tok = spec.params.split()
+        for j in range(0, len(tok), 2):
+            name = tok[j]
+            if name not in params:
+                model.warn("musen-unknown-model-parameter", f"{job.path}:{spec.line}: "
+                           f"{spec.name} has no parameter {name}; ignored as MUSEN does")
+                continue
+            try:
+                params[name] = float(tok[j + 1])
+            except (IndexError, ValueError):
+                raise InputError(job.path, spec.line, f"{spec.name} parameter {name}: expected "
+                                 "a number") from None
+        chosen[kind] = (spec.name, params)
+    return chosen
+
+
+def apply_simulator_settings(model: GranularModel, job: MusenJob) -> None:
+    """Fill ``model.plan`` (and materials, geometries, bonds) from a SIMULATOR job, in the
+    order cmusen applies them: materials, scene (domain, PBC, bonds, motion), models, times."""
+    if job.component != "SIMULATOR":
+        raise InputError(job.path, job.where("COMPONENT"), f"job {job.index} is "
+                         f"{job.component}, not a SIMULATOR job")
+    for key, ln, why in job.refused:
+        raise InputError(job.path, ln, f"{key}: {why}")
+    check_simulable(model)
+    for kind, msg in job.warnings:
+        model.warn(kind, msg)
+    plan = model.plan
+    _apply_materials(model, job)
+    if job.anisotropy:
+        model.warn("musen-anisotropy", f"{job.path}:{job.where('ANISOTROPY')}: ANISOTROPY 1: "
+                   "fibrelmp's spheres are isotropic")
+    if job.anisotropy is not None:
+        model.passthrough["anisotropy"] = job.anisotropy
+    if job.contact_radius is not None:
+        model.passthrough["contact_radius_flag"] = job.contact_radius
+    if job.simulation_domain is not None:
+        d = job.simulation_domain
+        if any(d[j] >= d[j + 3] for j in range(3)):
+            raise InputError(job.path, job.where("SIMULATION_DOMAIN"), "SIMULATION_DOMAIN: need "
+                             "xmin ymin zmin xmax ymax zmax with each min < max")
+        plan.domain = (np.array(d[:3]), np.array(d[3:]))
+        model.warnings = [w for w in model.warnings if w[0] != "musen-outside-domain"]
+        domain_warning(model)
+    if job.pbc_flags is not None:
+        plan.periodic = tuple(bool(f) for f in job.pbc_flags)
+    if job.pbc_domain is not None:
+        plan.periodic_box = (np.array(job.pbc_domain[:3]), np.array(job.pbc_domain[3:]))
+    if job.reset_bonds:
+        reset_bond_lengths(model)
+    _apply_motion(model, job)
+    models = _resolve_models(model, job)
+    model.passthrough["musen_models"] = models
+    _check_models(model, job, models)
+    if "SB" in models:
+        plan.bond_breakage = int(models["SB"][1]["CONSIDER_BREAKAGE"])
+        if plan.bond_breakage not in (0, 1, 2):
+            raise InputError(job.path, job.where("MODEL_SB_PARAMS"), "CONSIDER_BREAKAGE must be "
+                             f"0, 1 or 2 (got {models['SB'][1]['CONSIDER_BREAKAGE']:g})")
+    if job.connected_pp_contact is not None:
+        plan.contacts_between_bonded = job.connected_pp_contact
+    _apply_times(model, job)
+
+
+def _apply_materials(model: GranularModel, job: MusenJob) -> None:
+    keys = {m.key: i for i, m in enumerate(model.materials)}
+
+    def index(key: str, ln: int) -> int:
+        if key not in keys:
+            names = {m.name: m.key for m in model.materials}
+            hint = (f"; material {key!r} has key {names[key]}" if key in names else
+                    f"; known keys: {', '.join(keys)}")
+            raise InputError(job.path, ln, f"no material with key {key!r} in the scene "
+                             f"(cmusen silently ignores the line){hint}")
+        return keys[key]
+
+    changed = False
+    for pid, key, value, ln in job.material_properties:
+        mat = model.materials[index(key, ln)]
+        mat.props[pid] = value
+        attr = {0: "density", 7: "youngs", 8: "normal_strength", 9: "shear_strength",
+                10: "poisson"}.get(pid)
+        if attr:
+            setattr(mat, attr, value)
+        _check_material(mat.key, mat.name, mat.props, job.path, ln)
+        changed = True
+    inter = model.passthrough.setdefault("interactions", {})
+    for pid, k1, k2, value, ln in job.interaction_properties:
+        a, b = sorted((index(k1, ln), index(k2, ln)))
+        inter.setdefault((a, b), dict(INTERACTION_DEFAULTS))[pid] = value
+        changed = True
+    if changed:
+        sp = model.spheres
+        density = np.array([m.density for m in model.materials])
+        sp.mass = density[sp.material] * 4.0 / 3.0 * np.pi * sp.radius ** 3
+        for (a, b) in list(model.contacts):
+            props = inter.get((a, b), INTERACTION_DEFAULTS)
+            model.contacts[(a, b)] = contact_law(model.materials[a], model.materials[b], props)
+
+
+def reset_bond_lengths(model: GranularModel) -> None:
+    """RESET_INITIAL_BOND_LENGTH: L0 = current centre distance (minimum image with PBC).
+    MUSEN gives bonds with an inactive sphere length 0; those keep their L0 here."""
+    b = model.bonds
+    if b is None:
+        return
+    sp = model.spheres
+    d = sp.position[b.pair[:, 1]] - sp.position[b.pair[:, 0]]
+    plan = model.plan
+    if any(plan.periodic) and plan.periodic_box is not None:
+        size = plan.periodic_box[1] - plan.periodic_box[0]
+        for k in range(3):
+            if plan.periodic[k]:
+                d[:, k] -= size[k] * np.round(d[:, k] / size[k])
+    t = plan.t_start
+    active = ((b.active_start <= t) & (b.active_end > t)
+              & (sp.active_start[b.pair].max(axis=1) <= t) & (sp.active_end[b.pair].min(axis=1) > t))
+    b.length0 = np.where(active, np.linalg.norm(d, axis=1), b.length0)
+
+
+def _apply_motion(model: GranularModel, job: MusenJob) -> None:
+    def geometry(name: str, ln: int):
+        for g in model.geometries:
+            if g.name == name:
+                return g
+        if name.isdigit() and int(name) < len(model.geometries):
+            return model.geometries[int(name)]
+        raise InputError(job.path, ln, f"no geometry {name!r} in the scene (known: "
+                         f"{', '.join(g.name for g in model.geometries) or 'none'}); cmusen "
+                         "silently ignores the line")
+
+    cleared = set()
+    for name, interval, ln in job.geometry_motion_time:
+        g = geometry(name, ln)
+        if id(g) not in cleared:
+            g.motion, g.motion_type = [], 1
+            g.raw_lines = [r for r in g.raw_lines if not r.startswith("26")]
+            cleared.add(id(g))
+        g.motion.append(interval)
+    for name, ln in job.geometry_motion_force:
+        geometry(name, ln)
+        raise InputError(job.path, ln, "GEOMETRY_MOTION_FORCE: force-dependent geometry motion "
+                         "is not supported")
+
+
+def _check_models(model: GranularModel, job: MusenJob, models: dict) -> None:
+    """ConsoleSimulator::SimulationPrecheck, made strict where fibrelmp cannot follow."""
+    if "PP" not in models:
+        raise InputError(job.path, job.line, f"job {job.index}: no particle-particle model "
+                         "(MODEL_PP ModelPPHertzMindlin); cmusen would run without particle "
+                         "contacts, which fibrelmp does not do")
+    if model.triangles is not None and model.triangles.count and "PW" not in models:
+        raise InputError(job.path, job.line, f"job {job.index}: the scene has walls but no "
+                         "MODEL_PW (cmusen: 'Particle-wall contact model is not specified')")
+    if model.bonds is not None and model.bonds.count and "SB" not in models:
+        raise InputError(job.path, job.line, f"job {job.index}: the scene has solid bonds but no "
+                         "MODEL_SB (cmusen: 'Solid bond model is not specified')")
+
+
+def _round2(value: float) -> float:
+    """MixedFunctions.h RoundToDecimalPlaces(value, 2)."""
+    factor = 10.0 ** (2 - math.ceil(math.log10(abs(value))))
+    return round(value * factor) / factor
+
+
+def recommended_time_step(model: GranularModel) -> float:
+    """CSystemStructure::GetRecommendedTimeStep: 0.1 x the smallest Rayleigh step of spheres
+    and bond oscillation step, at the start state."""
+    sp = model.spheres
+    mats = model.materials
+    rho = np.array([m.density for m in mats])
+    nu = np.array([m.poisson for m in mats])
+    e = np.array([m.youngs for m in mats])
+    steps = [10.0]
+    if sp.count:
+        k = sp.material
+        steps.append(float(np.min(np.pi * sp.contact_radius * np.sqrt(2 * rho[k] * (1 + nu[k]) / e[k])
+                                  / (0.1631 * nu[k] + 0.8766))))
+    b = model.bonds
+    if b is not None and b.count:
+        t = model.plan.t_start
+        d = sp.position[b.pair[:, 1]] - sp.position[b.pair[:, 0]]
+        length = np.linalg.norm(d, axis=1)
+        ok = ((b.active_start <= t) & (t <= b.active_end) & (length > 0)
+              & (sp.active_start[b.pair].max(axis=1) <= t) & (sp.active_end[b.pair].min(axis=1) >= t))
+        if ok.any():
+            k = b.material[ok]
+            area = np.pi * b.diameter[ok] ** 2 / 4
+            kb = np.maximum(e[k] * area / length[ok], e[k] * area / (2 * length[ok] * (1 + nu[k])))
+            mass = sp.mass[b.pair[ok]].min(axis=1)
+            steps.append(float(np.min(2 * np.sqrt(mass / kb))))
+    return min(steps) * 0.1
+
+
+def _apply_times(model: GranularModel, job: MusenJob) -> None:
+    plan = model.plan
+    used = []
+    rec = None
+    if job.simulation_step_factor or job.saving_step_factor or job.end_time_factor:
+        rec = recommended_time_step(model)
+    for attr, factor, value, key in (("dt", job.simulation_step_factor, job.simulation_step, "dt"),
+                                     ("save_every_time", job.saving_step_factor, job.saving_step,
+                                      "save"),
+                                     ("t_end", job.end_time_factor, job.end_time, "t_end")):
+        if factor:
+            setattr(plan, attr, _round2(factor * rec))
+        elif value:
+            setattr(plan, attr, value)
+        else:
+            current = getattr(plan, attr)
+            if current is None or not math.isfinite(current):
+                setattr(plan, attr, MUSEN_DEFAULTS[key])
+                used.append(f"{attr} {MUSEN_DEFAULTS[key]:g}")
+    plan.save_every_steps = None
+    if job.ext_accel is not None:
+        plan.gravity = np.array(job.ext_accel, np.float64)
+    elif not model.passthrough.get("musen_gravity_set"):
+        plan.gravity = np.array(MUSEN_DEFAULTS["gravity"])
+        used.append("gravity (0, 0, -9.81)")
+    model.passthrough["musen_gravity_set"] = True
+    if used:
+        model.warn("musen-default-settings", f"{job.path}:{job.line}: job {job.index} does not "
+                   f"set {', '.join(used)}: MUSEN's defaults for a freshly imported scene are used")
+    if plan.t_end <= plan.t_start:
+        raise InputError(job.path, job.where("END_TIME"), f"END_TIME {plan.t_end:g} s is not after "
+                         f"the scene's start time {plan.t_start:g} s")
+    if plan.dt > plan.t_end - plan.t_start:
+        raise InputError(job.path, job.where("SIMULATION_STEP"), f"simulation step {plan.dt:g} s "
+                         f"is longer than the run ({plan.t_end - plan.t_start:g} s)")

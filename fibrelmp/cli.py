@@ -13,7 +13,7 @@ import typer
 
 from fibrelmp import __version__
 
-from fibrelmp.registry import INPUT, TARGET, formats, names
+from fibrelmp.registry import FRAMES, INPUT, TARGET, formats, names
 
 _INPUTS = formats(INPUT)
 _TITLES = ", ".join(f.title for f in _INPUTS[:-1]) + " or " + _INPUTS[-1].title
@@ -304,7 +304,7 @@ Examples:
   fibrelmp post traj.dcd --topology top.pdb --to NAME -o final
 """)
 @_guard
-def post(dump: Path = typer.Argument(..., help="LAMMPS text dump (.gz too), or any MDAnalysis trajectory.",
+def post(dump: Path = typer.Argument(..., help=" or ".join(f.title for f in formats(FRAMES)) + ".",
                                      readable=False),
          to: Optional[str] = typer.Option(None, "--to", help=f"One of: {', '.join(names(TARGET))}.",
                                           autocompletion=lambda: names(TARGET)),
@@ -321,8 +321,8 @@ def post(dump: Path = typer.Argument(..., help="LAMMPS text dump (.gz too), or a
          gravity: Optional[tuple[float, float, float]] = typer.Option(None, "--gravity", help="gx gy gz for "
                                                                       "the gravitational energy."),
          force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
-         topology: Optional[Path] = typer.Option(None, "--topology", help="Topology for MDAnalysis "
-                                                 "trajectory formats."),
+         topology: Optional[Path] = typer.Option(None, "--topology", help="Topology file, for "
+                                                 "trajectory formats that need one."),
          quiet: bool = _QUIET, verbose: bool = _VERBOSE) -> None:
     from fibrelmp.post.convert import post_command
 

@@ -30,14 +30,15 @@ def _input(path: Path):
 
 
 def read(path: str | Path):
-    """The neutral model of any supported input: a ``Model`` (FibreNet), a ``GranularModel``
-    (MUSEN scene, DEMDF) or, for a cmusen job script, its checked ``ScriptPlan``."""
+    """The neutral model of any supported input (``fibrelmp.registry.formats("input")``): a
+    ``Model`` (bead-spring networks), a ``GranularModel`` (DEM scenes) or, for a job script of
+    several simulations, its checked ``ScriptPlan``."""
     path = Path(path)
     return _input(path).read(path)
 
 
 def translate_job(path: str | Path, folder: str | Path, warn: Warn | None = None) -> Path:
-    """Write ``folder/in.lammps`` and its data file for the input at ``path`` (a cmusen
+    """Write ``folder/in.lammps`` and its data file for the input at ``path`` (a job
     script: its first simulation); returns the script's path (replay: ``lmp -in in.lammps``).
     ``warn`` receives the input's warnings, then those the translation found."""
     return write_job(path, folder, warn).script
@@ -88,10 +89,10 @@ def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | N
         say: Say = _quiet, warn: Warn | None = None) -> RunResult:
     """Run any supported input on LAMMPS and write its results in the input's own format.
 
-    ``out``: the results' folder (FibreNet, DEMDF, cmusen script) or file (MUSEN scene);
+    ``out``: the results' folder, or the result file of an input with a single result;
     default next to the input.  Existing results are replaced, completely, only with
-    ``force``.  ``end_time``/``step``/``save_step`` (MUSEN scene, DEMDF) and ``steps``
-    (DEMDF) override the input.  ``say`` receives progress notes, ``warn`` lists of
+    ``force``.  ``end_time``/``step``/``save_step`` and ``steps`` override the
+    input's (an input that sets them itself refuses them).  ``say`` receives progress notes, ``warn`` lists of
     ``(kind, text)`` warnings as they are found (they are also in the result)."""
     from fibrelmp.checkpoint import check_every
     from fibrelmp.pipeline import RunOptions, run as run_plan
@@ -124,8 +125,9 @@ def convert(dump: str | Path, to: str, out: str | Path, *, frames: str | None = 
             types: list[str] | None = None, data: str | Path | None = None,
             local: str | Path | None = None, gravity: tuple[float, float, float] | None = None,
             force: bool = False, topology: str | Path | None = None, say: Say = _quiet) -> list[Path]:
-    """Convert a LAMMPS dump (or an MDAnalysis trajectory with ``topology``) into ``to``
-    (xyz, res, musen, demdf, mercury, vtk); returns the files written (docs/post.md)."""
+    """Convert a trajectory (``fibrelmp.registry.formats("frames")``; ``topology`` for those
+    that need one) into ``to``, any of ``fibrelmp.registry.names("target")``; returns the
+    files written (docs/post.md)."""
     from fibrelmp.post.convert import post_command
 
     return post_command(Path(dump), to, Path(out), False, frames, types,

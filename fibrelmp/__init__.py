@@ -16,7 +16,7 @@ from __future__ import annotations
 __version__ = "0.1.0"
 
 _API = ("read", "check", "translate_job", "run", "convert", "describe", "RunResult", "CheckReport")
-__all__ = [*_API, "translate", "InputError", "RunError", "lammps_instance", "lammps_module",
+__all__ = [*_API, "translate", "InputError", "InputErrors", "RunError", "lammps_instance", "lammps_module",
            "__version__"]
 
 
@@ -30,7 +30,7 @@ def __getattr__(name: str):
         import importlib
 
         return importlib.import_module("fibrelmp.translate")
-    if name in ("InputError", "RunError"):
+    if name in ("InputError", "InputErrors", "RunError"):
         from fibrelmp import errors
 
         return getattr(errors, name)

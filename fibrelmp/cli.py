@@ -324,11 +324,15 @@ def post(dump: Path = typer.Argument(..., help=" or ".join(f.title for f in form
          topology: Optional[Path] = typer.Option(None, "--topology", help="Topology file, for "
                                                  "trajectory formats that need one."),
          quiet: bool = _QUIET, verbose: bool = _VERBOSE) -> None:
-    from fibrelmp.post.convert import post_command
+    from fibrelmp.python_api import convert, describe
 
     _set_flags(quiet, verbose)
-    written = post_command(dump, to, out, info, frames, types, data, local, gravity, force, topology,
-                           typer.echo if info else _say, report=_report_warnings)
+    if info:
+        describe(dump, topology, say=typer.echo, warn=_report_warnings)
+        return
+    written = convert(dump, to, out, frames=frames, types=types, data=data, local=local,
+                      gravity=gravity, force=force, topology=topology, say=_say,
+                      warn=_report_warnings)
     for path in written:
         _say(f"wrote {path}")
 

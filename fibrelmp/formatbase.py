@@ -59,6 +59,10 @@ class Writer(ABC):
     """Writes one output (one or several files) from a stream of frames."""
 
     format: ClassVar[str] = ""
+    # after a successful close, remove files of an earlier output that this one did not
+    # write again (a conversion with fewer frames leaves no old frame files behind); run
+    # results leave this to fibrelmp.outputs, which knows every writer of the run
+    replaces_earlier: ClassVar[bool] = False
 
     def __init__(self, target: str | os.PathLike, *, force: bool = True):
         """``target``: the output's path (or base name, for multi-file formats).  Without
@@ -70,10 +74,10 @@ class Writer(ABC):
         self._staged: dict[Path, Path] = {}        # final path -> temp path
         self._handles: dict[Path, IO] = {}         # final path -> open temp file
         self._parts: list[Writer] = []             # writers whose files belong to this output
-        if not force:
-            existing = [p for p in self.outputs() if p.exists()]
-            if existing:
-                raise InputError(existing[0], None, "output exists; use --force to overwrite")
+        existing = [p for p in self.outputs() if p.exists()]
+        if existing and not force:
+            raise InputError(existing[0], None, "output exists; use --force to overwrite")
+        self._earlier = [p for p in existing if p.is_file()] if self.replaces_earlier else []
 
     # -- what derived writers implement ------------------------------------------------
     def outputs(self) -> list[Path]:
@@ -165,6 +169,12 @@ class Writer(ABC):
             self.abort()
             raise
         self._closed()
+        for old in self._earlier:          # only now: a failed close keeps the earlier output
+            if old not in done:
+                try:
+                    old.unlink(missing_ok=True)
+                except OSError as exc:
+                    raise InputError(old, None, f"cannot remove old output: {exc.strerror or exc}") from None
         return done
 
     def _settle(self) -> None:

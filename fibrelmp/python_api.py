@@ -121,18 +121,21 @@ def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | N
     return result
 
 
-def convert(dump: str | Path, to: str, out: str | Path, *, frames: str | None = None,
+def convert(dump: str | Path, to: str | None, out: str | Path | None, *, frames: str | None = None,
             types: list[str] | None = None, data: str | Path | None = None,
             local: str | Path | None = None, gravity: tuple[float, float, float] | None = None,
-            force: bool = False, topology: str | Path | None = None, say: Say = _quiet) -> list[Path]:
+            force: bool = False, topology: str | Path | None = None, say: Say = _quiet,
+            warn: Warn | None = None) -> list[Path]:
     """Convert a trajectory (``fibrelmp.registry.formats("frames")``; ``topology`` for those
     that need one) into ``to``, any of ``fibrelmp.registry.names("target")``; returns the
-    files written (docs/post.md)."""
+    files written (docs/post.md).  ``warn`` receives the conversion's ``(kind, text)``
+    warnings (without it they go to ``say`` as text)."""
     from fibrelmp.post.convert import post_command
 
-    return post_command(Path(dump), to, Path(out), False, frames, types,
+    return post_command(Path(dump), to, None if out is None else Path(out), False, frames, types,
                         None if data is None else Path(data), None if local is None else Path(local),
-                        gravity, force, None if topology is None else Path(topology), say)
+                        gravity, force, None if topology is None else Path(topology), say,
+                        report=warn)
 
 
 @dataclass
@@ -176,9 +179,11 @@ def _read_for_check(read, patch):
     raise InputErrors(errors, at_limit=len(errors) >= MAX_ERRORS)
 
 
-def describe(dump: str | Path, topology: str | Path | None = None, say: Say = print) -> None:
-    """``fibrelmp post --info``: frames, atoms, columns and box of a trajectory."""
+def describe(dump: str | Path, topology: str | Path | None = None, say: Say = print,
+             warn: Warn | None = None) -> None:
+    """``fibrelmp post --info``: frames, atoms, columns and box of a trajectory, line by line
+    to ``say``; ``warn`` as in ``convert``."""
     from .post.convert import post_command
 
     post_command(Path(dump), None, None, True, None, None, None, None, None, False,
-                 None if topology is None else Path(topology), say)
+                 None if topology is None else Path(topology), say, report=warn)

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import errno
 import os
+import re
 from pathlib import Path
 
 import numpy as np
@@ -134,6 +135,52 @@ def test_target_failure_mid_way_leaves_earlier_output(tmp_path, to, monkeypatch)
         convert(dump, to, tmp_path / "out" / "run", force=True, frames="0:")
     assert len(calls) == 2
     assert listing(tmp_path / "out") == before          # no temp file, nothing replaced
+
+
+@pytest.mark.parametrize("to", TARGETS)
+def test_target_failure_while_closing_leaves_earlier_output(tmp_path, to, monkeypatch):
+    """Every frame written, then the renames fail: the earlier output stays complete (no old
+    frame file removed before the new ones are in place)."""
+    from fibrelmp import formatbase
+
+    first, _ = write_dump(tmp_path, "first.dump", seed=2, frames=4)
+    convert(first, to, tmp_path / "out" / "run", frames="0:")
+    before = listing(tmp_path / "out")
+    dump, _ = write_dump(tmp_path)
+
+    def failing(self):
+        raise OSError(errno.ENOSPC, ENOSPC)
+    monkeypatch.setattr(formatbase.Writer, "_commit", failing)
+    with pytest.raises((RunError, InputError), match=ENOSPC):
+        convert(dump, to, tmp_path / "out" / "run", force=True, frames="0:")
+    assert listing(tmp_path / "out") == before
+
+
+@pytest.mark.parametrize("to", TARGETS)
+def test_target_force_replaces_the_earlier_output_completely(tmp_path, to):
+    """A --force conversion with fewer frames leaves no file of the earlier one behind."""
+    first, _ = write_dump(tmp_path, "first.dump", seed=2, frames=4)
+    convert(first, to, tmp_path / "out" / "run", frames="0:")
+    dump, _ = write_dump(tmp_path, frames=1)
+    written = convert(dump, to, tmp_path / "out" / "run", force=True, frames="0:")
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == sorted(p.name for p in written)
+
+
+def test_fifo_trajectory_is_refused_not_waited_for(tmp_path):
+    fifo = tmp_path / "frames.dump"
+    os.mkfifo(fifo)
+    with pytest.raises(InputError, match="not a regular file"):
+        convert(fifo, TARGETS[0], tmp_path / "out")
+    assert not (tmp_path / "out").exists()
+
+
+def test_convert_reports_warnings_to_the_caller(tmp_path):
+    text, _ = dump_text()
+    dump = tmp_path / "notime.dump"
+    dump.write_text(re.sub(r"ITEM: TIME\n[^\n]*\n", "", text))
+    got: list = []
+    convert(dump, "vtk", tmp_path / "out" / "run", warn=got.extend)
+    assert any(kind == "no times" for kind, _ in got), got
 
 
 def completed_frames(dump: Path) -> list:

@@ -138,7 +138,7 @@ def _run_serial(rendered: Rendered, token: Callable, convert: Consumer, progress
     except BaseException:
         try:
             convert(aborted())      # the writers discard what they staged
-        except RunAborted:
+        except BaseException:       # never hide the run's own error (or the stop signal)
             pass
         raise
     return convert(iter(tokens))

@@ -17,6 +17,7 @@ from fibrelmp.post.complete import Completer
 from fibrelmp.post.selection import Selection
 from fibrelmp.post.target import DumpTarget, PostContext, TypeNames
 from fibrelmp.registry import FRAMES, TARGET, choose, formats, names
+from fibrelmp.textio import refuse_special_file
 
 
 def post_command(dump: Path, to: str | None, out: Path | None, info: bool, frames: str | None,
@@ -51,6 +52,7 @@ def open_frames(path: Path, topology: Path | None, warnings: list):
     the first registered one (which then explains what is wrong with the file)."""
     if not path.exists():
         raise InputError(path, None, "file not found")
+    refuse_special_file(path, "trajectory")     # a FIFO would block the format test for ever
     readers = [f.load(FRAMES) for f in formats(FRAMES)]
     kind = next((r for r in readers if r.claims(path, topology)), readers[0])
     return kind(path, topology, warnings)
@@ -67,6 +69,8 @@ def _post(dump, to, out, info, frames, types, data, local, gravity, force, topol
     kind: type[DumpTarget] = choose(TARGET, to.lower(), "--to").load(TARGET)
     if out is None:
         raise InputError(None, None, "give the output with -o/--out")
+    if local is not None and local.exists():
+        refuse_special_file(local, "--local dump")
     if local is not None and not kind.uses_local:
         users = " or ".join(f.name for f in formats(TARGET) if f.load(TARGET).uses_local)
         raise InputError(local, None, f"--local (per-contact data) is used by --to {users} only")

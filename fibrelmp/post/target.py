@@ -92,6 +92,7 @@ class DumpTarget(Writer):
     last_frame_by_default: ClassVar[bool] = False     # without --frames: the last frame only
     uses_local: ClassVar[bool] = False                # reads --local contact dumps
     lookahead: ClassVar[int] = 1                      # frames ``start`` sees
+    replaces_earlier: ClassVar[bool] = True           # --force: old frame files go too
 
     def __init__(self, base: str | Path, context: PostContext | None = None, *,
                  force: bool = True):

@@ -28,7 +28,9 @@ def _vector(frame: Frame, names: tuple[str, str, str], n: int) -> np.ndarray:
 
 
 def model_from_frame(first: Frame, source: Path, names: Mapping[int, str], kind: str,
-                     time: float, dt: float) -> GranularModel:
+                     time: float, dt: float, keep_ids: bool = True) -> GranularModel:
+    """The scene of the first frame; ``keep_ids``: the atoms' ids become the spheres' ids
+    (else 0..n-1, for formats whose particles have no ids)."""
     n = first.count
     if not first.has("radius"):
         raise InputError(source, first.line, f"--to {kind} needs sphere radii: the dump has no "
@@ -50,7 +52,7 @@ def model_from_frame(first: Frame, source: Path, names: Mapping[int, str], kind:
             mat.props[0] = rho
         materials.append(mat)
     x = first.wrapped()
-    spheres = Spheres(ids=ids if kind == "musen" else np.arange(n), material=np.array([mat_of_type[t] for t in types]),
+    spheres = Spheres(ids=ids if keep_ids else np.arange(n), material=np.array([mat_of_type[t] for t in types]),
                       radius=radius, contact_radius=radius.copy(), mass=mass, position=x,
                       velocity=_vector(first, ("vx", "vy", "vz"), n),
                       omega=_vector(first, ("omegax", "omegay", "omegaz"), n),
@@ -117,12 +119,13 @@ class _GranularTarget(DumpTarget):
 
     lookahead = 2                 # the save interval comes from the first two frames
     kind: ClassVar[str]
+    keeps_ids: ClassVar[bool]
 
     def start(self, first: list[Frame]) -> None:
         times = [self.time_of(f) for f in first]
         dt = times[1] - times[0] if len(times) > 1 else 1.0
         self.model = model_from_frame(first[0], Path(self.context.source), self.context.type_names,
-                                      self.kind, times[0], dt)
+                                      self.kind, times[0], dt, self.keeps_ids)
         self.out = self.adopt(self.result_writer(self.model, dt))
 
     def result_writer(self, model: GranularModel, dt: float) -> Writer:
@@ -141,6 +144,7 @@ class MusenTarget(_GranularTarget):
     """``<base>``: a MUSEN text result (SI units)."""
 
     kind = "musen"
+    keeps_ids = True                 # MUSEN objects keep their ids
     units = ("MUSEN", SI)
 
     def result_writer(self, model: GranularModel, dt: float) -> Writer:
@@ -162,6 +166,7 @@ class DemdfTarget(_GranularTarget):
     """``<base>_<n>.json``: a DEMDF snapshot per frame."""
 
     kind = "demdf"
+    keeps_ids = False                # DEMDF particles are rows, without ids
 
     @classmethod
     def files(cls, base: Path) -> list[Path]:

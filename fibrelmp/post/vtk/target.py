@@ -2,10 +2,8 @@
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
-from fibrelmp.errors import InputError
 from fibrelmp.post.lammps_dump.reader import Frame
 from fibrelmp.post.target import DumpTarget, ReadBack
 from fibrelmp.post.vtk.reader import read_pvd, read_vtu
@@ -14,15 +12,6 @@ from fibrelmp.post.vtk.writer import VtkWriter
 
 def _vtus(base: Path) -> list[Path]:
     return sorted(base.parent.glob(f"{base.name}_[0-9][0-9][0-9][0-9][0-9][0-9].vtu"))
-
-
-def remove_stale(base: Path) -> None:
-    """Delete ``<base>_*.vtu`` of an earlier conversion (called only with --force)."""
-    for p in _vtus(base):
-        try:
-            os.unlink(p)
-        except OSError as exc:
-            raise InputError(p, None, f"cannot remove old output: {exc.strerror or exc}") from None
 
 
 class VtkTarget(DumpTarget):
@@ -40,10 +29,6 @@ class VtkTarget(DumpTarget):
     def write_frame(self, frame: Frame) -> None:
         self.time_of(frame)                  # (warns when the dump has no times)
         self.out.add(frame)
-
-    def end(self) -> None:
-        if self.count:
-            remove_stale(self.target)        # frames of an earlier conversion (only with --force)
 
     @classmethod
     def read_back(cls, files: list[Path]) -> list[ReadBack]:

@@ -46,13 +46,13 @@ DIMENSIONLESS = UnitSystem("dimensionless", "si", "1", "1", "1", "1",
                            "DEMDF numbers have no units; run unconverted")
 
 _SYSTEMS = {s.name: s for s in (LJ, SI, DIMENSIONLESS)}
-FORMAT_UNITS: dict[str, UnitSystem] = {"fibrenet": LJ, "musen": SI, "musen-script": SI,
-                                       "demdf": DIMENSIONLESS}
 
 
-def for_format(kind: str) -> UnitSystem:
-    """The unit system an input format is read in (``formats.detect`` names)."""
-    return FORMAT_UNITS[kind]
+def for_format(name: str) -> UnitSystem:
+    """The unit system a format's numbers are in (its registry record's ``units``)."""
+    from fibrelmp.registry import get
+
+    return _SYSTEMS[get(name).units]
 
 
 def system(name: str) -> UnitSystem:

@@ -2,8 +2,8 @@
 of the spacings, number spellings and line ends the format allows), read it back, compare.
 
 * FibreNet input + model text -> ``translate.fibrenet.read``
-* MUSEN scene text -> ``musen.read`` -> ``post.musen_out.MusenResultWriter`` -> ``musen.read``
-* DEMDF JSON -> ``demdf.read`` -> ``post.demdf_out.DemdfSnapshotWriter`` -> ``demdf.read_snapshot``
+* MUSEN scene text -> ``musen.read`` -> ``translate.musen.writer.MusenResultWriter`` -> ``musen.read``
+* DEMDF JSON -> ``demdf.read`` -> ``translate.demdf.writer.DemdfSnapshotWriter`` -> ``demdf.read_snapshot``
 * LAMMPS dump text (plain and gzip) -> ``post.lammps_dump.iter_frames``
 
 Examples are bounded (``PROFILE``) so CI stays fast; ``FIBRELMP_HYPOTHESIS_EXAMPLES=2000``

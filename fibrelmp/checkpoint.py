@@ -136,13 +136,16 @@ def check_every(every: int | None) -> None:
         raise InputError(None, None, f"--checkpoint-every must be a positive number of steps, got {every}")
 
 
+NO_CHECKPOINT = ("no checkpoint to resume from (run without --resume, or give the same --work "
+                 "folder as the interrupted run)")
+
+
 def load(folder: Path, script_text: str, inputs: list[Path] = ()) -> dict:
     """The checkpoint state in ``folder``; an InputError when there is none or the job
     (script or any file it reads) changed since it was written."""
     path = Path(folder) / STATE
     if not path.exists():
-        raise InputError(path, None, "no checkpoint to resume from (run without --resume, or "
-                         "give the same --work folder as the interrupted run)")
+        raise InputError(path, None, NO_CHECKPOINT)
     try:
         state = json.loads(path.read_text())
         commands, line, steps = int(state["commands"]), int(state["line"]), int(state["steps"])

@@ -172,3 +172,9 @@ def finish(outputs: Outputs, written: list[Path]) -> list[Path]:
             old.unlink(missing_ok=True)
             removed.append(old)
     return removed
+
+
+def work_folder(results: str | os.PathLike, name: str, work: str | os.PathLike | None) -> Path:
+    """The folder of a run's LAMMPS job: ``work`` when given, else ``<name>_work`` beside the
+    results (``results`` is their folder); absolute."""
+    return (Path(work) if work is not None else Path(results) / f"{name}_work").resolve()

@@ -111,8 +111,9 @@ def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | N
     settings = RunSettings(None if out is None else Path(out), None if work is None else Path(work),
                            end_time, step, save_step, steps, precision)
     if resume and not hook.has_checkpoint(path, settings.out, settings.work):    # before reading
-        raise InputError(path, None, "no checkpoint to resume from (run without --resume, or "
-                         "give the same --work folder as the interrupted run)")
+        from .checkpoint import NO_CHECKPOINT
+
+        raise InputError(path, None, NO_CHECKPOINT)
     plan = hook.plan(path, settings, RunOptions(progress, force, checkpoint_every, resume), say, warned)
     outcome = run_plan(plan, warn=warned)
     result.outputs, result.notes = outcome.outputs, list(plan.notes)

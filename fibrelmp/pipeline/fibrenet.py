@@ -44,7 +44,9 @@ def fibrenet_outputs(model: "Model", out: str | Path | None = None,
     if not target.name or target.name in (".", ".."):
         raise InputError(model.source, spec.line, f"output_file {spec.basename!r} names no file")
     folder, prefix = target.parent, target.name
-    work_folder = (Path(work) if work is not None else folder / f"{prefix}_work").resolve()
+    from fibrelmp.outputs import work_folder as job_folder
+
+    work_folder = job_folder(folder, prefix, work)
     files = [folder / f"{prefix}{XYZ_SUFFIX[f]}" for f in spec.fields] + [folder / f"{prefix}{RESTART_SUFFIX}"]
     family = [folder / f"{prefix}{suffix}" for suffix in (*XYZ_SUFFIX.values(), RESTART_SUFFIX)]
     return Outputs(model.source, work_folder, files, family, inputs=list(model.inputs)), folder, prefix

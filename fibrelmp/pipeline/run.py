@@ -33,8 +33,9 @@ def run(plan: RunPlan, warn: Warn | None = None) -> Outcome:
     rank, size = mpi_rank_size()
     options = plan.options
     if options.resume and not has_checkpoint(plan.outputs.work):
-        raise InputError(plan.outputs.source, None, "no checkpoint to resume from (run without "
-                         "--resume, or give the same --work folder as the interrupted run)")
+        from fibrelmp.checkpoint import NO_CHECKPOINT
+
+        raise InputError(plan.outputs.source, None, NO_CHECKPOINT)
     outcome = Outcome()
     # resuming continues this run's own (locked) work: its partial results are not "earlier" ones
     with locked(plan.outputs, options.force or options.resume, rank):

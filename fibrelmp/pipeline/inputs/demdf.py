@@ -60,7 +60,9 @@ def _folders(source: str | Path, out: str | Path | None, work: str | Path | None
     """(the snapshots' folder: the input's or ``out``; the work folder: ``work``, default
     ``<input stem>_work`` in the snapshots' folder)."""
     folder = (Path(out) if out is not None else Path(source).parent).resolve()
-    return folder, (Path(work) if work is not None else folder / f"{Path(source).stem}_work").resolve()
+    from fibrelmp.outputs import work_folder
+
+    return folder, work_folder(folder, Path(source).stem, work)
 
 
 def demdf_outputs(model: "GranularModel", out: str | Path | None = None,

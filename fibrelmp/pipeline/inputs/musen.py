@@ -81,7 +81,9 @@ def scene_plan(model: "GranularModel", result: str | Path, work: str | Path | No
 
 
 def _work_folder(target: Path, work: str | Path | None) -> Path:
-    return (Path(work) if work is not None else target.resolve().parent / f"{target.stem}_work").resolve()
+    from fibrelmp.outputs import work_folder
+
+    return work_folder(target.resolve().parent, target.stem, work)
 
 
 def scene_result_path(scene: str | Path, out: str | Path | None = None) -> Path:

@@ -86,8 +86,9 @@ class ScriptInput(InputFormat):
                        cleanup=[remove_spools])
 
     def work_folder(self, path: Path, out: Path | None, work: Path | None) -> Path:
-        return Path(work) if work is not None else \
-            Path(out or Path(path).resolve().parent) / f"{Path(path).stem}_work"
+        from fibrelmp.outputs import work_folder
+
+        return work_folder(out or Path(path).resolve().parent, Path(path).stem, work)
 
 
 def _announce(step: "ScriptStep", say: Say, warn: Warn, rank0: bool) -> list[Path]:

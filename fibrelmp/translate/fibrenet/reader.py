@@ -294,13 +294,7 @@ def _apply_restart(inp: _InputFile, particles: Particles, type_names: list[str],
     """Apply ``restart_file``/``restart_data``; the restart file read, if any."""
     path, folder, n = inp.path, inp.path.parent, particles.count
     restart_lines = inp.all("restart_file")
-    restart_fields: set[str] = set()
-    for line in inp.all("restart_data"):
-        value = line.tokens[1]
-        if value not in ("position", "velocity", "force", "all"):
-            raise InputError(path, line.number, f"restart_data must be position, velocity, force "
-                             f"or all, got '{value}'")
-        restart_fields |= {"position", "velocity", "force"} if value == "all" else {value}
+    restart_fields = _data_fields(inp, "restart_data")
     if not restart_lines:
         return None
     rline = restart_lines[-1]           # the last restart_file line wins
@@ -332,15 +326,22 @@ def _apply_restart(inp: _InputFile, particles: Particles, type_names: list[str],
     return rpath
 
 
-def _output_spec(inp: _InputFile, type_index: dict[str, int], out_freq: int) -> OutputSpec:
-    path = inp.path
+def _data_fields(inp: _InputFile, key: str) -> set[str]:
+    """The fields named by every ``key`` line (``restart_data``/``output_data``): position,
+    velocity, force, or all of them."""
     fields: set[str] = set()
-    for line in inp.all("output_data"):
+    for line in inp.all(key):
         value = line.tokens[1]
         if value not in ("position", "velocity", "force", "all"):
-            raise InputError(path, line.number, f"output_data must be position, velocity, force "
+            raise InputError(inp.path, line.number, f"{key} must be position, velocity, force "
                              f"or all, got '{value}'")
         fields |= {"position", "velocity", "force"} if value == "all" else {value}
+    return fields
+
+
+def _output_spec(inp: _InputFile, type_index: dict[str, int], out_freq: int) -> OutputSpec:
+    path = inp.path
+    fields = _data_fields(inp, "output_data")
     out_types: set[int] | None = set()
     for line in inp.all("output_type"):
         if line.tokens[1] == "all":

@@ -90,6 +90,17 @@ def lammps_word(value: str, path: str | PathLike | None = None, line: int | None
                      "start with a letter or '_' and contain only ASCII letters, digits and '_'")
 
 
+def lammps_path(value: str | PathLike, what: str = "file") -> LammpsText:
+    """A file path as one LAMMPS word (double-quoted when it holds spaces); a path LAMMPS
+    could read differently (quotes, ``#``, ``$``, ``&``, backslash, control or non-ASCII
+    characters) is a :class:`~fibrelmp.errors.RunError` naming it."""
+    text = str(value)
+    if not text or _FRAGMENT_BAD.search(text) or '"' in text:
+        raise RunError(f"{what} path {text!r} cannot be used in a LAMMPS script (it holds "
+                       "characters LAMMPS would interpret); move it to a plain path")
+    return LammpsText(f'"{text}"' if " " in text else text)
+
+
 def check_fragment(value: str) -> str:
     """``value`` if a template may print it verbatim, else :class:`UnsafeText`.
 

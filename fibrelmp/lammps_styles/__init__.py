@@ -29,6 +29,7 @@ from fibrelmp.lammps_styles import build as _build
 ENV_STOCK = "FIBRELMP_STOCK_STYLES"
 _lock = threading.Lock()
 _found: "Plugin | None" = None
+_stock_requested = False
 
 
 @dataclass(frozen=True)
@@ -74,8 +75,11 @@ def _locate() -> Plugin:
 
 
 def plugin() -> Plugin:
-    """The plugin to load (looked up, and built if needed, once per process)."""
+    """The plugin jobs load (looked up, and built if needed, once per process); a Plugin
+    without path when stock styles were requested (:func:`request_stock`) or it is missing."""
     global _found
+    if _stock_requested:
+        return Plugin(None, "stock styles requested (--stock-styles)")
     with _lock:
         if _found is None:
             _found = _locate()
@@ -87,3 +91,10 @@ def forget() -> None:
     global _found
     with _lock:
         _found = None
+
+
+def request_stock(flag: bool = True) -> bool:
+    """Render jobs with stock styles (``--stock-styles``); returns the previous setting."""
+    global _stock_requested
+    previous, _stock_requested = _stock_requested, bool(flag)
+    return previous

@@ -17,7 +17,8 @@ import numpy as np
 
 from fibrelmp.errors import InputError
 from fibrelmp.granmodel import GranularModel
-from fibrelmp.lammps_text import template_environment
+from fibrelmp import lammps_styles
+from fibrelmp.lammps_text import lammps_path, template_environment
 from fibrelmp.textio import atomic_write
 from fibrelmp.translate.granular.bonds import select_bonds
 from fibrelmp.translate.granular.box import box_axes, box_commands, domain_bounds, fit_box, periodic_axes
@@ -132,8 +133,10 @@ def build_granular_job(model: GranularModel, folder: str | Path):
     tile_groups = [(wp, f"w{k + 1}") for k, wp in enumerate(wall_plans)
                    if wp.kind == "tiles" and wp.tile_ids is not None and len(wp.tile_ids)]
     mats, tile_mats = spheres.mats, tiles.materials
+    styles = lammps_styles.plugin()
     script = template_environment().get_template("granular.lammps.j2").render(
-        model=model, fmt=float_text, dim=dim, bnd=axes.bnd, data_name=DATA_NAME, frames_name=FRAMES_NAME,
+        model=model, plugin=lammps_path(styles.path, "plugin") if styles.path else None,
+        fmt=float_text, dim=dim, bnd=axes.bnd, data_name=DATA_NAME, frames_name=FRAMES_NAME,
         bonds_name=BONDS_NAME, tiles_name=TILES_NAME, breaks_name=BREAKS_NAME,
         comm_cut=comm_cut, skin=skin, pair_lines=pair_lines, has_bonds=has_bonds,
         overlay=bool(plan.contacts_between_bonded), breakage=breakage, bond_types=bonds.types,

@@ -9,7 +9,7 @@ from the running LAMMPS, so it links against nothing.
 The library's name carries a build id: a hash of the sources, the flags and the LAMMPS version,
 so edited sources or another LAMMPS never load a stale plugin.
 
-    python -m fibrelmp.lammps_styles.build [OUT_DIR]     # default: the package's _lib folder
+    python -m fibrelmp.lammps_styles [OUT_DIR]     # default: the package's _lib folder
 """
 
 from __future__ import annotations
@@ -18,7 +18,6 @@ import hashlib
 import os
 import shlex
 import subprocess
-import sys
 import tempfile
 from concurrent.futures import ThreadPoolExecutor
 from importlib import metadata, util
@@ -134,11 +133,9 @@ def build(out_dir: Path | str = LIB_DIR, jobs: int | None = None) -> Path:
         finally:
             if os.path.exists(partial):
                 os.unlink(partial)
+    if out_dir.resolve() == LIB_DIR:        # the package's own folder: drop superseded builds
+        for old in LIB_DIR.glob(f"{STEM}-*.so"):
+            if old != target:
+                old.unlink(missing_ok=True)
     return target
 
-
-if __name__ == "__main__":
-    try:
-        print(build(sys.argv[1] if len(sys.argv) > 1 else LIB_DIR))
-    except BuildError as exc:
-        sys.exit(f"fibrelmp: LAMMPS styles not built: {exc}")

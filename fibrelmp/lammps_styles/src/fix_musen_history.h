@@ -60,6 +60,7 @@ class FixMusenHistory : public Fix {
 
  private:
   int nval;             // doubles per entry (without key and mark)
+  int nmax_alloc;       // atoms the per-atom arrays are allocated for
   int *num;             // entries per atom
   int *cap;             // capacity (entries) per atom
   double **data;        // per atom: cap entries of (key, mark, values...), grown per atom

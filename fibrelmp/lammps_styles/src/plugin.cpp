@@ -15,6 +15,8 @@
 #include <cstring>
 #include <string>
 
+#include "fix_musen_history.h"
+
 #if __has_include("pair_musen_hm.h")
 #include "pair_musen_hm.h"
 #define HAVE_PAIR_MUSEN_HM
@@ -48,6 +50,10 @@ using namespace LAMMPS_NS;
 namespace {
 
 // one creator per style (LAMMPS calls them through the C plugin interface)
+Fix *fix_musen_history_creator(LAMMPS *lmp, int narg, char **arg)
+{
+  return new FixMusenHistory(lmp, narg, arg);
+}
 #ifdef HAVE_PAIR_MUSEN_HM
 Pair *pair_musen_hm_creator(LAMMPS *lmp) { return new PairMusenHM(lmp); }
 #endif
@@ -103,6 +109,9 @@ extern "C" void lammpsplugin_init(void *ptr, void *handle, void *regfunc)
                         FIBRELMP_STYLES_ID, FIBRELMP_LAMMPS_NUM_VER, lmp->num_ver, lmp->version);
     return;
   }
+  // per-atom history of the MUSEN styles (created by them, not by input scripts)
+  add(reg, lmp, handle, "fix", "MUSEN/HISTORY", "per-atom contact/bond history of fibrelmp styles",
+      nullptr, (lammpsplugin_factory2 *) &fix_musen_history_creator);
 #ifdef HAVE_PAIR_MUSEN_HM
   add(reg, lmp, handle, "pair", "musen/hm", "MUSEN Hertz-Mindlin particle-particle contact",
       (lammpsplugin_factory1 *) &pair_musen_hm_creator, nullptr);

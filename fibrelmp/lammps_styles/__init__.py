@@ -21,8 +21,10 @@ from __future__ import annotations
 
 import os
 import threading
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Iterator
 
 from fibrelmp.lammps_styles import build as _build
 
@@ -44,7 +46,7 @@ class Plugin:
 
     def describe(self) -> str:
         if self.path is None:
-            return f"stock LAMMPS styles (approximate physics: {self.how})"
+            return f"stock LAMMPS styles ({self.how})"
         return f"fibrelmp plugin ({self.how}: {self.path})"
 
 
@@ -98,3 +100,13 @@ def request_stock(flag: bool = True) -> bool:
     global _stock_requested
     previous, _stock_requested = _stock_requested, bool(flag)
     return previous
+
+
+@contextmanager
+def stock(flag: bool = True) -> Iterator[None]:
+    """Within the block, render jobs with stock styles if ``flag`` (restored afterwards)."""
+    previous = request_stock(flag or _stock_requested)
+    try:
+        yield
+    finally:
+        request_stock(previous)

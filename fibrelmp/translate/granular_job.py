@@ -134,6 +134,10 @@ def build_granular_job(model: GranularModel, folder: str | Path):
                    if wp.kind == "tiles" and wp.tile_ids is not None and len(wp.tile_ids)]
     mats, tile_mats = spheres.mats, tiles.materials
     styles = lammps_styles.plugin()
+    if not styles.available:
+        warnings.append(("approximate MUSEN physics", f"fibrelmp's LAMMPS styles are not used "
+                         f"({styles.how}): stock LAMMPS styles stand in for MUSEN's contact, "
+                         "bond and wall laws (see the warnings that follow and docs/granular.md)"))
     script = template_environment().get_template("granular.lammps.j2").render(
         model=model, plugin=lammps_path(styles.path, "plugin") if styles.path else None,
         fmt=float_text, dim=dim, bnd=axes.bnd, data_name=DATA_NAME, frames_name=FRAMES_NAME,

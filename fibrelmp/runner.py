@@ -177,7 +177,8 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
                 continue                 # followed by execute(); LAMMPS's own jump needs a file
             replaying = done <= skip_to
             if replaying:
-                if words[0] in ACTIONS:
+                # fix_modify ID write FILE: a frame of fix musen/wall/mesh's triangle forces
+                if words[0] in ACTIONS or (words[0] == "fix_modify" and words[2:3] == ["write"]):
                     if words[0] == "write_dump":
                         frames += 1
                         if on_command is not None:

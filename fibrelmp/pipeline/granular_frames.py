@@ -1,7 +1,8 @@
 """Granular frames: a ``GranularFrame`` per saved step, built from a running job's dumps.
 
 The job (``translate.granular_job``) dumps the spheres, the alive bonds (a local dump) and the
-wall tiles at every saved step, and appends every bond break to ``breaks.dump``.  A
+wall tiles (or fix musen/wall/mesh's triangle forces) at every saved step, and appends every
+bond break to ``breaks.dump``.  A
 ``FrameBuilder`` reads them back (``post.lammps_dump``'s reader, local dumps included) as
 soon as LAMMPS has written them and keeps only one frame plus the per-bond/per-sphere end
 times in memory.  It is the pipeline's frame source for granular jobs.
@@ -70,6 +71,7 @@ class FrameBuilder:
         self.frames = iter_frames(job.frames)
         self.bonds = iter_frames(job.bond_dump) if job.bond_dump is not None else None
         self.tiles = iter_frames(job.tile_dump) if job.tile_dump is not None else None
+        self.mesh = iter_frames(job.wall_forces) if job.wall_forces is not None else None
         self.breaks = _BreakLog(job.breaks)
         self.sphere_end = np.full(sp.count, np.inf)
         self.present = np.zeros(sp.count, bool)
@@ -232,6 +234,11 @@ class FrameBuilder:
                 if len(hit):
                     k = nearest_triangle(cp[hit], verts[wp.triangle_rows])
                     np.add.at(tforce, wp.triangle_rows[k], -fw[hit])
+        if self.mesh is not None:
+            # fix musen/wall/mesh: the force on each triangle (id = its position in the mesh)
+            fm = next(self.mesh).columns
+            k = fm["id"].astype(np.int64) - 1
+            tforce[self.job.mesh_rows[k]] = np.column_stack([fm["fx"], fm["fy"], fm["fz"]])
         if self.tiles is not None:
             ft = next(self.tiles).columns
             ids = ft["id"].astype(np.int64)
@@ -248,6 +255,6 @@ class FrameBuilder:
 
     def close(self) -> None:
         self.breaks.close()
-        for dump in (self.frames, self.bonds, self.tiles):
+        for dump in (self.frames, self.bonds, self.tiles, self.mesh):
             if dump is not None:
                 dump.close()

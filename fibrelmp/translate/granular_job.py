@@ -28,7 +28,9 @@ from fibrelmp.translate.granular.reach import Travel, speed_bound
 from fibrelmp.translate.granular.schedule import compress_ids, run_time, save_steps, schedule
 from fibrelmp.translate.granular.spheres import select_spheres
 from fibrelmp.translate.granular.tiles import TILE_MASS_FACTOR, place_tiles, tile_estimate, tile_types
-from fibrelmp.translate.granular.walls import WallPlan, describe_walls, plan_walls, wall_commands
+from fibrelmp.translate.granular.mesh import MESH_FIX, MESH_FORCES_NAME, MESH_NAME, mesh_rows, write_mesh
+from fibrelmp.translate.granular.walls import (WallPlan, describe_walls, plan_walls, wall_commands,
+                                               wall_warnings)
 from fibrelmp.translate.lammps_format import float_text
 from fibrelmp.translate.steps import SaveSteps
 
@@ -69,6 +71,8 @@ class GranularJob:
     removal_axes: np.ndarray         # (3,) bool: axes where leaving the box removes a sphere
     frame_columns: list[str] = field(default_factory=list)
     warnings: list[tuple[str, str]] = field(default_factory=list)
+    wall_forces: Path | None = None  # fix musen/wall/mesh: per-triangle forces per frame
+    mesh_rows: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))   # model row of each
 
 
 def write_granular_job(model: GranularModel, folder: str | Path) -> GranularJob:
@@ -100,6 +104,8 @@ def build_granular_job(model: GranularModel, folder: str | Path):
     spheres = select_spheres(model, run, periodic, dom_lo, dom_hi, warnings)
     rows, r_max = spheres.rows, spheres.r_max
     wall_plans = plan_walls(model, dt, run.t_end)
+    warnings.extend(wall_warnings(model, wall_plans, t_start, run.t_end))
+    mesh = mesh_rows(wall_plans)
     tiles = tile_types(wall_plans, spheres.r_min, len(spheres.mats))
     ntypes = len(spheres.mats) + len(tiles.materials) or 1
     axes = box_axes(model, dim, periodic, dom_lo, dom_hi, spheres)
@@ -118,6 +124,8 @@ def build_granular_job(model: GranularModel, folder: str | Path):
                    ntypes, tiles.x, tiles.types, tiles.v, tiles.ids, tiles.radius,
                    TILE_MASS_FACTOR * float(spheres.mass.max() if len(spheres.mass) else 1.0),
                    bonds.rows, bonds.type, len(bonds.types))
+        if len(mesh):
+            write_mesh(model, wall_plans, spheres, folder / MESH_NAME)
 
     # ---- script
     saves = save_steps(model, total, dt)
@@ -153,6 +161,7 @@ def build_granular_job(model: GranularModel, folder: str | Path):
         gnorm=float(np.linalg.norm(g)), var_cmds=var_cmds, wall_cmds=wall_cmds,
         frame_columns=frame_columns, acts=acts, compress_ids=compress_ids,
         lost=bool(axes.removal_axes.any()), walls=[(wp.name, wp.description) for wp in wall_plans],
+        mesh_fix=MESH_FIX if len(mesh) else None, mesh_forces_name=MESH_FORCES_NAME,
     )
     job = GranularJob(
         folder=folder, script=folder / SCRIPT_NAME, data=data_path, total_steps=total,
@@ -164,5 +173,6 @@ def build_granular_job(model: GranularModel, folder: str | Path):
         walls=[(wp.name, wp.description) for wp in wall_plans], dt=dt, t_start=t_start,
         sphere_rows=rows, outside_rows=spheres.outside_rows, late_rows=spheres.late_rows,
         bond_rows=bonds.rows, deletions=spheres.deletions, wall_plans=wall_plans, domain_lo=dom_lo,
-        domain_hi=dom_hi, removal_axes=axes.removal_axes, frame_columns=frame_columns, warnings=warnings)
+        domain_hi=dom_hi, removal_axes=axes.removal_axes, frame_columns=frame_columns, warnings=warnings,
+        wall_forces=folder / MESH_FORCES_NAME if len(mesh) else None, mesh_rows=mesh)
     return job, script, write_data_file

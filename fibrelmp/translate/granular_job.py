@@ -104,7 +104,7 @@ def build_granular_job(model: GranularModel, folder: str | Path):
     spheres = select_spheres(model, run, periodic, dom_lo, dom_hi, warnings)
     rows, r_max = spheres.rows, spheres.r_max
     wall_plans = plan_walls(model, dt, run.t_end)
-    warnings.extend(wall_warnings(model, wall_plans, t_start, run.t_end))
+    warnings.extend(wall_warnings(model, wall_plans, t_start, run.t_end, spheres))
     mesh = mesh_rows(wall_plans)
     tiles = tile_types(wall_plans, spheres.r_min, len(spheres.mats))
     ntypes = len(spheres.mats) + len(tiles.materials) or 1

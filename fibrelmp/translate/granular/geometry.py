@@ -368,18 +368,15 @@ class Kinematics:
         return m.velocity.copy() if m is not None else np.zeros(3)
 
     def kept_velocity(self, t0: float, t1: float) -> tuple[float, np.ndarray, np.ndarray] | None:
-        """The first time in [t0, t1] at which the geometry stands still while MUSEN keeps a
+        """The first time in [t0, t1) from which the geometry stands still while MUSEN keeps a
         non-zero wall velocity or rotation velocity (time, velocity, rotation velocity), or
         None: the quirk ``wall_state`` describes, which fibrelmp reproduces and warns about."""
-        times = sorted({t0} | {m.t_end for m in self.motions if t0 <= m.t_end <= t1}
-                       | {m.t_begin for m in self.motions if t0 <= m.t_begin <= t1})
-        probes = []
-        for a, b in zip(times, times[1:] + [t1]):
-            probes += [a, 0.5 * (a + b)] if b > a else [a]
-        for t in probes:
-            m, moving = self.wall_state(t)
+        bounds = sorted({t0, t1} | {m.t_begin for m in self.motions if t0 < m.t_begin < t1}
+                        | {m.t_end for m in self.motions if t0 <= m.t_end < t1})
+        for a, b in zip(bounds, bounds[1:]):
+            m, moving = self.wall_state(0.5 * (a + b))
             if m is not None and not moving:
-                return t, m.velocity.copy(), m.omega.copy()
+                return a, m.velocity.copy(), m.omega.copy()
         return None
 
     def angle(self, t: float) -> float:

@@ -143,14 +143,56 @@ def describe_walls(model: GranularModel) -> list[str]:
     return out
 
 
+def spheres_behind(v: np.ndarray, x: np.ndarray, r: np.ndarray) -> int:
+    """How many of the triangles v (k,3,3) have a sphere (centres x, radii r) touching their
+    face from behind: the centre projects inside the triangle at a signed distance in
+    (-r, 0] along the normal (V2 - V1) x (V3 - V1)."""
+    if not len(v) or not len(x):
+        return 0
+    order = np.argsort(x[:, 0], kind="stable")
+    xs, rs = x[order], r[order]
+    reach = float(rs.max())
+    e1, e2 = v[:, 1] - v[:, 0], v[:, 2] - v[:, 0]
+    n = np.cross(e1, e2)
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    lo, hi = v.min(axis=1) - reach, v.max(axis=1) + reach
+    a = np.searchsorted(xs[:, 0], lo[:, 0], "left")
+    b = np.searchsorted(xs[:, 0], hi[:, 0], "right")
+    count = 0
+    for k in np.flatnonzero(b > a):
+        p, rr = xs[a[k]:b[k]], rs[a[k]:b[k]]
+        near = ((p >= lo[k]) & (p <= hi[k])).all(axis=1)
+        p, rr = p[near], rr[near]
+        d = (p - v[k, 0]) @ n[k]
+        q = p - d[:, None] * n[k] - v[k, 0]
+        d00, d01, d11 = e1[k] @ e1[k], e1[k] @ e2[k], e2[k] @ e2[k]
+        d20, d21 = q @ e1[k], q @ e2[k]
+        den = d00 * d11 - d01 * d01
+        g, bt = (d11 * d20 - d01 * d21) / den, (d00 * d21 - d01 * d20) / den
+        inside = (g >= 0) & (bt >= 0) & (g + bt <= 1)
+        if (inside & (d <= 0) & (d > -rr)).any():
+            count += 1
+    return count
+
+
 def wall_warnings(model: GranularModel, wall_plans: list[WallPlan], t_start: float,
-                  t_end: float) -> list[tuple[str, str]]:
+                  t_end: float, spheres=None) -> list[tuple[str, str]]:
     """What the job's wall representation does not reproduce (stock walls standing in for
-    MUSEN's), walls MUSEN does not simulate, and MUSEN's kept wall velocity."""
+    MUSEN's), walls MUSEN does not simulate, MUSEN's kept wall velocity, and spheres behind
+    the faces of exact triangles (``spheres``: a ``SimulatedSpheres``)."""
     out: list[tuple[str, str]] = []
     if model.kind != "musen":
         return out
     for wp in wall_plans:
+        if wp.kind == "mesh" and spheres is not None and len(spheres.rows):
+            behind = spheres_behind(model.triangles.vertices[wp.triangle_rows], spheres.x[spheres.rows],
+                                    spheres.crad[spheres.rows])
+            if behind:
+                out.append(("spheres behind walls", f"geometry '{wp.name}': {behind} triangle(s) have a "
+                            "sphere touching them from behind (the side their normal (V2-V1)x(V3-V1) "
+                            "points away from): MUSEN's particle-wall law pushes spheres along the "
+                            "normal, so it pushes these through the wall; check the orientation of "
+                            "the triangles"))
         if wp.kind in ("box", "cylinder", "tiles"):
             out.append(("approximate MUSEN physics", f"wall geometry '{wp.name}' represented as "
                         f"{wp.description}: LAMMPS's granular wall law stands in for MUSEN's "

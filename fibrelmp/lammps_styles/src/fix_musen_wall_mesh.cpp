@@ -662,7 +662,7 @@ void FixMusenWallMesh::build_grid(double rmax)
     lo[k] = domain->sublo[k] - pad;
     hi[k] = domain->subhi[k] + pad;
   }
-  double cs = std::max(2.0 * reach, 1e-300);
+  double cs = std::max(reach, 1e-300);
   const double cap = std::max<double>(GRID_CELL_CAP_MIN, 4.0 * atom->nlocal);
   for (int it = 0; it < 200; it++) {
     double cells = 1.0;

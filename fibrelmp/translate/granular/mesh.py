@@ -11,6 +11,7 @@ MUSEN motion intervals (the wall velocity the contact law sees)."""
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -33,7 +34,9 @@ def _num(x: float) -> str:
 
 
 def _words(name: str) -> str:
-    return "_".join(str(name).split()) or "_"
+    """A name as one plain ASCII word (letters, digits, _ . -): the file is read by LAMMPS
+    ranks and user text must not reach it as anything but a label."""
+    return re.sub(r"[^A-Za-z0-9_.-]", "_", str(name))[:64] or "_"
 
 
 @dataclass

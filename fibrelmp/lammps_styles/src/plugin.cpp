@@ -17,6 +17,8 @@
 
 #include "fix_musen_history.h"
 
+// FIBRELMP_CORE_ONLY: the registration and the history fix alone (tests of the version check)
+#ifndef FIBRELMP_CORE_ONLY
 #if __has_include("pair_musen_hm.h")
 #include "pair_musen_hm.h"
 #define HAVE_PAIR_MUSEN_HM
@@ -36,6 +38,7 @@
 #if __has_include("fix_fibrenet_output.h")
 #include "fix_fibrenet_output.h"
 #define HAVE_FIX_FIBRENET_OUTPUT
+#endif
 #endif
 
 #ifndef FIBRELMP_LAMMPS_NUM_VER

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -252,9 +253,10 @@ def default_laws(mu_gg=0.45, mu_r_gg=0.05):
 class Recorder:
     """fix external callback: the reference forces of every step from the state the pair saw."""
 
-    def __init__(self, lmp, laws, dt, period=None):
+    def __init__(self, lmp, laws, dt, period=None, push=None):
         self.lmp, self.laws, self.dt = lmp, laws, dt
-        self.period = period        # box length of a periodic cubic box
+        self.push = push or {}      # sphere index -> constant force added after the pair's
+        self.period = None if period is None else np.broadcast_to(np.asarray(period, float), (3,))
         self.contacts: dict[tuple[int, int], Contact] = {}
         self.setup = True
         self.worst = 0.0
@@ -311,6 +313,8 @@ class Recorder:
                 if not own:
                     ref_f[b] -= total
                     ref_t[b] += m2
+        for k, force in self.push.items():
+            ref_f[k] += V(force)
         for k, idx in enumerate(order):
             for got, want in ((f[idx], ref_f[k].arr()), (t[idx], ref_t[k].arr())):
                 scale = max(np.abs(want).max(), 1e-300)
@@ -346,13 +350,6 @@ def collide(plugin, bodies, laws=None, dt=5e-8, nsteps=400, chunks=1, **kw):
     return rec, final
 
 
-def touching(r1, r2, gap, direction, offset=(0.0, 0.0, 0.0)):
-    """Centres of two spheres ``gap`` apart along ``direction`` (unit), the second shifted."""
-    d = np.asarray(direction, float) / np.linalg.norm(direction)
-    x2 = d * (r1 + r2 + gap) + np.asarray(offset, float)
-    return (0.0, 0.0, 0.0), tuple(x2)
-
-
 CASES = {
     # glass hit head-on by a smaller steel sphere
     "normal_glass_steel": [Body("glass", 1e-3, (0, 0, 0), (0, 0, 0)),
@@ -372,7 +369,6 @@ def test_forces_and_torques_equal_musen(case):
     plugin = plugin_or_skip()
     rec, _ = collide(plugin, CASES[case], nsteps=500)
     assert rec.contact_steps > 100, f"the spheres must collide ({rec.contact_steps} contact steps)"
-    print(case, rec.worst, rec.contact_steps, rec.slip_steps, rec.stick_steps)
     assert rec.worst <= 1e-12, f"largest relative difference {rec.worst:.3g}"
     if case == "oblique_spinning":
         assert rec.slip_steps > 5 and rec.stick_steps > 5, (rec.slip_steps, rec.stick_steps)
@@ -479,3 +475,210 @@ def test_scenario_pairs_as_in_cmusen(tmp_path, case):
     g_half_step = 9.81 * 5e-8 / 2
     np.testing.assert_allclose(v[:, :2], v_ref[:, :2], rtol=0, atol=1e-10)
     np.testing.assert_allclose(v[:, 2] - g_half_step, v_ref[:, 2], rtol=0, atol=1e-10)
+
+
+# ---------------------------------------------------------------- migration, MPI, restart
+
+# Two contacts on a periodic box split between 2 processors along y (processors 1 2 1):
+# A) a glass and a steel sphere held together by a spring between their centres (fix spring
+#    couple, ~1 N), orbiting each other (5 m/s relative) and spinning against each other
+#    (slip, then stick, rolling friction), drifting at 20 m/s along y: the contact crosses the
+#    periodic and the processor boundary, and the orbit swaps the spheres' local order when
+#    LAMMPS sorts atoms (every 50 steps), so either atom ends up computing the pair;
+# B) an oblique glass-glass collision right at the processor boundary.
+# Each sphere has one contact, so its force is one pair term (+ the spring): the sums have no
+# order to depend on, and the serial and 2-rank runs must agree bit for bit.
+_D = 1.7495e-3                                  # centre distance of A (overlap 5e-7 m)
+_M1, _M2 = 2500 * 4 / 3 * math.pi * 1e-9, 7800 * 4 / 3 * math.pi * 0.75e-3 ** 3
+_U1 = 5.0 * _M2 / (_M1 + _M2)                   # orbit: zero momentum relative to the drift
+_U2 = 5.0 - _U1
+PERSISTENT = [
+    Body("glass", 1e-3, (-2.0e-3 - _D * _M2 / (_M1 + _M2), 7.0e-3, 0.0), (0.0, 20.0 + _U1, 0.0),
+         (0.0, 0.0, 300.0)),
+    Body("steel", 0.75e-3, (-2.0e-3 + _D * _M1 / (_M1 + _M2), 7.0e-3, 0.0), (0.0, 20.0 - _U2, 0.0),
+         (0.0, 0.0, -300.0)),
+    Body("glass", 1e-3, (2.0e-3, -1.5e-3, 0.0), (0.0, 1.0, 0.0), (50.0, 0.0, 0.0)),
+    Body("glass", 1e-3, (2.3e-3, 0.52e-3, 0.25e-3), (0.0, -1.0, 0.0)),
+]
+BOX = ((-4e-3, 4e-3), (-8e-3, 8e-3), (-2e-3, 2e-3))
+HOLD = ["group a1 id 1", "group a2 id 2", f"fix hold a1 spring couple a2 {1.0 / _D!r} 0.0 0.0 0.0 0.0"]
+STEPS = 6000
+PERSISTENT_DT = 1e-7
+
+CASE_SCRIPT = r"""
+import sys, json
+sys.path.insert(0, {root!r})
+from tests.test_style_musen_pair import persistent_lammps, gathered
+lmp = persistent_lammps({plugin!r}, procs={procs!r})
+lmp.command("run {steps} post no")
+state = gathered(lmp)
+lmp.close()
+if state is not None:
+    print("STATE", json.dumps(state))
+"""
+
+
+def persistent_lammps(plugin, procs=None, record=False, log=None):
+    """The two contacts above; ``record``: a fix external (for a Recorder) placed before the
+    spring, so that it sees the pair forces alone."""
+    laws = default_laws()
+    lmp = new_lammps(["-log", "none", "-screen", str(log) if log else "none", "-nocite"])
+    (xl, xh), (yl, yh), (zl, zh) = BOX
+    cmds = [f"plugin load {plugin}", "units si", "atom_style sphere", "boundary p p p",
+            "newton off", "comm_modify vel yes", "atom_modify map array sort 50 0.001"]
+    if procs:
+        cmds.append(f"processors {procs}")
+    cmds += [f"region box block {xl} {xh} {yl} {yh} {zl} {zh}", "create_box 2 box"]
+    for k, b in enumerate(PERSISTENT):
+        t = 1 if b.kind == "glass" else 2
+        cmds += [f"create_atoms {t} single {b.x[0]!r} {b.x[1]!r} {b.x[2]!r} units box remap yes",
+                 f"set atom {k + 1} diameter {2 * b.r!r} density {RHO[b.kind]!r}",
+                 f"set atom {k + 1} vx {b.v[0]!r} vy {b.v[1]!r} vz {b.v[2]!r}",
+                 f"set atom {k + 1} omega {b.w[0]!r} {b.w[1]!r} {b.w[2]!r}"]
+    cmds += ["pair_style musen/hm"] + [coeff_line(i, j, p) for (i, j), p in laws.items()]
+    cmds += ["neighbor 0.0005 bin", "neigh_modify every 1 delay 0 check yes",
+             f"timestep {PERSISTENT_DT!r}", "fix integrate all nve/sphere"]
+    if record:
+        cmds.append("fix ext all external pf/callback 1 1")
+    cmds += HOLD
+    for c in cmds:
+        lmp.command(c)
+    return lmp
+
+
+def gathered(lmp):
+    """x, v, omega of every atom by id, on rank 0 (None elsewhere)."""
+    out = {}
+    for name in ("x", "v", "omega"):
+        data = lmp.gather_atoms(name, 1, 3)
+        out[name] = [float(c) for c in data]
+    return out if lmp.extract_setting("world_rank") == 0 else None
+
+
+def test_history_migrates_with_atoms_serial():
+    """Serial run with atom sorting and periodic wrapping: the pair forces of every step equal
+    MUSEN's (the reference keeps its own history), while the pressed contact is computed
+    from the glass sphere's side, from the steel sphere's side, and across the boundary."""
+    plugin = plugin_or_skip()
+    laws = default_laws()
+    lmp = persistent_lammps(plugin, record=True)
+    rec = Recorder(lmp, laws, PERSISTENT_DT, [hi - lo for lo, hi in BOX])
+    swapped = []
+
+    def record(caller, step, nlocal, tag, x, fext):
+        rec(caller, step, nlocal, tag, x, fext)
+        order = list(tag)
+        swapped.append(order.index(2) < order.index(1))
+
+    lmp.set_fix_external_callback("ext", record)
+    try:
+        rec.setup = True
+        lmp.command(f"run {STEPS} post no")
+    finally:
+        lmp.close()
+    assert rec.worst <= 1e-12, rec.worst
+    assert rec.contact_steps >= STEPS                 # A never lets go
+    assert rec.ghost_pairs > 100                      # A across the periodic boundary
+    assert 100 < sum(swapped) < len(swapped) - 100    # A's atoms in both local orders
+    assert rec.slip_steps >= 5 and rec.stick_steps > 1000, (rec.slip_steps, rec.stick_steps)
+
+
+def _run_case(plugin, ranks, steps, tmp_path):
+    code = CASE_SCRIPT.format(root=str(ROOT), plugin=str(plugin), procs="1 2 1" if ranks else None,
+                              steps=steps)
+    cmd = ([MPIEXEC, "-n", str(ranks)] if ranks else []) + [sys.executable, "-c", code]
+    env = dict(os.environ, OMP_NUM_THREADS="1")
+    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=120, cwd=tmp_path, env=env)
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-3000:]
+    line = [ln for ln in proc.stdout.splitlines() if ln.startswith("STATE ")]
+    assert len(line) == 1, proc.stdout
+    import json
+    return json.loads(line[0][6:])
+
+
+@pytest.mark.skipif(not MPIEXEC, reason="mpiexec not found (pip install mpich)")
+def test_serial_and_two_ranks_bitwise(tmp_path):
+    """The contacts above under mpiexec -n 2 (each contact crosses the processor boundary;
+    pairs with a ghost are computed on both ranks from each side): bit-identical to serial."""
+    plugin = plugin_or_skip()
+    serial = _run_case(plugin, None, STEPS, tmp_path)
+    two = _run_case(plugin, 2, STEPS, tmp_path)
+    for name in ("x", "v", "omega"):
+        assert serial[name] == two[name], name
+
+
+def test_restart_round_trip(tmp_path):
+    """write_restart in the middle of the pressed contact; a new LAMMPS reading it (and
+    re-defining the fixes) continues bit for bit as the original."""
+    plugin = plugin_or_skip()
+    restart = tmp_path / "mid.restart"
+    lmp = persistent_lammps(plugin)
+    try:
+        lmp.command(f"run {STEPS // 2} post no")
+        lmp.command(f"write_restart {restart}")
+        lmp.command(f"run {STEPS // 2} post no")
+        straight = gathered(lmp)
+    finally:
+        lmp.close()
+    lmp = new_lammps(["-log", "none", "-screen", "none", "-nocite"])
+    try:
+        for c in [f"plugin load {plugin}", f"read_restart {restart}", "comm_modify vel yes",
+                  "neighbor 0.0005 bin", "neigh_modify every 1 delay 0 check yes",
+                  "fix integrate all nve/sphere", *HOLD[2:], f"run {STEPS // 2} post no"]:
+            lmp.command(c)
+        again = gathered(lmp)
+    finally:
+        lmp.close()
+    for name in ("x", "v", "omega"):
+        assert straight[name] == again[name], name
+
+
+# ---------------------------------------------------------------- bad input
+
+@pytest.mark.parametrize("change, message", [
+    (("pair_coeff 1 2", None), "no pair_coeff for types 1 2"),
+    (("pair_coeff 1 1", "pair_coeff 1 1 5e10 2e10 0.0 0.3 0.01"), "restitution coefficient e must be in (0, 1]"),
+    (("pair_coeff 1 1", "pair_coeff 1 1 5e10 2e10 1.2 0.3 0.01"), "restitution coefficient e must be in (0, 1]"),
+    (("pair_coeff 1 1", "pair_coeff 1 1 -5e10 2e10 0.9 0.3 0.01"), "Estar must be > 0"),
+    (("pair_coeff 1 1", "pair_coeff 1 1 5e10 -1 0.9 0.3 0.01"), "Gstar must be >= 0"),
+    (("pair_coeff 1 1", "pair_coeff 1 1 5e10 2e10 0.9 -0.3 0.01"), "mu must be >= 0"),
+    (("pair_coeff 1 1", "pair_coeff 1 1 5e10 2e10 0.9 0.3 -1e-3"), "mu_r must be >= 0"),
+    (("pair_coeff 1 1", "pair_coeff 1 1 5e10 2e10 0.9 0.3"), "pair_coeff I J Estar Gstar e mu mu_r"),
+    (("comm_modify", "comm_modify vel no"), "comm_modify vel yes"),
+    (("pair_style", "pair_style musen/hm 1.0"), "it takes no arguments"),
+])
+def test_bad_input_is_a_clear_error(change, message):
+    plugin = plugin_or_skip()
+    laws = default_laws()
+    lmp = new_lammps(["-log", "none", "-screen", "none", "-nocite"])
+    cmds = [f"plugin load {plugin}", "units si", "atom_style sphere", "boundary f f f",
+            "comm_modify vel yes", "region box block -0.01 0.01 -0.01 0.01 -0.01 0.01",
+            "create_box 2 box", "create_atoms 1 single 0 0 0", "create_atoms 2 single 0.0019 0 0",
+            "set type 1 density 2500", "set type 2 density 7800", "pair_style musen/hm",
+            *[coeff_line(i, j, p) for (i, j), p in laws.items()], "fix 1 all nve/sphere"]
+    prefix, replacement = change
+    cmds = [replacement if c.startswith(prefix) else c for c in cmds]
+    cmds = [c for c in cmds if c is not None] + ["run 0 post no"]
+    try:
+        with pytest.raises(Exception, match=".*".join(map(re.escape, message.split()))):
+            for c in cmds:
+                lmp.command(c)
+    finally:
+        lmp.close()
+
+
+def test_partial_special_weights_are_refused():
+    plugin = plugin_or_skip()
+    lmp = new_lammps(["-log", "none", "-screen", "none", "-nocite"])
+    cmds = [f"plugin load {plugin}", "units si", "atom_style bpm/sphere", "boundary f f f",
+            "comm_modify vel yes", "region box block -0.01 0.01 -0.01 0.01 -0.01 0.01",
+            "create_box 1 box bond/types 1 extra/bond/per/atom 1 extra/special/per/atom 2",
+            "create_atoms 1 single 0 0 0", "pair_style musen/hm",
+            "pair_coeff * * 5e10 2e10 0.9 0.3 0.01", "special_bonds lj 0.5 1.0 1.0",
+            "fix 1 all nve/sphere", "run 0 post no"]
+    try:
+        with pytest.raises(Exception, match="special_bonds lj weights must be 0"):
+            for c in cmds:
+                lmp.command(c)
+    finally:
+        lmp.close()

@@ -26,6 +26,7 @@ import subprocess
 import sys
 from dataclasses import dataclass
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -682,3 +683,110 @@ def test_partial_special_weights_are_refused():
                 lmp.command(c)
     finally:
         lmp.close()
+
+
+# ---------------------------------------------------------------- translation
+
+def _translate(source: Path, out: Path, *extra: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "fibrelmp.cli", "translate", str(source), "-o", str(out),
+                           *extra], capture_output=True, text=True, cwd=ROOT)
+
+
+def _oblique_job(folder: Path, end_time: float | None = None) -> Path:
+    src = data_path("real-outputs", "musen", "scenarios", "oblique_two_materials")
+    folder.mkdir(parents=True, exist_ok=True)
+    shutil.copy(src / "oblique_scene.txt", folder)
+    job = (src / "job_oblique.txt").read_text()
+    if end_time is not None:
+        job = re.sub(r"(?m)^END_TIME\s+\S+", f"END_TIME             {end_time!r}", job)
+    (folder / "job_oblique.txt").write_text(job)
+    return folder / "job_oblique.txt"
+
+
+def test_musen_job_uses_musen_hm_with_line_33_coefficients(tmp_path):
+    """With the plugin: newton off, pair_style musen/hm and, per type pair, the E*/G* MUSEN
+    mixes from the materials and e/mu/mu_r of the scene's `33` line."""
+    plugin_or_skip()
+    proc = _translate(_oblique_job(tmp_path / "in"), tmp_path / "job")
+    assert proc.returncode == 0, proc.stderr
+    script = (tmp_path / "job" / "in.lammps").read_text()
+    assert "\nnewton          off\n" in script and "\npair_style      musen/hm\n" in script
+    lines = {tuple(ln.split()[1:3]): [float(v) for v in ln.split()[3:]]
+             for ln in script.splitlines() if ln.startswith("pair_coeff")}
+    expected = {("1", "1"): interaction(GLASS, GLASS, 0.9, 0.45, 0.05),
+                ("1", "2"): interaction(GLASS, STEEL, 0.85, 0.15, 0.01),
+                ("2", "2"): interaction(STEEL, STEEL, 0.9, 0.2, 0.01)}
+    assert set(lines) == set(expected)
+    for key, p in expected.items():
+        np.testing.assert_allclose(lines[key], [p.e_star, p.g_star, p.rest, p.mu, p.mu_r], rtol=1e-14)
+    assert "rolling friction acts on the relative rolling" not in proc.stderr
+
+
+def test_stock_styles_keep_granular_and_say_how_it_differs(tmp_path):
+    proc = _translate(_oblique_job(tmp_path / "in"), tmp_path / "job", "--stock-styles")
+    assert proc.returncode == 0, proc.stderr
+    script = (tmp_path / "job" / "in.lammps").read_text()
+    assert "musen/hm" not in script and "\npair_style      granular\n" in script
+    assert "rolling sds" in script and "tangential mindlin" in script
+    text = " ".join(proc.stderr.split())
+    assert "approximate MUSEN physics" in text
+    assert "rolling friction acts on the relative rolling (LAMMPS rolling sds) instead of each sphere's own spin" in text
+    assert "tangential damping is inside the Coulomb test" in text
+
+
+def test_demdf_stays_on_stock_granular(tmp_path):
+    """DEMDF's frictionless soft-sphere stand-in for BOS's collisions is not MUSEN's law; the
+    stock style is exact for it and it keeps it with the plugin."""
+    proc = _translate(ROOT / "examples" / "demdf" / "head_on.json", tmp_path / "job")
+    assert proc.returncode == 0, proc.stderr
+    script = next((tmp_path / "job").rglob("in.lammps")).read_text()
+    assert "\npair_style      granular\n" in script and "musen/hm" not in script
+
+
+def test_wall_particles_with_musen_hm(tmp_path):
+    """The sphere-tile pair_coeff scales E* and G* by sqrt((R_p + r_w)/r_w), so that the
+    contact is the flat wall's (R* = R_p); mu_r stays (musen/hm's rolling torque uses the
+    sphere's own radius).  (Spheres on moving tiled walls with musen/hm:
+    tests/test_granular_walls.py, which runs with the plugin when it is there.)"""
+    plugin_or_skip()
+    from fibrelmp.granmodel import ContactLaw
+    from fibrelmp.translate.granular.contacts import pair_coeff_lines
+
+    class Spheres:
+        mats = [0]
+        m_min = {0: 1e-5}
+        r_mean = {0: 1e-3}
+
+    class Model:
+        source = "x"
+        materials = {0: SimpleNamespace(name="glass"), 1: SimpleNamespace(name="wall")}
+        contacts = {(0, 0): ContactLaw(3e10, 1e10, 0.8, 0.4, 0.02),
+                    (0, 1): ContactLaw(5e10, 2e10, 0.7, 0.3, 0.03)}
+
+    rw = 0.3e-3
+    lines = pair_coeff_lines(Model, Spheres, [1], rw, 1e-7, musen_hm=True)
+    scale = math.sqrt((1e-3 + rw) / rw)
+    got = {tuple(ln.split()[1:3]): [float(v) for v in ln.split()[3:]] for ln in lines}
+    assert got[("1", "1")] == [3e10, 1e10, 0.8, 0.4, 0.02]
+    assert got[("1", "2")] == [5e10 * scale, 2e10 * scale, 0.7, 0.3, 0.03]
+    assert got[("2", "2")] == got[("1", "1")]         # never in contact (excluded)
+
+
+def test_oblique_scenario_sphere_sphere_metrics(tmp_path):
+    """fibrelmp run of the oblique scenario to 1.2 ms (every impact is over): the free-flight
+    sphere pairs (10-13, particle-particle law only) against the real cmusen, with the
+    metric script tests/scenarios/oblique_metrics.py.  README tolerances: |v| 0.01 m/s,
+    omega 20 rad/s; measured |v| within 1.5e-7 m/s, omega within 1.5e-9 rad/s.  (The plate
+    impacts depend on the wall law, not asserted here.)"""
+    plugin_or_skip()
+    from tests.scenarios.oblique_metrics import compare, sphere_sphere
+
+    job = _oblique_job(tmp_path / "run", end_time=0.0012)
+    proc = subprocess.run([sys.executable, "-m", "fibrelmp.cli", "--quiet", "run", job.name],
+                          cwd=job.parent, capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    rows = sphere_sphere(compare(job.parent / "oblique_result_prec17.txt"))
+    assert len(rows) == 8
+    for r in rows:
+        assert r.ok, r.line()
+        assert r.diff <= (1e-6 if r.kind == "pair_v" else 1e-6), r.line()

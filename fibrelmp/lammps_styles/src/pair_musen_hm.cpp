@@ -20,6 +20,8 @@
    arithmetic (swapping the two spheres negates the contact vector, the relative velocity and
    xi, and every product and sum only changes sign), so both sides compute bit-identical
    values and the two entries stay exact negatives of each other through atom migration.
+   (Across a periodic boundary the two sides see images shifted by +L and -L, which round
+   differently: there the two sides agree to round-off only, in serial as under MPI.)
    The price is that pairs across a processor boundary are computed twice; the gain is no
    reverse communication of history and no dependence on which atom LAMMPS lists first.
 ------------------------------------------------------------------------- */

@@ -139,7 +139,7 @@ def build_granular_job(model: GranularModel, folder: str | Path):
     tile_groups = [(wp, f"w{k + 1}") for k, wp in enumerate(wall_plans)
                    if wp.kind == "tiles" and wp.tile_ids is not None and len(wp.tile_ids)]
     mats, tile_mats = spheres.mats, tiles.materials
-    if not styles.available:
+    if not styles.available and model.kind == "musen":     # DEMDF's law is stock-exact
         warnings.append(("approximate MUSEN physics", f"fibrelmp's LAMMPS styles are not used "
                          f"({styles.how}): stock LAMMPS styles stand in for MUSEN's contact, "
                          "bond and wall laws (see the warnings that follow and docs/granular.md)"))

@@ -265,8 +265,8 @@ bool musen_breaks(int criterion, const double *h, const LawOutput &out, double s
 BondMusenElastic::BondMusenElastic(LAMMPS *lmp) :
     Bond(lmp), youngs(nullptr), shear(nullptr), sigma_n(nullptr), tau_s(nullptr),
     viscosity(nullptr), diam0(nullptr), len0(nullptr), breakage(1), kelvin(0),
-    max_damp_ratio(1.0), breaks_fp(nullptr), per_atom_geometry(0), ipartners(-1), ivalues(-1),
-    npartners(0), nvalues_per(0), update_special(0), max_length0(0.0), history(nullptr),
+    max_damp_ratio(1.0), breaks_fp(nullptr), per_atom_geometry(0), nslots(0), nvalues_per(0),
+    update_special(0), max_length0(0.0), history(nullptr),
     history_id(HISTORY_ID)
 {
   partial_flag = 1;    // broken bonds get type 0 (the neighbor lists then skip them)
@@ -385,19 +385,18 @@ double *BondMusenElastic::init_entry(int i1, int i2, int type)
   const tagint partner = atom->tag[i2];
   double d, L0, ov[3] = {0.0, 0.0, 0.0};
   if (per_atom_geometry) {
-    const int *p = atom->iarray[ipartners][i1];
-    const double *val = atom->darray[ivalues][i1];
     int k = 0;
-    while (k < npartners && p[k] != partner) k++;
-    if (k == npartners)
+    while (k < nslots && atom->ivector[ipartners[k]][i1] != partner) k++;
+    if (k == nslots)
       error->one(FLERR,
-                 "Bond style musen/elastic: bond {}-{} has no entry in the per-atom arrays i2_{} "
-                 "/ d2_{} (the first atom of a bond lists its partner there)",
-                 atom->tag[i1], partner, partners_name, values_name);
-    d = val[k * nvalues_per];
-    L0 = val[k * nvalues_per + 1];
+                 "Bond style musen/elastic: bond {}-{} has no entry in the per-atom slots i_{}1.."
+                 "i_{}{} (the first atom of a bond lists its partner there)",
+                 atom->tag[i1], partner, partners_name, partners_name, nslots);
+    const double *val = atom->darray[ivalues[k]][i1];
+    d = val[0];
+    L0 = val[1];
     if (nvalues_per == 5)
-      for (int c = 0; c < 3; c++) ov[c] = val[k * nvalues_per + 2 + c];
+      for (int c = 0; c < 3; c++) ov[c] = val[2 + c];
   } else {
     d = diam0[type];
     L0 = len0[type];
@@ -546,11 +545,15 @@ void BondMusenElastic::settings(int narg, char **arg)
                           "(0: no cap), got {}", arg[iarg + 1]);
       iarg += 2;
     } else if (key == "geometry") {
-      if (iarg + 3 > narg) utils::missing_cmd_args(FLERR, "bond_style musen/elastic geometry", error);
+      if (iarg + 4 > narg) utils::missing_cmd_args(FLERR, "bond_style musen/elastic geometry", error);
       partners_name = arg[iarg + 1];
       values_name = arg[iarg + 2];
+      nslots = utils::inumeric(FLERR, arg[iarg + 3], false, lmp);
+      if (nslots < 1)
+        error->all(FLERR, "Bond style musen/elastic: geometry needs K >= 1 slots, got {}",
+                   arg[iarg + 3]);
       per_atom_geometry = 1;
-      iarg += 3;
+      iarg += 4;
     } else if (key == "breaks") {
       if (iarg + 2 > narg) utils::missing_cmd_args(FLERR, "bond_style musen/elastic breaks", error);
       breaks_file = arg[iarg + 1];
@@ -627,21 +630,26 @@ void BondMusenElastic::init_style()
                       "angular velocities of the partner atoms)");
 
   if (per_atom_geometry) {
-    int flag, cols;
-    ipartners = atom->find_custom(partners_name.c_str(), flag, cols);
-    if (ipartners < 0 || flag != 0 || cols == 0)
-      error->all(FLERR, "Bond style musen/elastic: no per-atom integer array i2_{} (fix "
-                        "property/atom i2_{} K)", partners_name, partners_name);
-    npartners = cols;
-    ivalues = atom->find_custom(values_name.c_str(), flag, cols);
-    if (ivalues < 0 || flag != 1 || cols == 0)
-      error->all(FLERR, "Bond style musen/elastic: no per-atom double array d2_{} (fix "
-                        "property/atom d2_{} 2K or 5K)", values_name, values_name);
-    if (cols != 2 * npartners && cols != 5 * npartners)
-      error->all(FLERR, "Bond style musen/elastic: d2_{} has {} columns; i2_{} has {} partners, so "
-                        "it needs {} (d L0) or {} (d L0 and the initial tangential overlap)",
-                 values_name, cols, partners_name, npartners, 2 * npartners, 5 * npartners);
-    nvalues_per = cols / npartners;
+    ipartners.assign(nslots, -1);
+    ivalues.assign(nslots, -1);
+    nvalues_per = 0;
+    for (int k = 0; k < nslots; k++) {
+      const std::string pname = fmt::format("{}{}", partners_name, k + 1);
+      const std::string vname = fmt::format("{}{}", values_name, k + 1);
+      int flag, cols;
+      ipartners[k] = atom->find_custom(pname.c_str(), flag, cols);
+      if (ipartners[k] < 0 || flag != 0 || cols != 0)
+        error->all(FLERR, "Bond style musen/elastic: no per-atom integer vector i_{} (fix "
+                          "property/atom i_{} d2_{} 2)", pname, pname, vname);
+      ivalues[k] = atom->find_custom(vname.c_str(), flag, cols);
+      if (ivalues[k] < 0 || flag != 1 || (cols != 2 && cols != 5))
+        error->all(FLERR, "Bond style musen/elastic: no per-atom double array d2_{} with 2 "
+                          "(d L0) or 5 (d L0 and the initial tangential overlap) columns", vname);
+      if (k > 0 && cols != nvalues_per)
+        error->all(FLERR, "Bond style musen/elastic: the geometry slots have {} and {} columns",
+                   nvalues_per, cols);
+      nvalues_per = cols;
+    }
   }
 
   update_special = (force->special_lj[1] != 1.0 || force->special_coul[1] != 1.0) ? 1 : 0;

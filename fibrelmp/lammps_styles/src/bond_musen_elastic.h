@@ -8,17 +8,18 @@
    MUSEN is BSD-3-Clause, (c) MUSEN Development Team.
 
      bond_style musen/elastic [breakage 0|1|2] [kelvin MAX_DAMP_RATIO]
-                              [geometry PARTNERS VALUES] [breaks FILE]
+                              [geometry PARTNER VALUES K] [breaks FILE]
      bond_coeff N E G sigma_n tau_s mu [d L0]
 
    The law is incremental: every bond keeps MUSEN's state (tangential overlap, twisting and
    bending moments, the previous bond vector; see the H_* offsets) in a FixMusenHistory
    entry on the atom that stores the bond (newton_bond on: the first atom of the Bonds line,
    MUSEN's "left" sphere) keyed by the partner's tag, together with the bond's own diameter
-   and initial length.  Those come from per-atom arrays (fix property/atom i2_PARTNERS K
-   d2_VALUES 2K or 5K: for each partner tag d, L0 [and the initial tangential overlap])
-   or, without the geometry keyword, from the bond type's d and L0.  L0 <= 0 means "the
-   distance at the first use" (MUSEN's RESET_INITIAL_BOND_LENGTH).
+   and initial length.  Those come from K slots of per-atom values (fix property/atom
+   i_PARTNERk d2_VALUESk 2|5, k = 1..K: a partner tag, and d, L0 [and the initial tangential
+   overlap] of the bond to it; one slot per line of a read_data section, whose lines LAMMPS
+   limits to 256 characters) or, without the geometry keyword, from the bond type's d and L0.
+   L0 <= 0 means "the distance at the first use" (MUSEN's RESET_INITIAL_BOND_LENGTH).
 ------------------------------------------------------------------------- */
 
 #ifdef BOND_CLASS
@@ -73,11 +74,12 @@ class BondMusenElastic : public Bond {
   int breakage;              // MUSEN CONSIDER_BREAKAGE: 0 none, 1 sums, 2 each term
   int kelvin;                // 1: ModelSBKelvin's damping
   double max_damp_ratio;     // its MAX_DAMP_RATIO (0: no cap)
-  std::string partners_name, values_name;    // per-atom geometry arrays (empty: coefficients)
+  std::string partners_name, values_name;    // per-atom geometry slots (empty: coefficients)
   std::string breaks_file;   // "step id1 id2" per broken bond (rank 0 appends)
   FILE *breaks_fp;
   int per_atom_geometry;
-  int ipartners, ivalues, npartners, nvalues_per;    // resolved in init_style
+  int nslots, nvalues_per;                     // K slots of nvalues_per values
+  std::vector<int> ipartners, ivalues;         // their custom-property indices (init_style)
   int update_special;        // 1-2 weights not 1: a broken bond's pair must become a contact
   double max_length0;        // longest L0 seen (equilibrium_distance)
   class FixMusenHistory *history;

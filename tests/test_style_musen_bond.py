@@ -1040,3 +1040,36 @@ def test_sigterm_and_resume_continue_the_bonds_exactly(tmp_path):
         # 1.4e-6 m/s, overlaps 1.5e-13 m after the impact's chaos amplified round-off.
         for key, tol in (("x", 1e-9), ("v", 1e-3), ("overlap", 1e-10)):
             assert np.nanmax(np.abs(a[key] - b[key])) <= tol, key
+
+
+# --------------------------------------------------------------------------------------------
+# MUSEN's agglomerate impact (minutes): FIBRELMP_SLOW=1
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(os.environ.get("FIBRELMP_SLOW") != "1", reason="long scenario check: set FIBRELMP_SLOW=1")
+def test_agglomerate_impact_scenario(tmp_path):
+    """fibrelmp run of tests/data/.../agglomerate_impact (5,696 spheres, 18,802 bonds, 30,000
+    steps) against cmusen's result, with the README's tolerances on the metrics its -t=1 run was
+    checked on (cmusen_t1_summary.txt).  Before musen/elastic: 873 broken bonds (460) and a
+    1.34 m/s rebound (2.51)."""
+    import gzip
+
+    plugin_or_skip()
+    sys.path.insert(0, str(Path(__file__).resolve().parent / "scenarios"))
+    import agglomerate_metrics as am
+    from .conftest import data_path
+
+    case = data_path("real-outputs", "musen", "scenarios", "agglomerate_impact")
+    with gzip.open(case / "agglo_impact_scene.txt.gz", "rb") as src:
+        (tmp_path / "agglo_impact_scene.txt").write_bytes(src.read())
+    shutil.copy(case / "job_agglo.txt", tmp_path)
+    proc = subprocess.run([sys.executable, "-m", "fibrelmp.cli", "-q", "run", "job_agglo.txt"],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=3600)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    ref = am.metrics(am.read(case / "cmusen_agglo_impact_result.txt.gz"))
+    got = am.metrics(am.read(tmp_path / "agglo_impact_result.txt"))
+    checked = ["broken@50us", "broken@100us", "broken@300us", "COMvz@50us", "COMvz@100us",
+               "COMvz@300us", "largest_fragment", "single_spheres"]
+    bad = {k: (ref[k], got[k]) for k in checked if not am.within(k, ref[k], got[k])}
+    assert not bad, bad

@@ -653,6 +653,11 @@ void BondMusenElastic::init_style()
   }
 
   update_special = (force->special_lj[1] != 1.0 || force->special_coul[1] != 1.0) ? 1 : 0;
+  if (update_special && force->pair && utils::strmatch(force->pair_style, "^hybrid"))
+    error->all(FLERR, "Bond style musen/elastic: with 1-2 special weights other than 1 (no "
+                      "contacts between bonded spheres) a broken bond's spheres must become a "
+                      "contact pair, which the style does in the pair style's neighbor list; a "
+                      "hybrid pair style has none");
 
   if (!history) {
     Fix *fix = modify->get_fix_by_id(history_id);

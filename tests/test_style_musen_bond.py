@@ -897,12 +897,13 @@ def test_stock_job_warns_about_the_approximation(tmp_path):
         write_granular_job(model, tmp_path / "job2")
 
 
-@pytest.mark.parametrize("criterion", [1, 2])
-def test_pipeline_break_time_is_musens(tmp_path, criterion):
+@pytest.mark.parametrize("model_name,criterion", [("elastic", 1), ("elastic", 2), ("kelvin", 1)])
+def test_pipeline_break_time_is_musens(tmp_path, model_name, criterion):
     """A bond pulled apart through fibrelmp's pipeline: its activity end is the time of the
     step in which MUSEN's criterion is first met (MUSEN's EndActivity = the time of the
     positions its force stage used), computed here with the numpy model on the same motion
-    (heavy spheres: constant velocity)."""
+    (heavy spheres: constant velocity).  Kelvin (glass's viscosity 1e40, capped at the elastic
+    force) breaks on the elastic stresses alone, at the same step."""
     plugin_or_skip()
     from tests.granular_models import run
 
@@ -910,8 +911,10 @@ def test_pipeline_break_time_is_musens(tmp_path, criterion):
     x = np.array([[0, 0, 0], [L0, 0, 0]])
     vel = np.array([[-v / 2, 0, 0], [v / 2, 0, 0]])
     model, glass = _glass_pair_model(x, vel, [[0, 1]], [d], [L0], dt, 1200, save=100,
-                                     density=1e20, bond_breakage=criterion)
+                                     density=1e20, bond_breakage=criterion, bond_model=model_name,
+                                     viscosity=1e40)
     job, frames = run(model, tmp_path)
+    assert ("kelvin 1.0" in job.script.read_text()) == (model_name == "kelvin")
     b = MusenBond(0, 1, d, L0, glass.youngs, glass.shear_modulus, 5e7, 5e7)
     b.start(x)
     for k in range(1, 1200):

@@ -862,7 +862,7 @@ def test_job_keeps_each_bonds_geometry_exactly(tmp_path):
     job = write_granular_job(model, tmp_path / "job")
     script = job.script.read_text()
     assert "bond_style      musen/elastic breakage 1 kelvin 0.5 geometry fl_bp fl_bv 2 breaks breaks.dump" in script
-    assert "newton          on on" in script
+    assert "newton          off on" in script          # musen/hm: pairs newton off
     coeff = [ln.split() for ln in script.splitlines() if ln.startswith("bond_coeff")]
     assert len(coeff) == 1
     assert [float(v) for v in coeff[0][2:7]] == [glass.youngs, glass.shear_modulus, 5e7, 5e7, 123.5]

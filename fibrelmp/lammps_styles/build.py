@@ -105,16 +105,20 @@ def _run(cmd: list[str]) -> None:
         raise BuildError(f"{cmd[0]} failed: {_first_error(proc.stderr + proc.stdout)}")
 
 
-def build(out_dir: Path | str = LIB_DIR, jobs: int | None = None) -> Path:
-    """Compile the plugin into ``out_dir`` (atomically; nothing if it is already there)."""
+def build(out_dir: Path | str = LIB_DIR, jobs: int | None = None, *, num_ver: int | None = None,
+          core_only: bool = False) -> Path:
+    """Compile the plugin into ``out_dir`` (atomically; nothing if it is already there).
+    ``num_ver`` / ``core_only`` are for tests: a plugin claiming another LAMMPS version, or
+    only its registration and history fix."""
     out_dir = Path(out_dir)
     target = out_dir / library_name()
     if target.exists():
         return target
     inc = ["-I", str(SRC), "-I", str(lammps_include()), "-I", str(mpi_include())]
-    defs = [f"-DFIBRELMP_LAMMPS_NUM_VER={lammps_num_ver()}", f'-DFIBRELMP_STYLES_ID="{build_id()}"']
+    defs = [f"-DFIBRELMP_LAMMPS_NUM_VER={num_ver or lammps_num_ver()}",
+            f'-DFIBRELMP_STYLES_ID="{build_id()}"'] + (["-DFIBRELMP_CORE_ONLY"] if core_only else [])
     cxx = _compiler()
-    srcs = sources()
+    srcs = [SRC / "plugin.cpp", SRC / "fix_musen_history.cpp"] if core_only else sources()
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
     except OSError as exc:

@@ -187,17 +187,31 @@ class FrameBuilder:
         bf = np.full((self.nb, 3), np.nan)
         # no bond dump when no bond survives the start (e.g. all left the domain at t = 0)
         cols = next(self.bonds).columns if self.bonds is not None else {}
+        # musen/elastic also dumps the tangential overlap and |M_n + M_t| (MUSEN's TotalTorque)
+        extra = "c_fl_bforce[7]" in cols
+        overlap = np.full((self.nb, 3), np.nan) if extra else None
+        torque = np.full(self.nb, np.nan) if extra else None
         if len(cols.get("c_fl_bpair[1]", [])):
             i1 = cols["c_fl_bpair[1]"].astype(np.int64)
             i2 = cols["c_fl_bpair[2]"].astype(np.int64)
             fb = np.column_stack([cols[f"c_fl_bforce[{k}]"] for k in range(1, 4)])
             br = self._bond_lookup(i1, i2)
             ok = br >= 0
-            # b5..b7 is the force on batom1; report the force on the bond's first sphere
+            # the force on batom1 (and the overlap seen from it): report them for the bond's
+            # first sphere
             sign = np.where(i1[ok] == self.first_id[br[ok]], 1.0, -1.0)
             bf[br[ok]] = fb[ok] * sign[:, None]
+            if extra:
+                ov = np.column_stack([cols[f"c_fl_bforce[{k}]"] for k in range(4, 7)])
+                overlap[br[ok]] = ov[ok] * sign[:, None]
+                torque[br[ok]] = cols["c_fl_bforce[7]"][ok]
         bf[~self.bond_alive] = 0.0
         frame.bond_force = bf
+        if extra:
+            overlap[~self.bond_alive] = 0.0
+            torque[~self.bond_alive] = 0.0
+            frame.bond_tangential_overlap = overlap
+            frame.bond_torque = torque
 
     def _exit_time(self, r: int, t: float) -> float:
         """Ballistic estimate of when sphere r crossed the domain, from the previous frame."""

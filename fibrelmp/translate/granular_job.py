@@ -20,9 +20,11 @@ from fibrelmp.granmodel import GranularModel
 from fibrelmp import lammps_styles
 from fibrelmp.lammps_text import lammps_path, template_environment
 from fibrelmp.textio import atomic_write
-from fibrelmp.translate.granular.bonds import select_bonds
+from fibrelmp.translate.granular.bonds import (GEOMETRY_FIX, GEOMETRY_SECTION, PARTNERS, VALUES,
+                                              bond_geometry, select_bonds)
 from fibrelmp.translate.granular.box import box_axes, box_commands, domain_bounds, fit_box, periodic_axes
-from fibrelmp.translate.granular.contacts import law_args, pair_coeff_lines, rolling_spring
+from fibrelmp.translate.granular.contacts import (STOCK_PAIR_WARNING, law_args, pair_coeff_lines,
+                                                  rolling_spring, stock_pair_deviates)
 from fibrelmp.translate.granular.data import write_data
 from fibrelmp.translate.granular.reach import Travel, speed_bound
 from fibrelmp.translate.granular.schedule import compress_ids, run_time, save_steps, schedule
@@ -113,17 +115,30 @@ def build_granular_job(model: GranularModel, folder: str | Path):
     place_tiles(model, wall_plans, tiles, spheres, axes, travel, t_start, warnings)
     fit = fit_box(model, axes, spheres, tiles, dim)
     box_cmds = box_commands(fit, axes, spheres, tiles, travel, dt, warnings)
-    bonds = select_bonds(model, run, spheres, periodic, warnings)
-    pair_lines = pair_coeff_lines(model, spheres, tiles.materials, tiles.radius, dt)
+    styles = lammps_styles.plugin()
+    if not styles.available and model.kind == "musen":     # DEMDF's law is stock-exact
+        warnings.append(("approximate MUSEN physics", f"fibrelmp's LAMMPS styles are not used "
+                         f"({styles.how}): stock LAMMPS styles stand in for MUSEN's contact, "
+                         "bond and wall laws (see the warnings that follow and docs/granular.md)"))
+    bonds = select_bonds(model, run, spheres, periodic, warnings, exact=styles.available)
+    # MUSEN's particle-particle law exactly with the plugin; DEMDF's soft-sphere stand-in for
+    # BOS's instantaneous collisions (frictionless Hertz, docs/demdf.md) stays on the stock
+    # style, which is exact for it
+    musen_hm = styles.available and model.kind == "musen"
+    pair_lines = pair_coeff_lines(model, spheres, tiles.materials, tiles.radius, dt, musen_hm)
     wall_cmds, var_cmds, frame_columns = wall_commands(model, wall_plans, spheres, dt)
     wall_cmds = box_cmds + wall_cmds
 
     data_path = folder / DATA_NAME
+    # musen/elastic: each bond's d, L0 (and initial tangential overlap) on its first sphere
+    geometry = (bond_geometry(model, bonds, rows, len(rows) + len(tiles.x))
+                if bonds.exact and len(bonds.rows) else None)
+
     def write_data_file() -> None:
         write_data(model, data_path, rows, spheres.type_of_mat, spheres.smat, spheres.crad, axes.lo, axes.hi,
                    ntypes, tiles.x, tiles.types, tiles.v, tiles.ids, tiles.radius,
                    TILE_MASS_FACTOR * float(spheres.mass.max() if len(spheres.mass) else 1.0),
-                   bonds.rows, bonds.type, len(bonds.types))
+                   bonds.rows, bonds.type, len(bonds.types), geometry)
         if len(mesh):
             write_mesh(model, wall_plans, spheres, folder / MESH_NAME)
 
@@ -141,17 +156,18 @@ def build_granular_job(model: GranularModel, folder: str | Path):
     tile_groups = [(wp, f"w{k + 1}") for k, wp in enumerate(wall_plans)
                    if wp.kind == "tiles" and wp.tile_ids is not None and len(wp.tile_ids)]
     mats, tile_mats = spheres.mats, tiles.materials
-    styles = lammps_styles.plugin()
-    if not styles.available:
-        warnings.append(("approximate MUSEN physics", f"fibrelmp's LAMMPS styles are not used "
-                         f"({styles.how}): stock LAMMPS styles stand in for MUSEN's contact, "
-                         "bond and wall laws (see the warnings that follow and docs/granular.md)"))
+    if model.kind == "musen" and not musen_hm and stock_pair_deviates(model, spheres.mats):
+        warnings.append(("approximate MUSEN physics (particle-particle contact)", STOCK_PAIR_WARNING))
     script = template_environment().get_template("granular.lammps.j2").render(
         model=model, plugin=lammps_path(styles.path, "plugin") if styles.path else None,
         fmt=float_text, dim=dim, bnd=axes.bnd, data_name=DATA_NAME, frames_name=FRAMES_NAME,
         bonds_name=BONDS_NAME, tiles_name=TILES_NAME, breaks_name=BREAKS_NAME,
-        comm_cut=comm_cut, skin=skin, pair_lines=pair_lines, has_bonds=has_bonds,
+        comm_cut=comm_cut, skin=skin, musen_hm=musen_hm, pair_lines=pair_lines, has_bonds=has_bonds,
         overlay=bool(plan.contacts_between_bonded), breakage=breakage, bond_types=bonds.types,
+        musen_bonds=geometry is not None, bond_geometry=geometry, bond_partners=PARTNERS,
+        bond_values=VALUES, geometry_fix=GEOMETRY_FIX, geometry_section=GEOMETRY_SECTION,
+        bond_criterion=int(plan.bond_breakage), bond_model=plan.bond_model,
+        bond_max_damp_ratio=plan.bond_max_damp_ratio,
         sphere_types=[spheres.type_of_mat[m] for m in mats],
         sphere_type_names=[model.materials[m].name for m in mats],
         tile_types=[tiles.type_of_mat[m] for m in tile_mats],

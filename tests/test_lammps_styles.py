@@ -1,0 +1,141 @@
+"""fibrelmp's LAMMPS styles plugin: what is registered, the LAMMPS-version guard, the stock
+fallback and how jobs load it (the styles' physics: tests/test_style_*.py)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from fibrelmp import lammps_styles
+from fibrelmp._lammps import new_lammps
+from fibrelmp.errors import RunError
+from fibrelmp.lammps_styles import build
+from fibrelmp.lammps_text import lammps_path
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENE_JOB = ROOT / "examples" / "musen" / "single_particle_job.txt"
+
+
+def plugin_or_skip() -> Path:
+    found = lammps_styles.plugin()
+    if not found.available:
+        pytest.skip(f"fibrelmp's LAMMPS styles are unavailable here: {found.how}")
+    return found.path
+
+
+def _lammps(log: Path):
+    return new_lammps(["-log", "none", "-screen", str(log), "-nocite"])
+
+
+def test_plugin_registers_its_styles(tmp_path):
+    path = plugin_or_skip()
+    lmp = _lammps(tmp_path / "screen.txt")
+    try:
+        lmp.command(f"plugin load {path}")
+        lmp.command("plugin list")
+    finally:
+        lmp.close()
+    listing = (tmp_path / "screen.txt").read_text()
+    assert "fix style plugin MUSEN/HISTORY" in listing
+    expected = {"pair_musen_hm": "pair style plugin musen/hm",
+                "bond_musen_elastic": "bond style plugin musen/elastic",
+                "fix_musen_wall_mesh": "fix style plugin musen/wall/mesh",
+                "angle_fibrenet": "angle style plugin fibrenet",
+                "fix_fibrenet_output": "fix style plugin fibrenet/output"}
+    for stem, line in expected.items():
+        assert (line in listing) == (build.SRC / f"{stem}.cpp").exists(), line
+    assert "WARNING" not in listing
+
+
+def test_plugin_refuses_another_lammps_version(tmp_path):
+    """A plugin compiled for another LAMMPS registers nothing and says why; using one of its
+    styles then fails with LAMMPS's own 'unrecognized style' error."""
+    plugin_or_skip()            # needs a working compiler and the headers, as the real build
+    wrong = build.build(tmp_path, num_ver=20000101, core_only=True)
+    log = tmp_path / "screen.txt"
+    # a fresh process: plugins loaded by other tests stay registered in this one
+    code = f"""
+from fibrelmp._lammps import new_lammps
+lmp = new_lammps(["-log", "none", "-screen", {str(log)!r}, "-nocite"])
+lmp.command("plugin load {wrong}")
+lmp.command("units si")
+lmp.command("region box block 0 1 0 1 0 1")
+lmp.command("create_box 1 box")
+try:
+    lmp.command("fix history all MUSEN/HISTORY 3")
+except Exception as exc:
+    print("REFUSED", exc)
+"""
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
+    assert "REFUSED" in proc.stdout and "nrecognized fix style" in proc.stdout, proc.stdout + proc.stderr
+    text = " ".join(log.read_text().split())
+    assert "compiled for LAMMPS version 20000101" in text
+    assert "none registered" in text and "rebuild them against this LAMMPS" in text
+
+
+def test_build_without_compiler_is_a_clear_error(tmp_path, monkeypatch):
+    monkeypatch.setenv("CXX", str(tmp_path / "no-such-compiler"))
+    with pytest.raises(build.BuildError, match="no C\\+\\+ compiler"):
+        build.build(tmp_path / "out", core_only=True)
+    assert not list((tmp_path).glob("out/*.so"))
+
+
+def test_build_id_changes_with_the_sources(tmp_path, monkeypatch):
+    before = build.build_id()
+    src = tmp_path / "src"
+    src.mkdir()
+    for p in build.SRC.iterdir():
+        (src / p.name).write_bytes(p.read_bytes())
+    (src / "plugin.cpp").write_text((src / "plugin.cpp").read_text() + "\n// edited\n")
+    monkeypatch.setattr(build, "SRC", src)
+    assert build.build_id() != before
+
+
+def test_stock_request_and_restore():
+    with lammps_styles.stock(True):
+        assert not lammps_styles.plugin().available
+        assert "--stock-styles" in lammps_styles.plugin().how
+    assert lammps_styles.request_stock(False) is False
+
+
+def _translate(folder: Path, *extra: str, env_stock: bool = False) -> subprocess.CompletedProcess:
+    import os
+
+    env = dict(os.environ)
+    if env_stock:
+        env[lammps_styles.ENV_STOCK] = "1"
+    return subprocess.run([sys.executable, "-m", "fibrelmp.cli", "translate", str(SCENE_JOB), "-o",
+                           str(folder), *extra], capture_output=True, text=True, env=env, cwd=ROOT)
+
+
+@pytest.mark.parametrize("how", ["option", "environment"])
+def test_stock_styles_job_has_no_plugin_and_warns(tmp_path, how):
+    proc = _translate(tmp_path / "job", *(["--stock-styles"] if how == "option" else []),
+                      env_stock=how == "environment")
+    assert proc.returncode == 0, proc.stderr
+    script = (tmp_path / "job" / "in.lammps").read_text()
+    assert "plugin" not in script.split("units")[0].replace("# fibrelmp's own styles", "")
+    assert "approximate MUSEN physics" in proc.stderr
+
+
+def test_job_loads_the_plugin(tmp_path):
+    path = plugin_or_skip()
+    proc = _translate(tmp_path / "job")
+    assert proc.returncode == 0, proc.stderr
+    script = (tmp_path / "job" / "in.lammps").read_text()
+    assert f"plugin          load {path}" in script
+    assert "approximate MUSEN physics: fibrelmp's LAMMPS styles are not used" not in proc.stderr
+
+
+@pytest.mark.parametrize("bad", ["/tmp/a$b/x.so", "/tmp/a#b.so", '/tmp/a"b.so', "/tmp/a\nb.so",
+                                 "/tmp/a&b.so", "/tmp/\u00e9.so"])
+def test_plugin_path_is_escaped(bad):
+    with pytest.raises(RunError, match="cannot be used in a LAMMPS script"):
+        lammps_path(bad, "plugin")
+
+
+def test_plugin_path_with_spaces_is_one_word():
+    assert lammps_path("/tmp/my plugins/x.so") == '"/tmp/my plugins/x.so"'

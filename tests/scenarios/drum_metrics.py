@@ -4,6 +4,9 @@ cmusen result.
 
     python tests/scenarios/drum_metrics.py RESULT [--scene drum_scene.txt] [--reference CMUSEN_RESULT]
 
+(defaults: the scene and the 6-digit cmusen result in tests/data/real-outputs/musen/scenarios/
+rotating_drum.)
+
 Averages over the saved times in [0.3, 0.8] s (the README's definitions, checked against its
 cmusen figures):
 - bed angle: the mass-weighted centre of mass seen from the axis, in degrees from the bottom
@@ -31,6 +34,10 @@ sys.path.insert(0, str(HERE.parents[2]))
 from fibrelmp.translate.musen.scene import read as read_scene  # noqa: E402
 from fibrelmp.translate.musen.text import read_time_points  # noqa: E402
 
+# the scenario as copied into the repository (tests/data), else the developers' shared folder
+_PARTS = ("real-outputs", "musen", "scenarios", "rotating_drum")
+SCENARIO = next((p for p in (HERE.parents[1] / "data" / Path(*_PARTS), HERE.parents[3] / "shared" / Path(*_PARTS))
+                 if p.exists()), HERE.parents[1] / "data" / Path(*_PARTS))
 TOLERANCES = {"bed_angle_deg": ("abs", 3.0), "com_radius": ("rel", 0.03),
               "kinetic_energy": ("rel", 0.30), "max_reach": ("abs", 50e-6)}
 
@@ -82,10 +89,9 @@ def main(argv=None) -> int:
     p.add_argument("--scene", default=None)
     p.add_argument("--reference", default=None)
     a = p.parse_args(argv)
-    shared = HERE.parents[3] / "shared" / "real-outputs" / "musen" / "scenarios" / "rotating_drum"
-    scene = a.scene or shared / "drum_scene.txt"
+    scene = a.scene or SCENARIO / "drum_scene.txt"
     mine = drum_metrics(a.result, scene)
-    ref_path = a.reference or shared / "cmusen_drum_result.txt.gz"
+    ref_path = a.reference or SCENARIO / "cmusen_drum_result.txt.gz"
     ref = drum_metrics(ref_path, scene)
     print(f"# metric\tthis\tcmusen\twithin tolerance\t({mine['saves']} / {ref['saves']} saves in 0.3-0.8 s)")
     for key, mv, rv, ok in compare(mine, ref):

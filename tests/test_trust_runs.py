@@ -182,7 +182,8 @@ def test_sigterm_then_resume_gives_the_uninterrupted_results(tmp_path, kind, ran
 
 # -- 3. two runs, one folder -----------------------------------------------------------------
 def test_second_run_into_a_busy_folder_exits_2(tmp_path):
-    inp = fibre_case(tmp_path / "in", run="12000", output_freq="2000")
+    # long enough (~6 s with angle_style fibrenet, ~10 us per step) to be busy while the second starts
+    inp = fibre_case(tmp_path / "in", run="600000", output_freq="100000")
     out = tmp_path / "out"
     first = subprocess.Popen(CLI + ["-q", "run", str(inp), "-o", str(out)], stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 60
@@ -195,7 +196,7 @@ def test_second_run_into_a_busy_folder_exits_2(tmp_path):
     assert "another fibrelmp run is using this folder" in second.stderr
     assert "Traceback" not in second.stderr
     frames = read_xyz(out / "fibre_network_coord.xyz")
-    assert [f.step for f in frames] == list(range(0, 12001, 2000))
+    assert [f.step for f in frames] == list(range(0, 600001, 100000))
 
 
 # -- 4. overwriting --------------------------------------------------------------------------

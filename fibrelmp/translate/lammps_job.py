@@ -1,7 +1,10 @@
 """Turn a bead-spring Model into a LAMMPS data file and input script (rendered to disk).
 
-The script is self-contained stock LAMMPS (no Python hooks): ``lmp -in in.lammps`` inside the
-job folder replays exactly what ``fibrelmp run`` executes line by line.
+The script is self-contained LAMMPS (no Python hooks): ``lmp -in in.lammps`` inside the job
+folder replays exactly what ``fibrelmp run`` executes line by line.  FibreNet's angles use
+fibrelmp's ``angle_style fibrenet`` (``plugin load`` of fibrelmp's styles); without the
+plugin (``--stock-styles``) the same law runs as ``angle_style lepton`` (slower, see
+``stock_angle_warning``).
 """
 
 from __future__ import annotations
@@ -12,8 +15,9 @@ from pathlib import Path
 
 import numpy as np
 
+from fibrelmp import lammps_styles
 from fibrelmp.errors import InputError
-from fibrelmp.lammps_text import comment_text, template_environment
+from fibrelmp.lammps_text import comment_text, lammps_path, template_environment
 from fibrelmp.model import Model
 from fibrelmp.textio import atomic_write
 from fibrelmp.translate.lammps_format import data_rows, float_text
@@ -104,6 +108,22 @@ def angle_expression(c: float, theta0: float) -> str:
     return (f"{float_text(c)}*theta^2+select(step({float_text(s)}-sin(phi)),D-floor(D*{float_text(q)})/{float_text(q)},0);"
             f"D={float_text(2 * c * s)}*(phi+phi^3/18-{float_text(u)}*log(tan(max(abs(phi),1e-300)/2)))"
             f"-{float_text(c)}*theta^2;phi={float_text(u)}-theta")
+
+
+STOCK_ANGLES = "FibreNet angles via angle_style lepton"
+
+
+def stock_angle_warning(why: str) -> str:
+    """What a job without fibrelmp's plugin says about its angles (measured in
+    tests/test_style_fibrenet_angle.py and benchmarks/fibrenet_angle.py)."""
+    return (f"fibrelmp's LAMMPS styles are not used ({why}): FibreNet's angles run as "
+            "angle_style lepton with fibrelmp's clamp-cancelling expression instead of "
+            "angle_style fibrenet. This is not a physics approximation -- the law is the same "
+            "E = c1 (theta - theta0)^2 with forces along FibreNet's directions -- but it is the "
+            "slower route (about 3x the angle cost of angle_style fibrenet, plus ~1 ms per step "
+            "for re-evaluating the expressions), and LAMMPS derives theta from acos(cos theta), "
+            "so for triples within phi = pi - theta < 1e-4 rad of straight the force carries a "
+            "rounding error of about 1e-16/phi^2 of its size (FibreNet's own acos has the same)")
 
 
 def _schedule(model: Model, general_lambda: bool) -> tuple[list[tuple], SaveSteps, int]:
@@ -226,6 +246,13 @@ def write_job(model: Model, folder: str | Path, write_files: bool = True) -> Job
     comm_cut = max(max_cut + skin, 2.0 * leg_len + skin)
 
     acts, out_steps, total = _schedule(model, general_lambda)
+    plugin = None
+    if model.angles.count:
+        styles = lammps_styles.plugin()
+        if styles.available:
+            plugin = lammps_path(styles.path, "plugin")
+        else:
+            model.warn(STOCK_ANGLES, stock_angle_warning(styles.how))
 
     data_path = folder / DATA_NAME
     if write_files:
@@ -238,7 +265,7 @@ def write_job(model: Model, folder: str | Path, write_files: bool = True) -> Job
         general_lambda=general_lambda, data_name=DATA_NAME, frames_name=FRAMES_NAME,
         state_section=STATE_SECTION, wall_pad=float(box.lengths.max()),
         type_names=[p.type_names[int(t)] for t in ltypes[:, 0]],
-        rad2deg=180.0 / math.pi, inf=float("inf"), angle_expression=angle_expression,
+        rad2deg=180.0 / math.pi, inf=float("inf"), angle_expression=angle_expression, plugin=plugin,
         extra_packages=_extra_packages(pair_styles, btypes, use_mvv),
     )
     script_path = folder / SCRIPT_NAME

@@ -8,6 +8,10 @@
  *   nan, hex, text, wrong token count, blank line, odd whitespace) returns -1 so that the
  *   caller uses its numpy path, which produces the result or the precise error.
  *
+ * fp_parse_tagged: the same for a FibreNet model block (BEAD / SPRING / ANGLE lines): each line
+ *   starts with a keyword and a name (type name, spring or angle kind) before the numbers;
+ *   the name is stored as its index in a table.  Declines (-1) just as fp_parse_block does.
+ *
  * fp_format_xyz: rows "name\t%.5f\t%.5f\t%.5f\n" byte-identical to printf: |x| 10^5 is
  *   split into an exact sum p + e (Dekker's product), so rounding (ties to even) is decided
  *   on the exact binary value, as glibc does.  Non-finite or |x| 10^5 >= 2^51 returns -1.
@@ -130,6 +134,66 @@ int fp_parse_block(const char *buf, int64_t len, double *out, int64_t nrows, int
         }
         if (p < end) p++;   /* '\n' */
         row++;
+    }
+    return p == end ? 0 : -1;
+}
+
+/* the token at *pp (up to a separator or the end): its start and length; advances *pp */
+static inline int64_t word_token(const char **pp, const char *e, const char **start)
+{
+    const char *p = *pp;
+    *start = p;
+    while (p < e && !is_sep(*p)) p++;
+    *pp = p;
+    return (int64_t)(p - *start);
+}
+
+/* nrows lines "KEY NAME number ... number" (ncols tokens in all) into out: column 0 = 0,
+   column 1 = index of NAME in names (nnames entries, each NUL-padded to w bytes), then the
+   numbers as fp_parse_block reads them.  Leading spaces/tabs, a '\r' before '\n' and a
+   missing last '\n' are accepted; anything else (blank lines, another keyword, an unknown
+   name, a bad number, a wrong token count) returns -1. */
+int fp_parse_tagged(const char *buf, int64_t len, const char *key, int64_t klen, const char *names,
+                    int64_t nnames, int64_t w, double *out, int64_t nrows, int64_t ncols)
+{
+    const char *p = buf, *end = buf + len;
+    double *o = out;
+    if (FP_EXCESS_PRECISION || ncols < 2) return -1;
+    for (int64_t row = 0; row < nrows; row++) {
+        if (p >= end) return -1;
+        while (p < end && (*p == ' ' || *p == '\t')) p++;
+        const char *t;
+        int64_t n = word_token(&p, end, &t);
+        if (n != klen || memcmp(t, key, (size_t)klen) != 0) return -1;
+        while (p < end && (*p == ' ' || *p == '\t')) p++;
+        n = word_token(&p, end, &t);
+        if (n == 0 || n > w) return -1;
+        int64_t which = -1;
+        for (int64_t k = 0; k < nnames; k++) {
+            const char *name = names + k * w;
+            if (memcmp(t, name, (size_t)n) == 0 && (n == w || name[n] == 0)) {
+                which = k;
+                break;
+            }
+        }
+        if (which < 0) return -1;
+        o[0] = 0.0;
+        o[1] = (double)which;
+        int64_t col = 2;
+        for (;;) {
+            while (p < end && (*p == ' ' || *p == '\t')) p++;
+            if (p >= end || *p == '\n' || *p == '\r') break;
+            if (col >= ncols) return -1;
+            if (parse_token(&p, end, o + col)) return -1;
+            col++;
+        }
+        if (col != ncols) return -1;
+        if (p < end && *p == '\r') {
+            p++;
+            if (!(p < end && *p == '\n')) return -1;
+        }
+        if (p < end) p++;   /* '\n' */
+        o += ncols;
     }
     return p == end ? 0 : -1;
 }

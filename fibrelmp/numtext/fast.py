@@ -128,6 +128,9 @@ def _open(lib: Path) -> ctypes.CDLL:
         dll.fp_parse_block.restype = ctypes.c_int
         dll.fp_format_xyz.argtypes = [ptr, ptr, i64, ctypes.c_char_p, i64, i64, ctypes.c_int, ptr, i64]
         dll.fp_format_xyz.restype = i64
+        dll.fp_parse_tagged.argtypes = [ptr, i64, ctypes.c_char_p, i64, ctypes.c_char_p, i64, i64,
+                                         ptr, i64, i64]
+        dll.fp_parse_tagged.restype = ctypes.c_int
         dll.fp_count_lines.argtypes = [ptr, i64]
         dll.fp_count_lines.restype = i64
         dll.fp_nth_newline.argtypes = [ptr, i64, i64, ctypes.POINTER(i64)]
@@ -247,6 +250,42 @@ def parse_numbers(block: bytes, nrows: int, ncols: int) -> np.ndarray | None:
     if lib.fp_parse_block(base, len(block), out.ctypes.data, nrows, ncols) != 0:
         return None
     return out
+
+
+def parse_tagged(block: bytes | memoryview, key: str, names: list[str], ncols: int) -> np.ndarray | None:
+    """(nrows, ncols) float64 array of a FibreNet model block whose lines read
+    ``key name number ...`` (ncols tokens): column 0 is 0, column 1 the index of ``name`` in
+    ``names``; None without the C library or for anything unusual (see fp_parse_tagged)."""
+    lib = library()
+    if lib is None or not block or not names:
+        return None
+    enc = [n.encode() for n in names]
+    if any(not e or b"\0" in e for e in enc) or b"\0" in key.encode():
+        return None
+    w = max(len(e) for e in enc)
+    table = b"".join(e.ljust(w, b"\0") for e in enc)
+    kb = key.encode()
+    raw = np.frombuffer(block, np.uint8)         # no copy; keeps ``block`` alive
+    base, size = raw.ctypes.data, len(raw)
+    nrows = lib.fp_count_lines(base, size) + (0 if raw[-1] == 10 else 1)
+    out = np.empty((nrows, ncols), np.float64)
+
+    def part(start: int, stop: int, row0: int, rows: int) -> bool:
+        return lib.fp_parse_tagged(base + start, stop - start, kb, len(kb), table, len(enc), w,
+                                   out[row0:].ctypes.data, rows, ncols) == 0
+
+    pool = _helper() if size >= SPLIT_BYTES and nrows >= 2 else None
+    if pool is not None:
+        found = np.flatnonzero(raw[size // 2:size // 2 + 4096] == 10)     # a '\n' near the middle
+        mid = size // 2 + int(found[0]) if len(found) else -1
+        if 0 <= mid < size - 1:
+            first = lib.fp_count_lines(base, mid + 1)           # rows in [0, mid]
+            if 0 < first < nrows:
+                job = pool.submit(part, mid + 1, size, first, nrows - first)
+                ok = part(0, mid + 1, 0, first)
+                ok = job.result() and ok
+                return out if ok else None
+    return out if part(0, size, 0, nrows) else None
 
 
 def _format_rows(lib, codes, values, n, names, nnames, w, decimals) -> np.ndarray | None:

@@ -1,0 +1,172 @@
+"""The FibreNet model reader's fast paths give the line-by-line reader's model, bit for bit.
+
+``fast_reader`` parses the BEAD / SPRING / ANGLE blocks with the C helper of
+``numtext.fast`` (``fp_parse_tagged``), or with np.loadtxt without it; anything unusual falls
+back to the line-by-line reader.  All three must produce identical arrays, for clean files and
+for the layouts the C helper declines or tolerates (CRLF, mixed blanks and tabs, trailing blank
+lines, no final newline, number spellings)."""
+
+from __future__ import annotations
+
+import importlib.util
+import shutil
+from dataclasses import fields
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fibrelmp.numtext import fast
+from fibrelmp.translate.fibrenet import fast_reader
+from fibrelmp.translate.fibrenet.reader import read
+
+from .conftest import REPO
+
+EXAMPLE = REPO / "examples" / "fibre_network"
+
+
+def _arrays(model) -> dict[str, np.ndarray]:
+    out = {}
+    for part in ("particles", "bonds", "angles"):
+        obj = getattr(model, part)
+        for f in fields(obj):
+            value = getattr(obj, f.name)
+            if isinstance(value, np.ndarray):
+                out[f"{part}.{f.name}"] = value
+    return out
+
+
+def _read_three_ways(inp: Path, monkeypatch) -> dict[str, dict]:
+    """{'C' | 'loadtxt' | 'slow': arrays of the model} and which path the fast reader took."""
+    out = {}
+    calls = {"tagged": 0, "loadtxt": 0}
+    real_tagged, real_loadtxt = fast.parse_tagged, fast_reader._loadtxt
+
+    def tagged(*args, **kw):
+        result = real_tagged(*args, **kw)
+        calls["tagged"] += result is not None
+        return result
+
+    def loadtxt(*args, **kw):
+        calls["loadtxt"] += 1
+        return real_loadtxt(*args, **kw)
+
+    with monkeypatch.context() as m:
+        m.setattr(fast, "parse_tagged", tagged)
+        m.setattr(fast_reader, "_loadtxt", loadtxt)
+        out["C"] = _arrays(read(inp))
+    out["calls"] = calls
+    with monkeypatch.context() as m:
+        m.setattr(fast, "library", lambda: None)
+        out["loadtxt"] = _arrays(read(inp))
+    with monkeypatch.context() as m:
+        m.setattr(fast_reader, "fast_read_model", lambda *a, **k: None)
+        out["slow"] = _arrays(read(inp))
+    return out
+
+
+def _assert_same(found: dict) -> None:
+    slow = found["slow"]
+    for path in ("C", "loadtxt"):
+        assert found[path].keys() == slow.keys()
+        for name, ref in slow.items():
+            got = found[path][name]
+            assert got.dtype == ref.dtype and got.shape == ref.shape, (path, name)
+            assert got.tobytes() == ref.tobytes(), (path, name)
+
+
+def _case(tmp_path: Path, model_text: bytes | None = None) -> Path:
+    folder = tmp_path / "case"
+    folder.mkdir()
+    shutil.copy(EXAMPLE / "input.txt", folder)
+    (folder / "model.txt").write_bytes(model_text if model_text is not None
+                                       else (EXAMPLE / "model.txt").read_bytes())
+    return folder / "input.txt"
+
+
+def test_example_network_three_ways(tmp_path, monkeypatch):
+    if fast.library() is None:
+        pytest.skip(f"no C helper: {fast.active_path()}")
+    found = _read_three_ways(_case(tmp_path), monkeypatch)
+    assert found["calls"] == {"tagged": 3, "loadtxt": 0}       # the C path did the work
+    _assert_same(found)
+
+
+def test_generated_network_three_ways(tmp_path, monkeypatch):
+    """A large generated network (two threads per block in the C path)."""
+    if fast.library() is None:
+        pytest.skip(f"no C helper: {fast.active_path()}")
+    spec = importlib.util.spec_from_file_location("generate_network", REPO / "examples" / "generate_network.py")
+    gen = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(gen)
+    gen.generate(gen.parse_args(["--beads", "30000", "--out", str(tmp_path / "net")]))
+    assert (tmp_path / "net" / "model.txt").stat().st_size > fast.SPLIT_BYTES
+    found = _read_three_ways(tmp_path / "net" / "input.txt", monkeypatch)
+    assert found["calls"] == {"tagged": 3, "loadtxt": 0}
+    _assert_same(found)
+
+
+def _rewrite(text: bytes, how: str) -> bytes:
+    lines = text.split(b"\n")
+    if how == "crlf":
+        return b"\r\n".join(lines)
+    if how == "tabs_and_blanks":
+        return b"\n".join(ln.replace(b"\t", b" \t ") + b" \t" if ln else ln for ln in lines)
+    if how == "trailing_blank_lines":
+        return text.rstrip(b"\n") + b"\n\n  \n\t\n"
+    if how == "no_final_newline":
+        return text.rstrip(b"\n")
+    if how == "number_spellings":       # same values, other spellings strtod reads alike
+        out = []
+        for ln in lines:
+            if ln.startswith(b"BEAD"):
+                t = ln.split(b"\t")
+                t[4] = b"+" + t[4]                                     # radius "+0.42"
+                t[9] = b"%.6e" % float(t[9])                           # vx in e-notation
+                t[12] = b"-0" if float(t[12]) == 0 else t[12]          # fx "-0"
+                ln = b"\t".join(t)
+            out.append(ln)
+        return b"\n".join(out)
+    raise AssertionError(how)
+
+
+@pytest.mark.parametrize("how", ["crlf", "tabs_and_blanks", "trailing_blank_lines",
+                                 "no_final_newline", "number_spellings"])
+def test_layout_variants_three_ways(tmp_path, monkeypatch, how):
+    if fast.library() is None:
+        pytest.skip(f"no C helper: {fast.active_path()}")
+    text = _rewrite((EXAMPLE / "model.txt").read_bytes(), how)
+    found = _read_three_ways(_case(tmp_path, text), monkeypatch)
+    assert found["calls"]["tagged"] == 3, found["calls"]
+    _assert_same(found)
+
+
+@pytest.mark.parametrize("how", ["blank_line_inside", "huge_integer", "hex_number"])
+def test_declined_layouts_still_read_identically(tmp_path, monkeypatch, how):
+    """What the C helper declines (a blank line inside a block, a tag beyond 2^53 digits,
+    a number strtod reads but the helper does not) goes to loadtxt or the slow reader."""
+    if fast.library() is None:
+        pytest.skip(f"no C helper: {fast.active_path()}")
+    lines = (EXAMPLE / "model.txt").read_bytes().split(b"\n")
+    if how == "blank_line_inside":
+        lines.insert(5, b"")
+    elif how == "huge_integer":
+        t = lines[3].split(b"\t")
+        t[2] = b"1" + b"0" * 25 + b".0"              # tag 1e25: not an exact integer
+        lines[3] = b"\t".join(t)
+    else:
+        t = lines[3].split(b"\t")
+        t[4] = b"0x1.ae147ae147ae1p-2"               # 0.42 in hex: loadtxt and the slow reader refuse
+        lines[3] = b"\t".join(t)
+    inp = _case(tmp_path, b"\n".join(lines))
+    if how in ("huge_integer", "hex_number"):
+        # the fast paths decline, the slow reader names the line
+        from fibrelmp.errors import InputError
+
+        with pytest.raises(InputError) as err:
+            read(inp)
+        assert err.value.line == 4
+        return
+    found = _read_three_ways(inp, monkeypatch)
+    assert found["calls"]["loadtxt"] >= 1
+    _assert_same(found)

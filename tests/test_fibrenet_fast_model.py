@@ -170,3 +170,36 @@ def test_declined_layouts_still_read_identically(tmp_path, monkeypatch, how):
     found = _read_three_ways(inp, monkeypatch)
     assert found["calls"]["loadtxt"] >= 1
     _assert_same(found)
+
+
+def test_data_file_rows_c_and_numpy_identical(monkeypatch):
+    """The C row formatter of data files (fp_format_fixed_rows) writes the numpy path's bytes:
+    ints, fixed-point floats with 0..8 decimals, negative values, zeros, literal columns."""
+    from fibrelmp.numtext import shortest
+
+    if fast.library() is None:
+        pytest.skip(f"no C helper: {fast.active_path()}")
+    rng = np.random.default_rng(11)
+    compared = 0
+    for trial in range(150):
+        n = 40000 if trial % 10 == 0 else int(rng.integers(1, 80))     # both thread layouts
+        cols: list = [rng.integers(0, 10 ** int(rng.integers(1, 8)), size=n)]
+        for _ in range(int(rng.integers(0, 7))):
+            kind = int(rng.integers(0, 5))
+            if kind == 0:
+                cols.append(rng.integers(-10 ** int(rng.integers(1, 12)), 10 ** int(rng.integers(1, 12)), size=n))
+            elif kind == 1:
+                cols.append(np.round(rng.normal(0, 10.0 ** int(rng.integers(-3, 6)), size=n), int(rng.integers(0, 9))))
+            elif kind == 2:
+                cols.append(np.zeros(n) * -1.0)
+            elif kind == 3:
+                cols.append(-np.abs(np.round(rng.normal(0, 1, size=n), 3)))
+            else:
+                cols.append("0")
+        c_text = shortest._rows_text_c(cols)
+        with monkeypatch.context() as m:
+            m.setattr(shortest, "_rows_text_c", lambda columns: None)
+            numpy_text = shortest.rows_text(cols)
+        assert c_text == numpy_text, trial
+        compared += c_text is not None
+    assert compared == 150

@@ -131,6 +131,8 @@ def _open(lib: Path) -> ctypes.CDLL:
         dll.fp_parse_tagged.argtypes = [ptr, i64, ctypes.c_char_p, i64, ctypes.c_char_p, i64, i64,
                                          ptr, i64, i64]
         dll.fp_parse_tagged.restype = ctypes.c_int
+        dll.fp_format_fixed_rows.argtypes = [ptr, i64, i64, ptr, ptr, ptr, i64]
+        dll.fp_format_fixed_rows.restype = i64
         dll.fp_count_lines.argtypes = [ptr, i64]
         dll.fp_count_lines.restype = i64
         dll.fp_nth_newline.argtypes = [ptr, i64, i64, ctypes.POINTER(i64)]
@@ -286,6 +288,36 @@ def parse_tagged(block: bytes | memoryview, key: str, names: list[str], ncols: i
                 ok = job.result() and ok
                 return out if ok else None
     return out if part(0, size, 0, nrows) else None
+
+
+def format_fixed_rows(values: np.ndarray, decimals: np.ndarray, widths: np.ndarray) -> bytes | None:
+    """Rows of (nrows, ncols) int64 ``values``, column c printed as value / 10^decimals[c]
+    right-aligned in widths[c], one space between columns (see fp_format_fixed_rows); None
+    without the C library or if a field does not fit its width."""
+    lib = library()
+    if lib is None or values.ndim != 2 or not values.size:
+        return None
+    values = np.ascontiguousarray(values, np.int64)
+    k = np.ascontiguousarray(decimals, np.int64)
+    w = np.ascontiguousarray(widths, np.int64)
+    n, ncols = values.shape
+    if len(k) != ncols or len(w) != ncols:
+        return None
+    row = int(w.sum()) + ncols              # every row has exactly this many bytes
+    buf = np.empty(n * row, np.uint8)
+
+    def part(a: int, b: int) -> bool:
+        return lib.fp_format_fixed_rows(values[a:].ctypes.data, b - a, ncols, k.ctypes.data,
+                                        w.ctypes.data, buf[a * row:].ctypes.data,
+                                        (b - a) * row) == (b - a) * row
+    pool = _helper() if n * row >= SPLIT_BYTES and n >= 2 else None
+    if pool is not None:
+        job = pool.submit(part, n // 2, n)
+        ok = part(0, n // 2)
+        ok = job.result() and ok
+    else:
+        ok = part(0, n)
+    return buf.tobytes() if ok else None
 
 
 def _format_rows(lib, codes, values, n, names, nnames, w, decimals) -> np.ndarray | None:

@@ -46,10 +46,14 @@ def _unique_rows(*cols: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     if not cols[0].size:
         return np.zeros((0, len(cols))), np.zeros(0, np.int64)
     key = np.zeros(len(cols[0]), np.int64)
+    span = 1                                       # key < span
     for col in cols:
         u, inv = np.unique(col, return_inverse=True)
-        key = key * len(u) + inv.reshape(-1)
-        key = np.unique(key, return_inverse=True)[1].reshape(-1)   # re-compress: no overflow
+        if span * len(u) >= 2 ** 62:               # re-compress first: no overflow
+            key = np.unique(key, return_inverse=True)[1].reshape(-1)
+            span = int(key.max(initial=0)) + 1
+        key = key * len(u) + inv.reshape(-1)       # order-preserving: lexicographic by column
+        span *= len(u)
     _, first, inverse = np.unique(key, return_index=True, return_inverse=True)
     return np.column_stack([np.asarray(c)[first] for c in cols]), inverse.reshape(-1)
 

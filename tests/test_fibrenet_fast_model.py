@@ -203,3 +203,65 @@ def test_data_file_rows_c_and_numpy_identical(monkeypatch):
         assert c_text == numpy_text, trial
         compared += c_text is not None
     assert compared == 150
+
+
+def test_restart_rows_c_and_python_identical():
+    """FibreNet restart rows (\\t%g) from the C helper equal Python's % formatting, including
+    zeros, -0, tiny and tie-like values; a non-finite value makes the C path decline."""
+    from fibrelmp.translate.fibrenet import writer
+
+    if fast.library() is None:
+        pytest.skip(f"no C helper: {fast.active_path()}")
+    rng = np.random.default_rng(2)
+    for trial in range(60):
+        n = 20000 if trial % 10 == 0 else int(rng.integers(1, 50))
+        cols = [rng.normal(0, 10.0 ** int(rng.integers(-8, 9)), (n, 3)) for _ in range(4)]
+        if trial % 3 == 0:
+            cols[0] = np.round(cols[0], 5)
+        if trial % 4 == 0:
+            cols[1][: n // 2] = 0.0
+            cols[2][:1] = -0.0
+            cols[3][:1] = 1e-300
+            cols[3][-1:] = 123456.5
+        codes = rng.integers(0, 3, n)
+        table = ["F1", "Fibre_B", "x"]
+        state = writer.RestartState(int(rng.integers(0, 10 ** 6)), 0.0005, np.array([63.1, 7.0, 1e3]),
+                                    codes, table, *cols)
+        names = np.array(table, dtype=object)[codes]
+        assert writer.restart_bytes(state) == writer.restart_text(
+            state.step, state.dt, state.lengths, names, *cols).encode(), trial
+    cols[3][0, 0] = np.nan
+    assert fast.format_g_rows(codes, table, np.hstack(cols)) is None
+
+
+def test_seventeen_digit_numbers_parse_exactly():
+    """The C parser's extended-precision path (17-19 significant digits, as %.17g dumps hold
+    them) gives float()'s double for every token, including 19-digit decimals next to the
+    halfway point between two doubles, where rounding twice would go wrong (the parser then
+    hands the token to strtod)."""
+    from decimal import Decimal, localcontext
+
+    if fast.library() is None:
+        pytest.skip(f"no C helper: {fast.active_path()}")
+    rng = np.random.default_rng(5)
+    tokens = []
+    for e in range(-28, 29, 3):
+        x = rng.uniform(1, 10, 2000) * 10.0 ** e * rng.choice([-1, 1], 2000)
+        tokens += ["%.17g" % v for v in x] + ["%.19g" % v for v in x]
+    with localcontext() as ctx:
+        ctx.prec = 60
+        for v in rng.uniform(1, 1e6, 8000):
+            a = float(v)
+            mid = (Decimal(a) + Decimal(float(np.nextafter(a, np.inf)))) / 2
+            tokens += [format(mid, ".19g"), format(mid * (1 + Decimal("1e-18")), ".19g")]
+    for a in rng.integers(2 ** 52, 2 ** 53, 4000):
+        s = int(rng.integers(1, 10))
+        m = (int(a) << s) | (1 << (s - 1))         # exactly halfway between two doubles
+        tokens += [str(m - 1), str(m), str(m + 1), f"{m}e-3"]
+    ref = np.array([float(t) for t in tokens])
+    for i in range(0, len(tokens), 20000):
+        chunk = tokens[i:i + 20000]
+        got = fast.parse_numbers((" ".join(chunk) + "\n").encode(), 1, len(chunk))
+        assert got is not None
+        bad = np.flatnonzero(got.ravel().view(np.int64) != ref[i:i + 20000].view(np.int64))
+        assert not len(bad), [chunk[j] for j in bad[:5]]

@@ -4,7 +4,10 @@
  * fp_parse_block: a block of whitespace-separated decimal numbers, exactly nrows lines of
  *   ncols tokens, into a row-major float64 array.  Correctly rounded (bit-identical to
  *   strtod / float() / np.loadtxt): Clinger's fast path (mantissa < 2^53, |exp10| <= 22:
- *   one exact multiply or divide), otherwise strtod on the token.  Anything unusual (inf,
+ *   one exact multiply or divide), then (x86-64: 17-19 digit mantissas, as %.17g writes them)
+ *   one x87 extended-precision multiply or divide rounded to double, unless that double
+ *   rounding could differ (the extended result sits exactly on a halfway point), otherwise
+ *   strtod on the token.  Anything unusual (inf,
  *   nan, hex, text, wrong token count, blank line, odd whitespace) returns -1 so that the
  *   caller uses its numpy path, which produces the result or the precise error.
  *
@@ -15,6 +18,9 @@
  * fp_format_fixed_rows: rows of fixed-point columns (integer s / 10^k, exactly k decimals),
  *   each right-aligned in its column width, one space between columns: the bytes
  *   numtext.shortest.rows_text writes with numpy (data files).
+ *
+ * fp_format_g_rows: rows "\tname" + ncols x "\t%g" + "\n" (FibreNet restart files) with the C
+ *   library's printf, which rounds %g exactly as Python's % does; non-finite values decline.
  *
  * fp_format_xyz: rows "name\t%.5f\t%.5f\t%.5f\n" byte-identical to printf: |x| 10^5 is
  *   split into an exact sum p + e (Dekker's product), so rounding (ties to even) is decided
@@ -27,6 +33,7 @@
 #include <string.h>
 #include <math.h>
 #include <float.h>
+#include <stdio.h>
 
 #if !defined(FLT_EVAL_METHOD) || FLT_EVAL_METHOD != 0
 #define FP_EXCESS_PRECISION 1     /* x87: the fast paths would double-round; decline everything */
@@ -37,6 +44,20 @@
 static const double P10[23] = {
     1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
     1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+
+/* x87 extended precision (64-bit significand): mantissa < 2^64 and 10^k, k <= 27, are exact
+   there, so mant * 10^k or mant / 10^k is one correctly rounded operation; rounding that to
+   double equals rounding the exact value unless the extended result is exactly halfway
+   between two doubles (its low 11 significand bits are 10000000000b): then strtod decides. */
+#if defined(__x86_64__) && defined(LDBL_MANT_DIG) && LDBL_MANT_DIG == 64
+#define FP_EXTENDED 1
+static const long double P10L[28] = {
+    1e0L, 1e1L, 1e2L, 1e3L, 1e4L, 1e5L, 1e6L, 1e7L, 1e8L, 1e9L, 1e10L, 1e11L, 1e12L, 1e13L,
+    1e14L, 1e15L, 1e16L, 1e17L, 1e18L, 1e19L, 1e20L, 1e21L, 1e22L, 1e23L, 1e24L, 1e25L, 1e26L,
+    1e27L};
+#else
+#define FP_EXTENDED 0
+#endif
 
 #define MAXTOK 400
 
@@ -104,6 +125,19 @@ static inline int parse_token(const char **pp, const char *e, double *out)
     }
     if (p < e && !is_sep(*p)) return -1;
     *pp = p;
+#if FP_EXTENDED
+    if (ndig <= 19 && exp10 >= -27 && exp10 <= 27 &&
+        (mant >= (1ULL << 53) || exp10 < -22 || exp10 > 22)) {
+        long double l = (long double)mant;                  /* exact: mant < 10^19 < 2^64 */
+        l = exp10 < 0 ? l / P10L[-exp10] : l * P10L[exp10];
+        uint64_t sig;
+        memcpy(&sig, &l, sizeof sig);                       /* the 64-bit significand */
+        if ((sig & 0x7FF) == 0x400) return slow_token(s, p, out);
+        double v = (double)l;
+        *out = neg ? -v : v;
+        return 0;
+    }
+#endif
     if (ndig > 19 || mant >= (1ULL << 53) || exp10 < -22 || exp10 > 22)
         return slow_token(s, p, out);
     double v = (double)mant;           /* exact */
@@ -394,6 +428,37 @@ int64_t fp_format_fixed_rows(const int64_t *vals, int64_t nrows, int64_t ncols, 
             }
             *o++ = c + 1 < ncols ? ' ' : '\n';
         }
+    }
+    return (int64_t)(o - out);
+}
+
+/* ---------------------------------------------------------------- %g rows */
+
+/* Row i: '\t', names[codes[i]] (NUL-padded to w bytes), then "\t%g" for each of the ncols
+   values, '\n'.  Returns the bytes written, or -1 (a non-finite value, or out too small). */
+int64_t fp_format_g_rows(const int64_t *codes, const double *vals, int64_t n, int64_t ncols,
+                         const char *names, int64_t nnames, int64_t w, char *out, int64_t cap)
+{
+    char *o = out, *end = out + cap;
+    for (int64_t i = 0; i < n; i++) {
+        int64_t c = codes[i];
+        if (c < 0 || c >= nnames) return -1;
+        const char *name = names + c * w;
+        int64_t len = 0;
+        while (len < w && name[len]) len++;
+        if (end - o < len + 1 + ncols * 32 + 1) return -1;
+        *o++ = '\t';
+        memcpy(o, name, (size_t)len);
+        o += len;
+        for (int64_t k = 0; k < ncols; k++) {
+            double x = vals[i * ncols + k];
+            if (!isfinite(x)) return -1;
+            *o++ = '\t';
+            int m = snprintf(o, 31, "%g", x);
+            if (m < 0 || m >= 31) return -1;
+            o += m;
+        }
+        *o++ = '\n';
     }
     return (int64_t)(o - out);
 }

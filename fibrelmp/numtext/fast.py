@@ -133,6 +133,8 @@ def _open(lib: Path) -> ctypes.CDLL:
         dll.fp_parse_tagged.restype = ctypes.c_int
         dll.fp_format_fixed_rows.argtypes = [ptr, i64, i64, ptr, ptr, ptr, i64]
         dll.fp_format_fixed_rows.restype = i64
+        dll.fp_format_g_rows.argtypes = [ptr, ptr, i64, i64, ctypes.c_char_p, i64, i64, ptr, i64]
+        dll.fp_format_g_rows.restype = i64
         dll.fp_count_lines.argtypes = [ptr, i64]
         dll.fp_count_lines.restype = i64
         dll.fp_nth_newline.argtypes = [ptr, i64, i64, ctypes.POINTER(i64)]
@@ -140,10 +142,11 @@ def _open(lib: Path) -> ctypes.CDLL:
     except (OSError, AttributeError) as exc:
         raise _Unavailable(f"cannot load: {exc}") from exc
     # self-check against Python's correctly rounded conversions before trusting it
-    probe = b"0.1 -2.5e-3 1.7976931348623157e308 123456789012345678901 4.9e-324 -0\n"
-    out = np.empty(6)
+    probe = (b"0.1 -2.5e-3 1.7976931348623157e308 123456789012345678901 4.9e-324 -0 "
+             b"43.549386012345678 9007199254740993 0.30000000000000004 -1.2345678901234567e-25\n")
+    out = np.empty(10)
     praw = np.frombuffer(probe, np.uint8)
-    if dll.fp_parse_block(praw.ctypes.data, len(probe), out.ctypes.data, 1, 6) != 0 or \
+    if dll.fp_parse_block(praw.ctypes.data, len(probe), out.ctypes.data, 1, 10) != 0 or \
             out.tobytes() != np.array([float(t) for t in probe.split()]).tobytes():
         raise _Unavailable(f"{lib} failed its self-check")
     return dll
@@ -318,6 +321,39 @@ def format_fixed_rows(values: np.ndarray, decimals: np.ndarray, widths: np.ndarr
     else:
         ok = part(0, n)
     return buf.tobytes() if ok else None
+
+
+def format_g_rows(codes: np.ndarray, table: list[str], values: np.ndarray) -> bytes | None:
+    """Rows ``\t table[codes[i]]`` + ``\t%g`` per value + ``\n`` (printf-identical to
+    Python's % formatting), or None without the C library or for non-finite values."""
+    lib = library()
+    n = len(codes)
+    if lib is None or n == 0 or values.ndim != 2 or len(values) != n:
+        return None
+    enc = [t.encode() for t in table]
+    if not enc or any(not e or b"\0" in e for e in enc):
+        return None
+    w = max(len(e) for e in enc)
+    names = b"".join(e.ljust(w, b"\0") for e in enc)
+    codes = np.ascontiguousarray(codes, np.int64)
+    values = np.ascontiguousarray(values, np.float64)
+    ncols = values.shape[1]
+    row_cap = 1 + w + ncols * 32 + 1
+
+    def part(a: int, b: int) -> np.ndarray | None:
+        buf = np.empty((b - a) * row_cap, np.uint8)
+        got = lib.fp_format_g_rows(codes[a:].ctypes.data, values[a:].ctypes.data, b - a, ncols,
+                                   names, len(enc), w, buf.ctypes.data, len(buf))
+        return None if got < 0 else buf[:got]
+    pool = _helper() if n >= 4096 else None
+    if pool is not None:
+        job = pool.submit(part, n // 2, n)
+        parts = [part(0, n // 2), job.result()]
+    else:
+        parts = [part(0, n)]
+    if any(p is None for p in parts):
+        return None
+    return b"".join(p.tobytes() for p in parts)
 
 
 def _format_rows(lib, codes, values, n, names, nnames, w, decimals) -> np.ndarray | None:

@@ -51,6 +51,9 @@ BENCHES = [
     Bench("post", "MDAnalysis reading a 256k-atom x 10-frame dump / fibrelmp post --to xyz of it",
           r"MDAnalysis-read / fibrelmp-convert ratio: ([0-9.]+)x", ">= 10",
           ["--atoms", "50000", "--frames", "4", "--repeat", "1"]),
+    Bench("fibrenet_angle", "angle_style fibrenet / harmonic: angle cost per step (5k and 50k beads, bent and straight)",
+          r"fibrenet/harmonic angle cost ratio \(worst case\): ([0-9.]+)", "<= 1.0",
+          ["--beads", "5000", "--repeat", "1", "--steps", "300"]),
     Bench("mpi_speedup", "serial fibrelmp run / mpiexec -n 2 fibrelmp run (260k beads, 1000 steps)",
           r"\d+-rank speed-up: ([0-9.]+)", ">= 1.7", ["--beads", "20000", "--steps", "200"]),
 ]

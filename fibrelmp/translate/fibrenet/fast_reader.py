@@ -21,6 +21,23 @@ _ODD = (b"\x0b", b"\x0c", b"\x1c", b"\x1d", b"\x1e", b"\x1f")
 _BLANK = frozenset(b" \t\r\n")
 
 
+def _line_start(raw: bytes, key: bytes) -> int:
+    """Offset of the first line that starts with ``key``, or -1.  Keywords' first letters are
+    rare in number columns, so a few single-byte searches (memchr) usually find it; after
+    16 misses (type names with that letter) the general search takes over."""
+    if raw.startswith(key):
+        return 0
+    i = raw.find(key[:1], 1)
+    for _ in range(16):
+        if i < 0:
+            return -1
+        if raw[i - 1] == 10 and raw.startswith(key, i):
+            return i
+        i = raw.find(key[:1], i + 1)
+    j = raw.find(b"\n" + key, max(i - 1, 0)) if i >= 0 else -1
+    return -1 if j < 0 else j + 1
+
+
 def model_blocks(raw: bytes) -> dict[str, memoryview] | None:
     """FibreGen layout (all BEAD lines, then SPRING lines, then ANGLE lines): {kind: its
     lines (ASCII, a view into ``raw``)}; None for any other layout or unusual bytes (use the
@@ -29,10 +46,7 @@ def model_blocks(raw: bytes) -> dict[str, memoryview] | None:
         return None
     if b"\r" in raw and raw.count(b"\r") != raw.count(b"\r\n"):
         return None
-    at = {}
-    for key in _NCOLS:
-        k = key.encode()
-        at[key] = 0 if raw.startswith(k) else (lambda i: -1 if i < 0 else i + 1)(raw.find(b"\n" + k))
+    at = {key: _line_start(raw, key.encode()) for key in _NCOLS}
     if at["BEAD"] != 0:
         return None
     order = [k for k in _NCOLS if at[k] >= 0]

@@ -337,6 +337,36 @@ def test_same_forces_as_the_lepton_route_where_both_are_exact(tmp_path, plugin_p
     assert results["fibrenet"][2] == pytest.approx(results["lepton"][2], rel=1e-11)
 
 
+def test_lepton_route_loses_precision_near_straight_where_the_style_does_not(tmp_path, plugin_path):
+    """Why the style: the lepton route derives theta from acos(cos theta), whose rounding
+    costs ~1e-16/phi^2 of the force (measured: 2e-8 at phi = 1e-4, 1.6e-4 at 1e-6, 2e-2 at
+    1e-7, 100 % at 1e-8 and below), what the warning of --stock-styles jobs states."""
+    rng = np.random.default_rng(9)
+    worst = {}
+    for phi in (1e-4, 1e-7):
+        cases = [(make_triple(rng, math.pi - phi), 20.0, t0) for t0 in (F32_PI, 3.0)]
+        res = {}
+        for style in ("fibrenet", "lepton"):
+            folder = tmp_path / f"{style}{phi:g}"
+            folder.mkdir()
+            tri = Triples(folder, cases, plugin_path, style)
+            try:
+                res[style] = tri.evaluate()
+            finally:
+                tri.close()
+        x = res["fibrenet"][0]
+        for style in res:
+            err = 0.0
+            for k, (_, c, t0) in enumerate(cases):
+                refs = reference(x[3 * k], x[3 * k + 1], x[3 * k + 2], c, t0)[1:]
+                for j, fr in enumerate(refs):
+                    err = max(err, np.linalg.norm(res[style][1][3 * k + j] - fr) / np.linalg.norm(fr))
+            worst[style, phi] = err
+    assert worst["fibrenet", 1e-4] <= REL and worst["fibrenet", 1e-7] <= REL
+    assert 1e-10 < worst["lepton", 1e-4] < 1e-6
+    assert worst["lepton", 1e-7] > 1e-3
+
+
 def test_bad_coefficients_are_clear_errors(tmp_path, plugin_path):
     rng = np.random.default_rng(1)
     tri = Triples(tmp_path, random_cases(rng, 1), plugin_path)

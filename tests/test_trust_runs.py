@@ -94,7 +94,8 @@ def test_sigkill_then_resume_and_no_temp_files_left(tmp_path):
     assert cli(["-q", "run", inp, "-o", tmp_path / "whole"], tmp_path).returncode == 0
     out = tmp_path / "cut"
     state = out / "fibre_network_work" / "checkpoint.json"
-    proc = subprocess.Popen(CLI + ["-q", "run", str(inp), "-o", str(out), "--checkpoint-every", "500"],
+    # checkpoints every 100 steps keep the fast run (~10 us per step) alive until step 2000
+    proc = subprocess.Popen(CLI + ["-q", "run", str(inp), "-o", str(out), "--checkpoint-every", "100"],
                             stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 120
     while proc.poll() is None and time.monotonic() < deadline:
@@ -380,7 +381,7 @@ def test_special_files_are_refused_at_once(tmp_path, special):
 def test_resume_after_editing_the_model_file_is_refused(tmp_path):
     inp = fibre_case(tmp_path, run="20000", output_freq="2000")
     state = tmp_path / "fibre_network_work" / "checkpoint.json"
-    proc = subprocess.Popen(CLI + ["-q", "run", str(inp), "--checkpoint-every", "300"],
+    proc = subprocess.Popen(CLI + ["-q", "run", str(inp), "--checkpoint-every", "100"],
                             stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 120
     while not state.exists() and proc.poll() is None and time.monotonic() < deadline:

@@ -265,3 +265,24 @@ def test_seventeen_digit_numbers_parse_exactly():
         assert got is not None
         bad = np.flatnonzero(got.ravel().view(np.int64) != ref[i:i + 20000].view(np.int64))
         assert not len(bad), [chunk[j] for j in bad[:5]]
+
+
+def test_g_format_is_printf_exact():
+    """fp_format_g_rows' own %g (6 significant digits, rounded on the exact binary value)
+    against Python's % over 40 decades, at and next to 6-digit rounding boundaries, exact
+    binary ties (decided to even), switch points between fixed and exponent notation, and
+    the printf fallback outside [1e-17, 1e28)."""
+    if fast.library() is None:
+        pytest.skip(f"no C helper: {fast.active_path()}")
+    rng = np.random.default_rng(3)
+    vals = [rng.uniform(1, 10, 2000) * 10.0 ** e * rng.choice([-1, 1], 2000) for e in range(-22, 32, 2)]
+    for j in range(-10, 10, 3):
+        ties = (rng.integers(100000, 1000000, 2000) + 0.5) * 10.0 ** j
+        vals += [ties, np.nextafter(ties, np.inf), np.nextafter(ties, -np.inf)]
+    vals += [(rng.integers(100000, 1000000, 2000) + 0.5) * 2.0 ** k for k in range(-12, 13, 4)]
+    special = [0.0, -0.0, 1e-4, 9.99995e-5, 9.999995e-5, 1e-5, 999999.5, 9.999995, 99999.95, 100000.5,
+               1e5, 1e6, 999999.0, 1234567.0, 1e-17, 1e-18, 1e27, 1e28, 1e300, 5e-324, 2.5, 0.5]
+    vals.append(np.array(special + [-v for v in special]))
+    x = np.concatenate(vals).reshape(-1, 1)
+    got = fast.format_g_rows(np.zeros(len(x), np.int64), ["F"], x)
+    assert got == "".join("\tF\t%g\n" % v for v in x[:, 0]).encode()

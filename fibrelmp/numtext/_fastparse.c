@@ -19,8 +19,10 @@
  *   each right-aligned in its column width, one space between columns: the bytes
  *   numtext.shortest.rows_text writes with numpy (data files).
  *
- * fp_format_g_rows: rows "\tname" + ncols x "\t%g" + "\n" (FibreNet restart files) with the C
- *   library's printf, which rounds %g exactly as Python's % does; non-finite values decline.
+ * fp_format_g_rows: rows "\tname" + ncols x "\t%g" + "\n" (FibreNet restart files),
+ *   byte-identical to printf / Python's %: the 6 significant digits are rounded on the exact
+ *   binary value (an exact product, or a quotient checked by exact products; ties to even),
+ *   printf itself only for |x| outside [1e-17, 1e28); non-finite values decline.
  *
  * fp_format_xyz: rows "name\t%.5f\t%.5f\t%.5f\n" byte-identical to printf: |x| 10^5 is
  *   split into an exact sum p + e (Dekker's product), so rounding (ties to even) is decided
@@ -434,12 +436,121 @@ int64_t fp_format_fixed_rows(const int64_t *vals, int64_t nrows, int64_t ncols, 
 
 /* ---------------------------------------------------------------- %g rows */
 
+/* u * d = p + (returned) exactly (Dekker's product; u, d > 0 and moderate) */
+static inline double prod_err(double u, double d, double p)
+{
+    double c = SPLIT * u, uh = c - (c - u), ul = u - uh;
+    double cd = SPLIT * d, dh = cd - (cd - d), dl = d - dh;
+    return ((uh * dh - p) + uh * dl + ul * dh) + ul * dl;
+}
+
+/* sign of a - u * d, exactly (a, u, d > 0) */
+static inline int cmp_prod(double a, double u, double d)
+{
+    double p = u * d;
+    if (a > 2.0 * p || a < 0.5 * p) return a > p ? 1 : -1;
+    double diff = a - p;                   /* exact (Sterbenz) */
+    double err = prod_err(u, d, p);
+    return diff > err ? 1 : (diff < err ? -1 : 0);
+}
+
+/* *m = a / d rounded to the nearest integer, ties to even, decided exactly (d = 10^j) */
+static inline int round_div(double a, double d, int64_t *m)
+{
+    double q = a / d;
+    if (!(q < LIMIT)) return -1;
+    int64_t c = (int64_t)(q + 0.5);
+    for (int iter = 0; iter < 4; iter++) {
+        int hi = cmp_prod(a, (double)c + 0.5, d);
+        if (hi > 0) { c++; continue; }
+        int lo = c > 0 ? cmp_prod(a, (double)c - 0.5, d) : 1;
+        if (lo < 0) { c--; continue; }
+        if ((hi == 0 || lo == 0) && (c & 1)) c += hi == 0 ? 1 : -1;
+        *m = c;
+        return 0;
+    }
+    return -1;
+}
+
+/* printf("%g", x) (6 significant digits, trailing zeros removed) into o; the length */
+static int format_g6(double x, char *o)
+{
+    char *start = o;
+    if (signbit(x)) {
+        *o++ = '-';
+        x = -x;
+    }
+    if (x == 0.0) {
+        *o++ = '0';
+        return (int)(o - start);
+    }
+    int64_t m = 0;
+    int e = 0, ok = x >= 1e-17 && x < 1e28;
+    if (ok) {
+        int b;
+        frexp(x, &b);
+        e = (int)floor((b - 1) * 0.30102999566398120);     /* floor(log10 x), maybe 1 low */
+        for (int tries = 0;; tries++) {
+            int k = 5 - e;
+            if (tries > 3 || k > 22 || k < -22 ||
+                (k >= 0 ? round_scaled(x, P10[k], &m) : round_div(x, P10[-k], &m))) {
+                ok = 0;
+                break;
+            }
+            if (m >= 1000000) e++;
+            else if (m < 100000) e--;
+            else break;
+        }
+    }
+    if (!ok) {                                   /* tiny or huge: the C library */
+        int n = snprintf(o, 32, "%g", x);
+        return n < 0 ? -1 : (int)(o - start) + n;
+    }
+    char d[6];
+    for (int j = 5; j >= 0; j--) {
+        d[j] = (char)('0' + m % 10);
+        m /= 10;
+    }
+    int last = 5;                                /* last significant digit kept */
+    if (e >= -4 && e < 6) {                      /* fixed notation, 5 - e decimals */
+        if (e >= 0) {
+            for (int j = 0; j <= e; j++) *o++ = d[j];
+            while (last > e && d[last] == '0') last--;
+            if (last > e) {
+                *o++ = '.';
+                for (int j = e + 1; j <= last; j++) *o++ = d[j];
+            }
+        } else {
+            *o++ = '0';
+            *o++ = '.';
+            for (int j = 0; j < -e - 1; j++) *o++ = '0';
+            while (last > 0 && d[last] == '0') last--;
+            for (int j = 0; j <= last; j++) *o++ = d[j];
+        }
+    } else {                                     /* exponent notation */
+        *o++ = d[0];
+        while (last > 0 && d[last] == '0') last--;
+        if (last > 0) {
+            *o++ = '.';
+            for (int j = 1; j <= last; j++) *o++ = d[j];
+        }
+        *o++ = 'e';
+        *o++ = e < 0 ? '-' : '+';
+        int ae = e < 0 ? -e : e;
+        if (ae >= 100) *o++ = (char)('0' + ae / 100);
+        *o++ = (char)('0' + ae / 10 % 10);
+        *o++ = (char)('0' + ae % 10);
+    }
+    return (int)(o - start);
+}
+
 /* Row i: '\t', names[codes[i]] (NUL-padded to w bytes), then "\t%g" for each of the ncols
    values, '\n'.  Returns the bytes written, or -1 (a non-finite value, or out too small). */
 int64_t fp_format_g_rows(const int64_t *codes, const double *vals, int64_t n, int64_t ncols,
                          const char *names, int64_t nnames, int64_t w, char *out, int64_t cap)
 {
     char *o = out, *end = out + cap;
+    if (FP_EXCESS_PRECISION) return -1;
     for (int64_t i = 0; i < n; i++) {
         int64_t c = codes[i];
         if (c < 0 || c >= nnames) return -1;
@@ -454,7 +565,7 @@ int64_t fp_format_g_rows(const int64_t *codes, const double *vals, int64_t n, in
             double x = vals[i * ncols + k];
             if (!isfinite(x)) return -1;
             *o++ = '\t';
-            int m = snprintf(o, 31, "%g", x);
+            int m = format_g6(x, o);
             if (m < 0 || m >= 31) return -1;
             o += m;
         }

@@ -22,6 +22,7 @@ counts, huge values -- so errors and edge cases are always handled by the numpy 
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import hashlib
 import os
@@ -205,9 +206,29 @@ def _cores() -> int:
         return os.cpu_count() or 1
 
 
+_cores_taken = 0         # cores this process keeps busy otherwise (LAMMPS during a run)
+
+
+@contextlib.contextmanager
+def cores_taken(n: int = 1):
+    """While this is open, ``n`` cores are busy with other work of this process (a LAMMPS run
+    that frames are converted beside): large calls split across threads only if a core is
+    still free, so the conversion does not take cores from LAMMPS."""
+    global _cores_taken
+    with _lock:
+        _cores_taken += n
+    try:
+        yield
+    finally:
+        with _lock:
+            _cores_taken -= n
+
+
 def _helper():
-    """A one-thread pool for the second half of large calls, or None on one core."""
+    """A one-thread pool for the second half of large calls, or None on one (free) core."""
     global _pool, _pool_pid
+    if _cores() - _cores_taken < 2:
+        return None
     if _pool is None or _pool_pid != os.getpid():       # a forked child has no worker thread
         with _lock:
             if _pool is None or _pool_pid != os.getpid():

@@ -286,3 +286,22 @@ def test_g_format_is_printf_exact():
     x = np.concatenate(vals).reshape(-1, 1)
     got = fast.format_g_rows(np.zeros(len(x), np.int64), ["F"], x)
     assert got == "".join("\tF\t%g\n" % v for v in x[:, 0]).encode()
+
+
+def test_block_search_finds_the_first_line_with_the_keyword():
+    """_line_start (single-byte searches, then the general one) against a plain search."""
+    import random
+
+    def plain(raw: bytes, key: bytes, start: int) -> int:
+        if raw.startswith(key, start) and (start == 0 or raw[start - 1] == 10):
+            return start
+        i = raw.find(b"\n" + key, max(start - 1, 0))
+        return -1 if i < 0 else i + 1
+
+    rnd = random.Random(1)
+    pieces = [b"S", b"SPRING", b"\n", b"x", b"A", b"ANGLE", b" ", b"SP", b"P", b"BEAD"]
+    for _ in range(20000):
+        raw = b"".join(rnd.choice(pieces) for _ in range(rnd.randint(0, 60)))
+        for key, probe in ((b"SPRING", b"P"), (b"ANGLE", b"A"), (b"SPRING", b"S")):
+            start = rnd.randint(0, len(raw))
+            assert fast_reader._line_start(raw, key, probe, start) == plain(raw, key, start), (raw, key, start)

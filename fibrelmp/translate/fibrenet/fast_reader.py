@@ -21,20 +21,23 @@ _ODD = (b"\x0b", b"\x0c", b"\x1c", b"\x1d", b"\x1e", b"\x1f")
 _BLANK = frozenset(b" \t\r\n")
 
 
-def _line_start(raw: bytes, key: bytes) -> int:
-    """Offset of the first line that starts with ``key``, or -1.  Keywords' first letters are
-    rare in number columns, so a few single-byte searches (memchr) usually find it; after
-    16 misses (type names with that letter) the general search takes over."""
-    if raw.startswith(key):
-        return 0
-    i = raw.find(key[:1], 1)
+def _line_start(raw: bytes, key: bytes, probe: bytes, start: int = 0) -> int:
+    """Offset of the first line at or after ``start`` that begins with ``key``, or -1.
+    ``probe`` is a letter of ``key`` that lines before it rarely hold (no 'P' or 'A' in
+    BEAD lines), so a few single-byte searches (memchr) usually find it; after 16 misses
+    (e.g. type names with that letter) the general search takes over."""
+    if raw.startswith(key, start) and (start == 0 or raw[start - 1] == 10):
+        return start
+    at = key.index(probe)
+    i = raw.find(probe, start + at + 1)
     for _ in range(16):
         if i < 0:
             return -1
-        if raw[i - 1] == 10 and raw.startswith(key, i):
-            return i
-        i = raw.find(key[:1], i + 1)
-    j = raw.find(b"\n" + key, max(i - 1, 0)) if i >= 0 else -1
+        j = i - at                              # where the key would start
+        if raw[j - 1] == 10 and raw.startswith(key, j):
+            return j
+        i = raw.find(probe, i + 1)
+    j = raw.find(b"\n" + key, max(i - at - 1, start)) if i >= 0 else -1
     return -1 if j < 0 else j + 1
 
 
@@ -46,7 +49,11 @@ def model_blocks(raw: bytes) -> dict[str, memoryview] | None:
         return None
     if b"\r" in raw and raw.count(b"\r") != raw.count(b"\r\n"):
         return None
-    at = {key: _line_start(raw, key.encode()) for key in _NCOLS}
+    at = {"BEAD": 0 if raw.startswith(b"BEAD") else -1,
+          "SPRING": _line_start(raw, b"SPRING", b"P")}
+    # ANGLE lines come after the springs (a file with them elsewhere makes a block's parse
+    # fail, and the line reader takes over)
+    at["ANGLE"] = _line_start(raw, b"ANGLE", b"A", max(at["SPRING"], 0))
     if at["BEAD"] != 0:
         return None
     order = [k for k in _NCOLS if at[k] >= 0]

@@ -24,6 +24,7 @@ runner, and refuses lines LAMMPS would join with the next one.
 
 from __future__ import annotations
 
+import functools
 import numbers
 import re
 import string
@@ -136,9 +137,11 @@ def _finalize(value: object) -> object:
     return check_fragment(str(value))
 
 
+@functools.lru_cache(maxsize=1)
 def template_environment():
     """The jinja2 environment for fibrelmp/templates: ``comment`` and ``word`` filters, and
-    a finalize that refuses every printed value :func:`check_fragment` refuses."""
+    a finalize that refuses every printed value :func:`check_fragment` refuses.  One per
+    process, so each template is compiled once (jinja reloads a template whose file changed)."""
     from jinja2 import Environment, PackageLoader, StrictUndefined
 
     env = Environment(loader=PackageLoader("fibrelmp", "templates"), undefined=StrictUndefined,

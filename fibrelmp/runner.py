@@ -325,11 +325,14 @@ def run_overlapped(script: Path, total_steps: int, frame_token: Callable[[list[s
                 raise result["error"]
             ready.put(token)
 
+    from fibrelmp.numtext.fast import cores_taken
+
     worker = threading.Thread(target=work, daemon=True)
     worker.start()
     try:
-        run_script(script, total_steps, progress=progress, on_command=hook, checkpoints=checkpoints,
-                   finished=finished)
+        with cores_taken(1):        # LAMMPS's core: the converter then uses one thread only
+            run_script(script, total_steps, progress=progress, on_command=hook, checkpoints=checkpoints,
+                       finished=finished)
     except BaseException:
         ready.put(abort)
         worker.join()

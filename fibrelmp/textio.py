@@ -119,6 +119,25 @@ def check_text_file(path: str | os.PathLike, what: str = "file") -> None:
         raise InputError(p, None, read_failure(exc, what)) from None
 
 
+def read_checked_bytes(path: str | os.PathLike, what: str = "file") -> bytes:
+    """The bytes of a file after the checks of ``check_text_file`` (its overlay text while
+    checking).  A pure-ASCII file (the usual case) is checked in memory, read once; any
+    other goes through ``check_text_file``, which locates the problem."""
+    p = Path(path)
+    if _OVERLAY and _OVERLAY.get(_overlay_key(p)) is not None:
+        return read_bytes(p)
+    try:
+        refuse_special_file(p, what)
+        raw = p.read_bytes()
+    except OSError as exc:
+        raise InputError(p, None, read_failure(exc, what)) from None
+    if not raw.isascii():                   # UTF-8, UTF-16 or binary: the detailed checks
+        check_text_file(p, what)
+    elif b"\x00" in raw[:4096]:
+        raise InputError(p, None, f"{what} looks binary (contains NUL bytes), expected text")
+    return raw
+
+
 def read_bytes(path: str | os.PathLike) -> bytes:
     """The bytes of a file ``read_text`` has accepted (its overlay text while checking)."""
     if _OVERLAY:

@@ -94,7 +94,8 @@ def test_sigkill_then_resume_and_no_temp_files_left(tmp_path):
     assert cli(["-q", "run", inp, "-o", tmp_path / "whole"], tmp_path).returncode == 0
     out = tmp_path / "cut"
     state = out / "fibre_network_work" / "checkpoint.json"
-    proc = subprocess.Popen(CLI + ["-q", "run", str(inp), "-o", str(out), "--checkpoint-every", "500"],
+    # checkpoints every 100 steps keep the fast run (~10 us per step) alive until step 2000
+    proc = subprocess.Popen(CLI + ["-q", "run", str(inp), "-o", str(out), "--checkpoint-every", "100"],
                             stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 120
     while proc.poll() is None and time.monotonic() < deadline:
@@ -142,8 +143,8 @@ def test_checkpoint_every_two_ranks(tmp_path, kind):
 
 def _case(kind: str, folder: Path) -> tuple[Path, list[str], str]:
     """A run long enough to interrupt: (input, extra CLI args, checkpoint every)."""
-    if kind == "fibrenet":
-        return fibre_case(folder, run="4000", output_freq="500"), [], "300"
+    if kind == "fibrenet":      # 80 checkpoints keep the short run (~10 us per step) busy long enough
+        return fibre_case(folder, run="4000", output_freq="500"), [], "50"
     if kind == "musen":
         return musen_case(folder, end_time="0.1"), [], "100000"
     folder.mkdir(parents=True)
@@ -182,7 +183,8 @@ def test_sigterm_then_resume_gives_the_uninterrupted_results(tmp_path, kind, ran
 
 # -- 3. two runs, one folder -----------------------------------------------------------------
 def test_second_run_into_a_busy_folder_exits_2(tmp_path):
-    inp = fibre_case(tmp_path / "in", run="12000", output_freq="2000")
+    # long enough (~6 s with angle_style fibrenet, ~10 us per step) to be busy while the second starts
+    inp = fibre_case(tmp_path / "in", run="600000", output_freq="100000")
     out = tmp_path / "out"
     first = subprocess.Popen(CLI + ["-q", "run", str(inp), "-o", str(out)], stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 60
@@ -195,7 +197,7 @@ def test_second_run_into_a_busy_folder_exits_2(tmp_path):
     assert "another fibrelmp run is using this folder" in second.stderr
     assert "Traceback" not in second.stderr
     frames = read_xyz(out / "fibre_network_coord.xyz")
-    assert [f.step for f in frames] == list(range(0, 12001, 2000))
+    assert [f.step for f in frames] == list(range(0, 600001, 100000))
 
 
 # -- 4. overwriting --------------------------------------------------------------------------
@@ -379,7 +381,7 @@ def test_special_files_are_refused_at_once(tmp_path, special):
 def test_resume_after_editing_the_model_file_is_refused(tmp_path):
     inp = fibre_case(tmp_path, run="20000", output_freq="2000")
     state = tmp_path / "fibre_network_work" / "checkpoint.json"
-    proc = subprocess.Popen(CLI + ["-q", "run", str(inp), "--checkpoint-every", "300"],
+    proc = subprocess.Popen(CLI + ["-q", "run", str(inp), "--checkpoint-every", "100"],
                             stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 120
     while not state.exists() and proc.poll() is None and time.monotonic() < deadline:

@@ -4,9 +4,25 @@
  * fp_parse_block: a block of whitespace-separated decimal numbers, exactly nrows lines of
  *   ncols tokens, into a row-major float64 array.  Correctly rounded (bit-identical to
  *   strtod / float() / np.loadtxt): Clinger's fast path (mantissa < 2^53, |exp10| <= 22:
- *   one exact multiply or divide), otherwise strtod on the token.  Anything unusual (inf,
+ *   one exact multiply or divide), then (x86-64: 17-19 digit mantissas, as %.17g writes them)
+ *   one x87 extended-precision multiply or divide rounded to double, unless that double
+ *   rounding could differ (the extended result sits exactly on a halfway point), otherwise
+ *   strtod on the token.  Anything unusual (inf,
  *   nan, hex, text, wrong token count, blank line, odd whitespace) returns -1 so that the
  *   caller uses its numpy path, which produces the result or the precise error.
+ *
+ * fp_parse_tagged: the same for a FibreNet model block (BEAD / SPRING / ANGLE lines): each line
+ *   starts with a keyword and a name (type name, spring or angle kind) before the numbers;
+ *   the name is stored as its index in a table.  Declines (-1) just as fp_parse_block does.
+ *
+ * fp_format_fixed_rows: rows of fixed-point columns (integer s / 10^k, exactly k decimals),
+ *   each right-aligned in its column width, one space between columns: the bytes
+ *   numtext.shortest.rows_text writes with numpy (data files).
+ *
+ * fp_format_g_rows: rows "\tname" + ncols x "\t%g" + "\n" (FibreNet restart files),
+ *   byte-identical to printf / Python's %: the 6 significant digits are rounded on the exact
+ *   binary value (an exact product, or a quotient checked by exact products; ties to even),
+ *   printf itself only for |x| outside [1e-17, 1e28); non-finite values decline.
  *
  * fp_format_xyz: rows "name\t%.5f\t%.5f\t%.5f\n" byte-identical to printf: |x| 10^5 is
  *   split into an exact sum p + e (Dekker's product), so rounding (ties to even) is decided
@@ -19,6 +35,7 @@
 #include <string.h>
 #include <math.h>
 #include <float.h>
+#include <stdio.h>
 
 #if !defined(FLT_EVAL_METHOD) || FLT_EVAL_METHOD != 0
 #define FP_EXCESS_PRECISION 1     /* x87: the fast paths would double-round; decline everything */
@@ -29,6 +46,20 @@
 static const double P10[23] = {
     1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
     1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+
+/* x87 extended precision (64-bit significand): mantissa < 2^64 and 10^k, k <= 27, are exact
+   there, so mant * 10^k or mant / 10^k is one correctly rounded operation; rounding that to
+   double equals rounding the exact value unless the extended result is exactly halfway
+   between two doubles (its low 11 significand bits are 10000000000b): then strtod decides. */
+#if defined(__x86_64__) && defined(LDBL_MANT_DIG) && LDBL_MANT_DIG == 64
+#define FP_EXTENDED 1
+static const long double P10L[28] = {
+    1e0L, 1e1L, 1e2L, 1e3L, 1e4L, 1e5L, 1e6L, 1e7L, 1e8L, 1e9L, 1e10L, 1e11L, 1e12L, 1e13L,
+    1e14L, 1e15L, 1e16L, 1e17L, 1e18L, 1e19L, 1e20L, 1e21L, 1e22L, 1e23L, 1e24L, 1e25L, 1e26L,
+    1e27L};
+#else
+#define FP_EXTENDED 0
+#endif
 
 #define MAXTOK 400
 
@@ -96,6 +127,19 @@ static inline int parse_token(const char **pp, const char *e, double *out)
     }
     if (p < e && !is_sep(*p)) return -1;
     *pp = p;
+#if FP_EXTENDED
+    if (ndig <= 19 && exp10 >= -27 && exp10 <= 27 &&
+        (mant >= (1ULL << 53) || exp10 < -22 || exp10 > 22)) {
+        long double l = (long double)mant;                  /* exact: mant < 10^19 < 2^64 */
+        l = exp10 < 0 ? l / P10L[-exp10] : l * P10L[exp10];
+        uint64_t sig;
+        memcpy(&sig, &l, sizeof sig);                       /* the 64-bit significand */
+        if ((sig & 0x7FF) == 0x400) return slow_token(s, p, out);
+        double v = (double)l;
+        *out = neg ? -v : v;
+        return 0;
+    }
+#endif
     if (ndig > 19 || mant >= (1ULL << 53) || exp10 < -22 || exp10 > 22)
         return slow_token(s, p, out);
     double v = (double)mant;           /* exact */
@@ -130,6 +174,66 @@ int fp_parse_block(const char *buf, int64_t len, double *out, int64_t nrows, int
         }
         if (p < end) p++;   /* '\n' */
         row++;
+    }
+    return p == end ? 0 : -1;
+}
+
+/* the token at *pp (up to a separator or the end): its start and length; advances *pp */
+static inline int64_t word_token(const char **pp, const char *e, const char **start)
+{
+    const char *p = *pp;
+    *start = p;
+    while (p < e && !is_sep(*p)) p++;
+    *pp = p;
+    return (int64_t)(p - *start);
+}
+
+/* nrows lines "KEY NAME number ... number" (ncols tokens in all) into out: column 0 = 0,
+   column 1 = index of NAME in names (nnames entries, each NUL-padded to w bytes), then the
+   numbers as fp_parse_block reads them.  Leading spaces/tabs, a '\r' before '\n' and a
+   missing last '\n' are accepted; anything else (blank lines, another keyword, an unknown
+   name, a bad number, a wrong token count) returns -1. */
+int fp_parse_tagged(const char *buf, int64_t len, const char *key, int64_t klen, const char *names,
+                    int64_t nnames, int64_t w, double *out, int64_t nrows, int64_t ncols)
+{
+    const char *p = buf, *end = buf + len;
+    double *o = out;
+    if (FP_EXCESS_PRECISION || ncols < 2) return -1;
+    for (int64_t row = 0; row < nrows; row++) {
+        if (p >= end) return -1;
+        while (p < end && (*p == ' ' || *p == '\t')) p++;
+        const char *t;
+        int64_t n = word_token(&p, end, &t);
+        if (n != klen || memcmp(t, key, (size_t)klen) != 0) return -1;
+        while (p < end && (*p == ' ' || *p == '\t')) p++;
+        n = word_token(&p, end, &t);
+        if (n == 0 || n > w) return -1;
+        int64_t which = -1;
+        for (int64_t k = 0; k < nnames; k++) {
+            const char *name = names + k * w;
+            if (memcmp(t, name, (size_t)n) == 0 && (n == w || name[n] == 0)) {
+                which = k;
+                break;
+            }
+        }
+        if (which < 0) return -1;
+        o[0] = 0.0;
+        o[1] = (double)which;
+        int64_t col = 2;
+        for (;;) {
+            while (p < end && (*p == ' ' || *p == '\t')) p++;
+            if (p >= end || *p == '\n' || *p == '\r') break;
+            if (col >= ncols) return -1;
+            if (parse_token(&p, end, o + col)) return -1;
+            col++;
+        }
+        if (col != ncols) return -1;
+        if (p < end && *p == '\r') {
+            p++;
+            if (!(p < end && *p == '\n')) return -1;
+        }
+        if (p < end) p++;   /* '\n' */
+        o += ncols;
     }
     return p == end ? 0 : -1;
 }
@@ -278,4 +382,194 @@ int64_t fp_nth_newline(const char *buf, int64_t len, int64_t need, int64_t *foun
     }
     *found = c;
     return -1;
+}
+
+/* ---------------------------------------------------------------- fixed-point rows */
+
+/* Row r: for each column c, the integer s = vals[r * ncols + c] printed as |s| / 10^k[c] with
+   exactly k[c] decimals (at least k[c] + 1 digits), '-' before the first digit if s < 0,
+   right-aligned in width[c]; columns separated by one space, rows ended by '\n'.  width[c]
+   must hold the widest field of the column (the caller computes it).  Returns the bytes
+   written, or -1 if a field is wider than its column or out would overflow. */
+int64_t fp_format_fixed_rows(const int64_t *vals, int64_t nrows, int64_t ncols, const int64_t *k,
+                             const int64_t *width, char *out, int64_t cap)
+{
+    int64_t rowlen = 0;
+    for (int64_t c = 0; c < ncols; c++) {
+        if (k[c] < 0 || k[c] > 18 || width[c] < 1 || width[c] > 40) return -1;
+        rowlen += width[c] + 1;
+    }
+    if (rowlen * nrows > cap) return -1;
+    char *o = out;
+    char digits[24];
+    for (int64_t r = 0; r < nrows; r++) {
+        for (int64_t c = 0; c < ncols; c++) {
+            int64_t s = vals[r * ncols + c];
+            uint64_t mag = s < 0 ? (uint64_t)0 - (uint64_t)s : (uint64_t)s;
+            int nd = 0;                              /* digits of mag (reversed), >= k + 1 */
+            while (mag >= 100) {
+                unsigned two = (unsigned)(mag % 100);
+                mag /= 100;
+                digits[nd++] = DIG2[2 * two + 1];
+                digits[nd++] = DIG2[2 * two];
+            }
+            if (mag >= 10) {
+                digits[nd++] = DIG2[2 * mag + 1];
+                digits[nd++] = DIG2[2 * mag];
+            } else {
+                digits[nd++] = (char)('0' + mag);
+            }
+            while (nd < k[c] + 1) digits[nd++] = '0';
+            int64_t len = nd + (s < 0) + (k[c] > 0);
+            if (len > width[c]) return -1;
+            for (int64_t pad = width[c] - len; pad > 0; pad--) *o++ = ' ';
+            if (s < 0) *o++ = '-';
+            for (int j = nd - 1; j >= 0; j--) {
+                *o++ = digits[j];
+                if (j == k[c] && k[c] > 0) *o++ = '.';
+            }
+            *o++ = c + 1 < ncols ? ' ' : '\n';
+        }
+    }
+    return (int64_t)(o - out);
+}
+
+/* ---------------------------------------------------------------- %g rows */
+
+/* u * d = p + (returned) exactly (Dekker's product; u, d > 0 and moderate) */
+static inline double prod_err(double u, double d, double p)
+{
+    double c = SPLIT * u, uh = c - (c - u), ul = u - uh;
+    double cd = SPLIT * d, dh = cd - (cd - d), dl = d - dh;
+    return ((uh * dh - p) + uh * dl + ul * dh) + ul * dl;
+}
+
+/* sign of a - u * d, exactly (a, u, d > 0) */
+static inline int cmp_prod(double a, double u, double d)
+{
+    double p = u * d;
+    if (a > 2.0 * p || a < 0.5 * p) return a > p ? 1 : -1;
+    double diff = a - p;                   /* exact (Sterbenz) */
+    double err = prod_err(u, d, p);
+    return diff > err ? 1 : (diff < err ? -1 : 0);
+}
+
+/* *m = a / d rounded to the nearest integer, ties to even, decided exactly (d = 10^j) */
+static inline int round_div(double a, double d, int64_t *m)
+{
+    double q = a / d;
+    if (!(q < LIMIT)) return -1;
+    int64_t c = (int64_t)(q + 0.5);
+    for (int iter = 0; iter < 4; iter++) {
+        int hi = cmp_prod(a, (double)c + 0.5, d);
+        if (hi > 0) { c++; continue; }
+        int lo = c > 0 ? cmp_prod(a, (double)c - 0.5, d) : 1;
+        if (lo < 0) { c--; continue; }
+        if ((hi == 0 || lo == 0) && (c & 1)) c += hi == 0 ? 1 : -1;
+        *m = c;
+        return 0;
+    }
+    return -1;
+}
+
+/* printf("%g", x) (6 significant digits, trailing zeros removed) into o; the length */
+static int format_g6(double x, char *o)
+{
+    char *start = o;
+    if (signbit(x)) {
+        *o++ = '-';
+        x = -x;
+    }
+    if (x == 0.0) {
+        *o++ = '0';
+        return (int)(o - start);
+    }
+    int64_t m = 0;
+    int e = 0, ok = x >= 1e-17 && x < 1e28;
+    if (ok) {
+        int b;
+        frexp(x, &b);
+        e = (int)floor((b - 1) * 0.30102999566398120);     /* floor(log10 x), maybe 1 low */
+        for (int tries = 0;; tries++) {
+            int k = 5 - e;
+            if (tries > 3 || k > 22 || k < -22 ||
+                (k >= 0 ? round_scaled(x, P10[k], &m) : round_div(x, P10[-k], &m))) {
+                ok = 0;
+                break;
+            }
+            if (m >= 1000000) e++;
+            else if (m < 100000) e--;
+            else break;
+        }
+    }
+    if (!ok) {                                   /* tiny or huge: the C library */
+        int n = snprintf(o, 32, "%g", x);
+        return n < 0 ? -1 : (int)(o - start) + n;
+    }
+    char d[6];
+    for (int j = 5; j >= 0; j--) {
+        d[j] = (char)('0' + m % 10);
+        m /= 10;
+    }
+    int last = 5;                                /* last significant digit kept */
+    if (e >= -4 && e < 6) {                      /* fixed notation, 5 - e decimals */
+        if (e >= 0) {
+            for (int j = 0; j <= e; j++) *o++ = d[j];
+            while (last > e && d[last] == '0') last--;
+            if (last > e) {
+                *o++ = '.';
+                for (int j = e + 1; j <= last; j++) *o++ = d[j];
+            }
+        } else {
+            *o++ = '0';
+            *o++ = '.';
+            for (int j = 0; j < -e - 1; j++) *o++ = '0';
+            while (last > 0 && d[last] == '0') last--;
+            for (int j = 0; j <= last; j++) *o++ = d[j];
+        }
+    } else {                                     /* exponent notation */
+        *o++ = d[0];
+        while (last > 0 && d[last] == '0') last--;
+        if (last > 0) {
+            *o++ = '.';
+            for (int j = 1; j <= last; j++) *o++ = d[j];
+        }
+        *o++ = 'e';
+        *o++ = e < 0 ? '-' : '+';
+        int ae = e < 0 ? -e : e;
+        if (ae >= 100) *o++ = (char)('0' + ae / 100);
+        *o++ = (char)('0' + ae / 10 % 10);
+        *o++ = (char)('0' + ae % 10);
+    }
+    return (int)(o - start);
+}
+
+/* Row i: '\t', names[codes[i]] (NUL-padded to w bytes), then "\t%g" for each of the ncols
+   values, '\n'.  Returns the bytes written, or -1 (a non-finite value, or out too small). */
+int64_t fp_format_g_rows(const int64_t *codes, const double *vals, int64_t n, int64_t ncols,
+                         const char *names, int64_t nnames, int64_t w, char *out, int64_t cap)
+{
+    char *o = out, *end = out + cap;
+    if (FP_EXCESS_PRECISION) return -1;
+    for (int64_t i = 0; i < n; i++) {
+        int64_t c = codes[i];
+        if (c < 0 || c >= nnames) return -1;
+        const char *name = names + c * w;
+        int64_t len = 0;
+        while (len < w && name[len]) len++;
+        if (end - o < len + 1 + ncols * 32 + 1) return -1;
+        *o++ = '\t';
+        memcpy(o, name, (size_t)len);
+        o += len;
+        for (int64_t k = 0; k < ncols; k++) {
+            double x = vals[i * ncols + k];
+            if (!isfinite(x)) return -1;
+            *o++ = '\t';
+            int m = format_g6(x, o);
+            if (m < 0 || m >= 31) return -1;
+            o += m;
+        }
+        *o++ = '\n';
+    }
+    return (int64_t)(o - out);
 }

@@ -22,6 +22,7 @@ counts, huge values -- so errors and edge cases are always handled by the numpy 
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import hashlib
 import os
@@ -128,6 +129,13 @@ def _open(lib: Path) -> ctypes.CDLL:
         dll.fp_parse_block.restype = ctypes.c_int
         dll.fp_format_xyz.argtypes = [ptr, ptr, i64, ctypes.c_char_p, i64, i64, ctypes.c_int, ptr, i64]
         dll.fp_format_xyz.restype = i64
+        dll.fp_parse_tagged.argtypes = [ptr, i64, ctypes.c_char_p, i64, ctypes.c_char_p, i64, i64,
+                                         ptr, i64, i64]
+        dll.fp_parse_tagged.restype = ctypes.c_int
+        dll.fp_format_fixed_rows.argtypes = [ptr, i64, i64, ptr, ptr, ptr, i64]
+        dll.fp_format_fixed_rows.restype = i64
+        dll.fp_format_g_rows.argtypes = [ptr, ptr, i64, i64, ctypes.c_char_p, i64, i64, ptr, i64]
+        dll.fp_format_g_rows.restype = i64
         dll.fp_count_lines.argtypes = [ptr, i64]
         dll.fp_count_lines.restype = i64
         dll.fp_nth_newline.argtypes = [ptr, i64, i64, ctypes.POINTER(i64)]
@@ -135,10 +143,11 @@ def _open(lib: Path) -> ctypes.CDLL:
     except (OSError, AttributeError) as exc:
         raise _Unavailable(f"cannot load: {exc}") from exc
     # self-check against Python's correctly rounded conversions before trusting it
-    probe = b"0.1 -2.5e-3 1.7976931348623157e308 123456789012345678901 4.9e-324 -0\n"
-    out = np.empty(6)
+    probe = (b"0.1 -2.5e-3 1.7976931348623157e308 123456789012345678901 4.9e-324 -0 "
+             b"43.549386012345678 9007199254740993 0.30000000000000004 -1.2345678901234567e-25\n")
+    out = np.empty(10)
     praw = np.frombuffer(probe, np.uint8)
-    if dll.fp_parse_block(praw.ctypes.data, len(probe), out.ctypes.data, 1, 6) != 0 or \
+    if dll.fp_parse_block(praw.ctypes.data, len(probe), out.ctypes.data, 1, 10) != 0 or \
             out.tobytes() != np.array([float(t) for t in probe.split()]).tobytes():
         raise _Unavailable(f"{lib} failed its self-check")
     return dll
@@ -197,9 +206,29 @@ def _cores() -> int:
         return os.cpu_count() or 1
 
 
+_cores_taken = 0         # cores this process keeps busy otherwise (LAMMPS during a run)
+
+
+@contextlib.contextmanager
+def cores_taken(n: int = 1):
+    """While this is open, ``n`` cores are busy with other work of this process (a LAMMPS run
+    that frames are converted beside): large calls split across threads only if a core is
+    still free, so the conversion does not take cores from LAMMPS."""
+    global _cores_taken
+    with _lock:
+        _cores_taken += n
+    try:
+        yield
+    finally:
+        with _lock:
+            _cores_taken -= n
+
+
 def _helper():
-    """A one-thread pool for the second half of large calls, or None on one core."""
+    """A one-thread pool for the second half of large calls, or None on one (free) core."""
     global _pool, _pool_pid
+    if _cores() - _cores_taken < 2:
+        return None
     if _pool is None or _pool_pid != os.getpid():       # a forked child has no worker thread
         with _lock:
             if _pool is None or _pool_pid != os.getpid():
@@ -247,6 +276,105 @@ def parse_numbers(block: bytes, nrows: int, ncols: int) -> np.ndarray | None:
     if lib.fp_parse_block(base, len(block), out.ctypes.data, nrows, ncols) != 0:
         return None
     return out
+
+
+def parse_tagged(block: bytes | memoryview, key: str, names: list[str], ncols: int) -> np.ndarray | None:
+    """(nrows, ncols) float64 array of a FibreNet model block whose lines read
+    ``key name number ...`` (ncols tokens): column 0 is 0, column 1 the index of ``name`` in
+    ``names``; None without the C library or for anything unusual (see fp_parse_tagged)."""
+    lib = library()
+    if lib is None or not block or not names:
+        return None
+    enc = [n.encode() for n in names]
+    if any(not e or b"\0" in e for e in enc) or b"\0" in key.encode():
+        return None
+    w = max(len(e) for e in enc)
+    table = b"".join(e.ljust(w, b"\0") for e in enc)
+    kb = key.encode()
+    raw = np.frombuffer(block, np.uint8)         # no copy; keeps ``block`` alive
+    base, size = raw.ctypes.data, len(raw)
+    nrows = lib.fp_count_lines(base, size) + (0 if raw[-1] == 10 else 1)
+    out = np.empty((nrows, ncols), np.float64)
+
+    def part(start: int, stop: int, row0: int, rows: int) -> bool:
+        return lib.fp_parse_tagged(base + start, stop - start, kb, len(kb), table, len(enc), w,
+                                   out[row0:].ctypes.data, rows, ncols) == 0
+
+    pool = _helper() if size >= SPLIT_BYTES and nrows >= 2 else None
+    if pool is not None:
+        found = np.flatnonzero(raw[size // 2:size // 2 + 4096] == 10)     # a '\n' near the middle
+        mid = size // 2 + int(found[0]) if len(found) else -1
+        if 0 <= mid < size - 1:
+            first = lib.fp_count_lines(base, mid + 1)           # rows in [0, mid]
+            if 0 < first < nrows:
+                job = pool.submit(part, mid + 1, size, first, nrows - first)
+                ok = part(0, mid + 1, 0, first)
+                ok = job.result() and ok
+                return out if ok else None
+    return out if part(0, size, 0, nrows) else None
+
+
+def format_fixed_rows(values: np.ndarray, decimals: np.ndarray, widths: np.ndarray) -> bytes | None:
+    """Rows of (nrows, ncols) int64 ``values``, column c printed as value / 10^decimals[c]
+    right-aligned in widths[c], one space between columns (see fp_format_fixed_rows); None
+    without the C library or if a field does not fit its width."""
+    lib = library()
+    if lib is None or values.ndim != 2 or not values.size:
+        return None
+    values = np.ascontiguousarray(values, np.int64)
+    k = np.ascontiguousarray(decimals, np.int64)
+    w = np.ascontiguousarray(widths, np.int64)
+    n, ncols = values.shape
+    if len(k) != ncols or len(w) != ncols:
+        return None
+    row = int(w.sum()) + ncols              # every row has exactly this many bytes
+    buf = np.empty(n * row, np.uint8)
+
+    def part(a: int, b: int) -> bool:
+        return lib.fp_format_fixed_rows(values[a:].ctypes.data, b - a, ncols, k.ctypes.data,
+                                        w.ctypes.data, buf[a * row:].ctypes.data,
+                                        (b - a) * row) == (b - a) * row
+    pool = _helper() if n * row >= SPLIT_BYTES and n >= 2 else None
+    if pool is not None:
+        job = pool.submit(part, n // 2, n)
+        ok = part(0, n // 2)
+        ok = job.result() and ok
+    else:
+        ok = part(0, n)
+    return buf.tobytes() if ok else None
+
+
+def format_g_rows(codes: np.ndarray, table: list[str], values: np.ndarray) -> bytes | None:
+    """Rows ``\t table[codes[i]]`` + ``\t%g`` per value + ``\n`` (printf-identical to
+    Python's % formatting), or None without the C library or for non-finite values."""
+    lib = library()
+    n = len(codes)
+    if lib is None or n == 0 or values.ndim != 2 or len(values) != n:
+        return None
+    enc = [t.encode() for t in table]
+    if not enc or any(not e or b"\0" in e for e in enc):
+        return None
+    w = max(len(e) for e in enc)
+    names = b"".join(e.ljust(w, b"\0") for e in enc)
+    codes = np.ascontiguousarray(codes, np.int64)
+    values = np.ascontiguousarray(values, np.float64)
+    ncols = values.shape[1]
+    row_cap = 1 + w + ncols * 32 + 1
+
+    def part(a: int, b: int) -> np.ndarray | None:
+        buf = np.empty((b - a) * row_cap, np.uint8)
+        got = lib.fp_format_g_rows(codes[a:].ctypes.data, values[a:].ctypes.data, b - a, ncols,
+                                   names, len(enc), w, buf.ctypes.data, len(buf))
+        return None if got < 0 else buf[:got]
+    pool = _helper() if n >= 4096 else None
+    if pool is not None:
+        job = pool.submit(part, n // 2, n)
+        parts = [part(0, n // 2), job.result()]
+    else:
+        parts = [part(0, n)]
+    if any(p is None for p in parts):
+        return None
+    return b"".join(p.tobytes() for p in parts)
 
 
 def _format_rows(lib, codes, values, n, names, nnames, w, decimals) -> np.ndarray | None:

@@ -34,8 +34,9 @@ def _fixed(s: np.ndarray, k: int) -> np.ndarray:
     return d
 
 
-def float_text(x: np.ndarray, max_decimals: int = 9) -> np.ndarray | None:
-    """Fixed-point text that parses back to exactly x, or None (caller falls back to repr).
+def scaled(x: np.ndarray, max_decimals: int = 9) -> tuple[np.ndarray, int] | None:
+    """(s, k): the fewest decimals k <= max_decimals with x == s / 10^k exactly (s int64),
+    or None when some value needs more (or is not finite).
 
     round(x 10^k) / 10^k == x means the k-decimal string is the correctly rounded decimal
     of x (integer / power of ten is correctly rounded in IEEE arithmetic), so float() or
@@ -51,13 +52,61 @@ def float_text(x: np.ndarray, max_decimals: int = 9) -> np.ndarray | None:
             return None
         s = np.round(x * scale)
         if (s / scale == x).all():
-            return _fixed(s.astype(np.int64), k)
+            return s.astype(np.int64), k
     return None
+
+
+def float_text(x: np.ndarray, max_decimals: int = 9) -> np.ndarray | None:
+    """Fixed-point text that parses back to exactly x, or None (caller falls back to repr);
+    see ``scaled``."""
+    found = scaled(x, max_decimals)
+    return None if found is None else _fixed(*found)
+
+
+def _width(s: np.ndarray, k: int) -> int:
+    """The column width _fixed(s, k) gives: digits, a '-' column if any s < 0, a '.'."""
+    mag = int(np.abs(s).max(initial=0))
+    ndig = max(int(np.searchsorted(_POW10, mag, side="right")), k + 1)
+    return ndig + bool((s < 0).any()) + (k > 0)
+
+
+def _rows_text_c(columns: list) -> bytes | None:
+    """rows_text through the C helper (the same bytes), or None when it cannot."""
+    from fibrelmp.numtext import fast
+
+    if fast.library() is None:
+        return None
+    n = len(columns[0])
+    cols, decimals, widths = [], [], []
+    for col in columns:
+        if isinstance(col, str):
+            if not col.isdigit() or str(int(col)) != col:
+                return None
+            s, k = np.full(n, int(col), np.int64), 0
+        else:
+            col = np.asarray(col)
+            if col.dtype.kind in "iub":
+                s, k = col.astype(np.int64), 0
+            else:
+                found = scaled(col)
+                if found is None:
+                    return None
+                s, k = found
+        if len(s) and int(s.min()) == np.iinfo(np.int64).min:
+            return None
+        cols.append(s)
+        decimals.append(k)
+        widths.append(_width(s, k))
+    return fast.format_fixed_rows(np.column_stack(cols), np.array(decimals), np.array(widths))
 
 
 def rows_text(columns: list) -> bytes | None:
     """Space-separated rows of int/float columns, or None if a float column needs repr."""
     n = len(columns[0])
+    if n:
+        text = _rows_text_c(columns)
+        if text is not None:
+            return text
     parts = []
     for col in columns:
         if isinstance(col, str):                    # literal text in every row

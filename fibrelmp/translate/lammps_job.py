@@ -1,7 +1,10 @@
 """Turn a bead-spring Model into a LAMMPS data file and input script (rendered to disk).
 
-The script is self-contained stock LAMMPS (no Python hooks): ``lmp -in in.lammps`` inside the
-job folder replays exactly what ``fibrelmp run`` executes line by line.
+The script is self-contained LAMMPS (no Python hooks): ``lmp -in in.lammps`` inside the job
+folder replays exactly what ``fibrelmp run`` executes line by line.  FibreNet's angles use
+fibrelmp's ``angle_style fibrenet`` (``plugin load`` of fibrelmp's styles); without the
+plugin (``--stock-styles``) the same law runs as ``angle_style lepton`` (slower, see
+``stock_angle_warning``).
 """
 
 from __future__ import annotations
@@ -53,10 +56,14 @@ def _unique_rows(*cols: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     if not cols[0].size:
         return np.zeros((0, len(cols))), np.zeros(0, np.int64)
     key = np.zeros(len(cols[0]), np.int64)
+    span = 1                                       # key < span
     for col in cols:
         u, inv = np.unique(col, return_inverse=True)
-        key = key * len(u) + inv.reshape(-1)
-        key = np.unique(key, return_inverse=True)[1].reshape(-1)   # re-compress: no overflow
+        if span * len(u) >= 2 ** 62:               # re-compress first: no overflow
+            key = np.unique(key, return_inverse=True)[1].reshape(-1)
+            span = int(key.max(initial=0)) + 1
+        key = key * len(u) + inv.reshape(-1)       # order-preserving: lexicographic by column
+        span *= len(u)
     _, first, inverse = np.unique(key, return_index=True, return_inverse=True)
     return np.column_stack([np.asarray(c)[first] for c in cols]), inverse.reshape(-1)
 
@@ -115,6 +122,23 @@ def angle_expression(c: float, theta0: float) -> str:
     return (f"{float_text(c)}*theta^2+select(step({float_text(s)}-sin(phi)),D-floor(D*{float_text(q)})/{float_text(q)},0);"
             f"D={float_text(2 * c * s)}*(phi+phi^3/18-{float_text(u)}*log(tan(max(abs(phi),1e-300)/2)))"
             f"-{float_text(c)}*theta^2;phi={float_text(u)}-theta")
+
+
+STOCK_ANGLES = "FibreNet angles via angle_style lepton"
+
+
+def stock_angle_warning(why: str) -> str:
+    """What a job without fibrelmp's plugin says about its angles (figures measured by
+    tests/test_style_fibrenet_angle.py and benchmarks/fibrenet_angle.py)."""
+    return (f"fibrelmp's LAMMPS styles are not used ({why}): FibreNet's angles run as "
+            "angle_style lepton with fibrelmp's clamp-cancelling expression instead of "
+            "angle_style fibrenet. This is not a physics approximation -- the law is the same, "
+            "E = c1 (theta - theta0)^2 with FibreNet's force directions -- but it is the slower "
+            "route: several times the angle cost of angle_style fibrenet, plus ~1-2 ms per step "
+            "of expression set-up whatever the size. Its theta comes from acos(cos theta), as "
+            "FibreNet's does, which costs ~1e-16/phi^2 of the force for triples phi = pi - theta "
+            "from straight (2e-8 at 1e-4 rad, 2e-4 at 1e-6 rad, all of it below ~1e-8 rad); "
+            "angle_style fibrenet is exact there")
 
 
 def _schedule(model: Model, general_lambda: bool) -> tuple[list[tuple], SaveSteps, int]:
@@ -240,6 +264,8 @@ def write_job(model: Model, folder: str | Path, write_files: bool = True) -> Job
     type_names = [p.type_names[int(t)] for t in ltypes[:, 0]]
     styles = lammps_styles.plugin()
     native, native_files = _native_output(model, folder, type_names, styles.path is not None)
+    if model.angles.count and not styles.available:
+        model.warn(STOCK_ANGLES, stock_angle_warning(styles.how))
 
     data_path = folder / DATA_NAME
     if write_files:

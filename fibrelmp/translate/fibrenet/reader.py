@@ -16,7 +16,7 @@ import numpy as np
 from fibrelmp.errors import InputError
 from fibrelmp.model import (Angles, Bonds, Box, Dynamics, Model, OutputSpec, PairLaw, Particles,
                      RunPlan, Stage)
-from fibrelmp.textio import check_text_file, integer_column, parse_table, read_bytes, read_text, to_float, to_int
+from fibrelmp.textio import integer_column, parse_table, read_checked_bytes, read_text, to_float, to_int
 from fibrelmp.units import LJ
 
 EXTENSIONS = (".txt", ".in", ".inp")
@@ -403,8 +403,9 @@ def _read_model(path: Path, type_index: dict[str, int], type_names: list[str], s
                 notes: list) -> tuple[Particles, "_Springs", Angles]:
     from fibrelmp.translate.fibrenet.fast_reader import fast_read_model
 
-    check_text_file(path, "FibreNet model file")    # encoding / binary checks, streamed
-    fast = fast_read_model(read_bytes(path), type_index, type_names, size, _Springs)
+    raw = read_checked_bytes(path, "FibreNet model file")    # encoding / binary checks
+    fast = fast_read_model(raw, type_index, type_names, size, _Springs)
+    del raw
     if fast is not None:
         return fast
     sections = _model_sections(path)

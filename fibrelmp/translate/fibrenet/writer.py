@@ -15,7 +15,7 @@ import numpy as np
 from fibrelmp.errors import InputError
 from fibrelmp.formatbase import Writer
 from fibrelmp.textio import format_rows, parse_table, read_text
-from fibrelmp.numtext.fast import format_xyz_parts
+from fibrelmp.numtext.fast import format_g_rows, format_xyz_parts
 from fibrelmp.numtext.printf import fixed_chars, join_fields, name_chars
 
 XYZ_SUFFIX = {"position": "_coord.xyz", "velocity": "_vel.xyz", "force": "_force.xyz"}
@@ -111,12 +111,26 @@ def _g(x: float) -> str:
     return f"{x:g}"
 
 
+def _restart_head(n: int, step: int, dt: float, lengths: np.ndarray) -> str:
+    return (f"{n}\nFRAME\t{step}\t{_g(dt)}\t{_g(lengths[0])}\t{_g(lengths[1])}\t"
+            f"{_g(lengths[2])}\n")
+
+
 def restart_text(step: int, dt: float, lengths: np.ndarray, names: np.ndarray, x: np.ndarray,
                  unwrapped: np.ndarray, v_tilde: np.ndarray, force: np.ndarray) -> str:
-    head = (f"{len(names)}\nFRAME\t{step}\t{_g(dt)}\t{_g(lengths[0])}\t{_g(lengths[1])}\t"
-            f"{_g(lengths[2])}\n")
     values = np.hstack([x, unwrapped, v_tilde, force])
-    return head + _rows("\t%s" + "\t%g" * 12 + "\n", names, values)
+    return _restart_head(len(names), step, dt, lengths) + _rows("\t%s" + "\t%g" * 12 + "\n", names, values)
+
+
+def restart_bytes(s: "RestartState") -> bytes:
+    """The restart file of ``s``: formatted in C when available (fastparse), else by
+    ``restart_text``; the same bytes."""
+    values = np.hstack([s.x, s.unwrapped, s.v_tilde, s.force])
+    rows = format_g_rows(s.codes, s.table, values)
+    if rows is not None:
+        return _restart_head(len(s.codes), s.step, s.dt, s.lengths).encode() + rows
+    names = np.array(s.table, dtype=object)[s.codes]
+    return restart_text(s.step, s.dt, s.lengths, names, s.x, s.unwrapped, s.v_tilde, s.force).encode()
 
 
 class RestartState(NamedTuple):
@@ -147,10 +161,7 @@ class RestartWriter(Writer):
 
     def finish(self) -> None:
         if self.last is not None:
-            s = self.last
-            names = np.array(s.table, dtype=object)[s.codes]
-            self.put(self.target, restart_text(s.step, s.dt, s.lengths, names, s.x, s.unwrapped,
-                                               s.v_tilde, s.force).encode())
+            self.put(self.target, restart_bytes(self.last))
 
 
 def write_restart(path: str | Path, step: int, dt: float, lengths: np.ndarray, names: np.ndarray,

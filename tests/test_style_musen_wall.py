@@ -648,7 +648,7 @@ def test_rest_height_on_mesh_equals_plane(plugin_path, tmp_path, where):
     out = {}
     for name, verts in (("mesh", fan), ("plane", big)):
         out[name] = run_on(plugin_path, tmp_path / name, verts, law, s, dt, steps, steps // 4, 0.0)
-    zm, zp = out["mesh"][-1][1][2], out["plane"][-1][1][2]
+    zm, zp = float(out["mesh"][-1][1][2]), float(out["plane"][-1][1][2])
     vm = np.abs(out["mesh"][-1][2]).max()
     d0 = static_overlap(law, s["m"], R, G)
     print(f"\n{where}: rest height mesh {zm!r}, plane {zp!r} (R - delta0 = {R - d0!r}); |v| {vm:.1e}")

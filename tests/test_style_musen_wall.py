@@ -586,10 +586,11 @@ def static_overlap(law, m, R, g_normal):
     return (m * g_normal / (4.0 / 3.0 * law["E"] * math.sqrt(R))) ** (2.0 / 3.0)
 
 
-def run_on(plugin, folder, verts, law, sphere, dt, steps, every, theta):
+def run_on(plugin, folder, verts, law, sphere, dt, steps, every, theta,
+           box=(-0.05, 0.12, -0.05, 0.05, -0.05, 0.05), boundary="f f f"):
     mesh = mesh_text(verts, [0] * len(verts), [0] * len(verts), {(1, 0): law}, [{"name": "slope"}])
     lmp = Lammps(plugin, folder, mesh, [sphere], dt, integrate=True, gravity=(0.0, 0.0, -1.0),
-                 box=(-0.05, 0.12, -0.05, 0.05, -0.05, 0.05))
+                 box=box, boundary=boundary)
     lmp.set_state(sphere["x"][None], sphere["v"][None], sphere["w"][None])
     out = []
     try:
@@ -647,7 +648,7 @@ def test_rest_height_on_mesh_equals_plane(plugin_path, tmp_path, where):
     out = {}
     for name, verts in (("mesh", fan), ("plane", big)):
         out[name] = run_on(plugin_path, tmp_path / name, verts, law, s, dt, steps, steps // 4, 0.0)
-    zm, zp = out["mesh"][-1][1][2], out["plane"][-1][1][2]
+    zm, zp = float(out["mesh"][-1][1][2]), float(out["plane"][-1][1][2])
     vm = np.abs(out["mesh"][-1][2]).max()
     d0 = static_overlap(law, s["m"], R, G)
     print(f"\n{where}: rest height mesh {zm!r}, plane {zp!r} (R - delta0 = {R - d0!r}); |v| {vm:.1e}")
@@ -677,6 +678,42 @@ def test_rolling_across_seams_is_smooth(plugin_path, tmp_path):
           f"travelled {a[-1][1][0]:.4f} m")
     assert a[-1][1][0] > 0.02                   # crossed many triangles
     assert worst < 1e-12
+
+
+def test_periodic_floor_acts_like_a_plane(plugin_path, tmp_path):
+    """A floor spanning a periodic box (x periodic, 4 triangles): a sphere rolling with spin
+    across the periodic boundary touches the triangles on both sides of it at once through its
+    periodic image (MUSEN's virtual particles); one contact acts, so it stays on the floor
+    with the plane's normal force.  Until it first reaches the boundary it moves exactly as on
+    one big triangle; crossing it, the tangential overlap restarts, as in MUSEN (its
+    adjacency of triangles ignores periodicity)."""
+    law = make_law(1e6, 4e5, 0.5, 0.4, 0.02)
+    R, L = 0.001, 0.01
+    h = L / 2
+    floor = np.array([[[-h, -0.004, 0], [0.0, -0.004, 0], [0.0, 0.004, 0]],
+                      [[-h, -0.004, 0], [0.0, 0.004, 0], [-h, 0.004, 0]],
+                      [[0.0, -0.004, 0], [h, -0.004, 0], [h, 0.004, 0]],
+                      [[0.0, -0.004, 0], [h, 0.004, 0], [0.0, 0.004, 0]]])
+    s = one_sphere(R, v=(0.2, 0.0, 0.0), w=(0.0, 120.0, 10.0))
+    d0 = static_overlap(law, s["m"], R, G)
+    s["x"] = np.array([h - 0.004, 0.0003, R - d0])
+    dt, steps, every = 1e-5, 10000, 50
+    a = run_on(plugin_path, tmp_path / "periodic", floor, law, s, dt, steps, every, 0.0,
+               box=(-h, h, -0.004, 0.004, -0.004, 0.004), boundary="p f f")
+    b = run_on(plugin_path, tmp_path / "plane", slope_mesh(0.0, single=True), law, s, dt, steps, every, 0.0)
+    before, fz_worst = 0, 0.0
+    for (t, x, v, w, f, tq), (_, xp, vp, wp, fp, tqp) in zip(a, b):
+        if xp[0] + R < h:                  # not yet near the boundary: the plane's motion exactly
+            before += 1
+            assert (x == xp).all() and (f == fp).all() and (tq == tqp).all()
+        weight = s["m"] * G                              # f includes gravity: the wall's part
+        assert fp[2] + weight > 0.5 * weight
+        fz_worst = max(fz_worst, abs((f[2] + weight) / (fp[2] + weight) - 1))
+        assert abs(x[2] - xp[2]) < 1e-3 * d0          # on the floor: one contact, never two or none
+    crossings = int((b[-1][1][0] - s["x"][0] + 0.004) // L)
+    print(f"\nperiodic floor: {before} saves as the plane before the boundary, {crossings} crossings, "
+          f"normal force within {fz_worst:.1e} of the plane's")
+    assert before >= 5 and crossings >= 2 and fz_worst < 1e-3
 
 
 # =======================================================================================

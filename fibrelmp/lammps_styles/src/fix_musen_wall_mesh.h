@@ -29,6 +29,11 @@
      moves the geometry the triangles stand still but KEEP the last velocity, rotation
      velocity and rotation centre in the contact law (MUSEN never resets them);
      "rotate around centre" rotates about the area-weighted centroid of the triangles.
+   - periodic boxes: a sphere also meets the periodic images of the triangles (MUSEN's
+     virtual particles), after its own contacts; a triangle touched by the sphere itself is
+     not touched by an image.
+   A set-up force evaluation (every run, run 0) computes forces without advancing the
+   contacts (as LAMMPS's granular styles): only time steps change the tangential overlaps.
    Triangle positions follow the exact solution x(t) = R(t) x0 + b(t) of the motion (the
    coefficients come from FILE: fibrelmp's translation writes the same ones it reports wall
    positions with), evaluated at the current time of every force computation.

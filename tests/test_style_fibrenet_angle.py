@@ -288,6 +288,19 @@ def test_straight_triple_gets_no_force_and_its_energy(tmp_path, plugin_path):
     assert energy == pytest.approx(expected, rel=REL)
 
 
+def test_zero_length_leg_gives_no_force_and_no_energy(tmp_path, plugin_path):
+    """Two beads of a triple at the same place (no angle; the reader refuses such models, a
+    run could still produce one): finite zeros, not NaN (FibreNet's kernel would give NaN)."""
+    x2 = np.array([13.0, 14.0, 15.0])
+    cases = [((x2.copy(), x2, x2 + [0.5, 0.25, 0.0]), 7.0, math.pi)]
+    tri = Triples(tmp_path, cases, plugin_path)
+    try:
+        _, f, energy, virial, _, eloc = tri.evaluate()
+    finally:
+        tri.close()
+    assert not f.any() and energy == 0.0 and not virial.any() and not eloc.any()
+
+
 def test_force_is_minus_energy_gradient(tmp_path, plugin_path):
     """Central differences of the LAMMPS energy against the LAMMPS force, including one nearly
     straight triple with theta0 = float(pi)."""

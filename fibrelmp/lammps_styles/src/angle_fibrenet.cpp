@@ -72,7 +72,9 @@ inline double bend(const double *a, const double *b, double c, double theta0,
   const double ab = std::sqrt(aa * bb);
 
   double dtheta;
-  if (tn < -d)    // theta > 3 pi / 4: theta - theta0 = (pi - theta0) - phi, phi = pi - theta
+  if (ab == 0.0)    // a leg of zero length: no angle, so no energy and no force
+    dtheta = 0.0;
+  else if (tn < -d)    // theta > 3 pi / 4: theta - theta0 = (pi - theta0) - phi, phi = pi - theta
     dtheta = pi_minus_theta0 - std::asin(tn / ab);
   else if (tn < d)    // theta < pi / 4
     dtheta = std::asin(tn / ab) - theta0;

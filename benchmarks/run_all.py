@@ -59,6 +59,9 @@ BENCHES = [
     Bench("bond_styles", "bond time per step: musen/elastic / bpm/rotational (MUSEN agglomerate, 1000 steps)",
           r"musen/elastic / bpm/rotational: loop [0-9.]+, bonds ([0-9.]+)", "<= 1.0",
           ["--steps", "100", "--repeat", "1"]),
+    Bench("musen_styles", "MUSEN agglomerate loop per step: fibrelmp's styles / --stock-styles",
+          r"ratio plugin / stock \(per-step cost\): ([0-9.]+)", "<= 1.0",
+          ["--steps", "100", "--repeat", "1"]),
 ]
 
 

@@ -51,6 +51,24 @@ inline void cross(const double *a, const double *b, double *c)    // CVector3 op
   c[1] = a[2] * b[0] - a[0] * b[2];
   c[2] = a[0] * b[1] - a[1] * b[0];
 }
+// (v1 - v0) x (v2 - v0) of the triangle p = {v0, v1, v2}: its normal times twice its area
+inline void face_cross(const double *p, double *c)
+{
+  double u[3], w[3];
+  for (int k = 0; k < 3; k++) {
+    u[k] = p[3 + k] - p[k];
+    w[k] = p[6 + k] - p[k];
+  }
+  cross(u, w, c);
+}
+// axis-aligned bounds (lo, hi) of the triangle p
+inline void face_bounds(const double *p, double *lo, double *hi)
+{
+  for (int k = 0; k < 3; k++) {
+    lo[k] = std::min(std::min(p[k], p[3 + k]), p[6 + k]);
+    hi[k] = std::max(std::max(p[k], p[3 + k]), p[6 + k]);
+  }
+}
 inline double sqlen(const double *a)
 {
   return a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
@@ -403,20 +421,13 @@ void FixMusenWallMesh::parse(const std::string &text)
   thi.resize(3 * (size_t) ntri);
   for (int t = 0; t < ntri; t++) {
     const double *v = &vert[9 * (size_t) t];
-    double a[3], b[3], c[3];
-    for (int k = 0; k < 3; k++) {
-      a[k] = v[3 + k] - v[k];
-      b[k] = v[6 + k] - v[k];
-    }
-    cross(a, b, c);
+    double c[3];
+    face_cross(v, c);
     const double len = std::sqrt(sqlen(c));
     if (!(len > 0))
       error->all(FLERR, "Fix musen/wall/mesh: {}: triangle {} has zero area", file, t + 1);
     for (int k = 0; k < 3; k++) nrm[3 * (size_t) t + k] = c[k] / len;
-    for (int k = 0; k < 3; k++) {
-      tlo[3 * (size_t) t + k] = std::min(std::min(v[k], v[3 + k]), v[6 + k]);
-      thi[3 * (size_t) t + k] = std::max(std::max(v[k], v[3 + k]), v[6 + k]);
-    }
+    face_bounds(v, &tlo[3 * (size_t) t], &thi[3 * (size_t) t]);
   }
   ftri.assign(3 * (size_t) ntri, 0.0);
   ftri_all.assign(3 * (size_t) ntri, 0.0);
@@ -550,19 +561,12 @@ void FixMusenWallMesh::place(double t)
         for (int i = 0; i < 3; i++)
           p[3 * a + i] = p0[3 * a] * R[i][0] + p0[3 * a + 1] * R[i][1] + p0[3 * a + 2] * R[i][2] + b[i];
       if (G.rotating) {    // MUSEN recomputes normals only while a geometry rotates
-        double u[3], w[3], c[3];
-        for (int k = 0; k < 3; k++) {
-          u[k] = p[3 + k] - p[k];
-          w[k] = p[6 + k] - p[k];
-        }
-        cross(u, w, c);
+        double c[3];
+        face_cross(p, c);
         const double len = std::sqrt(sqlen(c));
         for (int k = 0; k < 3; k++) nrm[3 * (size_t) tr + k] = c[k] / len;
       }
-      for (int k = 0; k < 3; k++) {
-        tlo[3 * (size_t) tr + k] = std::min(std::min(p[k], p[3 + k]), p[6 + k]);
-        thi[3 * (size_t) tr + k] = std::max(std::max(p[k], p[3 + k]), p[6 + k]);
-      }
+      face_bounds(p, &tlo[3 * (size_t) tr], &thi[3 * (size_t) tr]);
     }
   }
   t_placed = t;
@@ -601,12 +605,8 @@ void FixMusenWallMesh::motion_state(double t)
       double area_sum = 0.0, wc[3] = {0, 0, 0};
       for (int tr : G.tris) {
         const double *p = &vert[9 * (size_t) tr];
-        double u[3], w[3], c[3];
-        for (int k = 0; k < 3; k++) {
-          u[k] = p[3 + k] - p[k];
-          w[k] = p[6 + k] - p[k];
-        }
-        cross(u, w, c);
+        double c[3];
+        face_cross(p, c);
         const double area = 0.5 * std::sqrt(sqlen(c));
         area_sum += area;
         for (int k = 0; k < 3; k++) wc[k] += area * ((p[k] + p[3 + k] + p[6 + k]) / 3.);

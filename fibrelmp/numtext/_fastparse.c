@@ -149,6 +149,28 @@ static inline int parse_token(const char **pp, const char *e, double *out)
     return 0;
 }
 
+/* The numbers of one row from column col on into row[col..ncols), then its line end ('\n',
+   "\r\n" or the buffer's end); 0, or -1 on a bad number or a wrong number of columns. */
+static int parse_row_rest(const char **pp, const char *end, double *row, int64_t col, int64_t ncols)
+{
+    const char *p = *pp;
+    for (;;) {
+        while (p < end && (*p == ' ' || *p == '\t')) p++;
+        if (p >= end || *p == '\n' || *p == '\r') break;
+        if (col >= ncols) return -1;
+        if (parse_token(&p, end, row + col)) return -1;
+        col++;
+    }
+    if (col != ncols) return -1;
+    if (p < end && *p == '\r') {
+        p++;
+        if (!(p < end && *p == '\n')) return -1;
+    }
+    if (p < end) p++;   /* '\n' */
+    *pp = p;
+    return 0;
+}
+
 /* 0 on success; -1: caller must use its own (numpy) path */
 int fp_parse_block(const char *buf, int64_t len, double *out, int64_t nrows, int64_t ncols)
 {
@@ -158,21 +180,8 @@ int fp_parse_block(const char *buf, int64_t len, double *out, int64_t nrows, int
     if (FP_EXCESS_PRECISION) return -1;
     while (row < nrows) {
         if (p >= end) return -1;
-        int64_t col = 0;
-        for (;;) {
-            while (p < end && (*p == ' ' || *p == '\t')) p++;
-            if (p >= end || *p == '\n' || *p == '\r') break;
-            if (col >= ncols) return -1;
-            if (parse_token(&p, end, o)) return -1;
-            o++;
-            col++;
-        }
-        if (col != ncols) return -1;
-        if (p < end && *p == '\r') {
-            p++;
-            if (!(p < end && *p == '\n')) return -1;
-        }
-        if (p < end) p++;   /* '\n' */
+        if (parse_row_rest(&p, end, o, 0, ncols)) return -1;
+        o += ncols;
         row++;
     }
     return p == end ? 0 : -1;
@@ -219,20 +228,7 @@ int fp_parse_tagged(const char *buf, int64_t len, const char *key, int64_t klen,
         if (which < 0) return -1;
         o[0] = 0.0;
         o[1] = (double)which;
-        int64_t col = 2;
-        for (;;) {
-            while (p < end && (*p == ' ' || *p == '\t')) p++;
-            if (p >= end || *p == '\n' || *p == '\r') break;
-            if (col >= ncols) return -1;
-            if (parse_token(&p, end, o + col)) return -1;
-            col++;
-        }
-        if (col != ncols) return -1;
-        if (p < end && *p == '\r') {
-            p++;
-            if (!(p < end && *p == '\n')) return -1;
-        }
-        if (p < end) p++;   /* '\n' */
+        if (parse_row_rest(&p, end, o, 2, ncols)) return -1;
         o += ncols;
     }
     return p == end ? 0 : -1;

@@ -220,6 +220,18 @@ class Body:
     w: tuple = (0.0, 0.0, 0.0)
 
 
+def body_commands(bodies: list[Body]) -> list[str]:
+    """create_atoms / set commands of ``bodies`` (type 1 glass, 2 steel; ids from 1)."""
+    cmds = []
+    for k, b in enumerate(bodies):
+        t = 1 if b.kind == "glass" else 2
+        cmds += [f"create_atoms {t} single {b.x[0]!r} {b.x[1]!r} {b.x[2]!r} units box remap yes",
+                 f"set atom {k + 1} diameter {2 * b.r!r} density {RHO[b.kind]!r}",
+                 f"set atom {k + 1} vx {b.v[0]!r} vy {b.v[1]!r} vz {b.v[2]!r}",
+                 f"set atom {k + 1} omega {b.w[0]!r} {b.w[1]!r} {b.w[2]!r}"]
+    return cmds
+
+
 def setup_lammps(plugin: Path, bodies: list[Body], laws: dict, dt: float, *, periodic=False,
                  box=0.02, center=None, newton="off", extra=(), log=None):
     """LAMMPS with the plugin, ``bodies`` (type 1 glass, 2 steel) in a cube of half-side
@@ -231,12 +243,7 @@ def setup_lammps(plugin: Path, bodies: list[Body], laws: dict, dt: float, *, per
             "region box block {} {} {} {} {} {}".format(
                 *(c + s * box for c in (bodies[0].x if center is None else center) for s in (-1, 1))),
             "create_box 2 box"]
-    for k, b in enumerate(bodies):
-        t = 1 if b.kind == "glass" else 2
-        cmds += [f"create_atoms {t} single {b.x[0]!r} {b.x[1]!r} {b.x[2]!r} units box remap yes",
-                 f"set atom {k + 1} diameter {2 * b.r!r} density {RHO[b.kind]!r}",
-                 f"set atom {k + 1} vx {b.v[0]!r} vy {b.v[1]!r} vz {b.v[2]!r}",
-                 f"set atom {k + 1} omega {b.w[0]!r} {b.w[1]!r} {b.w[2]!r}"]
+    cmds += body_commands(bodies)
     cmds += ["pair_style musen/hm"] + [coeff_line(i, j, p) for (i, j), p in laws.items()]
     cmds += ["neighbor 0.0005 bin", "neigh_modify every 1 delay 0 check yes",
              f"timestep {dt!r}", "fix integrate all nve/sphere", *extra]
@@ -530,12 +537,7 @@ def persistent_lammps(plugin, procs=None, record=False, log=None):
     if procs:
         cmds.append(f"processors {procs}")
     cmds += [f"region box block {xl} {xh} {yl} {yh} {zl} {zh}", "create_box 2 box"]
-    for k, b in enumerate(PERSISTENT):
-        t = 1 if b.kind == "glass" else 2
-        cmds += [f"create_atoms {t} single {b.x[0]!r} {b.x[1]!r} {b.x[2]!r} units box remap yes",
-                 f"set atom {k + 1} diameter {2 * b.r!r} density {RHO[b.kind]!r}",
-                 f"set atom {k + 1} vx {b.v[0]!r} vy {b.v[1]!r} vz {b.v[2]!r}",
-                 f"set atom {k + 1} omega {b.w[0]!r} {b.w[1]!r} {b.w[2]!r}"]
+    cmds += body_commands(PERSISTENT)
     cmds += ["pair_style musen/hm"] + [coeff_line(i, j, p) for (i, j), p in laws.items()]
     cmds += ["neighbor 0.0005 bin", "neigh_modify every 1 delay 0 check yes",
              f"timestep {PERSISTENT_DT!r}", "fix integrate all nve/sphere"]

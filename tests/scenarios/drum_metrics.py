@@ -20,10 +20,7 @@ Tolerances (README): angle 3 deg, COM radius 3 %, KE 30 %, reach 50 um.
 from __future__ import annotations
 
 import argparse
-import gzip
-import shutil
 import sys
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -32,7 +29,7 @@ HERE = Path(__file__).resolve()
 sys.path.insert(0, str(HERE.parents[2]))
 
 from fibrelmp.translate.musen.scene import read as read_scene  # noqa: E402
-from fibrelmp.translate.musen.text import read_time_points  # noqa: E402
+from tests.scenarios.spheres import sphere_time_points  # noqa: E402
 
 # the scenario as copied into the repository (tests/data), else the developers' shared folder
 _PARTS = ("real-outputs", "musen", "scenarios", "rotating_drum")
@@ -42,19 +39,9 @@ TOLERANCES = {"bed_angle_deg": ("abs", 3.0), "com_radius": ("rel", 0.03),
               "kinetic_energy": ("rel", 0.30), "max_reach": ("abs", 50e-6)}
 
 
-def _plain(path: Path, tmp: Path) -> Path:
-    if path.suffix != ".gz":
-        return path
-    out = tmp / path.stem
-    with gzip.open(path, "rb") as src, open(out, "wb") as dst:
-        shutil.copyfileobj(src, dst)
-    return out
-
-
 def drum_metrics(result: str | Path, scene: str | Path, t0: float = 0.3, t1: float = 0.8) -> dict:
     """The four metrics of one result (radii and masses from ``scene``, matched by id)."""
-    with tempfile.TemporaryDirectory() as tmp:
-        tp = read_time_points(_plain(Path(result), Path(tmp)), types=(1,), tags=(12, 15, 16))
+    tp = sphere_time_points(result)
     model = read_scene(scene)
     where = {int(i): k for k, i in enumerate(model.spheres.ids)}
     rows = np.array([where[int(i)] for i in tp.ids])

@@ -21,10 +21,7 @@ norm of the difference.
 
 from __future__ import annotations
 
-import gzip
-import shutil
 import sys
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -72,22 +69,12 @@ class Row:
                 f"  diff {self.diff:.3g} (tol {self.tol:g})")
 
 
-def _plain(path: Path, tmp: Path) -> Path:
-    if path.suffix != ".gz":
-        return path
-    out = tmp / path.stem
-    with gzip.open(path, "rb") as src, open(out, "wb") as dst:
-        shutil.copyfileobj(src, dst)
-    return out
-
-
 def metrics(path: str | Path) -> dict[str, tuple[str, np.ndarray]]:
     """name -> (tolerance kind, value) of one MUSEN text result."""
     sys.path.insert(0, str(ROOT))
-    from fibrelmp.translate.musen.text import read_time_points
+    from tests.scenarios.spheres import sphere_time_points
 
-    with tempfile.TemporaryDirectory() as tmp:
-        tp = read_time_points(_plain(Path(path), Path(tmp)), types=(1,), tags=(12, 15, 16))
+    tp = sphere_time_points(path)
     ids = list(tp.ids)
 
     def at(t: float, tag: int, obj: int) -> np.ndarray | None:

@@ -79,7 +79,7 @@ def build_id() -> str:
 
 
 def library_name() -> str:
-    return f"{STEM}-{build_id()}.so"
+    return f"{STEM}-{build_id()}.so"      # build() names its library the same way
 
 
 def _compiler() -> list[str]:
@@ -111,12 +111,12 @@ def build(out_dir: Path | str = LIB_DIR, jobs: int | None = None, *, num_ver: in
     ``num_ver`` / ``core_only`` are for tests: a plugin claiming another LAMMPS version, or
     only its registration and history fix."""
     out_dir = Path(out_dir)
-    target = out_dir / library_name()
+    bid = build_id()
+    target = out_dir / f"{STEM}-{bid}.so"
     if target.exists():
         return target
     inc = ["-I", str(SRC), "-I", str(lammps_include()), "-I", str(mpi_include())]
-    defs = [f"-DFIBRELMP_LAMMPS_NUM_VER={num_ver or lammps_num_ver()}",
-            f'-DFIBRELMP_STYLES_ID="{build_id()}"'] + (["-DFIBRELMP_CORE_ONLY"] if core_only else [])
+    defs = [f"-DFIBRELMP_LAMMPS_NUM_VER={num_ver or lammps_num_ver()}", f'-DFIBRELMP_STYLES_ID="{bid}"'] + (["-DFIBRELMP_CORE_ONLY"] if core_only else [])
     cxx = _compiler()
     srcs = [SRC / "plugin.cpp", SRC / "fix_musen_history.cpp"] if core_only else sources()
     try:

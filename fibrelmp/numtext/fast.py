@@ -213,7 +213,8 @@ _cores_taken = 0         # cores this process keeps busy otherwise (LAMMPS durin
 def cores_taken(n: int = 1):
     """While this is open, ``n`` cores are busy with other work of this process (a LAMMPS run
     that frames are converted beside): large calls split across threads only if a core is
-    still free, so the conversion does not take cores from LAMMPS."""
+    still free, so the conversion does not take cores from LAMMPS.  ``n = -1`` gives one back
+    (the run is known to be over before its context ends)."""
     global _cores_taken
     with _lock:
         _cores_taken += n

@@ -56,6 +56,12 @@ BENCHES = [
           ["--beads", "5000", "--repeat", "1", "--steps", "300"]),
     Bench("mpi_speedup", "serial fibrelmp run / mpiexec -n 2 fibrelmp run (260k beads, 1000 steps)",
           r"\d+-rank speed-up: ([0-9.]+)", ">= 1.7", ["--beads", "20000", "--steps", "200"]),
+    Bench("bond_styles", "bond time per step: musen/elastic / bpm/rotational (MUSEN agglomerate, 1000 steps)",
+          r"musen/elastic / bpm/rotational: loop [0-9.]+, bonds ([0-9.]+)", "<= 1.0",
+          ["--steps", "100", "--repeat", "1"]),
+    Bench("musen_styles", "MUSEN agglomerate loop per step: fibrelmp's styles / --stock-styles",
+          r"ratio plugin / stock \(per-step cost\): ([0-9.]+)", "<= 1.0",
+          ["--steps", "100", "--repeat", "1"]),
 ]
 
 

@@ -25,6 +25,7 @@ import ctypes
 import hashlib
 import json
 import os
+import re
 import signal
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -35,9 +36,10 @@ STATE = "checkpoint.json"             # written last: names the files below
 RESTART = "checkpoint-{n}.restart"     # n: commands done (see runner.run_script)
 FORCES = "checkpoint-{n}.forces.npz"   # the step's forces and torques (see runner.step_state)
 # commands that change the state or write output: done already when resuming
+# (fibrenet/frame: fix fibrenet/output's frame, appended to FibreNet's xyz files)
 ACTIONS = frozenset({"run", "minimize", "velocity", "displace_atoms", "reset_timestep", "write_dump",
                      "write_restart", "write_data", "set", "delete_atoms", "create_atoms",
-                     "delete_bonds", "displace_box", "change_box"})
+                     "delete_bonds", "displace_box", "change_box", "fibrenet/frame"})
 
 
 class CheckpointStop(Exception):
@@ -185,7 +187,14 @@ def inputs_digest(paths) -> str:
     return h.hexdigest()
 
 
+_PLUGIN_LOAD = re.compile(r'^(plugin\s+load\s+)("[^"]*"|\S+)', re.MULTILINE)
+
+
 def _sha(text: str) -> str:
+    """The script's hash; a ``plugin load`` path counts by its file name only (it names the
+    plugin's build, whose id changes with its sources), so the same plugin found elsewhere,
+    e.g. installed vs. compiled into the user cache, does not block a resume."""
+    text = _PLUGIN_LOAD.sub(lambda m: m.group(1) + os.path.basename(m.group(2).strip('"')), text)
     return hashlib.sha256(text.encode()).hexdigest()
 
 

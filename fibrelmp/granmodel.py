@@ -161,6 +161,8 @@ class GranularPlan:
     periodic: tuple[bool, bool, bool] = (False, False, False)
     periodic_box: tuple[np.ndarray, np.ndarray] | None = None
     bond_breakage: int = 1                  # MUSEN CONSIDER_BREAKAGE: 0 none, 1 combined, 2 separate
+    bond_model: str = "elastic"             # MUSEN solid bond: "elastic" (ModelSBElastic), "kelvin"
+    bond_max_damp_ratio: float = 1.0        # ModelSBKelvin MAX_DAMP_RATIO (0: no cap)
     contacts_between_bonded: bool = True    # MUSEN default
     dimension: int = 3
 

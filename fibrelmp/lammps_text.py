@@ -91,6 +91,20 @@ def lammps_word(value: str, path: str | PathLike | None = None, line: int | None
                      "start with a letter or '_' and contain only ASCII letters, digits and '_'")
 
 
+# one argument LAMMPS reads back verbatim: printable ASCII but space " # $ & ' \\
+_TOKEN = re.compile(r"[A-Za-z0-9!%()*+,\-./:;<=>?@\[\]^_`{|}~]+\Z")
+
+
+def lammps_token(value: str) -> LammpsText | None:
+    """``value`` unchanged if LAMMPS reads it back as exactly that one argument (printable
+    ASCII without whitespace, quotes, ``# $ & \\``), else None: for text a style takes
+    verbatim (FibreNet type names written into its files), where the caller has another way
+    than refusing the input."""
+    if isinstance(value, str) and _TOKEN.match(value):
+        return LammpsText(value)
+    return None
+
+
 def lammps_path(value: str | PathLike, what: str = "file") -> LammpsText:
     """A file path as one LAMMPS word (double-quoted when it holds spaces); a path LAMMPS
     could read differently (quotes, ``#``, ``$``, ``&``, backslash, control or non-ASCII

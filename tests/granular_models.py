@@ -68,6 +68,20 @@ def box_triangles(lo, hi) -> np.ndarray:
     return np.array(tris)
 
 
+def oriented(verts, outward: bool = True) -> np.ndarray:
+    """The triangles of a closed convex shape with normals (V2-V1)x(V3-V1) pointing out of it
+    (or into it): MUSEN pushes spheres along a wall's normal, so its normals face the spheres
+    (outward for a plate the spheres sit on, inward for a container)."""
+    v = np.array(verts, float)
+    c = v.reshape(-1, 3).mean(0)
+    n = np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0])
+    flip = ((v.mean(1) - c) * n).sum(1) < 0
+    if not outward:
+        flip = ~flip
+    v[flip] = v[flip][:, [0, 2, 1]]
+    return v
+
+
 def rect_triangles(corners) -> np.ndarray:
     a, b, c, d = [np.asarray(p, float) for p in corners]
     return np.array([[a, b, c], [a, c, d]])

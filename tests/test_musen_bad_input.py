@@ -241,7 +241,7 @@ GOOD = ("MODEL_PP ModelPPHertzMindlin\nMODEL_PW ModelPWHertzMindlin\nMODEL_SB Mo
         "SIMULATION_STEP 1e-7\nSAVING_STEP 1e-4\nEND_TIME 1e-3\n")
 
 APPLY_ERRORS = [  # script, line, words: parsed fine, refused when the job is applied
-    (GOOD.replace("ModelSBElastic", "ModelSBKelvin"), 3, "not supported; fibrelmp translates "
+    (GOOD.replace("ModelSBElastic", "ModelSBAerogel"), 3, "not supported; fibrelmp translates "
      "ModelSBElastic only"),
     (GOOD.replace("ModelPPHertzMindlin", "ModelPPHertzMindlln"), 1, "did you mean ModelPPHertzMindlin?"),
     (GOOD.replace("MODEL_PW ModelPWHertzMindlin", "MODEL_PW ModelPPHertz"), 2,
@@ -258,6 +258,9 @@ APPLY_ERRORS = [  # script, line, words: parsed fine, refused when the job is ap
     (GOOD + "INTERACTION_PROPERTY SLIDING_FRICTION GLASS WOOD 0.1\n", 7, "no material with key 'WOOD'"),
     (GOOD.replace("END_TIME 1e-3", "END_TIME 1e-8"), 4, "longer than the run"),
     (GOOD + "MODEL_SB_PARAMS CONSIDER_BREAKAGE 3\n", 7, "CONSIDER_BREAKAGE must be 0, 1 or 2"),
+    (GOOD + "MODEL_SB_PARAMS CONSIDER_BREAKAGE 1.5\n", 7, "CONSIDER_BREAKAGE must be 0, 1 or 2"),
+    (GOOD.replace("ModelSBElastic", "ModelSBKelvin") + "MODEL_SB_PARAMS MAX_DAMP_RATIO -1\n", 7,
+     "MAX_DAMP_RATIO must be >= 0"),
     (GOOD + "MODEL_SB_PARAMS CONSIDER_BREAKAGE\n", 3, "expected a number"),
     (GOOD + "GEOMETRY_MOTION_FORCE Plate 1 MAX 0 0 1 0 0 0 0 0 0\n", 7, "force-dependent"),
     (GOOD + "GEOMETRY_MOTION_TIME Lid 0 1 0 0 1 0 0 0 0 0 0\n", 7, "no geometry 'Lid'"),
@@ -275,6 +278,30 @@ def test_bad_job_settings(tmp_path, text, line, words):
         ms.apply_simulator_settings(m, job)
     assert str(exc.value).startswith(f"{path}:{line}: "), str(exc.value)
     assert words in str(exc.value)
+
+
+def test_kelvin_bond_needs_the_styles(tmp_path):
+    """ModelSBKelvin is translated with fibrelmp's styles (bond_style musen/elastic kelvin);
+    with stock styles it is refused, saying why."""
+    from fibrelmp import lammps_styles
+
+    path = tmp_path / "job.txt"
+    path.write_text(GOOD.replace("ModelSBElastic", "ModelSBKelvin") +
+                    "MODEL_SB_PARAMS CONSIDER_BREAKAGE 2 MAX_DAMP_RATIO 0.5\n")
+    (job,) = ms.read_script(path)
+    with lammps_styles.stock(True):
+        m = musen.read(scene(tmp_path, BASE))
+        with pytest.raises(InputError) as exc:
+            ms.apply_simulator_settings(m, job)
+    assert str(exc.value).startswith(f"{path}:3: ")
+    assert "ModelSBKelvin needs fibrelmp's LAMMPS styles" in str(exc.value)
+    assert "stock LAMMPS has no such solid bond" in str(exc.value)
+    if not lammps_styles.plugin().available:
+        pytest.skip(f"fibrelmp's LAMMPS styles are unavailable here: {lammps_styles.plugin().how}")
+    m = musen.read(scene(tmp_path, BASE))
+    ms.apply_simulator_settings(m, job)
+    # Kelvin: any non-zero CONSIDER_BREAKAGE is MUSEN's criterion 1
+    assert (m.plan.bond_model, m.plan.bond_breakage, m.plan.bond_max_damp_ratio) == ("kelvin", 1, 0.5)
 
 
 def test_job_warnings_and_motion(tmp_path):

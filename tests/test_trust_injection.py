@@ -287,16 +287,25 @@ def test_rendered_granular_job_with_hostile_names_is_safe(tmp_path, monkeypatch)
         m.name = f"{HOSTILE}{k}"
     for g in model.geometries:
         g.name = HOSTILE
-    for kind in ("box", "tiles"):
+    from fibrelmp import lammps_styles
+
+    for kind in ("mesh", "box", "tiles"):
+        if kind == "mesh" and not lammps_styles.plugin().available:
+            continue
         if kind == "tiles":
             monkeypatch.setattr(walls, "detect_oriented_box", lambda v: None)
             monkeypatch.setattr(walls, "detect_cylinder", lambda v: None)
-        job = granular_job.write_granular_job(model, tmp_path / kind)
+        with lammps_styles.stock(kind != "mesh"):    # fix musen/wall/mesh, or stock walls
+            job = granular_job.write_granular_job(model, tmp_path / kind)
         assert [wp.kind for wp in job.wall_plans] == [kind]
         _assert_safe_job(job.folder)
         text = job.script.read_text()
-        assert "# Wall-particle types:" in text or kind == "box"
+        assert "# Wall-particle types:" in text or kind != "tiles"
         assert "# wall '" in text
+        if kind == "mesh":       # the fix's triangle file: printable ASCII, no user text but labels
+            mesh = (job.folder / "walls.mesh").read_bytes().decode("ascii")
+            assert all(re.fullmatch(r"[\x20-\x7e]*", ln) for ln in mesh.split("\n"))
+            assert "PWNED" not in mesh.replace("_touch_PWNED", "")
 
 
 def test_input_lines_splits_like_lammps():

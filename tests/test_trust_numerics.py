@@ -166,6 +166,16 @@ def test_clipped_tiling_is_the_full_tiling_inside_the_box():
         assert gj.tile_estimate(v, 0.0004) >= len(p)
 
 
+@pytest.fixture
+def stock_styles():
+    """The wall-particle tiling is the stock representation: fibrelmp's styles off."""
+    from fibrelmp import lammps_styles
+
+    previous = lammps_styles.request_stock(True)
+    yield
+    lammps_styles.request_stock(previous)
+
+
 def _drop_on_triangle():
     """A sphere falling 0.3 mm onto a 4 cm triangle (tiled, not a box) and bouncing."""
     mats, contacts = gm.two_materials()
@@ -175,7 +185,7 @@ def _drop_on_triangle():
     return m
 
 
-def test_tiles_within_reach_give_the_same_bounce(tmp_path, monkeypatch):
+def test_tiles_within_reach_give_the_same_bounce(tmp_path, monkeypatch, stock_styles):
     full_job, full = run(_drop_on_triangle(), tmp_path, "full")
     monkeypatch.setattr(tiles, "TILE_CLIP_MIN", 0)
     clip_job, clipped = run(_drop_on_triangle(), tmp_path, "clipped")
@@ -190,7 +200,7 @@ def test_tiles_within_reach_give_the_same_bounce(tmp_path, monkeypatch):
         np.testing.assert_allclose(b.triangle_force, a.triangle_force, rtol=1e-9, atol=1e-12)
 
 
-def test_sphere_leaving_the_tiled_region_stops_the_run(tmp_path, monkeypatch):
+def test_sphere_leaving_the_tiled_region_stops_the_run(tmp_path, monkeypatch, stock_styles):
     monkeypatch.setattr(tiles, "TILE_CLIP_MIN", 0)
     monkeypatch.setattr(reach, "REACH_SAFETY", 1e-6)       # a wrong reach estimate
     m = _drop_on_triangle()

@@ -402,22 +402,30 @@ def test_resume_after_editing_the_model_file_is_refused(tmp_path):
 
 # -- 10. MPI: the failing rank's message always arrives ---------------------------------------
 @pytest.mark.skipif(not MPIEXEC, reason="mpiexec not found (pip install mpich)")
-def test_mpi_rank0_write_failure_always_prints(tmp_path):
-    """Rank 0 fails while writing the results (a full disk, simulated by sitecustomize)."""
+@pytest.mark.parametrize("styles", ["plugin", "stock"])
+def test_mpi_rank0_write_failure_always_prints(tmp_path, styles):
+    """Rank 0 fails while writing the results (a full disk, simulated by sitecustomize): with
+    the plugin when the files LAMMPS wrote move into place, with stock styles when fibrelmp
+    converts the frames."""
     hook = tmp_path / "hook"
     hook.mkdir()
     (hook / "sitecustomize.py").write_text(
         "import errno, os\n"
         "if os.environ.get('PMI_RANK') == '0':\n"
         "    from fibrelmp.translate.fibrenet import writer as fibrenet_out\n"
+        "    from fibrelmp.pipeline import fibrenet as fibrenet_pipeline\n"
         "    def finish(self):\n"
         "        raise OSError(errno.ENOSPC, 'No space left on device', str(self.path))\n"
-        "    fibrenet_out.XyzWriter.finish = finish\n")
+        "    def move_file(src, dst):\n"
+        "        raise OSError(errno.ENOSPC, 'No space left on device', str(dst))\n"
+        "    fibrenet_out.XyzWriter.finish = finish\n"
+        "    fibrenet_pipeline.move_file = move_file\n")
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(hook), str(REPO)]))
     inp = fibre_case(tmp_path / "in", run="200", output_freq="100")
-    for k in range(6):
-        res = subprocess.run([MPIEXEC, "-n", "2"] + CLI + ["-q", "run", str(inp), "-o", str(tmp_path / f"o{k}")],
-                             cwd=tmp_path, capture_output=True, text=True, timeout=120, env=env)
+    extra = ["--stock-styles"] if styles == "stock" else []
+    for k in range(6 if styles == "stock" else 3):
+        res = subprocess.run([MPIEXEC, "-n", "2"] + CLI + ["-q", "run", str(inp), "-o", str(tmp_path / f"o{k}")]
+                             + extra, cwd=tmp_path, capture_output=True, text=True, timeout=120, env=env)
         assert res.returncode != 0
         assert "No space left on device" in res.stderr, f"attempt {k}: no message\n{res.stderr}"
 

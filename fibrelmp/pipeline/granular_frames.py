@@ -1,7 +1,8 @@
 """Granular frames: a ``GranularFrame`` per saved step, built from a running job's dumps.
 
 The job (``translate.granular_job``) dumps the spheres, the alive bonds (a local dump) and the
-wall tiles at every saved step, and appends every bond break to ``breaks.dump``.  A
+wall tiles (or fix musen/wall/mesh's triangle forces) at every saved step, and appends every
+bond break to ``breaks.dump``.  A
 ``FrameBuilder`` reads them back (``post.lammps_dump``'s reader, local dumps included) as
 soon as LAMMPS has written them and keeps only one frame plus the per-bond/per-sphere end
 times in memory.  It is the pipeline's frame source for granular jobs.
@@ -70,6 +71,7 @@ class FrameBuilder:
         self.frames = iter_frames(job.frames)
         self.bonds = iter_frames(job.bond_dump) if job.bond_dump is not None else None
         self.tiles = iter_frames(job.tile_dump) if job.tile_dump is not None else None
+        self.mesh = iter_frames(job.wall_forces) if job.wall_forces is not None else None
         self.breaks = _BreakLog(job.breaks)
         self.sphere_end = np.full(sp.count, np.inf)
         self.present = np.zeros(sp.count, bool)
@@ -185,17 +187,31 @@ class FrameBuilder:
         bf = np.full((self.nb, 3), np.nan)
         # no bond dump when no bond survives the start (e.g. all left the domain at t = 0)
         cols = next(self.bonds).columns if self.bonds is not None else {}
+        # musen/elastic also dumps the tangential overlap and |M_n + M_t| (MUSEN's TotalTorque)
+        extra = "c_fl_bforce[7]" in cols
+        overlap = np.full((self.nb, 3), np.nan) if extra else None
+        torque = np.full(self.nb, np.nan) if extra else None
         if len(cols.get("c_fl_bpair[1]", [])):
             i1 = cols["c_fl_bpair[1]"].astype(np.int64)
             i2 = cols["c_fl_bpair[2]"].astype(np.int64)
             fb = np.column_stack([cols[f"c_fl_bforce[{k}]"] for k in range(1, 4)])
             br = self._bond_lookup(i1, i2)
             ok = br >= 0
-            # b5..b7 is the force on batom1; report the force on the bond's first sphere
+            # the force on batom1 (and the overlap seen from it): report them for the bond's
+            # first sphere
             sign = np.where(i1[ok] == self.first_id[br[ok]], 1.0, -1.0)
             bf[br[ok]] = fb[ok] * sign[:, None]
+            if extra:
+                ov = np.column_stack([cols[f"c_fl_bforce[{k}]"] for k in range(4, 7)])
+                overlap[br[ok]] = ov[ok] * sign[:, None]
+                torque[br[ok]] = cols["c_fl_bforce[7]"][ok]
         bf[~self.bond_alive] = 0.0
         frame.bond_force = bf
+        if extra:
+            overlap[~self.bond_alive] = 0.0
+            torque[~self.bond_alive] = 0.0
+            frame.bond_tangential_overlap = overlap
+            frame.bond_torque = torque
 
     def _exit_time(self, r: int, t: float) -> float:
         """Ballistic estimate of when sphere r crossed the domain, from the previous frame."""
@@ -232,6 +248,11 @@ class FrameBuilder:
                 if len(hit):
                     k = nearest_triangle(cp[hit], verts[wp.triangle_rows])
                     np.add.at(tforce, wp.triangle_rows[k], -fw[hit])
+        if self.mesh is not None:
+            # fix musen/wall/mesh: the force on each triangle (id = its position in the mesh)
+            fm = next(self.mesh).columns
+            k = fm["id"].astype(np.int64) - 1
+            tforce[self.job.mesh_rows[k]] = np.column_stack([fm["fx"], fm["fy"], fm["fz"]])
         if self.tiles is not None:
             ft = next(self.tiles).columns
             ids = ft["id"].astype(np.int64)
@@ -248,6 +269,6 @@ class FrameBuilder:
 
     def close(self) -> None:
         self.breaks.close()
-        for dump in (self.frames, self.bonds, self.tiles):
+        for dump in (self.frames, self.bonds, self.tiles, self.mesh):
             if dump is not None:
                 dump.close()

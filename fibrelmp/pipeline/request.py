@@ -35,6 +35,7 @@ class Rendered:
     text: str                          # the script (also on MPI ranks that wrote no file)
     schedule: Iterable[int]            # the steps of the saved frames, in order (lazy)
     dumps: list[Path]                  # files the script appends to (cut back on resume)
+    finished: Callable[[Any], None] | None = None   # called with LAMMPS after the last command
 
     @property
     def folder(self) -> Path:

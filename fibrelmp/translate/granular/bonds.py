@@ -1,6 +1,15 @@
 """Solid bonds of a granular job: the bonds alive at the start between simulated spheres, and
-their LAMMPS bond types (bpm/rotational coefficients, one per material and binned diameter
-and initial length)."""
+their LAMMPS bond types.
+
+With fibrelmp's LAMMPS styles (``exact``): ``bond_style musen/elastic``, MUSEN's elastic or
+Kelvin bond and its breakage criteria; one bond type per bond material (E, G, strengths,
+viscosity) and each bond's own diameter, initial length and initial tangential overlap in
+per-atom arrays (``fix property/atom``, a ``BondGeometry`` section of the data file) on the
+atom that stores it, the bond's first (MUSEN "left") sphere.
+
+Without them: stock ``bond_style bpm/rotational`` coefficients, one type per material and
+binned diameter and initial length, an approximation of MUSEN's law that says so.
+"""
 
 from __future__ import annotations
 
@@ -14,8 +23,27 @@ from fibrelmp.granmodel import GranularModel
 from fibrelmp.lammps_text import comment_text
 from fibrelmp.translate.granular.schedule import RunTime
 
-BOND_BIN_RTOL = 1e-3        # bond types: diameter and L0 binned to 0.1 % (log bins)
+BOND_BIN_RTOL = 1e-3        # stock bond types: diameter and L0 binned to 0.1 % (log bins)
 BIG = 1e300                 # "never breaks"
+GEOMETRY_SECTION = "BondGeometry"    # data-file sections BondGeometry1..K: per-atom bond geometry
+GEOMETRY_FIX = "fl_bgeom"           # their fix property/atom IDs fl_bgeom1..K
+PARTNERS, VALUES = "fl_bp", "fl_bv"  # their per-atom values i_fl_bpk, d2_fl_bvk
+
+
+@dataclass
+class BondGeometry:
+    """Per-atom slots for ``musen/elastic geometry``: for each LAMMPS atom (row of the data
+    file's atoms, in order) the partner ids of up to K bonds it stores (0: none) and, for
+    each, d, L0 [and the initial tangential overlap, 3].  One ``fix property/atom`` and one
+    data-file section per slot: read_data cuts lines at 256 characters, so a whole atom's
+    bonds cannot be one line."""
+    partners: np.ndarray             # (natoms, K) int
+    values: np.ndarray               # (natoms, K, width)
+    width: int                       # 2 (d L0) or 5 (d L0 overlap)
+
+    @property
+    def slots(self) -> int:
+        return self.partners.shape[1]
 
 
 @dataclass
@@ -24,13 +52,15 @@ class SimulatedBonds:
     types: list[dict] = field(default_factory=list)      # coefficients of each bond type
     type: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))    # type of each (0-based)
     max_length: float = 0.0          # longest bond (communication cutoff)
+    exact: bool = False              # musen/elastic (types: per material) or bpm/rotational
 
 
 def select_bonds(model: GranularModel, run: RunTime, spheres, periodic: np.ndarray,
-                 warnings: list[tuple[str, str]]) -> SimulatedBonds:
-    """Bonds alive at the start whose spheres are both simulated (``spheres``), typed."""
+                 warnings: list[tuple[str, str]], exact: bool = False) -> SimulatedBonds:
+    """Bonds alive at the start whose spheres are both simulated (``spheres``), typed:
+    ``exact`` for ``musen/elastic`` (fibrelmp's styles), else for stock ``bpm/rotational``."""
     bonds = model.bonds
-    out = SimulatedBonds()
+    out = SimulatedBonds(exact=exact)
     if bonds is None or not bonds.count:
         return out
     eps, t_start, keep, x = 0.5 * run.dt, run.t_start, spheres.keep, spheres.x
@@ -47,6 +77,24 @@ def select_bonds(model: GranularModel, run: RunTime, spheres, periodic: np.ndarr
         if (d <= 0).any() or (L0 <= 0).any():
             raise InputError(model.source, None, "solid bonds need diameter > 0 and initial length > 0")
         bm = bonds.material[bond_rows].astype(np.int64)
+        dist = np.linalg.norm(x[pair[bond_rows, 0]] - x[pair[bond_rows, 1]], axis=1)
+        out.max_length = float(max(L0.max(), dist.max() if not periodic.any() else L0.max()))
+        if exact:
+            mats, btype = np.unique(bm, return_inverse=True)
+            out.type = btype.reshape(-1)
+            out.types = [_musen_coeffs(model, int(m), int((bm == m).sum())) for m in mats]
+            return out
+        if model.plan.bond_model != "elastic":
+            raise InputError(model.source, None, f"MUSEN's {model.plan.bond_model} solid bond "
+                             "needs fibrelmp's LAMMPS styles (bond_style musen/elastic), which "
+                             "are not used here; stock LAMMPS has no equivalent")
+        breaking = ("LAMMPS bpm/rotational breaks on the sum of four load ratios, not MUSEN's "
+                    "two criteria (normal stress or tangential stress); "
+                    if int(model.plan.bond_breakage) else "")
+        warnings.append(("approximate MUSEN physics", f"solid bonds: {breaking}bond_style "
+                         "bpm/rotational bins diameters and initial lengths to 0.1 % and bends "
+                         "and twists with the total rotation (Wang 2009), not MUSEN's "
+                         "incremental law (docs/granular.md)"))
         key = np.stack([bm, _tol_bins(d, BOND_BIN_RTOL), _tol_bins(L0, BOND_BIN_RTOL)], 1)
         ukeys, btype = np.unique(key, axis=0, return_inverse=True)
         out.type = btype = btype.reshape(-1)
@@ -54,14 +102,63 @@ def select_bonds(model: GranularModel, run: RunTime, spheres, periodic: np.ndarr
             sel = btype == t
             out.types.append(_bond_coeffs(model, int(ukeys[t, 0]), float(d[sel].mean()),
                                           float(L0[sel].mean()), int(sel.sum())))
-        dist = np.linalg.norm(x[pair[bond_rows, 0]] - x[pair[bond_rows, 1]], axis=1)
         pre = np.abs(dist - L0) > 1e-3 * L0
         if pre.any() and not periodic.any():
             warnings.append(("bond prestress", f"{int(pre.sum())} bond(s) whose sphere distance "
                              "differs from the stored initial length by > 0.1 %: LAMMPS bonds "
                              "start unstressed at the current distance"))
-        out.max_length = float(max(L0.max(), dist.max() if not periodic.any() else L0.max()))
     return out
+
+
+def bond_geometry(model: GranularModel, bonds: SimulatedBonds, atom_rows: np.ndarray,
+                  natoms: int) -> BondGeometry:
+    """The per-atom bond geometry of the data file's ``natoms`` atoms; the first
+    ``len(atom_rows)`` are the spheres ``atom_rows`` (LAMMPS id = sphere row + 1)."""
+    b = model.bonds
+    rows = bonds.rows
+    left = b.pair[rows, 0].astype(np.int64)
+    right = b.pair[rows, 1].astype(np.int64)
+    where = np.full(int(max(atom_rows.max(initial=-1), left.max(initial=-1))) + 1, -1, np.int64)
+    where[atom_rows] = np.arange(len(atom_rows))
+    atom = where[left]                                   # data-file atom storing each bond
+    order = np.argsort(atom, kind="stable")
+    atom_sorted = atom[order]
+    first = np.searchsorted(atom_sorted, atom_sorted)    # slot = rank within the atom's bonds
+    slot = np.empty(len(rows), np.int64)
+    slot[order] = np.arange(len(rows)) - first
+    K = int(slot.max()) + 1 if len(rows) else 1
+    overlap = b.tangential_overlap
+    width = 5 if overlap is not None and np.any(overlap[rows]) else 2
+    partners = np.zeros((natoms, K), np.int64)
+    values = np.zeros((natoms, K, width))
+    partners[atom, slot] = right + 1
+    values[atom, slot, 0] = b.diameter[rows]
+    values[atom, slot, 1] = b.length0[rows]
+    if width == 5:
+        values[atom, slot, 2:] = overlap[rows]
+    return BondGeometry(partners, values, width)
+
+
+def _musen_coeffs(model: GranularModel, mat: int, count: int) -> dict:
+    """bond_coeff of musen/elastic for the bonds of material ``mat``: E G sigma_n tau_s mu
+    (SimplifiedScene::AddSolidBond: NormalStiffness = E, TangentialStiffness = G =
+    E/(2(1+nu)), strengths and the compound's dynamic viscosity)."""
+    m = model.materials[mat]
+    E, G = m.youngs, m.shear_modulus
+    if not (E > 0 and math.isfinite(E) and G > 0 and math.isfinite(G)):
+        raise InputError(model.source, None, f"material '{m.name}' of solid bonds needs Young's "
+                         "modulus > 0 and a Poisson ratio in (-1, 0.5]")
+    mu = 0.0
+    if model.plan.bond_model == "kelvin":
+        mu = m.props.get(2, float("nan"))
+        if not (math.isfinite(mu) and mu >= 0):
+            raise InputError(model.source, None, f"material '{m.name}' of solid bonds needs a "
+                             "dynamic viscosity >= 0 (property 2), which MUSEN's Kelvin bond uses")
+
+    def strength(value: float) -> float:
+        return value if math.isfinite(value) else BIG
+    return dict(E=E, G=G, sn=strength(m.normal_strength), ts=strength(m.shear_strength), mu=mu,
+                comment=f"{comment_text(m.name)} ({count} bonds)")
 
 
 def _tol_bins(values: np.ndarray, rtol: float) -> np.ndarray:

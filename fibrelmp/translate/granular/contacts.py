@@ -1,6 +1,8 @@
-"""Contact laws in LAMMPS terms: ``granular`` pair_coeff / fix wall/gran arguments reproducing a
-MUSEN/DEMDF Hertz-Mindlin law, the rolling-resistance spring, and the pair_coeff lines of
-every pair of LAMMPS types (spheres and wall particles)."""
+"""Contact laws in LAMMPS terms: the pair_coeff lines of every pair of LAMMPS types (spheres
+and wall particles), either for fibrelmp's ``pair_style musen/hm`` (MUSEN's law exactly:
+E*, G*, e, mu, mu_r as the model holds them) or for stock ``pair_style granular``
+(``law_args``: hertz/material + mindlin + rolling sds approximating it, also used by the
+``fix wall/gran`` walls), and the rolling-resistance spring of the stock form."""
 
 from __future__ import annotations
 
@@ -85,16 +87,46 @@ def rolling_spring(m_min: float, dt: float, source=None) -> tuple[float, float]:
 
 
 
+def musen_args(law: ContactLaw, scale: float = 1.0) -> str:
+    """``pair_coeff`` arguments of ``pair_style musen/hm``: E* G* e mu mu_r (moduli optionally
+    scaled, for wall particles)."""
+    return " ".join(float_text(v) for v in (law.youngs_eff * scale, law.shear_eff * scale,
+                                            law.restitution, law.friction, law.rolling_friction))
+
+
 # fallback of type pairs without a law (wall particle - wall particle: never in contact)
 NO_CONTACT = "hertz/material 1.0 1.0 0.0 tangential linear_nohistory 0.0 0.0 damping coeff_restitution"
+NO_CONTACT_MUSEN = "1.0 0.0 1.0 0.0 0.0"
+
+# the stock form's deviations from MUSEN's particle-particle law (docs/granular.md)
+STOCK_PAIR_WARNING = ("particle-particle contacts use stock `pair_style granular`: rolling friction "
+                      "acts on the relative rolling (LAMMPS rolling sds) instead of each sphere's "
+                      "own spin, spin about the contact normal is not braked, and the tangential "
+                      "damping is inside the Coulomb test (MUSEN tests the spring force alone)")
+
+
+def stock_pair_deviates(model: GranularModel, sphere_mats) -> bool:
+    """Whether stock ``pair_style granular`` deviates from MUSEN's law for some pair of these
+    sphere materials: only through friction (tangential or rolling); the normal law is exact."""
+    for a in sphere_mats:
+        for b in sphere_mats:
+            law = model.contacts.get((min(a, b), max(a, b)))
+            if law is not None and ((law.shear_eff > 0 and law.friction > 0) or law.rolling_friction > 0):
+                return True
+    return False
 
 
 def pair_coeff_lines(model: GranularModel, spheres, tile_materials: list[int], tile_radius: float,
-                     dt: float) -> list[str]:
+                     dt: float, musen_hm: bool = False) -> list[str]:
     """``pair_coeff i j ...`` of every pair of LAMMPS types: sphere types (one per sphere
     material of ``spheres``, a ``SimulatedSpheres``), then wall-particle types (one per
-    ``tile_materials``).  A sphere meets a wall particle of ``tile_radius`` with E*, G* and the
-    rolling friction scaled so the contact acts like one with the flat wall."""
+    ``tile_materials``).  ``musen_hm``: for ``pair_style musen/hm``, else ``granular``.
+
+    A sphere meets a wall particle of ``tile_radius`` with E* and G* scaled by
+    sqrt((R_p + r_w)/r_w) (R_p: the material's mean contact radius), so that the Hertz force
+    and both stiffnesses are those of the flat wall (R* = R_p).  The stock rolling spring's
+    cap, mu_roll |F_n| R*, is scaled to mu_r |F_n| R_p too; musen/hm's rolling torque already
+    uses the sphere's own radius, so mu_r stays."""
     pair_lines = []
     types_mat = [("s", m) for m in spheres.mats] + [("t", m) for m in tile_materials]
     if not types_mat:
@@ -105,18 +137,25 @@ def pair_coeff_lines(model: GranularModel, spheres, tile_materials: list[int], t
             kj, mj = types_mat[j]
             if ki == "s" and kj == "s":
                 law = check_law(model, mi, mj)
-                k, g = rolling_spring(min(spheres.m_min[mi], spheres.m_min[mj]), dt)
-                args = law_args(law, 2.0 * law.rolling_friction, k, g)
+                if musen_hm:
+                    args = musen_args(law)
+                else:
+                    k, g = rolling_spring(min(spheres.m_min[mi], spheres.m_min[mj]), dt)
+                    args = law_args(law, 2.0 * law.rolling_friction, k, g)
             elif ki == "s" and kj == "t":
                 law = check_law(model, mi, mj)
                 rp = spheres.r_mean[mi]
                 scale = math.sqrt((rp + tile_radius) / tile_radius)
-                k, g = rolling_spring(spheres.m_min[mi], dt)
-                args = law_args(law, law.rolling_friction * (rp + tile_radius) / tile_radius, k, g, scale)
+                if musen_hm:
+                    args = musen_args(law, scale)
+                else:
+                    k, g = rolling_spring(spheres.m_min[mi], dt)
+                    args = law_args(law, law.rolling_friction * (rp + tile_radius) / tile_radius, k, g,
+                                    scale)
             else:
                 args = None
             if args is not None and any_law is None:
                 any_law = args
             pair_lines.append([i + 1, j + 1, args])
-    fallback = any_law or NO_CONTACT
+    fallback = any_law or (NO_CONTACT_MUSEN if musen_hm else NO_CONTACT)
     return [f"pair_coeff      {i} {j} {a if a is not None else fallback}" for i, j, a in pair_lines]

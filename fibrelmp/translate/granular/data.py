@@ -10,11 +10,16 @@ import numpy as np
 
 from fibrelmp.lammps_text import comment_text
 from fibrelmp.textio import atomic_write
+from fibrelmp.translate.granular.bonds import GEOMETRY_SECTION
 from fibrelmp.translate.lammps_format import data_rows, float_text
 
 
 def write_data(model, path: Path, rows, type_of_mat, smat, crad, lo, hi, ntypes,
-               tx, ttype, tv, tids, tile_radius, tile_mass, bond_rows, btype, nbtypes) -> None:
+               tx, ttype, tv, tids, tile_radius, tile_mass, bond_rows, btype, nbtypes,
+               geometry=None) -> None:
+    """``geometry`` (bonds.BondGeometry, or None): the per-atom bond geometry sections
+    BondGeometry1..K that ``read_data … fix fl_bgeomk NULL BondGeometryk`` hands to fix
+    property/atom (one line per atom, in the Atoms section's order)."""
     sp = model.spheres
     n = len(rows) + len(tx)
     parts = [f"LAMMPS data file written by fibrelmp from {comment_text(model.source.name)}\n\n",
@@ -56,4 +61,9 @@ def write_data(model, path: Path, rows, type_of_mat, smat, crad, lo, hi, ntypes,
         b = model.bonds.pair[bond_rows].astype(np.int64) + 1
         parts.append("\nBonds\n\n")
         parts.append(data_rows("%d %d %d %d\n", [np.arange(1, len(b) + 1), btype + 1, b[:, 0], b[:, 1]]))
+        if geometry is not None:
+            for k in range(geometry.slots):
+                cols = [ids, geometry.partners[:, k]] + [geometry.values[:, k, c] for c in range(geometry.width)]
+                parts.append(f"\n{GEOMETRY_SECTION}{k + 1}\n\n")
+                parts.append(data_rows("%d %d" + " %.17g" * geometry.width + "\n", cols))
     atomic_write(path, "".join(parts))

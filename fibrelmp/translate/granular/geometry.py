@@ -15,10 +15,16 @@ Anything else is tiled with frozen wall particles (see ``tile_triangles``).
 
 Motion (MUSEN geometry motion type 1): in [t_begin, t_end) the geometry translates with v and
 rotates with angular velocity w about a fixed centre c (or about its own moving centroid when
-``rotate_around_centre``), i.e. dx/dt = v + w x (x - c).  The exact solution of each interval
-is x(t) = R(t) x0 + b(t) with every entry of R and b of the form
+``rotate_around_centre``: the area-weighted centroid of its triangles, as MUSEN's
+CPUSimulator::MoveWalls computes it), i.e. dx/dt = v + w x (x - c).  The exact solution of
+each interval is x(t) = R(t) x0 + b(t) with every entry of R and b of the form
 k0 + k1 tau + k2 cos(|w| tau) + k3 sin(|w| tau)  (tau = t - interval start), which is what
-the LAMMPS variables evaluate and what the frames report.
+the LAMMPS variables and fix musen/wall/mesh evaluate and what the frames report.
+
+The wall *velocity* MUSEN reports and its contact law uses is not always the motion's: when no
+interval moves a geometry any more (after the last one ends, or in a gap or a zero interval),
+MUSEN's MoveWalls skips it and its walls keep the velocity, rotation velocity and rotation
+centre they last had (``Kinematics.wall_state``).
 """
 
 from __future__ import annotations
@@ -159,6 +165,18 @@ def triangle_areas(v: np.ndarray) -> np.ndarray:
     return 0.5 * np.linalg.norm(np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0]), axis=1)
 
 
+def area_centroid(v: np.ndarray) -> np.ndarray:
+    """The area-weighted centroid of triangles (k,3,3): the centre a geometry rotating "around
+    its centre" turns about in MUSEN (CPUSimulator::MoveWalls)."""
+    if not len(v):
+        return np.zeros(3)
+    a = triangle_areas(v)
+    total = float(a.sum())
+    if total == 0.0:
+        return np.zeros(3)
+    return (a[:, None] * (v.sum(axis=1) / 3.0)).sum(axis=0) / total
+
+
 def detect_box(v: np.ndarray) -> BoxShape | None:
     pts = v.reshape(-1, 3)
     lo, hi = pts.min(0), pts.max(0)
@@ -288,6 +306,21 @@ class Segment:
 
 
 @dataclass
+class WallMotion:
+    """One MUSEN time interval as its contact law sees it (closed: t_begin <= t <= t_end)."""
+
+    t_begin: float
+    t_end: float
+    velocity: np.ndarray
+    centre: np.ndarray
+    omega: np.ndarray
+
+    @property
+    def moves(self) -> bool:
+        return bool(self.velocity.any() or self.omega.any())
+
+
+@dataclass
 class Kinematics:
     """Rigid motion of one geometry from t_start on (identity before the first interval)."""
 
@@ -296,6 +329,8 @@ class Kinematics:
     moving: bool = False
     rotating: bool = False
     single_axis: np.ndarray | None = None     # common rotation axis if all rotations share it
+    motions: list[WallMotion] = field(default_factory=list)   # sorted by t_begin, not ended at t_start
+    around_centre: bool = False
 
     def segment(self, t: float) -> Segment | None:
         for s in self.segments:
@@ -308,13 +343,41 @@ class Kinematics:
             return np.eye(3), np.zeros(3)
         return self.segment(t).at(t)
 
+    def wall_state(self, t: float) -> tuple[WallMotion | None, bool]:
+        """(the interval whose velocity, rotation velocity and centre MUSEN's walls carry at
+        time t or None (never moved: all zero), whether the geometry moves at t).
+
+        MUSEN (CGeometryMotion::UpdateMotionInfo) takes the interval with
+        t_begin <= t <= t_end; when there is none or it does not move the geometry,
+        CPUSimulator::MoveWalls skips the geometry and the walls keep the values of the last
+        interval that moved them: the wall stands still while MUSEN's contact law and its
+        result file still see it moving."""
+        cur = next((m for m in self.motions if m.t_begin <= t <= m.t_end), None)
+        if cur is not None and cur.moves:
+            return cur, True
+        last = None
+        for m in self.motions:
+            if m.t_begin <= t and m.moves:
+                last = m
+        return last, False
+
     def velocity(self, t: float) -> np.ndarray:
-        """The translation velocity MUSEN reports for the walls at time t (that of the motion
-        interval containing t)."""
-        for t0, t1, v in self.intervals:
-            if t0 <= t < t1:
-                return v.copy()
-        return np.zeros(3)
+        """The translation velocity MUSEN reports for the walls at time t: that of the motion
+        interval holding t, kept after the motion stops (``wall_state``)."""
+        m, _ = self.wall_state(t)
+        return m.velocity.copy() if m is not None else np.zeros(3)
+
+    def kept_velocity(self, t0: float, t1: float) -> tuple[float, np.ndarray, np.ndarray] | None:
+        """The first time in [t0, t1) from which the geometry stands still while MUSEN keeps a
+        non-zero wall velocity or rotation velocity (time, velocity, rotation velocity), or
+        None: the quirk ``wall_state`` describes, which fibrelmp reproduces and warns about."""
+        bounds = sorted({t0, t1} | {m.t_begin for m in self.motions if t0 < m.t_begin < t1}
+                        | {m.t_end for m in self.motions if t0 <= m.t_end < t1})
+        for a, b in zip(bounds, bounds[1:]):
+            m, moving = self.wall_state(0.5 * (a + b))
+            if m is not None and not moving:
+                return a, m.velocity.copy(), m.omega.copy()
+        return None
 
     def angle(self, t: float) -> float:
         """Rotation angle about ``single_axis`` (only when rotations share one axis)."""
@@ -331,12 +394,18 @@ def geometry_kinematics(geom: Geometry, vertices0: np.ndarray, t_start: float,
     """Segments of time-dependent motion (motion_type 1) from t_start to t_end.
 
     ``vertices0``: the geometry's triangles (k,3,3) at t_start (for the centroid when it
-    rotates about its own centre: the mean of the triangle centroids, as MUSEN computes it).
+    rotates about its own centre: their area-weighted centroid, as MUSEN computes it).
     """
     kin = Kinematics()
     if geom.motion_type != 1 or not geom.motion:
         return kin
-    g0 = vertices0.mean(axis=1).mean(axis=0) if len(vertices0) else np.zeros(3)
+    kin.around_centre = bool(geom.rotate_around_centre)
+    # a simulation starts with still walls (MUSEN's InitializeGeometricalObjects): intervals
+    # that ended before t_start leave no kept velocity
+    kin.motions = [WallMotion(float(iv.t_begin), float(iv.t_end), np.asarray(iv.velocity, float).copy(),
+                              np.asarray(iv.centre, float).copy(), np.asarray(iv.angular_velocity, float).copy())
+                   for iv in sorted(geom.motion, key=lambda m: m.t_begin) if iv.t_end >= t_start]
+    g0 = area_centroid(vertices0)
     rk, bk = np.eye(3), np.zeros(3)
     t = t_start
     axes = []

@@ -1,7 +1,12 @@
 """Walls of a granular job: how each geometry (triangle group) or plane is represented in
-LAMMPS (``plan_walls``: a region box / cylinder, wall particles, or a wall/gran plane) and the
-region, fix and variable commands of the regions, planes and moving wall particles
-(``wall_commands``)."""
+LAMMPS (``plan_walls``) and the region, fix and variable commands of the regions, planes and
+moving wall particles (``wall_commands``).
+
+With fibrelmp's LAMMPS styles (``lammps_styles.plugin()``), every geometry of a MUSEN scene is
+its exact triangles in ``fix musen/wall/mesh`` (kind ``mesh``: MUSEN's particle-wall law and
+contact resolution; see ``mesh.py``).  Without them (and for DEMDF planes, whose law is not
+MUSEN's) stock LAMMPS walls stand in: a region box / cylinder, wall particles ("tiles"), or a
+wall/gran plane, and MUSEN geometries are named in an "approximate MUSEN physics" warning."""
 
 from __future__ import annotations
 
@@ -9,12 +14,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from fibrelmp import lammps_styles
 from fibrelmp.errors import InputError
 from fibrelmp.granmodel import Geometry, GranularModel
+from fibrelmp.lammps_text import LammpsText, comment_text
 from fibrelmp.translate.granular.contacts import check_law, law_args, rolling_spring
 from fibrelmp.translate.granular.geometry import (BoxShape, CylinderShape, Kinematics, detect_cylinder,
                                                   detect_oriented_box, geometry_kinematics,
                                                   geometry_triangle_rows, piecewise_expression)
+from fibrelmp.translate.granular.mesh import MESH_FIX, MESH_NAME
 from fibrelmp.translate.lammps_format import float_text
 
 
@@ -23,7 +31,7 @@ class WallPlan:
     """How one geometry (group of triangles) or plane is represented."""
 
     name: str
-    kind: str                        # box | cylinder | tiles | plane
+    kind: str                        # mesh | box | cylinder | tiles | plane | ignored
     description: str
     triangle_rows: np.ndarray        # rows into model.triangles (empty for planes)
     kinematics: Kinematics
@@ -37,8 +45,18 @@ class WallPlan:
     plane_index: int | None = None           # index into model.planes
 
 
-def plan_walls(model: GranularModel, dt: float, t_end: float) -> list[WallPlan]:
-    """Representation of every geometry / plane (no files, used by ``fibrelmp check`` too)."""
+def use_mesh(model: GranularModel) -> bool:
+    """MUSEN's triangle walls become ``fix musen/wall/mesh`` triangles: with fibrelmp's styles
+    (DEMDF's planes keep stock walls: their law is fibrelmp's soft-sphere stand-in for BOS's
+    hard spheres, not MUSEN's)."""
+    return model.kind == "musen" and lammps_styles.plugin().available
+
+
+def plan_walls(model: GranularModel, dt: float, t_end: float, mesh: bool | None = None) -> list[WallPlan]:
+    """Representation of every geometry / plane (no files, used by ``fibrelmp check`` too).
+    ``mesh``: exact triangles in fix musen/wall/mesh (default: ``use_mesh``)."""
+    if mesh is None:
+        mesh = use_mesh(model)
     plans: list[WallPlan] = []
     tris = model.triangles
     t0 = model.plan.t_start
@@ -51,6 +69,17 @@ def plan_walls(model: GranularModel, dt: float, t_end: float) -> list[WallPlan]:
             kin = Kinematics()
         mats, counts = np.unique(tris.material[rows], return_counts=True)
         material = int(mats[np.argmax(counts)])
+        if mesh:
+            if geom is None:
+                plans.append(WallPlan(name, "ignored", "in no geometry: not simulated (MUSEN's "
+                                      "simulator only uses the walls of geometries)", rows, kin, material))
+                continue
+            desc = (f"{len(rows)} exact triangles -> fix musen/wall/mesh (MUSEN's particle-wall "
+                    "contact, face/edge/vertex)")
+            if kin.moving:
+                desc += ", moving (time-dependent motion)"
+            plans.append(WallPlan(name, "mesh", desc, rows, kin, material))
+            continue
         shape = detect_oriented_box(v) or detect_cylinder(v) if len(rows) else None
         if shape is not None and kin.rotating and not _region_can_rotate(shape, kin):
             shape = None        # a region rotates about one fixed axis direction only
@@ -108,8 +137,79 @@ def describe_walls(model: GranularModel) -> list[str]:
     plan = model.plan
     out = []
     for wp in plan_walls(model, plan.dt, plan.t_end):
+        counted = len(wp.triangle_rows) and wp.kind != "mesh"
         out.append(f"{wp.name}: {wp.description}" + (f" ({len(wp.triangle_rows)} triangles)"
-                                                     if len(wp.triangle_rows) else ""))
+                                                     if counted else ""))
+    return out
+
+
+def spheres_behind(v: np.ndarray, x: np.ndarray, r: np.ndarray) -> int:
+    """How many of the triangles v (k,3,3) have a sphere (centres x, radii r) touching their
+    face from behind: the centre projects inside the triangle at a signed distance in
+    (-r, 0] along the normal (V2 - V1) x (V3 - V1)."""
+    if not len(v) or not len(x):
+        return 0
+    order = np.argsort(x[:, 0], kind="stable")
+    xs, rs = x[order], r[order]
+    reach = float(rs.max())
+    e1, e2 = v[:, 1] - v[:, 0], v[:, 2] - v[:, 0]
+    n = np.cross(e1, e2)
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    lo, hi = v.min(axis=1) - reach, v.max(axis=1) + reach
+    a = np.searchsorted(xs[:, 0], lo[:, 0], "left")
+    b = np.searchsorted(xs[:, 0], hi[:, 0], "right")
+    count = 0
+    for k in np.flatnonzero(b > a):
+        p, rr = xs[a[k]:b[k]], rs[a[k]:b[k]]
+        near = ((p >= lo[k]) & (p <= hi[k])).all(axis=1)
+        p, rr = p[near], rr[near]
+        d = (p - v[k, 0]) @ n[k]
+        q = p - d[:, None] * n[k] - v[k, 0]
+        d00, d01, d11 = e1[k] @ e1[k], e1[k] @ e2[k], e2[k] @ e2[k]
+        d20, d21 = q @ e1[k], q @ e2[k]
+        den = d00 * d11 - d01 * d01
+        g, bt = (d11 * d20 - d01 * d21) / den, (d00 * d21 - d01 * d20) / den
+        inside = (g >= 0) & (bt >= 0) & (g + bt <= 1)
+        if (inside & (d <= 0) & (d > -rr)).any():
+            count += 1
+    return count
+
+
+def wall_warnings(model: GranularModel, wall_plans: list[WallPlan], t_start: float,
+                  t_end: float, spheres=None) -> list[tuple[str, str]]:
+    """What the job's wall representation does not reproduce (stock walls standing in for
+    MUSEN's), walls MUSEN does not simulate, MUSEN's kept wall velocity, and spheres behind
+    the faces of exact triangles (``spheres``: a ``SimulatedSpheres``)."""
+    out: list[tuple[str, str]] = []
+    if model.kind != "musen":
+        return out
+    for wp in wall_plans:
+        if wp.kind == "mesh" and spheres is not None and len(spheres.rows):
+            behind = spheres_behind(model.triangles.vertices[wp.triangle_rows], spheres.x[spheres.rows],
+                                    spheres.crad[spheres.rows])
+            if behind:
+                out.append(("spheres behind walls", f"geometry '{wp.name}': {behind} triangle(s) have a "
+                            "sphere touching them from behind (the side their normal (V2-V1)x(V3-V1) "
+                            "points away from): MUSEN's particle-wall law pushes spheres along the "
+                            "normal, so it pushes these through the wall; check the orientation of "
+                            "the triangles"))
+        if wp.kind in ("box", "cylinder", "tiles"):
+            out.append(("approximate MUSEN physics", f"wall geometry '{wp.name}' represented as "
+                        f"{wp.description}: LAMMPS's granular wall law stands in for MUSEN's "
+                        "particle-wall contact (docs/granular.md, Walls)"))
+        elif wp.kind == "ignored":
+            out.append(("walls in no geometry", f"{len(wp.triangle_rows)} triangular wall(s) belong "
+                        "to no geometry: MUSEN's simulator does not use them, so they are not "
+                        "simulated either"))
+        kept = wp.kinematics.kept_velocity(t_start, t_end) if wp.kind != "ignored" else None
+        if kept is not None:
+            t, v, w = kept
+            what = ("reproduced: the contact law sees the wall moving" if wp.kind == "mesh" else
+                    "NOT reproduced by the stock representation (its walls stop)")
+            out.append(("MUSEN kept wall velocity", f"geometry '{wp.name}' stops moving at t = "
+                        f"{t:.6g} but MUSEN keeps its last wall velocity ({', '.join(f'{c:.6g}' for c in v)}) "
+                        f"and rotation velocity ({', '.join(f'{c:.6g}' for c in w)}) in its contact law "
+                        f"and result file; {what}"))
     return out
 
 
@@ -122,9 +222,15 @@ def wall_commands(model: GranularModel, wall_plans: list[WallPlan], spheres, dt:
     frame_columns: list[str] = []
     mat_groups = spheres.material_groups()
     xs = spheres.x[spheres.rows]
+    if any(wp.kind == "mesh" for wp in wall_plans):
+        wall_cmds.append(LammpsText("# " + comment_text(f"the exact triangles of every wall geometry "
+                                                         f"({MESH_NAME}), MUSEN's particle-wall contact")))
+        wall_cmds.append(f"fix             {MESH_FIX} spheres musen/wall/mesh {MESH_NAME}")
     for gi, wp in enumerate(wall_plans):
         tag = f"w{gi + 1}"
-        if wp.kind in ("box", "cylinder"):
+        if wp.kind == "mesh":
+            wp.fixes.append(MESH_FIX)
+        elif wp.kind in ("box", "cylinder"):
             _region_wall(model, wp, tag, mat_groups, xs, spheres.smat, spheres.m_min, dt, wall_cmds,
                          var_cmds, frame_columns)
         elif wp.kind == "plane":

@@ -10,13 +10,17 @@ import math
 
 import numpy as np
 
+from fibrelmp import lammps_styles
 from fibrelmp.errors import InputError
 from fibrelmp.granmodel import GranularModel
 from fibrelmp.translate.musen.scene import (INTERACTION_DEFAULTS, _check_material, check_simulable, contact_law,
                     domain_warning)
 from fibrelmp.translate.musen.script_parse import MUSEN_MODELS, SUPPORTED_MODELS, MusenJob, model_kind
 
-MODEL_PARAMETERS = {"ModelSBElastic": {"CONSIDER_BREAKAGE": 1.0}}   # AddParameter(...) defaults
+MODEL_PARAMETERS = {"ModelSBElastic": {"CONSIDER_BREAKAGE": 1.0},    # AddParameter(...) defaults
+                    "ModelSBKelvin": {"CONSIDER_BREAKAGE": 1.0, "MAX_DAMP_RATIO": 1.0}}
+# models translated only with fibrelmp's own LAMMPS styles (stock LAMMPS has no equivalent)
+STYLE_MODELS = {"SB": {"ModelSBKelvin": "bond_style musen/elastic with MUSEN's Kelvin damping"}}
 MUSEN_DEFAULTS = {"dt": 1e-6, "save": 1e-3, "t_end": 1.0, "gravity": (0.0, 0.0, -9.81)}
 
 
@@ -32,7 +36,14 @@ def _resolve_models(model: GranularModel, job: MusenJob) -> dict[str, tuple[str,
         if spec.kind and spec.kind != kind:
             raise InputError(job.path, spec.line, f"{spec.name} is a {kind} model, given as "
                              f"MODEL_{spec.kind}")
-        if SUPPORTED_MODELS.get(kind) != spec.name:
+        if spec.name in STYLE_MODELS.get(kind, {}):
+            styles = lammps_styles.plugin()
+            if not styles.available:
+                raise InputError(job.path, spec.line, f"{spec.name} needs fibrelmp's LAMMPS styles "
+                                 f"({STYLE_MODELS[kind][spec.name]}), which are not available here "
+                                 f"({styles.how}); stock LAMMPS has no such solid bond, so fibrelmp "
+                                 "translates ModelSBElastic only without them")
+        elif SUPPORTED_MODELS.get(kind) != spec.name:
             what = {"PP": "particle-particle", "PW": "particle-wall", "SB": "solid-bond",
                     "LB": "liquid-bond", "EF": "external-force"}[kind]
             ok = SUPPORTED_MODELS.get(kind)
@@ -94,10 +105,19 @@ def apply_simulator_settings(model: GranularModel, job: MusenJob) -> None:
     model.passthrough["musen_models"] = models
     _check_models(model, job, models)
     if "SB" in models:
-        plan.bond_breakage = int(models["SB"][1]["CONSIDER_BREAKAGE"])
-        if plan.bond_breakage not in (0, 1, 2):
+        name, params = models["SB"]
+        plan.bond_breakage = int(params["CONSIDER_BREAKAGE"])
+        if plan.bond_breakage not in (0, 1, 2) or plan.bond_breakage != params["CONSIDER_BREAKAGE"]:
             raise InputError(job.path, job.where("MODEL_SB_PARAMS"), "CONSIDER_BREAKAGE must be "
-                             f"0, 1 or 2 (got {models['SB'][1]['CONSIDER_BREAKAGE']:g})")
+                             f"0, 1 or 2 (got {params['CONSIDER_BREAKAGE']:g})")
+        plan.bond_model = "kelvin" if name == "ModelSBKelvin" else "elastic"
+        if plan.bond_model == "kelvin":
+            # ModelSBKelvin: any non-zero CONSIDER_BREAKAGE is its one criterion (MUSEN's 1)
+            plan.bond_breakage = 1 if plan.bond_breakage else 0
+            plan.bond_max_damp_ratio = float(params["MAX_DAMP_RATIO"])
+            if not (plan.bond_max_damp_ratio >= 0 and math.isfinite(plan.bond_max_damp_ratio)):
+                raise InputError(job.path, job.where("MODEL_SB_PARAMS"), "MAX_DAMP_RATIO must be "
+                                 f">= 0 (0: no cap; got {plan.bond_max_damp_ratio:g})")
     if job.connected_pp_contact is not None:
         plan.contacts_between_bonded = job.connected_pp_contact
     _apply_times(model, job)

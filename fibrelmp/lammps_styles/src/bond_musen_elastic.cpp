@@ -1,0 +1,793 @@
+/* ----------------------------------------------------------------------
+   fibrelmp's LAMMPS styles; GPL-2.0-or-later like LAMMPS (see ../LICENSE).
+   BondMusenElastic: see bond_musen_elastic.h.
+
+   The law follows MUSEN's CModelSBElastic::CalculateSB / CModelSBKelvin::CalculateSB and
+   their ConsolidatePart term by term, in MUSEN's order of floating-point operations (its
+   CVector3 operator* of two vectors is the cross product, CMatrix3 * CVector3 a row-by-row
+   dot product), so a bond evolves as in MUSEN given the same positions and velocities.
+
+   Where the bond is evaluated in a step: LAMMPS computes bonds in the force stage, after
+   the positions x(t) were updated and with the velocities of the half step, exactly as
+   MUSEN's leapfrog evaluates CalculateSB with x(t) and v(t - dt/2).  The break time MUSEN
+   writes (EndActivity = the simulator's current time during the force stage) is the time
+   of x(t): the step number LAMMPS has during this compute.
+
+   Setup computes (update->setupflag: the start of every run command, run 0, read_restart)
+   evaluate the stored state without advancing it, like LAMMPS's granular pair styles do
+   with their contact history: a run split into several run commands then computes the same
+   forces as one run.
+------------------------------------------------------------------------- */
+
+#include "bond_musen_elastic.h"
+
+#include "fix_musen_history.h"
+
+#include "atom.h"
+#include "comm.h"
+#include "domain.h"
+#include "error.h"
+#include "force.h"
+#include "memory.h"
+#include "modify.h"
+#include "neigh_list.h"
+#include "neighbor.h"
+#include "pair.h"
+#include "update.h"
+#include "utils.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+
+using namespace LAMMPS_NS;
+
+namespace {
+
+// MUSEN's PI (MUSENDefinitions.h); A and I are computed from d with it as MUSEN does
+constexpr double MUSEN_PI = 3.14159265358979323846;
+const char *const HISTORY_ID = "FIBRELMP_MUSEN_BOND_HISTORY";
+
+// ---- vector helpers in MUSEN's operation order (CBasicVector3)
+inline double dot(const double *a, const double *b)
+{
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+inline double length(const double *a)
+{
+  return sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+}
+inline void cross(const double *a, const double *b, double *c)
+{
+  c[0] = a[1] * b[2] - a[2] * b[1];
+  c[1] = a[2] * b[0] - a[0] * b[2];
+  c[2] = a[0] * b[1] - a[1] * b[0];
+}
+inline void scale(const double *a, double s, double *c)
+{
+  c[0] = a[0] * s;
+  c[1] = a[1] * s;
+  c[2] = a[2] * s;
+}
+inline void sub(const double *a, const double *b, double *c)
+{
+  c[0] = a[0] - b[0];
+  c[1] = a[1] - b[1];
+  c[2] = a[2] - b[2];
+}
+inline void add(const double *a, const double *b, double *c)
+{
+  c[0] = a[0] + b[0];
+  c[1] = a[1] + b[1];
+  c[2] = a[2] + b[2];
+}
+// MUSEN's matrix M applied to v (CMatrix3 * CVector3)
+inline void matvec(const double m[3][3], const double *v, double *c)
+{
+  c[0] = m[0][0] * v[0] + m[0][1] * v[1] + m[0][2] * v[2];
+  c[1] = m[1][0] * v[0] + m[1][1] * v[1] + m[1][2] * v[2];
+  c[2] = m[2][0] * v[0] + m[2][1] * v[1] + m[2][2] * v[2];
+}
+
+// Kelvin damping capped at ratio * |elastic| (ModelSBKelvin: MAX_DAMP_RATIO, 0 = no cap)
+inline void cap_damping(double *damp, double elastic_length, double ratio)
+{
+  if (ratio != 0.0) {
+    const double dl = length(damp);
+    if (dl > ratio * elastic_length) {
+      const double s = ratio * elastic_length / dl;
+      damp[0] *= s;
+      damp[1] *= s;
+      damp[2] *= s;
+    }
+  }
+}
+
+struct LawInput {
+  const double *xl, *xr;    // left sphere, right sphere (the image closest to the left one)
+  const double *vl, *vr, *wl, *wr;
+  double dt, E, G, mu;
+  int kelvin;
+  double max_damp_ratio;
+};
+
+struct LawOutput {
+  double total[3];      // force on the left sphere (MUSEN TotalForce)
+  double mleft[3];      // moment on the left sphere
+  double mright[3];     // moment on the right sphere
+  double bond[3];       // left - right
+  double strain;
+  double normal_force_length;
+  double normal_scalar;    // -A E strain: the normal force along the unit bond vector
+  double tangential_force_length;
+};
+
+/* One evaluation of MUSEN's solid bond on the state h (FixMusenHistory values, H_* layout).
+   advance: MUSEN's CalculateSB (rotate and increment the state by one step of dt);
+   otherwise the forces of the stored state (tangential overlap, moments, damping) at the
+   current positions.  damp_now (not advancing): compute the Kelvin damping from the current
+   velocities and store it (a bond's first evaluation has no stored damping). */
+void musen_law(const LawInput &in, double *h, bool advance, bool damp_now, LawOutput &out)
+{
+  using B = BondMusenElastic;
+  const double d = h[B::H_DIAMETER], L0 = h[B::H_LENGTH0];
+  const double A = MUSEN_PI * d * d / 4;                // CrossCut (SimplifiedScene)
+  const double I = MUSEN_PI * d * d * d * d / 64;       // AxialMoment
+
+  double relAngleVel[3], currentBond[3], rAC[3], sumAngleVelocity[3], relativeVelocity[3];
+  double tmp[3], tmp2[3];
+  sub(in.wl, in.wr, relAngleVel);
+  sub(in.xl, in.xr, currentBond);    // GetSolidBond(right, left) = left - right
+  const double dist = length(currentBond);
+  scale(currentBond, 0.5, rAC);
+  add(in.wl, in.wr, sumAngleVelocity);
+  sub(in.vl, in.vr, tmp);
+  cross(sumAngleVelocity, rAC, tmp2);
+  sub(tmp, tmp2, relativeVelocity);
+
+  double currentContact[3] = {currentBond[0] / dist, currentBond[1] / dist, currentBond[2] / dist};
+
+  double normalVelocity[3], tangentialVelocity[3];
+  scale(currentContact, dot(currentContact, relativeVelocity), normalVelocity);
+  sub(relativeVelocity, normalVelocity, tangentialVelocity);
+
+  const double strain = (dist - L0) / L0;
+  const double normal_scalar = -1 * A * in.E * strain;
+  double normalForce[3];
+  scale(currentContact, normal_scalar, normalForce);
+
+  double *overlap = h + B::H_OVERLAP;
+  double *nmoment = h + B::H_NMOMENT;
+  double *tmoment = h + B::H_TMOMENT;
+  double *dampn = h + B::H_DAMPN;
+  double *dampt = h + B::H_DAMPT;
+  const double kt = in.G * A / L0;
+  double tangentialForce[3];
+
+  if (advance) {
+    double tv[3], phi[3];
+    cross(h + B::H_PREVBOND, currentBond, tv);
+    scale(currentContact, dot(sumAngleVelocity, currentContact) * in.dt * 0.5, phi);
+    // ModelSBElastic.cpp: the rotation of the bond frame over the step (first order)
+    const double M[3][3] = {
+        {1 + tv[2] * phi[2] + tv[1] * phi[1], phi[2] - tv[2] - tv[1] * phi[0],
+         -phi[1] - tv[2] * phi[0] + tv[1]},
+        {tv[2] - phi[2] - tv[0] * phi[1], tv[2] * phi[2] + 1 + tv[0] * phi[0],
+         -tv[2] * phi[1] + phi[0] - tv[0]},
+        {-tv[1] - tv[0] * phi[2] + phi[1], -tv[1] * phi[2] + tv[0] - phi[0],
+         tv[1] * phi[1] + tv[0] * phi[0] + 1}};
+
+    double normalAngleVel[3], tangAngleVel[3];
+    scale(currentContact, dot(currentContact, relAngleVel), normalAngleVel);
+    sub(relAngleVel, normalAngleVel, tangAngleVel);
+
+    if (in.kelvin) {
+      // -mu * v_n * A * E * |strain|, left to right
+      for (int k = 0; k < 3; k++) dampn[k] = normalVelocity[k] * -in.mu * A * in.E * fabs(strain);
+      cap_damping(dampn, length(normalForce), in.max_damp_ratio);
+    }
+
+    matvec(M, overlap, tmp);
+    scale(tangentialVelocity, in.dt, tmp2);
+    sub(tmp, tmp2, overlap);
+    scale(overlap, kt, tangentialForce);
+
+    if (in.kelvin) {
+      const double ol = length(overlap);
+      for (int k = 0; k < 3; k++) dampt[k] = tangentialVelocity[k] * -in.mu * ol * kt;
+      cap_damping(dampt, length(tangentialForce), in.max_damp_ratio);
+    }
+
+    matvec(M, nmoment, tmp);
+    scale(normalAngleVel, in.dt * 2 * I * in.G / L0, tmp2);
+    sub(tmp, tmp2, nmoment);
+    matvec(M, tmoment, tmp);
+    scale(tangAngleVel, in.dt * in.E * I / L0, tmp2);
+    sub(tmp, tmp2, tmoment);
+    for (int k = 0; k < 3; k++) h[B::H_PREVBOND + k] = currentBond[k];
+  } else {
+    scale(overlap, kt, tangentialForce);
+    if (in.kelvin && damp_now) {
+      for (int k = 0; k < 3; k++) dampn[k] = normalVelocity[k] * -in.mu * A * in.E * fabs(strain);
+      cap_damping(dampn, length(normalForce), in.max_damp_ratio);
+      const double ol = length(overlap);
+      for (int k = 0; k < 3; k++) dampt[k] = tangentialVelocity[k] * -in.mu * ol * kt;
+      cap_damping(dampt, length(tangentialForce), in.max_damp_ratio);
+    }
+  }
+
+  add(normalForce, tangentialForce, out.total);
+  if (in.kelvin) {
+    add(out.total, dampn, out.total);
+    add(out.total, dampt, out.total);
+  }
+  double unsym[3], msum[3];
+  cross(rAC, tangentialForce, unsym);    // MUSEN UnsymMoment: from the elastic part only
+  add(nmoment, tmoment, msum);
+  sub(msum, unsym, out.mleft);           // ConsolidatePart, left:  + (M_n + M_t) - rAC x F_t
+  add(msum, unsym, out.mright);          //                 right: - ((M_n + M_t) + rAC x F_t)
+  for (int k = 0; k < 3; k++) {
+    out.mright[k] = -out.mright[k];
+    out.bond[k] = currentBond[k];
+  }
+  out.strain = strain;
+  out.normal_force_length = length(normalForce);
+  out.normal_scalar = normal_scalar;
+  out.tangential_force_length = length(tangentialForce);
+}
+
+// MUSEN's breakage test (ModelSBElastic: CONSIDER_BREAKAGE 1 and 2; ModelSBKelvin: 1)
+bool musen_breaks(int criterion, const double *h, const LawOutput &out, double sigma_n,
+                  double tau_s)
+{
+  using B = BondMusenElastic;
+  if (criterion == 0) return false;
+  const double d = h[B::H_DIAMETER];
+  const double A = MUSEN_PI * d * d / 4;
+  const double I = MUSEN_PI * d * d * d * d / 64;
+  double forceLength = out.normal_force_length;
+  if (out.strain <= 0) forceLength *= -1;    // compression counts negative
+  const double maxStress1 = forceLength / A;
+  const double maxStress2 = length(h + B::H_TMOMENT) * d / (2.0 * I);
+  const double maxTorque1 = out.tangential_force_length / A;
+  const double maxTorque2 = length(h + B::H_NMOMENT) * d / (4.0 * I);
+  if (criterion == 1)
+    return maxStress1 + maxStress2 >= sigma_n || maxTorque1 + maxTorque2 >= tau_s;
+  return maxStress1 >= sigma_n || (maxStress2 >= sigma_n && out.strain > 0) ||
+      maxTorque1 >= tau_s || maxTorque2 >= tau_s;
+}
+
+}    // namespace
+
+/* ---------------------------------------------------------------------- */
+
+BondMusenElastic::BondMusenElastic(LAMMPS *lmp) :
+    Bond(lmp), youngs(nullptr), shear(nullptr), sigma_n(nullptr), tau_s(nullptr),
+    viscosity(nullptr), diam0(nullptr), len0(nullptr), breakage(1), kelvin(0),
+    max_damp_ratio(1.0), breaks_fp(nullptr), per_atom_geometry(0), nslots(0), nvalues_per(0),
+    update_special(0), max_length0(0.0), history(nullptr),
+    history_id(HISTORY_ID)
+{
+  partial_flag = 1;    // broken bonds get type 0 (the neighbor lists then skip them)
+  writedata = 0;       // the per-bond geometry is not a bond type's coefficient
+  single_extra = 7;    // force on the first atom (3), tangential overlap (3), |M_n + M_t|
+  svector = new double[single_extra];
+  born_matrix_enable = 0;
+}
+
+BondMusenElastic::~BondMusenElastic()
+{
+  if (copymode) return;
+  delete[] svector;
+  svector = nullptr;
+  if (breaks_fp) fclose(breaks_fp);
+  if (history && modify && modify->get_fix_by_id(history_id)) modify->delete_fix(history_id);
+  if (allocated) {
+    memory->destroy(setflag);
+    memory->destroy(youngs);
+    memory->destroy(shear);
+    memory->destroy(sigma_n);
+    memory->destroy(tau_s);
+    memory->destroy(viscosity);
+    memory->destroy(diam0);
+    memory->destroy(len0);
+  }
+}
+
+/* ---------------------------------------------------------------------- */
+
+void BondMusenElastic::compute(int eflag, int vflag)
+{
+  ev_init(eflag, vflag);
+
+  double **x = atom->x;
+  double **v = atom->v;
+  double **omega = atom->omega;
+  double **f = atom->f;
+  double **torque = atom->torque;
+  tagint *tag = atom->tag;
+  const int nlocal = atom->nlocal;
+  const int newton_bond = force->newton_bond;
+  int **bondlist = neighbor->bondlist;
+  const int nbondlist = neighbor->nbondlist;
+  const bool advance = !update->setupflag;
+
+  LawInput in;
+  in.dt = update->dt;
+  in.kelvin = kelvin;
+  in.max_damp_ratio = max_damp_ratio;
+  LawOutput out;
+
+  for (int n = 0; n < nbondlist; n++) {
+    const int i1 = bondlist[n][0];    // stores the bond: MUSEN's left sphere
+    const int i2 = bondlist[n][1];    // its partner's image closest to i1
+    const int type = bondlist[n][2];
+    if (type <= 0) continue;
+
+    double *h = history->find(i1, tag[i2]);
+    bool fresh = false;
+    if (!h) {
+      h = init_entry(i1, i2, type);
+      fresh = true;
+    }
+    in.xl = x[i1];
+    in.xr = x[i2];
+    in.vl = v[i1];
+    in.vr = v[i2];
+    in.wl = omega[i1];
+    in.wr = omega[i2];
+    in.E = youngs[type];
+    in.G = shear[type];
+    in.mu = viscosity[type];
+    musen_law(in, h, advance, fresh, out);
+
+    if (musen_breaks(breakage, h, out, sigma_n[type], tau_s[type])) {
+      // MUSEN: Active = false, EndActivity = time; an inactive bond is not consolidated
+      bondlist[n][2] = 0;
+      for (int m = 0; m < atom->num_bond[i1]; m++)
+        if (atom->bond_atom[i1][m] == tag[i2] && atom->bond_type[i1][m] == type) {
+          atom->bond_type[i1][m] = 0;
+          break;
+        }
+      history->erase(i1, tag[i2]);
+      broken.push_back(update->ntimestep);
+      broken.push_back(tag[i1]);
+      broken.push_back(tag[i2]);
+      continue;
+    }
+
+    for (int k = 0; k < 3; k++) {
+      f[i1][k] += out.total[k];
+      torque[i1][k] += out.mleft[k];
+      f[i2][k] -= out.total[k];
+      torque[i2][k] += out.mright[k];
+    }
+    if (evflag)
+      ev_tally_xyz(i1, i2, nlocal, newton_bond, 0.0, out.total[0], out.total[1], out.total[2],
+                   out.bond[0], out.bond[1], out.bond[2]);
+  }
+
+  if (breakage) process_breaks();
+}
+
+/* ----------------------------------------------------------------------
+   the state of a bond met for the first time: its d and L0 (per-atom arrays or the type's
+   coefficients; L0 <= 0: the current distance), the initial tangential overlap (per-atom
+   arrays, else 0), zero moments, and the bond vector left - right as previous bond.
+   (MUSEN's AddSolidBond stores right - left there, but its first, half-step "prediction"
+   step calls CalculateSB with unchanged positions, where PrevBond x currentBond is exactly
+   0 either way, and leaves left - right behind: what its later steps use.)
+------------------------------------------------------------------------- */
+
+double *BondMusenElastic::init_entry(int i1, int i2, int type)
+{
+  const tagint partner = atom->tag[i2];
+  double d, L0, ov[3] = {0.0, 0.0, 0.0};
+  if (per_atom_geometry) {
+    int k = 0;
+    while (k < nslots && atom->ivector[ipartners[k]][i1] != partner) k++;
+    if (k == nslots)
+      error->one(FLERR,
+                 "Bond style musen/elastic: bond {}-{} has no entry in the per-atom slots i_{}1.."
+                 "i_{}{} (the first atom of a bond lists its partner there)",
+                 atom->tag[i1], partner, partners_name, partners_name, nslots);
+    const double *val = atom->darray[ivalues[k]][i1];
+    d = val[0];
+    L0 = val[1];
+    if (nvalues_per == 5)
+      for (int c = 0; c < 3; c++) ov[c] = val[2 + c];
+  } else {
+    d = diam0[type];
+    L0 = len0[type];
+  }
+  if (!(d > 0.0) || !std::isfinite(d) || !std::isfinite(L0))
+    error->one(FLERR, "Bond style musen/elastic: bond {}-{} has diameter {} and length {}",
+               atom->tag[i1], partner, d, L0);
+  double bond[3];
+  sub(atom->x[i1], atom->x[i2], bond);
+  if (L0 <= 0.0) L0 = length(bond);    // RESET_INITIAL_BOND_LENGTH: the current distance
+  if (!(L0 > 0.0))
+    error->one(FLERR, "Bond style musen/elastic: bond {}-{} joins two spheres at one point",
+               atom->tag[i1], partner);
+  max_length0 = std::max(max_length0, L0);
+
+  double *h = history->get(i1, partner);
+  for (int c = 0; c < 3; c++) {
+    h[H_OVERLAP + c] = ov[c];
+    h[H_PREVBOND + c] = bond[c];
+  }
+  h[H_DIAMETER] = d;
+  h[H_LENGTH0] = L0;
+  return h;
+}
+
+/* ----------------------------------------------------------------------
+   bonds broken on any rank in this compute: counted, written (rank 0, sorted, so the
+   file does not depend on the domain decomposition) and, where bonded spheres do not
+   interact by contact (1-2 special weights not 1), removed from the special lists
+------------------------------------------------------------------------- */
+
+void BondMusenElastic::process_breaks()
+{
+  int mine = static_cast<int>(broken.size());
+  int total = mine;
+  if (comm->nprocs > 1) MPI_Allreduce(&mine, &total, 1, MPI_INT, MPI_SUM, world);
+  if (total == 0) return;
+
+  std::vector<bigint> all;
+  if (comm->nprocs > 1) {
+    std::vector<int> counts(comm->nprocs), displs(comm->nprocs, 0);
+    MPI_Allgather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, world);
+    for (int p = 1; p < comm->nprocs; p++) displs[p] = displs[p - 1] + counts[p - 1];
+    all.resize(total);
+    MPI_Allgatherv(broken.data(), mine, MPI_LMP_BIGINT, all.data(), counts.data(), displs.data(),
+                   MPI_LMP_BIGINT, world);
+  } else {
+    all.swap(broken);
+  }
+  broken.clear();
+
+  const int nbroken = total / 3;
+  std::vector<std::array<bigint, 3>> rec(nbroken);
+  for (int r = 0; r < nbroken; r++) rec[r] = {all[3 * r], all[3 * r + 1], all[3 * r + 2]};
+  std::sort(rec.begin(), rec.end());
+
+  atom->nbonds -= nbroken;
+  if (comm->me == 0 && breaks_fp) {
+    for (const auto &r : rec) utils::print(breaks_fp, "{} {} {}\n", r[0], r[1], r[2]);
+    fflush(breaks_fp);
+  }
+  if (update_special)
+    for (const auto &r : rec) forget_special((tagint) r[1], (tagint) r[2]);
+}
+
+/* a broken bond's spheres are no longer 1-2 neighbours: drop each from the other's special
+   list (owned atoms; the neighbor build reads those) and clear the special bits of their pair
+   in the current pair neighbor list, so their contact acts from the next step, as MUSEN's
+   contact list (CVerletList::RemoveSBContacts) keeps only pairs of active bonds out */
+
+void BondMusenElastic::forget_special(tagint a, tagint b)
+{
+  const int nlocal = atom->nlocal;
+  for (int side = 0; side < 2; side++) {
+    const tagint me = side ? b : a, other = side ? a : b;
+    const int i = atom->map(me);
+    if (i < 0 || i >= nlocal) continue;
+    tagint *sp = atom->special[i];
+    int *ns = atom->nspecial[i];
+    for (int k = 0; k < ns[0]; k++)
+      if (sp[k] == other) {
+        for (int m = k; m < ns[2] - 1; m++) sp[m] = sp[m + 1];
+        ns[0]--;
+        ns[1]--;
+        ns[2]--;
+        break;
+      }
+  }
+  Pair *pair = force->pair;
+  if (!pair || !pair->list) return;
+  NeighList *list = pair->list;
+  tagint *tag = atom->tag;
+  for (int ii = 0; ii < list->inum; ii++) {
+    const int i = list->ilist[ii];
+    if (tag[i] != a && tag[i] != b) continue;
+    const tagint other = tag[i] == a ? b : a;
+    int *jlist = list->firstneigh[i];
+    for (int jj = 0; jj < list->numneigh[i]; jj++) {
+      const int j = jlist[jj] & NEIGHMASK;
+      if (tag[j] == other) jlist[jj] = j | (jlist[jj] & (1 << HISTBITS));
+    }
+  }
+}
+
+/* ---------------------------------------------------------------------- */
+
+void BondMusenElastic::allocate()
+{
+  allocated = 1;
+  const int np1 = atom->nbondtypes + 1;
+  memory->create(youngs, np1, "bond:youngs");
+  memory->create(shear, np1, "bond:shear");
+  memory->create(sigma_n, np1, "bond:sigma_n");
+  memory->create(tau_s, np1, "bond:tau_s");
+  memory->create(viscosity, np1, "bond:viscosity");
+  memory->create(diam0, np1, "bond:diam0");
+  memory->create(len0, np1, "bond:len0");
+  memory->create(setflag, np1, "bond:setflag");
+  for (int i = 1; i < np1; i++) {
+    setflag[i] = 0;
+    diam0[i] = len0[i] = 0.0;
+  }
+}
+
+/* bond_style musen/elastic [breakage 0|1|2] [kelvin ratio] [geometry PARTNERS VALUES]
+   [breaks FILE] */
+
+void BondMusenElastic::settings(int narg, char **arg)
+{
+  int iarg = 0;
+  while (iarg < narg) {
+    const std::string key = arg[iarg];
+    if (key == "breakage") {
+      if (iarg + 2 > narg) utils::missing_cmd_args(FLERR, "bond_style musen/elastic breakage", error);
+      breakage = utils::inumeric(FLERR, arg[iarg + 1], false, lmp);
+      if (breakage < 0 || breakage > 2)
+        error->all(FLERR, "Bond style musen/elastic: breakage must be 0 (none), 1 (MUSEN's two "
+                          "stress sums) or 2 (each stress term alone), got {}", arg[iarg + 1]);
+      iarg += 2;
+    } else if (key == "kelvin") {
+      if (iarg + 2 > narg) utils::missing_cmd_args(FLERR, "bond_style musen/elastic kelvin", error);
+      kelvin = 1;
+      max_damp_ratio = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
+      if (max_damp_ratio < 0.0 || !std::isfinite(max_damp_ratio))
+        error->all(FLERR, "Bond style musen/elastic: kelvin MAX_DAMP_RATIO must be >= 0 "
+                          "(0: no cap), got {}", arg[iarg + 1]);
+      iarg += 2;
+    } else if (key == "geometry") {
+      if (iarg + 4 > narg) utils::missing_cmd_args(FLERR, "bond_style musen/elastic geometry", error);
+      partners_name = arg[iarg + 1];
+      values_name = arg[iarg + 2];
+      nslots = utils::inumeric(FLERR, arg[iarg + 3], false, lmp);
+      if (nslots < 1)
+        error->all(FLERR, "Bond style musen/elastic: geometry needs K >= 1 slots, got {}",
+                   arg[iarg + 3]);
+      per_atom_geometry = 1;
+      iarg += 4;
+    } else if (key == "breaks") {
+      if (iarg + 2 > narg) utils::missing_cmd_args(FLERR, "bond_style musen/elastic breaks", error);
+      breaks_file = arg[iarg + 1];
+      iarg += 2;
+    } else {
+      error->all(FLERR, "Bond style musen/elastic: unknown keyword {} (known: breakage, kelvin, "
+                        "geometry, breaks)", key);
+    }
+  }
+}
+
+/* bond_coeff N E G sigma_n tau_s mu [d L0] */
+
+void BondMusenElastic::coeff(int narg, char **arg)
+{
+  const int want = per_atom_geometry ? 6 : 8;
+  if (narg != want)
+    error->all(FLERR, "Bond style musen/elastic: bond_coeff needs {}: type E G sigma_n tau_s mu{}",
+               per_atom_geometry ? "6 values" : "8 values",
+               per_atom_geometry ? " (d and L0 come per bond from the geometry arrays)" : " d L0");
+  if (!allocated) allocate();
+  int ilo, ihi;
+  utils::bounds(FLERR, arg[0], 1, atom->nbondtypes, ilo, ihi, error);
+  const double E = utils::numeric(FLERR, arg[1], false, lmp);
+  const double G = utils::numeric(FLERR, arg[2], false, lmp);
+  const double sn = utils::numeric(FLERR, arg[3], false, lmp);
+  const double ts = utils::numeric(FLERR, arg[4], false, lmp);
+  const double mu = utils::numeric(FLERR, arg[5], false, lmp);
+  double d = 0.0, L0 = 0.0;
+  if (!per_atom_geometry) {
+    d = utils::numeric(FLERR, arg[6], false, lmp);
+    L0 = utils::numeric(FLERR, arg[7], false, lmp);
+    if (!(d > 0.0) || !std::isfinite(d))
+      error->all(FLERR, "Bond style musen/elastic: bond diameter must be > 0, got {}", arg[6]);
+    if (!std::isfinite(L0))
+      error->all(FLERR, "Bond style musen/elastic: L0 must be finite (<= 0: the distance at the "
+                        "first use), got {}", arg[7]);
+  }
+  if (!(E > 0.0) || !std::isfinite(E) || !(G > 0.0) || !std::isfinite(G))
+    error->all(FLERR, "Bond style musen/elastic: E and G must be > 0, got {} {}", arg[1], arg[2]);
+  if (std::isnan(sn) || std::isnan(ts) || !(mu >= 0.0))
+    error->all(FLERR, "Bond style musen/elastic: strengths must be numbers and mu >= 0, got {} "
+                      "{} {}", arg[3], arg[4], arg[5]);
+
+  int count = 0;
+  for (int i = ilo; i <= ihi; i++) {
+    youngs[i] = E;
+    shear[i] = G;
+    sigma_n[i] = sn;
+    tau_s[i] = ts;
+    viscosity[i] = mu;
+    diam0[i] = d;
+    len0[i] = L0;
+    setflag[i] = 1;
+    count++;
+  }
+  if (count == 0) error->all(FLERR, "Incorrect args for bond coefficients");
+}
+
+/* ---------------------------------------------------------------------- */
+
+void BondMusenElastic::init_style()
+{
+  if (!atom->omega_flag || !atom->torque_flag)
+    error->all(FLERR, "Bond style musen/elastic needs an atom style with omega and torque "
+                      "(e.g. bpm/sphere)");
+  if (atom->molecular != Atom::MOLECULAR)
+    error->all(FLERR, "Bond style musen/elastic needs a molecular atom style (bonds stored per atom)");
+  if (!force->newton_bond)
+    error->all(FLERR, "Bond style musen/elastic needs newton_bond on (each bond is computed once, "
+                      "on the atom that stores it and its history)");
+  if (!comm->ghost_velocity)
+    error->all(FLERR, "Bond style musen/elastic needs comm_modify vel yes (velocities and "
+                      "angular velocities of the partner atoms)");
+
+  if (per_atom_geometry) {
+    ipartners.assign(nslots, -1);
+    ivalues.assign(nslots, -1);
+    nvalues_per = 0;
+    for (int k = 0; k < nslots; k++) {
+      const std::string pname = fmt::format("{}{}", partners_name, k + 1);
+      const std::string vname = fmt::format("{}{}", values_name, k + 1);
+      int flag, cols;
+      ipartners[k] = atom->find_custom(pname.c_str(), flag, cols);
+      if (ipartners[k] < 0 || flag != 0 || cols != 0)
+        error->all(FLERR, "Bond style musen/elastic: no per-atom integer vector i_{} (fix "
+                          "property/atom i_{} d2_{} 2)", pname, pname, vname);
+      ivalues[k] = atom->find_custom(vname.c_str(), flag, cols);
+      if (ivalues[k] < 0 || flag != 1 || (cols != 2 && cols != 5))
+        error->all(FLERR, "Bond style musen/elastic: no per-atom double array d2_{} with 2 "
+                          "(d L0) or 5 (d L0 and the initial tangential overlap) columns", vname);
+      if (k > 0 && cols != nvalues_per)
+        error->all(FLERR, "Bond style musen/elastic: the geometry slots have {} and {} columns",
+                   nvalues_per, cols);
+      nvalues_per = cols;
+    }
+  }
+
+  update_special = (force->special_lj[1] != 1.0 || force->special_coul[1] != 1.0) ? 1 : 0;
+  if (update_special && force->pair && utils::strmatch(force->pair_style, "^hybrid"))
+    error->all(FLERR, "Bond style musen/elastic: with 1-2 special weights other than 1 (no "
+                      "contacts between bonded spheres) a broken bond's spheres must become a "
+                      "contact pair, which the style does in the pair style's neighbor list; a "
+                      "hybrid pair style has none");
+
+  if (!history) {
+    Fix *fix = modify->get_fix_by_id(history_id);
+    if (!fix)
+      fix = modify->add_fix(fmt::format("{} all MUSEN/HISTORY {}", history_id, (int) H_SIZE));
+    if (strcmp(fix->style, "MUSEN/HISTORY") != 0)
+      error->all(FLERR, "Bond style musen/elastic: fix {} is not its history", history_id);
+    history = static_cast<FixMusenHistory *>(fix);
+    if (history->nvalues() != H_SIZE)
+      error->all(FLERR, "Bond style musen/elastic: its history fix holds {} values per bond, "
+                        "not {}", history->nvalues(), (int) H_SIZE);
+  }
+
+  if (comm->me == 0 && !breaks_file.empty() && !breaks_fp) {
+    // appended to: a resumed run continues the file (fibrelmp cuts it back to its checkpoint)
+    breaks_fp = fopen(breaks_file.c_str(), "a");
+    if (!breaks_fp)
+      error->one(FLERR, "Bond style musen/elastic: cannot open {}: {}", breaks_file,
+                 utils::getsyserror());
+  }
+}
+
+double BondMusenElastic::equilibrium_distance(int i)
+{
+  return std::max(len0[i], max_length0);
+}
+
+/* ---------------------------------------------------------------------- */
+
+void BondMusenElastic::write_restart(FILE *fp)
+{
+  const int n = atom->nbondtypes;
+  for (double *a : {youngs, shear, sigma_n, tau_s, viscosity, diam0, len0})
+    fwrite(&a[1], sizeof(double), n, fp);
+}
+
+void BondMusenElastic::read_restart(FILE *fp)
+{
+  allocate();
+  const int n = atom->nbondtypes;
+  for (double *a : {youngs, shear, sigma_n, tau_s, viscosity, diam0, len0}) {
+    if (comm->me == 0) utils::sfread(FLERR, &a[1], sizeof(double), n, fp, nullptr, error);
+    MPI_Bcast(&a[1], n, MPI_DOUBLE, 0, world);
+  }
+  for (int i = 1; i <= n; i++) setflag[i] = 1;
+}
+
+void BondMusenElastic::write_restart_settings(FILE *fp)
+{
+  fwrite(&breakage, sizeof(int), 1, fp);
+  fwrite(&kelvin, sizeof(int), 1, fp);
+  fwrite(&max_damp_ratio, sizeof(double), 1, fp);
+}
+
+void BondMusenElastic::read_restart_settings(FILE *fp)
+{
+  if (comm->me == 0) {
+    utils::sfread(FLERR, &breakage, sizeof(int), 1, fp, nullptr, error);
+    utils::sfread(FLERR, &kelvin, sizeof(int), 1, fp, nullptr, error);
+    utils::sfread(FLERR, &max_damp_ratio, sizeof(double), 1, fp, nullptr, error);
+  }
+  MPI_Bcast(&breakage, 1, MPI_INT, 0, world);
+  MPI_Bcast(&kelvin, 1, MPI_INT, 0, world);
+  MPI_Bcast(&max_damp_ratio, 1, MPI_DOUBLE, 0, world);
+}
+
+/* ----------------------------------------------------------------------
+   for compute bond/local: the forces of the stored state at the current positions (what
+   the last compute applied when nothing moved since).  svector: force on atom i (3),
+   tangential overlap seen from i (3), |twisting + bending moment| (MUSEN's TotalTorque).
+   fforce: the normal force along the bond vector i - j divided by the distance.
+------------------------------------------------------------------------- */
+
+double BondMusenElastic::single(int type, double /*rsq*/, int i, int j, double &fforce)
+{
+  fforce = 0.0;
+  for (int k = 0; k < single_extra; k++) svector[k] = 0.0;
+  if (type <= 0 || !history) return 0.0;
+  tagint *tag = atom->tag;
+  double sign = 1.0;
+  int left = i, right = j;
+  double *h = (i < atom->nlocal) ? history->find(i, tag[j]) : nullptr;
+  if (!h && j < atom->nlocal) {
+    h = history->find(j, tag[i]);
+    sign = -1.0;
+    left = j;
+    right = i;
+  }
+  if (!h) return 0.0;
+
+  // the right sphere's image closest to the left one, as the bond list has it
+  double del[3];
+  sub(atom->x[left], atom->x[right], del);
+  domain->minimum_image(FLERR, del);
+  double xr[3];
+  sub(atom->x[left], del, xr);
+
+  LawInput in;
+  in.xl = atom->x[left];
+  in.xr = xr;
+  in.vl = atom->v[left];
+  in.vr = atom->v[right];
+  in.wl = atom->omega[left];
+  in.wr = atom->omega[right];
+  in.dt = update->dt;
+  in.E = youngs[type];
+  in.G = shear[type];
+  in.mu = viscosity[type];
+  in.kelvin = kelvin;
+  in.max_damp_ratio = max_damp_ratio;
+  double copy[H_SIZE];    // evaluating must not touch the state
+  std::copy(h, h + H_SIZE, copy);
+  LawOutput out;
+  musen_law(in, copy, false, false, out);
+
+  const double dist = length(out.bond);
+  fforce = out.normal_scalar / dist;
+  for (int k = 0; k < 3; k++) {
+    svector[k] = sign * out.total[k];
+    svector[3 + k] = sign * copy[H_OVERLAP + k];
+  }
+  double msum[3];
+  add(copy + H_NMOMENT, copy + H_TMOMENT, msum);
+  svector[6] = length(msum);
+  return 0.0;
+}
+
+double BondMusenElastic::memory_usage()
+{
+  double bytes = Bond::memory_usage();
+  bytes += 8.0 * (atom->nbondtypes + 1) * sizeof(double);
+  return bytes;
+}

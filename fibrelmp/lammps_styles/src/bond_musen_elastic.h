@@ -1,0 +1,99 @@
+/* -*- c++ -*- ----------------------------------------------------------
+   fibrelmp's LAMMPS styles; GPL-2.0-or-later like LAMMPS (see ../LICENSE).
+
+   bond_style musen/elastic: MUSEN's elastic solid bond (and, with the kelvin keyword, its
+   Kelvin bond) with MUSEN's breakage criteria.  Re-implemented from MUSEN's
+   Models/SolidBonds/BondModelElastic/ModelSBElastic.cpp and
+   Models/SolidBonds/BondModelKelvin/ModelSBKelvin.cpp (CalculateSB, ConsolidatePart);
+   MUSEN is BSD-3-Clause, (c) MUSEN Development Team.
+
+     bond_style musen/elastic [breakage 0|1|2] [kelvin MAX_DAMP_RATIO]
+                              [geometry PARTNER VALUES K] [breaks FILE]
+     bond_coeff N E G sigma_n tau_s mu [d L0]
+
+   The law is incremental: every bond keeps MUSEN's state (tangential overlap, twisting and
+   bending moments, the previous bond vector; see the H_* offsets) in a FixMusenHistory
+   entry on the atom that stores the bond (newton_bond on: the first atom of the Bonds line,
+   MUSEN's "left" sphere) keyed by the partner's tag, together with the bond's own diameter
+   and initial length.  Those come from K slots of per-atom values (fix property/atom
+   i_PARTNERk d2_VALUESk 2|5, k = 1..K: a partner tag, and d, L0 [and the initial tangential
+   overlap] of the bond to it; one slot per line of a read_data section, whose lines LAMMPS
+   limits to 256 characters) or, without the geometry keyword, from the bond type's d and L0.
+   L0 <= 0 means "the distance at the first use" (MUSEN's RESET_INITIAL_BOND_LENGTH).
+------------------------------------------------------------------------- */
+
+#ifdef BOND_CLASS
+// clang-format off
+BondStyle(musen/elastic,BondMusenElastic);
+// clang-format on
+#else
+
+#ifndef FIBRELMP_BOND_MUSEN_ELASTIC_H
+#define FIBRELMP_BOND_MUSEN_ELASTIC_H
+
+#include "bond.h"
+
+#include <cstdio>
+#include <string>
+#include <vector>
+
+namespace LAMMPS_NS {
+
+class BondMusenElastic : public Bond {
+ public:
+  BondMusenElastic(class LAMMPS *);
+  ~BondMusenElastic() override;
+  void compute(int, int) override;
+  void settings(int, char **) override;
+  void coeff(int, char **) override;
+  void init_style() override;
+  double equilibrium_distance(int) override;
+  void write_restart(FILE *) override;
+  void read_restart(FILE *) override;
+  void write_restart_settings(FILE *) override;
+  void read_restart_settings(FILE *) override;
+  double single(int, double, int, int, double &) override;
+  double memory_usage() override;
+
+  // per-bond history: offsets into a FixMusenHistory entry
+  enum {
+    H_OVERLAP = 0,      // tangential overlap (MUSEN TangentialOverlap), 3
+    H_NMOMENT = 3,      // twisting moment (MUSEN NormalMoment), 3
+    H_TMOMENT = 6,      // bending moment (MUSEN TangentialMoment), 3
+    H_PREVBOND = 9,     // bond vector left - right of the last update (MUSEN PrevBond), 3
+    H_DAMPN = 12,       // Kelvin normal damping force of the last update, 3
+    H_DAMPT = 15,       // Kelvin tangential damping force of the last update, 3
+    H_DIAMETER = 18,    // the bond's diameter d
+    H_LENGTH0 = 19,     // its initial length L0
+    H_SIZE = 20
+  };
+
+ protected:
+  // per bond type: material constants
+  double *youngs, *shear, *sigma_n, *tau_s, *viscosity, *diam0, *len0;
+  int breakage;              // MUSEN CONSIDER_BREAKAGE: 0 none, 1 sums, 2 each term
+  int kelvin;                // 1: ModelSBKelvin's damping
+  double max_damp_ratio;     // its MAX_DAMP_RATIO (0: no cap)
+  std::string partners_name, values_name;    // per-atom geometry slots (empty: coefficients)
+  std::string breaks_file;   // "step id1 id2" per broken bond (rank 0 appends)
+  FILE *breaks_fp;
+  int per_atom_geometry;
+  int nslots, nvalues_per;                     // K slots of nvalues_per values
+  std::vector<int> ipartners, ivalues;         // their custom-property indices (init_style)
+  int update_special;        // 1-2 weights not 1: a broken bond's pair must become a contact
+  double max_length0;        // longest L0 seen (equilibrium_distance)
+  class FixMusenHistory *history;
+  std::string history_id;
+
+  std::vector<bigint> broken;    // (step, tag left, tag right) found on this rank this call
+
+  void allocate();
+  double *init_entry(int i1, int i2, int type);
+  void process_breaks();
+  void forget_special(tagint, tagint);
+};
+
+}    // namespace LAMMPS_NS
+
+#endif
+#endif

@@ -1,0 +1,67 @@
+/* -*- c++ -*- ----------------------------------------------------------
+   fibrelmp's LAMMPS styles; GPL-2.0-or-later like LAMMPS (see ../LICENSE).
+
+   pair_style musen/hm: MUSEN's Hertz-Mindlin particle-particle contact
+   (MUSEN commit e0ff360, Models/ParticleParticle/HertzMindlin/ModelPPHertzMindlin.cpp,
+   CModelPPHertzMindlin::CalculatePP), re-implemented operation by operation.
+
+     pair_style musen/hm
+     pair_coeff I J Estar Gstar e mu mu_r
+
+   Estar, Gstar: the effective (already mixed) Young's and shear moduli of the material pair,
+   as MUSEN's CSimplifiedScene::CalculateInteractionProperty computes them; e: restitution
+   coefficient (0 < e <= 1), turned into MUSEN's damping coefficient
+   alpha = ln e / sqrt(pi^2 + ln^2 e); mu: sliding friction; mu_r: rolling friction.
+   Every type pair needs its own pair_coeff (MUSEN has no mixing rule for e, mu, mu_r).
+
+   The tangential overlap of each contact is kept by a FixMusenHistory (per atom, keyed by
+   the partner's tag); see pair_musen_hm.cpp for how pairs are owned under MPI.
+------------------------------------------------------------------------- */
+
+#ifdef PAIR_CLASS
+// clang-format off
+PairStyle(musen/hm,PairMusenHM);
+// clang-format on
+#else
+
+#ifndef FIBRELMP_PAIR_MUSEN_HM_H
+#define FIBRELMP_PAIR_MUSEN_HM_H
+
+#include "pair.h"
+
+namespace LAMMPS_NS {
+
+class FixMusenHistory;
+
+class PairMusenHM : public Pair {
+ public:
+  PairMusenHM(class LAMMPS *);
+  ~PairMusenHM() override;
+
+  void compute(int, int) override;
+  void settings(int, char **) override;
+  void coeff(int, char **) override;
+  void init_style() override;
+  double init_one(int, int) override;
+  void write_restart(FILE *) override;
+  void read_restart(FILE *) override;
+  void *extract(const char *, int &) override;
+  double memory_usage() override;
+
+  static constexpr const char *HISTORY_ID = "MUSEN_HM_HISTORY";
+
+ protected:
+  double **estar, **gstar;    // effective moduli per type pair
+  double **restitution;       // e, as given
+  double **alpha;             // MUSEN's dAlpha = ln e / sqrt(pi^2 + ln^2 e) (<= 0)
+  double **mu, **mu_roll;     // sliding and rolling friction
+  double *maxrad;             // largest radius per type (neighbor cutoff)
+  FixMusenHistory *history;
+
+  void allocate();
+};
+
+}    // namespace LAMMPS_NS
+
+#endif
+#endif

@@ -328,6 +328,10 @@ def run_overlapped(script: Path, total_steps: int, frame_token: Callable[[list[s
     from fibrelmp.numtext.fast import cores_taken
 
     worker = threading.Thread(target=work, daemon=True)
+    # LAMMPS runs without the GIL, but between two commands the main thread needs it back:
+    # while the converter holds it, that takes up to the switch interval (5 ms by default)
+    switch = sys.getswitchinterval()
+    sys.setswitchinterval(min(switch, 2e-4))
     worker.start()
     try:
         with cores_taken(1):        # LAMMPS's core: the converter then uses one thread only
@@ -337,6 +341,8 @@ def run_overlapped(script: Path, total_steps: int, frame_token: Callable[[list[s
         ready.put(abort)
         worker.join()
         raise
+    finally:
+        sys.setswitchinterval(switch)
     ready.put(done)
     worker.join()
     if "error" in result:

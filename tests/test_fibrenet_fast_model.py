@@ -305,3 +305,31 @@ def test_block_search_finds_the_first_line_with_the_keyword():
         for key, probe in ((b"SPRING", b"P"), (b"ANGLE", b"A"), (b"SPRING", b"S")):
             start = rnd.randint(0, len(raw))
             assert fast_reader._line_start(raw, key, probe, start) == plain(raw, key, start), (raw, key, start)
+
+
+def test_translation_shortcuts_equal_the_plain_computations():
+    """_unique_rows (sample-based factorizing) equals np.unique over rows, and scaled()
+    (sample first) finds the same decimals as trying every count from 0."""
+    from fibrelmp.numtext import shortest
+    from fibrelmp.translate import lammps_job
+
+    rng = np.random.default_rng(0)
+    for trial in range(200):
+        n = int(rng.integers(1, 30000))
+        cols = [rng.integers(0, int(rng.integers(1, 5)), n).astype(float) * rng.choice([0.5, 1.0, -0.0])
+                for _ in range(int(rng.integers(1, 4)))]
+        if trial % 7 == 0:
+            cols[0][int(rng.integers(0, n))] = 123.456                # a value the sample misses
+        if trial % 9 == 0:
+            cols = [rng.normal(size=n)]                                # all distinct
+        rows, inverse = lammps_job._unique_rows(*cols)
+        ref, ref_inv = np.unique(np.column_stack(cols), axis=0, return_inverse=True)
+        assert np.array_equal(rows, ref) and np.array_equal(inverse, ref_inv.reshape(-1)), trial
+        x = np.round(rng.normal(0, 10, n), int(rng.integers(0, 10)))
+        if trial % 5 == 0:
+            x[int(rng.integers(0, n))] = 0.1234567891                  # needs 10 decimals: None
+        found = shortest.scaled(x)
+        ref_k = next((k for k in range(10) if (np.round(x * 10.0 ** k) / 10.0 ** k == x).all()), None)
+        assert (found is None) == (ref_k is None), trial
+        if found is not None:
+            assert found[1] == ref_k and np.array_equal(found[0], np.round(x * 10.0 ** ref_k).astype(np.int64))

@@ -197,17 +197,20 @@ static inline int64_t word_token(const char **pp, const char *e, const char **st
     return (int64_t)(p - *start);
 }
 
-/* nrows lines "KEY NAME number ... number" (ncols tokens in all) into out: column 0 = 0,
+/* nrows lines "KEY NAME number ... number" (ncols tokens in all) into out (row-major, or with
+   stride != 0 column-major: value c of row r at out[c * stride + r]): column 0 = 0,
    column 1 = index of NAME in names (nnames entries, each NUL-padded to w bytes), then the
    numbers as fp_parse_block reads them.  Leading spaces/tabs, a '\r' before '\n' and a
    missing last '\n' are accepted; anything else (blank lines, another keyword, an unknown
    name, a bad number, a wrong token count) returns -1. */
 int fp_parse_tagged(const char *buf, int64_t len, const char *key, int64_t klen, const char *names,
-                    int64_t nnames, int64_t w, double *out, int64_t nrows, int64_t ncols)
+                    int64_t nnames, int64_t w, double *out, int64_t nrows, int64_t ncols,
+                    int64_t stride)
 {
     const char *p = buf, *end = buf + len;
     double *o = out;
-    if (FP_EXCESS_PRECISION || ncols < 2) return -1;
+    double row_values[64];
+    if (FP_EXCESS_PRECISION || ncols < 2 || ncols > 64) return -1;
     for (int64_t row = 0; row < nrows; row++) {
         if (p >= end) return -1;
         while (p < end && (*p == ' ' || *p == '\t')) p++;
@@ -226,10 +229,15 @@ int fp_parse_tagged(const char *buf, int64_t len, const char *key, int64_t klen,
             }
         }
         if (which < 0) return -1;
-        o[0] = 0.0;
-        o[1] = (double)which;
-        if (parse_row_rest(&p, end, o, 2, ncols)) return -1;
-        o += ncols;
+        double *v = stride ? row_values : o;
+        v[0] = 0.0;
+        v[1] = (double)which;
+        if (parse_row_rest(&p, end, v, 2, ncols)) return -1;
+        if (stride) {                       /* column-major: column c of row r at out[c * stride + r] */
+            for (int64_t c = 0; c < ncols; c++) out[c * stride + row] = v[c];
+        } else {
+            o += ncols;
+        }
     }
     return p == end ? 0 : -1;
 }

@@ -130,7 +130,7 @@ def _open(lib: Path) -> ctypes.CDLL:
         dll.fp_format_xyz.argtypes = [ptr, ptr, i64, ctypes.c_char_p, i64, i64, ctypes.c_int, ptr, i64]
         dll.fp_format_xyz.restype = i64
         dll.fp_parse_tagged.argtypes = [ptr, i64, ctypes.c_char_p, i64, ctypes.c_char_p, i64, i64,
-                                         ptr, i64, i64]
+                                         ptr, i64, i64, i64]
         dll.fp_parse_tagged.restype = ctypes.c_int
         dll.fp_format_fixed_rows.argtypes = [ptr, i64, i64, ptr, ptr, ptr, i64]
         dll.fp_format_fixed_rows.restype = i64
@@ -213,7 +213,8 @@ _cores_taken = 0         # cores this process keeps busy otherwise (LAMMPS durin
 def cores_taken(n: int = 1):
     """While this is open, ``n`` cores are busy with other work of this process (a LAMMPS run
     that frames are converted beside): large calls split across threads only if a core is
-    still free, so the conversion does not take cores from LAMMPS."""
+    still free, so the conversion does not take cores from LAMMPS.  ``n = -1`` gives one back
+    (the run is known to be over before its context ends)."""
     global _cores_taken
     with _lock:
         _cores_taken += n
@@ -279,11 +280,12 @@ def parse_numbers(block: bytes, nrows: int, ncols: int) -> np.ndarray | None:
 
 
 def parse_tagged(block: bytes | memoryview, key: str, names: list[str], ncols: int) -> np.ndarray | None:
-    """(nrows, ncols) float64 array of a FibreNet model block whose lines read
-    ``key name number ...`` (ncols tokens): column 0 is 0, column 1 the index of ``name`` in
-    ``names``; None without the C library or for anything unusual (see fp_parse_tagged)."""
+    """(ncols, nrows) float64 array -- one contiguous row per column -- of a FibreNet model
+    block whose lines read ``key name number ...`` (ncols tokens): column 0 is 0, column 1
+    the index of ``name`` in ``names``; None without the C library or for anything unusual
+    (see fp_parse_tagged)."""
     lib = library()
-    if lib is None or not block or not names:
+    if lib is None or not len(block) or not names:
         return None
     enc = [n.encode() for n in names]
     if any(not e or b"\0" in e for e in enc) or b"\0" in key.encode():
@@ -294,11 +296,12 @@ def parse_tagged(block: bytes | memoryview, key: str, names: list[str], ncols: i
     raw = np.frombuffer(block, np.uint8)         # no copy; keeps ``block`` alive
     base, size = raw.ctypes.data, len(raw)
     nrows = lib.fp_count_lines(base, size) + (0 if raw[-1] == 10 else 1)
-    out = np.empty((nrows, ncols), np.float64)
+    out = np.empty((ncols, nrows), np.float64)
+    item = out.itemsize
 
     def part(start: int, stop: int, row0: int, rows: int) -> bool:
         return lib.fp_parse_tagged(base + start, stop - start, kb, len(kb), table, len(enc), w,
-                                   out[row0:].ctypes.data, rows, ncols) == 0
+                                   out.ctypes.data + row0 * item, rows, ncols, nrows) == 0
 
     pool = _helper() if size >= SPLIT_BYTES and nrows >= 2 else None
     if pool is not None:

@@ -46,7 +46,13 @@ def scaled(x: np.ndarray, max_decimals: int = 9) -> tuple[np.ndarray, int] | Non
     if not np.isfinite(x).all():
         return None
     big = float(np.abs(x).max(initial=0.0))
-    for k in range(max_decimals + 1):
+    first = 0
+    if len(x) > 8192:       # a sample needs at most as many decimals as the column: start there
+        found = scaled(x[:: len(x) // 1024], max_decimals)
+        if found is None:
+            return None
+        first = found[1]
+    for k in range(first, max_decimals + 1):
         scale = 10.0 ** k
         if big * scale >= 2.0 ** 53:
             return None

@@ -150,11 +150,23 @@ def _scheduled(tokens: Iterator[Any], source, schedule: Iterator[int], rendered:
     """The frames of ``tokens``, checked against the job's schedule: a frame the schedule
     does not have, or one it has but the run did not write, is a RunError (raised inside the
     writers' loop, so they discard their partial results)."""
-    for step in tokens:
+    from fibrelmp.numtext.fast import cores_taken
+
+    try:
+        total = len(rendered.schedule)
+    except TypeError:
+        total = -1
+    for k, step in enumerate(tokens, 1):
         if step is _EXTRA:
             raise RunError(f"{rendered.script}: the run wrote more frames than the "
                            f"{_count(rendered.schedule)} scheduled")
-        yield source.read(step)
+        if k == total:
+            # the last frame ends the script: LAMMPS's core is free again for the reading
+            with cores_taken(-1):
+                frame = source.read(step)
+            yield frame
+        else:
+            yield source.read(step)
     missing = next(schedule, None)
     if missing is not None:
         raise RunError(f"{rendered.script}: the run ended without the frame of step {missing} "

@@ -51,6 +51,20 @@ class Job:
     native: NativeFiles | None = None     # FibreNet's files written by LAMMPS (the plugin)
 
 
+def _factorize(col: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """np.unique(col, return_inverse=True), faster for the few distinct values per column a
+    model has (types, masses, stiffnesses): the distinct values of a sample, checked to cover
+    the column, else np.unique itself."""
+    nan = col.dtype.kind == "f" and bool(np.isnan(col).any())     # np.unique merges NaNs
+    if len(col) > 8192 and not nan:
+        u = np.unique(col[:: len(col) // 2048])
+        inv = np.minimum(np.searchsorted(u, col), len(u) - 1)
+        if (u[inv] == col).all():
+            return u, inv
+    u, inv = np.unique(col, return_inverse=True)
+    return u, inv.reshape(-1)
+
+
 def _unique_rows(*cols: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """np.unique(rows, axis=0) via per-column integer codes (sorting ints, not byte rows)."""
     if not cols[0].size:
@@ -58,13 +72,17 @@ def _unique_rows(*cols: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     key = np.zeros(len(cols[0]), np.int64)
     span = 1                                       # key < span
     for col in cols:
-        u, inv = np.unique(col, return_inverse=True)
+        u, inv = _factorize(np.asarray(col))
         if span * len(u) >= 2 ** 62:               # re-compress first: no overflow
             key = np.unique(key, return_inverse=True)[1].reshape(-1)
             span = int(key.max(initial=0)) + 1
         key = key * len(u) + inv.reshape(-1)       # order-preserving: lexicographic by column
         span *= len(u)
-    _, first, inverse = np.unique(key, return_index=True, return_inverse=True)
+    u, inverse = _factorize(key)
+    if len(u) <= 64:        # a row per distinct key: where it first occurs
+        first = np.array([int(np.argmax(inverse == j)) for j in range(len(u))], np.int64)
+    else:
+        _, first, inverse = np.unique(key, return_index=True, return_inverse=True)
     return np.column_stack([np.asarray(c)[first] for c in cols]), inverse.reshape(-1)
 
 

@@ -68,10 +68,11 @@ def model_blocks(raw: bytes) -> dict[str, memoryview] | None:
 
 
 def table(text: memoryview, kind: str, col1: dict) -> np.ndarray | None:
-    """(n, ncols) floats of one block; column 0 must be the keyword on every non-blank line,
-    column 1 (type name / spring kind) is mapped through col1."""
+    """(ncols, n) floats of one block, one contiguous row per column; column 0 must be the
+    keyword on every non-blank line, column 1 (type name / spring kind) is mapped through
+    col1."""
     if not len(text):
-        return np.zeros((0, _NCOLS[kind]))
+        return np.zeros((_NCOLS[kind], 0))
     names = list(col1)
     # blank lines after the last row (before the next block) are what loadtxt skips as well
     end = len(text)
@@ -79,10 +80,13 @@ def table(text: memoryview, kind: str, col1: dict) -> np.ndarray | None:
         end -= 1
     val = fast.parse_tagged(text[:end], kind, names, _NCOLS[kind])
     if val is not None:
-        val[:, 1] = np.array([col1[n] for n in names], np.float64)[val[:, 1].astype(np.int64)]
+        val[1] = np.array([col1[n] for n in names], np.float64)[val[1].astype(np.int64)]
     else:
         val = _loadtxt(bytes(text).decode("ascii"), kind, col1)
-    if val is None or val.shape[1] != _NCOLS[kind] or not np.isfinite(val).all():
+        if val is None or val.shape[1] != _NCOLS[kind]:
+            return None
+        val = np.ascontiguousarray(val.T)
+    if val.shape[0] != _NCOLS[kind] or not np.isfinite(val).all():
         return None
     return val
 
@@ -112,40 +116,43 @@ def fast_read_model(raw: bytes, type_index: dict[str, int], type_names: list[str
     btext = blocks["BEAD"]
     if not len(btext):
         return None
-    val = table(btext, "BEAD", {k: float(v) for k, v in type_index.items()})
-    if val is None:
+    col = table(btext, "BEAD", {k: float(v) for k, v in type_index.items()})
+    if col is None:
         return None
-    n = len(val)
-    types, tags, loc = ints(val[:, 1]), ints(val[:, 2]), ints(val[:, 3])
+    n = col.shape[1]
+    types, tags, loc = ints(col[1]), ints(col[2]), ints(col[3])
     if tags is None or loc is None:
         return None
-    radius, mass = val[:, 4], val[:, 5]
-    pos, vel, force, image = val[:, 6:9], val[:, 9:12], val[:, 12:15], val[:, 15:18]
+    radius, mass = col[4], col[5]
+
+    def xyz(k: int) -> np.ndarray:                  # (n, 3) of columns k, k+1, k+2
+        return np.ascontiguousarray(col[k:k + 3].T)
+    pos, vel, force, image = xyz(6), xyz(9), xyz(12), xyz(15)
     if (radius < 0).any() or (mass < 0).any() or ((pos < 0) | (pos > size)).any():
         return None
     v_old = np.repeat(vel[:, :1], 3, axis=1)       # FibreNet's (vx, vx, vx) quirk
-    particles = Particles(list(type_names), types, pos.copy(), image.copy(), v_old, mass.copy(),
-                          radius.copy(), tags, loc, force.copy(), vel.copy())
+    particles = Particles(list(type_names), types, pos, image, v_old, mass.copy(),
+                          radius.copy(), tags, loc, force, vel.copy())
     stext = blocks["SPRING"]
-    sval = table(stext, "SPRING", {"HR": 0.0})
-    if sval is None:
+    scol = table(stext, "SPRING", {"HR": 0.0})
+    if scol is None:
         return None
-    s = springs_factory(len(sval))
-    st, a0, a1 = ints(sval[:, 2]), ints(sval[:, 3]), ints(sval[:, 4])
+    s = springs_factory(scol.shape[1])
+    st, a0, a1 = ints(scol[2]), ints(scol[3]), ints(scol[4])
     if st is None or a0 is None or a1 is None:
         return None
     s.tags, s.atoms = st, np.column_stack([a0, a1]).reshape(-1, 2)
-    s.r0, s.k = sval[:, 5].copy(), sval[:, 6].copy()
+    s.r0, s.k = scol[5].copy(), scol[6].copy()
     if ((s.atoms < 0) | (s.atoms >= n)).any() or (s.r0 < 0).any() or (s.k < 0).any() \
             or (s.atoms[:, 0] == s.atoms[:, 1]).any():
         return None
     atext = blocks["ANGLE"]
     if not len(atext):
         return particles, s, Angles.empty()
-    aval = table(atext, "ANGLE", {"HR": 0.0, "HR_FL": 1.0})
-    if aval is None:
+    acol = table(atext, "ANGLE", {"HR": 0.0, "HR_FL": 1.0})
+    if acol is None:
         return None
-    cols = [ints(aval[:, c]) for c in (3, 4, 5)]
+    cols = [ints(acol[c]) for c in (3, 4, 5)]
     if any(c is None for c in cols):
         return None
     atoms = np.column_stack(cols)
@@ -153,4 +160,4 @@ def fast_read_model(raw: bytes, type_index: dict[str, int], type_names: list[str
             or (atoms[:, 1] == atoms[:, 2]).any() or (atoms[:, 0] == atoms[:, 2]).any():
         return None
     # theta0 is read with std::stof in FibreNet: float precision
-    return particles, s, Angles(atoms, aval[:, 9].copy(), aval[:, 8].astype(np.float32).astype(np.float64))
+    return particles, s, Angles(atoms, acol[9].copy(), acol[8].astype(np.float32).astype(np.float64))

@@ -173,15 +173,16 @@ def read(path: str | Path) -> Model:
     bonds = springs.to_bonds()
     periodic = all(box.periodic)
     _check_positions(particles, box, periodic, model_path, notes)
-    _check_lengths(particles, bonds, angles, model_path)
-    _check_periodic_extent(particles, bonds, angles, box, model_path)
+    legs = _legs(particles, bonds, angles)
+    _check_lengths(particles, legs, model_path)
+    _check_periodic_extent(particles, legs, box, model_path)
     exclusion = _exclusion_rule(particles, bonds, model_path)
 
     output = _output_spec(inp, type_index, settings.out_freq)
     stages = _stages(inp, settings, notes)
     dyn = Dynamics(dt=settings.dt, damping=settings.damping, lambda_=settings.lam,
                    gravity=settings.gravity, pair_cutoff=cutoff, exclusion=exclusion)
-    _note_quirks(particles, bonds, angles, pairs, dyn, notes, model_path)
+    _note_quirks(particles, bonds, angles, legs, pairs, dyn, notes, model_path)
     model = Model(path, particles, bonds, angles, pairs, box, dyn, RunPlan(stages, output),
                   units=LJ.name)
     model.warnings.extend(notes)
@@ -627,15 +628,27 @@ def _apply_modif_spring(inp: _InputFile, springs: _Springs, notes: list) -> None
                              f"stiffness, c1, c2 or damping, got '{t[3]}'")
 
 
-def _check_lengths(p: Particles, bonds: Bonds, angles: Angles, path: Path) -> None:
+def _legs(p: Particles, bonds: Bonds, angles: Angles) -> list[tuple[str, np.ndarray, np.ndarray]]:
+    """(kind, index pairs (i, j), x_j - x_i on the unwrapped positions) of every spring and
+    both legs of every angle (the second angle leg is bead 2 -> bead 3), computed once for
+    the checks below."""
+    x = p.unwrapped
+    out = []
+    for kind, pairs in (("SPRING", bonds.atoms), ("ANGLE", angles.atoms[:, :2]),
+                        ("ANGLE", angles.atoms[:, 1:])):
+        with np.errstate(all="ignore"):
+            out.append((kind, pairs, x[pairs[:, 1]] - x[pairs[:, 0]]))
+    return out
+
+
+def _check_lengths(p: Particles, legs: list, path: Path) -> None:
     """Springs and angle legs of zero length have no direction: FibreNet's forces divide by
     the length (NaN), LAMMPS's bond style silently gives no force."""
     x = p.unwrapped
-    for kind, pairs in (("SPRING", bonds.atoms), ("ANGLE", angles.atoms[:, :2]),
-                        ("ANGLE", angles.atoms[:, 1:])):
+    for kind, pairs, d in legs:
         if not len(pairs):
             continue
-        same = (x[pairs[:, 0]] == x[pairs[:, 1]]).all(axis=1)
+        same = (d == 0).all(axis=1)              # finite positions: x_j - x_i == 0 iff equal
         if same.any():
             row = int(np.flatnonzero(same)[0])
             i, j = (int(v) for v in pairs[row])
@@ -645,7 +658,7 @@ def _check_lengths(p: Particles, bonds: Bonds, angles: Angles, path: Path) -> No
                              f"position ({', '.join(f'{v:g}' for v in x[i])}): {what}")
 
 
-def _check_periodic_extent(p: Particles, bonds: Bonds, angles: Angles, box: Box, path: Path) -> None:
+def _check_periodic_extent(p: Particles, legs: list, box: Box, path: Path) -> None:
     """Springs and angle legs must span less than half the box along every periodic axis.
 
     FibreNet computes springs and angles on the unwrapped positions (ix iy iz) with no minimum
@@ -657,14 +670,11 @@ def _check_periodic_extent(p: Particles, bonds: Bonds, angles: Angles, box: Box,
     per = np.asarray(box.periodic, bool)
     if not per.any():
         return
-    x = p.unwrapped
     half = 0.5 * box.lengths
-    for kind, pairs in (("SPRING", bonds.atoms), ("ANGLE", angles.atoms[:, :2]),
-                        ("ANGLE", angles.atoms[:, 1:])):
+    for kind, pairs, d in legs:
         if not len(pairs):
             continue
         with np.errstate(all="ignore"):
-            d = x[pairs[:, 1]] - x[pairs[:, 0]]
             bad = (~(np.abs(d[:, per]) < half[per])).any(axis=1)
         if not bad.any():
             continue
@@ -718,8 +728,8 @@ def _exclusion_rule(p: Particles, bonds: Bonds, path: Path) -> str:
                      "LAMMPS equivalent; give every bead of a fibre the same loc_id")
 
 
-def _note_quirks(p: Particles, bonds: Bonds, angles: Angles, pairs: list[PairLaw], dyn: Dynamics,
-                 notes: list, path: Path) -> None:
+def _note_quirks(p: Particles, bonds: Bonds, angles: Angles, legs: list, pairs: list[PairLaw],
+                 dyn: Dynamics, notes: list, path: Path) -> None:
     for law in pairs:
         if law.kind == "st" and law.params["B"] * (law.params["rstar"] - law.params["cutoff"]) != 0:
             jump = law.params["B"] * (law.params["rstar"] - law.params["cutoff"])
@@ -732,8 +742,7 @@ def _note_quirks(p: Particles, bonds: Bonds, angles: Angles, pairs: list[PairLaw
                       "(fix bond/break); FibreNet also breaks them in compression and keeps HR "
                       "angles that contain them"))
     if angles.count:
-        a, b, c = (p.unwrapped[angles.atoms[:, k]] for k in range(3))
-        u, v = a - b, c - b
+        u, v = -legs[1][2], legs[2][2]            # bead 1 - bead 2, bead 3 - bead 2
         with np.errstate(all="ignore"):         # huge coordinates overflow: not straight
             cos = (u * v).sum(1) / np.sqrt((u * u).sum(1) * (v * v).sum(1))
         if (cos <= -1.0 + 1e-14).any():

@@ -13,7 +13,7 @@ import typer
 
 from fibrelmp import __version__
 
-from fibrelmp.registry import FRAMES, INPUT, TARGET, formats, names
+from fibrelmp.registry import DOCUMENT, FRAMES, INPUT, TARGET, formats, names
 
 _INPUTS = formats(INPUT)
 _TITLES = ", ".join(f.title for f in _INPUTS[:-1]) + " or " + _INPUTS[-1].title
@@ -342,6 +342,47 @@ def post(dump: Path = typer.Argument(..., help=" or ".join(f.title for f in form
                       gravity=gravity, force=force, topology=topology, say=_say,
                       warn=_report_warnings)
     for path in written:
+        _say(f"wrote {path}")
+
+
+def _convert_examples() -> str:
+    """``fibrelmp convert A -o B`` for each pair of document formats with examples."""
+    docs = [f for f in formats(DOCUMENT) if f.example]
+    lines = []
+    for a in docs:
+        for b in docs:
+            if a is not b:
+                suffix = b.extensions[0] if b.extensions else Path(b.example).suffix
+                lines.append(f"  fibrelmp convert {a.example} -o {Path(a.example).stem}{suffix}")
+    return "\n".join(lines)
+
+
+@app.command("convert", help=f"""Convert a scene or result file into another form of the same code
+({"; ".join(f"{f.name}: {f.title}" for f in formats(DOCUMENT))}), e.g. a binary scene into text
+to diff or version-control it, and back.
+
+The output format comes from --to or the output's name; the file is written only when the
+whole conversion succeeded; an existing one is kept unless --force is given.
+
+\b
+Examples:
+{_convert_examples()}
+""")
+@_guard
+def convert_command(source: Path = typer.Argument(..., help="The file to convert.", readable=False),
+                    out: Path = typer.Option(..., "-o", "--out", help="The file to write."),
+                    to: Optional[str] = typer.Option(None, "--to", help=f"One of: {', '.join(names(DOCUMENT))} "
+                                                     "(default: from the output's name).",
+                                                     autocompletion=lambda: names(DOCUMENT)),
+                    precision: Optional[int] = typer.Option(None, "--precision", help="Significant digits of "
+                                                            "time-point values in text (default 6, as the code writes; "
+                                                            "17 keeps every double)."),
+                    force: bool = typer.Option(False, "--force", help="Overwrite an existing output."),
+                    quiet: bool = _QUIET, verbose: bool = _VERBOSE) -> None:
+    from fibrelmp.python_api import convert_file
+
+    _set_flags(quiet, verbose)
+    for path in convert_file(source, out, to=to, precision=precision, force=force):
         _say(f"wrote {path}")
 
 

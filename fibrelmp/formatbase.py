@@ -55,6 +55,24 @@ class Reader(ABC):
         raise NotImplementedError(f"{type(self).__name__} is not a frame format: call read()")
 
 
+class DocumentFormat(ABC):
+    """The ``document`` hook of a format: whole scene/result files ``fibrelmp convert``
+    reads (``open``: a document object the other forms' writers take) and writes
+    (``writer``: a ``Writer`` whose one ``add`` is the document)."""
+
+    suffixes: ClassVar[tuple[str, ...]] = ()       # output names that mean this format
+
+    @staticmethod
+    @abstractmethod
+    def open(path: Path) -> Any:
+        """The document in ``path`` (has ``close()``)."""
+
+    @staticmethod
+    @abstractmethod
+    def writer(target: Path, precision: int | None = None, *, force: bool = False) -> "Writer":
+        """The writer of a document at ``target``."""
+
+
 class Writer(ABC):
     """Writes one output (one or several files) from a stream of frames."""
 

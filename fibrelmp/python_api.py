@@ -150,6 +150,40 @@ def convert(dump: str | Path, to: str | None, out: str | Path | None, *, frames:
                         report=warn)
 
 
+def convert_file(source: str | Path, target: str | Path, *, to: str | None = None,
+                 precision: int | None = None, force: bool = False) -> list[Path]:
+    """Convert a whole scene/result file into another form of the same code (the registry's
+    ``document`` formats, e.g. a code's binary and text forms of a scene).  The target's format is ``to``, else its
+    file name's suffix; ``precision``: significant digits of text time-point values (default
+    6, as the codes write).  Returns the written path; existing files are kept unless ``force``."""
+    from fibrelmp.registry import DOCUMENT, choose, detect, formats, names
+
+    source, target = Path(source), Path(target)
+    fmt = detect(source)
+    if DOCUMENT not in fmt.roles:
+        raise InputError(source, None, f"{fmt.title} cannot be converted (convert takes "
+                         f"{', '.join(f.title for f in formats(DOCUMENT))})")
+    if to is not None:
+        out_fmt = choose(DOCUMENT, to, "--to")
+    else:
+        hits = [f for f in formats(DOCUMENT) if target.suffix.lower() in f.load(DOCUMENT).suffixes]
+        if not hits:
+            raise InputError(target, None, f"cannot tell the output format from the name: use "
+                             f"--to ({', '.join(names(DOCUMENT))})")
+        out_fmt = hits[0]
+    if target.resolve() == source.resolve():
+        raise InputError(target, None, "the output would overwrite the input; choose another name")
+    if precision is not None and not 1 <= precision <= 17:
+        raise InputError(None, None, f"--precision must be 1..17, got {precision}")
+    doc = fmt.load(DOCUMENT).open(source)
+    try:
+        with out_fmt.load(DOCUMENT).writer(target, precision, force=force) as writer:
+            writer.add(doc)
+    finally:
+        doc.close()
+    return [target]
+
+
 @dataclass
 class CheckReport:
     """What ``fibrelmp check`` prints: summary lines and the input's warnings."""

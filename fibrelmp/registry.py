@@ -17,6 +17,8 @@ Roles
   ``target``  a ``post --to`` output; its hook is a ``post.target.DumpTarget`` (a ``Writer``
               of LAMMPS dump frames).
   ``frames``  a trajectory ``post`` reads; its hook is a frame ``Reader``.
+  ``document`` a whole scene/result file ``fibrelmp convert`` reads and writes; its hook
+              has ``open(path)`` (a document) and ``writer(target, precision, force=)``.
 
 Adding a format: one module with its Reader/Writer subclass, one ``register_format`` call
 below (docs/architecture.md shows an example).  Like meshio's ``register_format`` and ASE's
@@ -33,8 +35,8 @@ from typing import Any
 
 from .errors import InputError
 
-INPUT, RESULT, TARGET, FRAMES = "input", "result", "target", "frames"
-ROLES = (INPUT, RESULT, TARGET, FRAMES)
+INPUT, RESULT, TARGET, FRAMES, DOCUMENT = "input", "result", "target", "frames", "document"
+ROLES = (INPUT, RESULT, TARGET, FRAMES, DOCUMENT)
 
 
 @dataclass(frozen=True)
@@ -47,6 +49,7 @@ class Format:
     magic: re.Pattern | None = None        # content test on the first MiB (inputs)
     example: str = ""                      # a command line for help texts
     home: str = ""                         # the format's package (docs)
+    binary: bool = False                   # detected first (text magics could match its bytes)
     roles: tuple[str, ...] = field(init=False)
 
     def __post_init__(self) -> None:
@@ -131,15 +134,11 @@ def detect(path: str | Path) -> Format:
             head = fh.read(DETECT_BYTES)
     except OSError as exc:
         raise InputError(path, None, f"cannot read input: {exc.strerror or exc}") from None
-    if path.suffix.lower() == ".mdem":
-        raise InputError(path, None, "binary MUSEN .mdem files cannot be read: export the scene "
-                         "as text (MUSEN: File > Export > Text, or a cmusen job with "
-                         "'COMPONENT EXPORT_TO_TEXT') and run that file")
     if head.startswith((b"\xff\xfe", b"\xfe\xff")):
         raise InputError(path, None, "the file is UTF-16 encoded; save it as UTF-8 (or ASCII) text")
     if head.startswith(b"\xef\xbb\xbf"):        # UTF-8 byte-order mark: the readers accept it
         head = head[3:]
-    inputs = formats(INPUT)
+    inputs = sorted(formats(INPUT), key=lambda f: not f.binary)     # stable: binary ones first
     for fmt in inputs:
         if fmt.magic is not None and fmt.magic.search(head):
             return fmt
@@ -161,12 +160,23 @@ register_format(Format(
     magic=re.compile(rb"^[ \t]*(JOB|SOURCE_FILE|COMPONENT)\b", re.M),
     example="examples/musen/single_particle_job.txt", home="fibrelmp.translate.musen"))
 register_format(Format(
+    # the signature 0x12345678 (little endian); binary: detected before the text formats, so
+    # that no text magic can match inside its compressed data
+    "mdem", "a MUSEN .mdem scene or result", "si",
+    {INPUT: "fibrelmp.pipeline.inputs.mdem:MdemSceneInput",
+     RESULT: "fibrelmp.translate.musen.mdem.result:MdemResultWriter",
+     TARGET: "fibrelmp.post.to_granular:MdemTarget",
+     DOCUMENT: "fibrelmp.translate.musen.mdem.convert:MdemDocument"},
+    extensions=(".mdem",), magic=re.compile(rb"\Ax\x56\x34\x12", re.S), binary=True,
+    example="examples/musen/SingelParticle.mdem", home="fibrelmp.translate.musen.mdem"))
+register_format(Format(
     # an object line "0 ID 1 TYPE 5 ...", or a scene line (22 domain / 32 material) of an
     # object-less scene; ".txt" is too common to mean MUSEN
     "musen", "a MUSEN text scene or result", "si",
     {INPUT: "fibrelmp.pipeline.inputs.musen:SceneInput",
      RESULT: "fibrelmp.translate.musen.writer:MusenResultWriter",
-     TARGET: "fibrelmp.post.to_granular:MusenTarget"},
+     TARGET: "fibrelmp.post.to_granular:MusenTarget",
+     DOCUMENT: "fibrelmp.translate.musen.mdem.convert:MusenTextDocument"},
     magic=re.compile(rb"\A\s*(0\s+\d+\s+1\s+\d+\s+5\b|(22|32)\s+\S)"),
     example="examples/musen/SingelParticle_text.txt", home="fibrelmp.translate.musen"))
 register_format(Format(

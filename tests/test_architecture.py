@@ -17,7 +17,7 @@ from pathlib import Path
 import pytest
 
 from fibrelmp import registry
-from fibrelmp.registry import FRAMES, INPUT, RESULT, TARGET
+from fibrelmp.registry import DOCUMENT, FRAMES, INPUT, RESULT, TARGET
 
 REPO = Path(__file__).resolve().parents[1]
 PACKAGE = REPO / "fibrelmp"
@@ -78,6 +78,7 @@ BASES = {
     RESULT: ("fibrelmp.formatbase", "Writer"),
     TARGET: ("fibrelmp.post.target", "DumpTarget"),
     FRAMES: ("fibrelmp.formatbase", "Reader"),
+    DOCUMENT: ("fibrelmp.formatbase", "DocumentFormat"),
 }
 
 

@@ -258,6 +258,16 @@ def _musen(folder: Path):
     return (lambda: MusenResultWriter(m, folder / "result.txt")), _granular_frames(m, 3)
 
 
+def _mdem(folder: Path):
+    from fibrelmp.translate.musen.mdem.result import MdemResultWriter
+
+    from .granular_models import GLASS, material, model, spheres
+
+    mats = [material("glass", **GLASS)]
+    m = model(spheres([[0, 0, 0], [0.01, 0, 0]], 0.004, 0, mats), mats, {}, 1e-5, 1e-3)
+    return (lambda: MdemResultWriter(m, folder / "result.mdem")), _granular_frames(m, 3)
+
+
 def _demdf(folder: Path):
     from fibrelmp.translate.demdf import reader as demdf
     from fibrelmp.translate.demdf.writer import DemdfSnapshotWriter
@@ -283,7 +293,7 @@ def _res(folder: Path):
 
 
 # format -> (folder -> (writer factory, frames)): how to build a writer and its frames
-RESULT_CASES = {"musen": _musen, "demdf": _demdf, "xyz": _xyz, "res": _res}
+RESULT_CASES = {"musen": _musen, "mdem": _mdem, "demdf": _demdf, "xyz": _xyz, "res": _res}
 
 
 def test_every_result_format_has_a_case():

@@ -37,7 +37,7 @@ def _files(folder: Path) -> set[Path]:
 
 
 def test_every_input_format_has_a_hook_and_an_example():
-    assert [f.name for f in FORMATS] == ["fibrenet", "musen-script", "musen", "demdf"]
+    assert [f.name for f in FORMATS] == ["fibrenet", "musen-script", "mdem", "musen", "demdf"]
     for fmt in FORMATS:
         assert (REPO / fmt.example).is_file(), fmt.name
         hook = fmt.load(INPUT)
@@ -66,7 +66,12 @@ def test_detect_read_check_translate(example, tmp_path):
 def test_bad_or_empty_input_is_an_input_error_and_writes_nothing(example, tmp_path, content):
     fmt, path = example
     bad = path.with_name("bad" + path.suffix)
-    if content:      # the example, spoilt after its first line (detected as the same format)
+    if content and fmt.binary:     # the example, spoilt after its headers (same signature)
+        data = bytearray(path.read_bytes())
+        data[2200:2300] = b"@" * 100
+        bad.write_bytes(bytes(data))
+        assert detect(bad).name == fmt.name
+    elif content:    # the example, spoilt after its first line (detected as the same format)
         lines = path.read_text().splitlines(keepends=True)
         bad.write_text(lines[0] + "@@@ not a line of any input @@@ ]]\n" + "".join(lines[1:]))
         assert detect(bad).name == fmt.name

@@ -83,7 +83,9 @@ def test_bare_scene_with_command_line_times(tmp_path):
     np.testing.assert_allclose(tp.fields[12][:, sphere, 2], expected, rtol=0, atol=1e-12)
 
 
-def test_mdem_result_name_becomes_txt(tmp_path):
+def test_mdem_result_name_gives_an_mdem_result(tmp_path):
+    from fibrelmp.translate.musen.mdem.document import MdemFile
+
     folder = _example(tmp_path, "SingelParticle_text.txt")
     (folder / "job.txt").write_text(
         "JOB\nSOURCE_FILE SingelParticle_text.txt\nRESULT_FILE out.mdem\nCOMPONENT SIMULATOR\n"
@@ -91,13 +93,16 @@ def test_mdem_result_name_becomes_txt(tmp_path):
         "SAVING_STEP 1e-3\nEND_TIME 2e-3\n")
     done = _cli(["run", "job.txt"], folder)
     assert done.returncode == 0, done.stderr
-    assert "out.txt" in done.stderr and "not written" in done.stderr
-    assert (folder / "out.txt").exists() and not (folder / "out.mdem").exists()
+    assert not (folder / "out.txt").exists()
+    with MdemFile(folder / "out.mdem") as mdem:
+        times = [t for t, _, _ in mdem.time_points()]
+        assert mdem.storage.modules_data.simulator.simulation_step == 1e-7
+    np.testing.assert_allclose(times, [0, 1e-3, 2e-3], rtol=1e-9)
 
 
 @pytest.mark.parametrize("script, message", [
     ("JOB\nSOURCE_FILE made_elsewhere.mdem\nRESULT_FILE r.mdem\nCOMPONENT SIMULATOR\n",
-     "no earlier job of this script produced"),
+     "made_elsewhere.mdem: file not found"),
     ("JOB\nSOURCE_FILE r.mdem\nRESULT_FILE ./r.txt\nCOMPONENT EXPORT_TO_TEXT\n",
      "no earlier job of this script produced it"),
     ("JOB\nSOURCE_FILE SingelParticle_text.txt\nRESULT_FILE r.mdem\nCOMPONENT PACKAGE_GENERATOR\n",
@@ -112,9 +117,10 @@ def test_script_errors_exit_2(tmp_path, script, message):
     assert "job.txt:" in done.stderr
 
 
-def test_binary_mdem_input_is_refused(tmp_path):
+def test_a_binary_that_is_no_mdem_is_an_input_error(tmp_path):
     scene = tmp_path / "scene.mdem"
     scene.write_bytes(b"\x08\x96\x01\x00\x12\x07protobuf\x00")
     done = _cli(["run", str(scene)], tmp_path)
     assert done.returncode == 2
-    assert "export" in done.stderr and "as text" in done.stderr and "Traceback" not in done.stderr
+    assert "not a MUSEN .mdem file" in done.stderr and "Traceback" not in done.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["scene.mdem"]

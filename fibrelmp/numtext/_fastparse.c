@@ -577,3 +577,277 @@ int64_t fp_format_g_rows(const int64_t *codes, const double *vals, int64_t n, in
     }
     return (int64_t)(o - out);
 }
+
+/* ---- MUSEN .mdem time points (protobuf wire format of ProtoTimePoint) -------------------
+   A time point is "1: double time" and "2: repeated ProtoTimeDependentProperties", one per
+   object.  An object's fields go to 34 columns (absent = 0, as protobuf reads them):
+     0-2 coord (1)  3-5 angles (2)  6-8 vel (3)  9-11 angle_vel (4)  12-14 angle_accl (6)
+     15 total_torque (8)  16 temperature (9)  17 liquid_film_mass (10)  18-20 force (11)
+     21-24 quaternion (12)  25-33 stress_tensor (13: three vectors)
+   and bit f of mask[i] says field f was on the wire.  Unknown fields are skipped. */
+#define TD_COLS 34
+
+static int pb_varint(const unsigned char **pp, const unsigned char *end, uint64_t *v)
+{
+    const unsigned char *p = *pp;
+    uint64_t x = 0;
+    for (int shift = 0; shift < 64; shift += 7) {
+        if (p >= end) return -1;
+        unsigned char b = *p++;
+        x |= (uint64_t)(b & 0x7F) << shift;
+        if (!(b & 0x80)) {
+            *v = x;
+            *pp = p;
+            return 0;
+        }
+    }
+    return -1;
+}
+
+static double pb_double(const unsigned char *p)
+{
+    double d;
+    memcpy(&d, p, 8);           /* little endian hosts only (checked by the loader) */
+    return d;
+}
+
+/* skip a field of wire type wt; 0 or -1 */
+static int pb_skip(const unsigned char **pp, const unsigned char *end, int wt)
+{
+    uint64_t n;
+    switch (wt) {
+    case 0: return pb_varint(pp, end, &n);
+    case 1: if (end - *pp < 8) return -1; *pp += 8; return 0;
+    case 5: if (end - *pp < 4) return -1; *pp += 4; return 0;
+    case 2:
+        if (pb_varint(pp, end, &n) || (uint64_t)(end - *pp) < n) return -1;
+        *pp += n;
+        return 0;
+    default: return -1;
+    }
+}
+
+/* doubles 1..k of a message (ProtoVector k=3, ProtoQuaternion k=4) into out[0..k) */
+static int pb_doubles(const unsigned char *p, const unsigned char *end, double *out, int k)
+{
+    while (p < end) {
+        uint64_t tag;
+        if (pb_varint(&p, end, &tag)) return -1;
+        int f = (int)(tag >> 3), wt = (int)(tag & 7);
+        if (f >= 1 && f <= k && wt == 1) {
+            if (end - p < 8) return -1;
+            out[f - 1] = pb_double(p);
+            p += 8;
+        } else if (pb_skip(&p, end, wt)) {
+            return -1;
+        }
+    }
+    return 0;
+}
+
+static int pb_object(const unsigned char *p, const unsigned char *end, double *row, uint32_t *mask)
+{
+    static const int vec_col[14] = {-1, 0, 3, 6, 9, -1, 12, -1, -1, -1, -1, 18, -1, -1};
+    while (p < end) {
+        uint64_t tag, n;
+        if (pb_varint(&p, end, &tag)) return -1;
+        int f = (int)(tag >> 3), wt = (int)(tag & 7);
+        if (wt == 2 && f >= 1 && f <= 13 && (vec_col[f] >= 0 || f == 12 || f == 13)) {
+            if (pb_varint(&p, end, &n) || (uint64_t)(end - p) < n) return -1;
+            const unsigned char *sub = p, *subend = p + n;
+            p = subend;
+            if (f == 12) {
+                if (pb_doubles(sub, subend, row + 21, 4)) return -1;
+            } else if (f == 13) {                     /* ProtoMatrix: v1 v2 v3 */
+                while (sub < subend) {
+                    uint64_t t2, m;
+                    if (pb_varint(&sub, subend, &t2)) return -1;
+                    int g = (int)(t2 >> 3), w2 = (int)(t2 & 7);
+                    if (g >= 1 && g <= 3 && w2 == 2) {
+                        if (pb_varint(&sub, subend, &m) || (uint64_t)(subend - sub) < m) return -1;
+                        if (pb_doubles(sub, sub + m, row + 25 + 3 * (g - 1), 3)) return -1;
+                        sub += m;
+                    } else if (pb_skip(&sub, subend, w2)) {
+                        return -1;
+                    }
+                }
+            } else if (pb_doubles(sub, subend, row + vec_col[f], 3)) {
+                return -1;
+            }
+            *mask |= 1u << f;
+        } else if (wt == 1 && f >= 8 && f <= 10) {
+            if (end - p < 8) return -1;
+            row[15 + (f - 8)] = pb_double(p);
+            p += 8;
+            *mask |= 1u << f;
+        } else if (pb_skip(&p, end, wt)) {
+            return -1;
+        }
+    }
+    return 0;
+}
+
+/* Number of objects in a serialized ProtoTimePoint, or -1 if it is malformed. */
+int64_t fp_mdem_count(const unsigned char *buf, int64_t len)
+{
+    const unsigned char *p = buf, *end = buf + len;
+    int64_t n = 0;
+    while (p < end) {
+        uint64_t tag;
+        if (pb_varint(&p, end, &tag)) return -1;
+        if ((tag >> 3) == 2 && (tag & 7) == 2) n++;
+        if (pb_skip(&p, end, (int)(tag & 7))) return -1;
+    }
+    return n;
+}
+
+/* Decode a ProtoTimePoint of n objects (fp_mdem_count) into time, out (n x 34, zeroed by the
+   caller) and mask (n, zeroed); 0, or -1 if malformed. */
+int fp_mdem_decode(const unsigned char *buf, int64_t len, double *time, double *out,
+                   uint32_t *mask, int64_t n)
+{
+    const unsigned char *p = buf, *end = buf + len;
+    int64_t i = 0;
+    while (p < end) {
+        uint64_t tag, m;
+        if (pb_varint(&p, end, &tag)) return -1;
+        int f = (int)(tag >> 3), wt = (int)(tag & 7);
+        if (f == 1 && wt == 1) {
+            if (end - p < 8) return -1;
+            *time = pb_double(p);
+            p += 8;
+        } else if (f == 2 && wt == 2) {
+            if (pb_varint(&p, end, &m) || (uint64_t)(end - p) < m || i >= n) return -1;
+            if (pb_object(p, p + m, out + i * TD_COLS, mask + i)) return -1;
+            p += m;
+            i++;
+        } else if (pb_skip(&p, end, wt)) {
+            return -1;
+        }
+    }
+    return i == n ? 0 : -1;
+}
+
+static unsigned char *pb_put_varint(unsigned char *o, uint64_t v)
+{
+    while (v >= 0x80) {
+        *o++ = (unsigned char)(v | 0x80);
+        v >>= 7;
+    }
+    *o++ = (unsigned char)v;
+    return o;
+}
+
+static int pb_varint_len(uint64_t v)
+{
+    int n = 1;
+    while (v >= 0x80) {
+        v >>= 7;
+        n++;
+    }
+    return n;
+}
+
+static int nonzero(double x)        /* proto3 writes a double unless its bits are all zero */
+{
+    uint64_t u;
+    memcpy(&u, &x, 8);
+    return u != 0;
+}
+
+static int doubles_len(const double *v, int k)
+{
+    int n = 0;
+    for (int j = 0; j < k; j++) n += nonzero(v[j]) ? 9 : 0;
+    return n;
+}
+
+static unsigned char *put_doubles(unsigned char *o, const double *v, int k)
+{
+    for (int j = 0; j < k; j++) {
+        if (!nonzero(v[j])) continue;
+        *o++ = (unsigned char)(((j + 1) << 3) | 1);
+        memcpy(o, v + j, 8);
+        o += 8;
+    }
+    return o;
+}
+
+static int object_len(const double *row, uint32_t mask)
+{
+    static const int cols[14] = {-1, 0, 3, 6, 9, -1, 12, -1, 15, 16, 17, 18, 21, 25};
+    int n = 0;
+    for (int f = 1; f <= 13; f++) {
+        if (!(mask & (1u << f)) || cols[f] < 0) continue;
+        const double *v = row + cols[f];
+        if (f >= 8 && f <= 10) {
+            n += nonzero(v[0]) ? 9 : 0;
+        } else if (f == 13) {
+            int m = 0;
+            for (int g = 0; g < 3; g++) {
+                int s = doubles_len(v + 3 * g, 3);
+                m += 1 + pb_varint_len((uint64_t)s) + s;
+            }
+            n += 1 + pb_varint_len((uint64_t)m) + m;
+        } else {
+            int s = doubles_len(v, f == 12 ? 4 : 3);
+            n += 1 + pb_varint_len((uint64_t)s) + s;
+        }
+    }
+    return n;
+}
+
+/* Serialize a ProtoTimePoint as protobuf does: time, then for object i a
+   ProtoTimeDependentProperties with the fields whose bit is set in mask[i] (a message field
+   is written even when all its values are 0, as after MUSEN's mutable_...(); a double only
+   when non-zero).  Returns the bytes written, or -1 if cap is too small. */
+int64_t fp_mdem_encode(double time, const double *vals, const uint32_t *mask, int64_t n,
+                       unsigned char *out, int64_t cap)
+{
+    static const int cols[14] = {-1, 0, 3, 6, 9, -1, 12, -1, 15, 16, 17, 18, 21, 25};
+    unsigned char *o = out, *end = out + cap;
+    if (end - o < 9) return -1;
+    if (nonzero(time)) {
+        *o++ = 0x09;
+        memcpy(o, &time, 8);
+        o += 8;
+    }
+    for (int64_t i = 0; i < n; i++) {
+        const double *row = vals + i * TD_COLS;
+        uint32_t mk = mask[i];
+        int len = object_len(row, mk);
+        if (end - o < 1 + 10 + len) return -1;
+        *o++ = 0x12;
+        o = pb_put_varint(o, (uint64_t)len);
+        for (int f = 1; f <= 13; f++) {
+            if (!(mk & (1u << f)) || cols[f] < 0) continue;
+            const double *v = row + cols[f];
+            if (f >= 8 && f <= 10) {
+                if (nonzero(v[0])) {
+                    *o++ = (unsigned char)((f << 3) | 1);
+                    memcpy(o, v, 8);
+                    o += 8;
+                }
+            } else if (f == 13) {
+                int m = 0;
+                for (int g = 0; g < 3; g++) {
+                    int s = doubles_len(v + 3 * g, 3);
+                    m += 1 + pb_varint_len((uint64_t)s) + s;
+                }
+                *o++ = (unsigned char)((f << 3) | 2);
+                o = pb_put_varint(o, (uint64_t)m);
+                for (int g = 0; g < 3; g++) {
+                    *o++ = (unsigned char)(((g + 1) << 3) | 2);
+                    o = pb_put_varint(o, (uint64_t)doubles_len(v + 3 * g, 3));
+                    o = put_doubles(o, v + 3 * g, 3);
+                }
+            } else {
+                int k = f == 12 ? 4 : 3;
+                *o++ = (unsigned char)((f << 3) | 2);
+                o = pb_put_varint(o, (uint64_t)doubles_len(v, k));
+                o = put_doubles(o, v, k);
+            }
+        }
+    }
+    return (int64_t)(o - out);
+}

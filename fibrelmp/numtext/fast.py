@@ -1,4 +1,5 @@
-"""Optional C fast paths for dump parsing and xyz formatting (``_fastparse.c``).
+"""Optional C fast paths for dump parsing, xyz formatting and MUSEN ``.mdem`` time points
+(``_fastparse.c``).
 
 The C source is normally compiled when fibrelmp is installed (``setup.py``: an optional
 build step that never fails the installation) into ``_fastparse_c<EXT_SUFFIX>`` next to this
@@ -140,6 +141,12 @@ def _open(lib: Path) -> ctypes.CDLL:
         dll.fp_count_lines.restype = i64
         dll.fp_nth_newline.argtypes = [ptr, i64, i64, ctypes.POINTER(i64)]
         dll.fp_nth_newline.restype = i64
+        dll.fp_mdem_count.argtypes = [ptr, i64]
+        dll.fp_mdem_count.restype = i64
+        dll.fp_mdem_decode.argtypes = [ptr, i64, ptr, ptr, ptr, i64]
+        dll.fp_mdem_decode.restype = ctypes.c_int
+        dll.fp_mdem_encode.argtypes = [ctypes.c_double, ptr, ptr, i64, ptr, i64]
+        dll.fp_mdem_encode.restype = i64
     except (OSError, AttributeError) as exc:
         raise _Unavailable(f"cannot load: {exc}") from exc
     # self-check against Python's correctly rounded conversions before trusting it
@@ -417,3 +424,43 @@ def format_xyz(codes: np.ndarray, table: list[str], values: np.ndarray, decimals
     """As format_xyz_parts, joined into bytes."""
     parts = format_xyz_parts(codes, table, values, decimals)
     return None if parts is None else b"".join(p.tobytes() for p in parts)
+
+
+# -- MUSEN .mdem time points (protobuf wire format) -----------------------------------------
+MDEM_COLUMNS = 34       # the columns of fp_mdem_decode (see _fastparse.c)
+
+
+def mdem_decode(raw: bytes) -> tuple[float, np.ndarray, np.ndarray] | None:
+    """A serialized ``ProtoTimePoint``: (time, values (n, 34), field masks (n,) uint32);
+    None without the C library; ValueError if malformed."""
+    lib = library()
+    if lib is None or sys.byteorder != "little":
+        return None
+    buf = np.frombuffer(raw, np.uint8)
+    n = lib.fp_mdem_count(buf.ctypes.data, len(raw))
+    if n < 0:
+        raise ValueError("malformed time point")
+    values = np.zeros((n, MDEM_COLUMNS))
+    masks = np.zeros(n, np.uint32)
+    time = ctypes.c_double(0.0)
+    if lib.fp_mdem_decode(buf.ctypes.data, len(raw), ctypes.addressof(time), values.ctypes.data,
+                          masks.ctypes.data, n) != 0:
+        raise ValueError("malformed time point")
+    return time.value, values, masks
+
+
+def mdem_encode(time: float, values: np.ndarray, masks: np.ndarray) -> bytes | None:
+    """The ``ProtoTimePoint`` protobuf would serialize (see fp_mdem_encode); None without C."""
+    lib = library()
+    if lib is None or sys.byteorder != "little":
+        return None
+    values = np.ascontiguousarray(values, dtype=np.float64)
+    masks = np.ascontiguousarray(masks, dtype=np.uint32)
+    n = len(masks)
+    cap = 16 + n * 512
+    out = np.empty(cap, np.uint8)
+    size = lib.fp_mdem_encode(float(time), values.ctypes.data, masks.ctypes.data, n,
+                              out.ctypes.data, cap)
+    if size < 0:
+        raise ValueError("time point buffer too small")
+    return out[:size].tobytes()

@@ -287,6 +287,23 @@ def _script_overwrites_scene(tmp: Path) -> list[str]:
     return ["run", str(tmp / "job.txt")]
 
 
+def _mdem(edit: Callable[[bytearray], None], command: str = "check") -> Callable[[Path], list[str]]:
+    """A spoilt copy of the example .mdem scene (SingelParticle.mdem, 6431 bytes)."""
+    def make(tmp: Path) -> list[str]:
+        data = bytearray((CORPUS.parents[1] / "examples" / "musen" / "SingelParticle.mdem").read_bytes())
+        edit(data)
+        path = tmp / "scene.mdem"
+        path.write_bytes(bytes(data))
+        return [command, str(path)] + (["--end-time", "1e-3"] if command == "run" else [])
+    return make
+
+
+def _set(offset: int, value: bytes) -> Callable[[bytearray], None]:
+    def edit(data: bytearray) -> None:
+        data[offset:offset + len(value)] = value
+    return edit
+
+
 def _device(tmp: Path) -> list[str]:
     return ["check", "/dev/zero"]
 
@@ -316,6 +333,18 @@ GENERATED = [
     Case("generated/script_overwrites_scene", "cmusen script", "", "RESULT_FILE names the "
          "SOURCE_FILE scene", command="run", make=_script_overwrites_scene),
     Case("generated/device", "any", "", "/dev/zero as the input", make=_device),
+    Case("generated/mdem_signature", "MUSEN .mdem", "", "a .mdem whose first 4 bytes are not "
+         "MUSEN's signature", make=_mdem(_set(0, b"\0\0\0\0"))),
+    Case("generated/mdem_version", "MUSEN .mdem", "", "file version 7 in the header",
+         make=_mdem(_set(4, b"\x07\0\0\0"))),
+    Case("generated/mdem_truncated", "MUSEN .mdem", "", "the file cut inside its scene block",
+         make=_mdem(lambda d: d.__delitem__(slice(2500, None)))),
+    Case("generated/mdem_hostile_size", "MUSEN .mdem", "", "a thread header claiming 2^60 bytes",
+         make=_mdem(_set(64 + 64, (1 << 60).to_bytes(8, "little")))),
+    Case("generated/mdem_corrupt", "MUSEN .mdem", "", "bytes of the compressed scene overwritten",
+         make=_mdem(_set(2200, b"@" * 100))),
+    Case("generated/mdem_run_truncated", "MUSEN .mdem", "", "run of a .mdem cut in its time "
+         "points", make=_mdem(lambda d: d.__delitem__(slice(6300, None)), "run")),
 ]
 
 CASES: list[Case] = (FIBRENET + FIBRENET_MODEL + MUSEN + MUSEN_SCRIPT + DEMDF + DUMP + GENERIC

@@ -1,4 +1,7 @@
-"""MUSEN text scenes (and results), run as cmusen runs a scene after IMPORT_FROM_TEXT."""
+"""MUSEN text scenes (and results), run as cmusen runs a scene after IMPORT_FROM_TEXT.
+
+Results are MUSEN text, or a ``.mdem`` file when the result's name ends in ``.mdem``
+(``musen_result_writer``)."""
 
 from __future__ import annotations
 
@@ -25,12 +28,15 @@ class SceneInput(InputFormat):
 
     def read_with(self, path: Path, settings: RunSettings) -> tuple["GranularModel", list[str]]:
         """The scene with the command line's settings, and what they set (to say)."""
-        from fibrelmp.translate.musen import scene as musen
-
         if settings.steps is not None:
             raise InputError(path, None, "--steps is for DEMDF inputs; a MUSEN scene takes --end-time")
-        model = musen.read(path)
+        model = self.read_scene(path)
         return model, bare_scene_settings(model, settings.end_time, settings.step, settings.save_step)
+
+    def read_scene(self, path: Path) -> "GranularModel":
+        from fibrelmp.translate.musen import scene as musen
+
+        return musen.read(path)
 
     def check_patch(self, path: Path) -> "Patch":
         from fibrelmp.translate.musen.script import check_patch
@@ -40,7 +46,7 @@ class SceneInput(InputFormat):
     def check_lines(self, path: Path, model: "GranularModel") -> list[str]:
         from fibrelmp.granular_check import summary
 
-        where = musen_result_path(scene_result_path(Path(path).resolve()))[0]
+        where = scene_result_path(Path(path).resolve())
         return summary(model) + [f"results      {where} (or -o FILE)"]
 
     def write_job(self, model: "GranularModel", folder: Path) -> "GranularJob":
@@ -58,26 +64,24 @@ class SceneInput(InputFormat):
                           settings.precision, options)
 
     def work_folder(self, path: Path, out: Path | None, work: Path | None) -> Path:
-        return _work_folder(musen_result_path(scene_result_path(path, out))[0], work)
+        return _work_folder(scene_result_path(path, out), work)
 
 
 def scene_plan(model: "GranularModel", result: str | Path, work: str | Path | None = None,
                precision: int = 6, options: "RunOptions | None" = None) -> "RunPlan":
     """The run of a MUSEN scene whose plan (step, end, saves) is set: one simulation, its
-    result in MUSEN text at ``result`` (a ``.mdem`` name becomes ``.txt``, with a note)."""
+    result at ``result`` (MUSEN text, or ``.mdem`` by its name)."""
     from fibrelmp.outputs import Outputs
     from fibrelmp.pipeline.granular import granular_request
     from fibrelmp.pipeline.request import RunOptions, RunPlan
-    from fibrelmp.translate.musen.writer import MusenResultWriter
 
     check_musen_runnable(model)
-    target, note = musen_result_path(result)
-    target = target.resolve()
+    target = Path(result).resolve()
     outputs = Outputs(Path(model.source), _work_folder(target, work), [target],
                       inputs=[Path(model.source)])
     request = granular_request(model, outputs.work,
-                               lambda: [MusenResultWriter(model, target, precision=precision)])
-    return RunPlan(outputs, [request], options or RunOptions(), notes=[note] if note else [])
+                               lambda: [musen_result_writer(model, target, precision=precision)])
+    return RunPlan(outputs, [request], options or RunOptions())
 
 
 def _work_folder(target: Path, work: str | Path | None) -> Path:
@@ -87,18 +91,27 @@ def _work_folder(target: Path, work: str | Path | None) -> Path:
 
 
 def scene_result_path(scene: str | Path, out: str | Path | None = None) -> Path:
-    """Where a bare MUSEN scene's result goes: ``out``, else ``<scene>_result.txt`` beside it."""
+    """Where a bare MUSEN scene's result goes: ``out``, else ``<scene>_result`` beside it, in
+    the scene's own form (``.mdem`` for a ``.mdem`` scene, else ``.txt``)."""
     scene = Path(scene)
-    return Path(out) if out is not None else scene.with_name(f"{scene.stem}_result.txt")
+    suffix = ".mdem" if scene.suffix.lower() == ".mdem" else ".txt"
+    return Path(out) if out is not None else scene.with_name(f"{scene.stem}_result{suffix}")
 
 
-def musen_result_path(path: str | Path) -> tuple[Path, str | None]:
-    """MUSEN result name: a ``.mdem`` name becomes ``.txt`` (fibrelmp writes text only)."""
-    path = Path(path)
-    if path.suffix.lower() == ".mdem":
-        new = path.with_suffix(".txt")
-        return new, f"MUSEN binary results are not written: {path} becomes {new} (MUSEN text format)"
-    return path, None
+def is_mdem(path: str | Path) -> bool:
+    return Path(path).suffix.lower() == ".mdem"
+
+
+def musen_result_writer(model: "GranularModel", target: str | Path, precision: int = 6, **text):
+    """The writer of a MUSEN result at ``target``: ``.mdem`` by its name, else MUSEN text
+    (``text``: the text writer's ``time_interval``/``selectors``)."""
+    if is_mdem(target):
+        from fibrelmp.translate.musen.mdem.result import MdemResultWriter
+
+        return MdemResultWriter(model, target, time_interval=text.get("time_interval"))
+    from fibrelmp.translate.musen.writer import MusenResultWriter
+
+    return MusenResultWriter(model, target, precision=precision, **text)
 
 
 def check_musen_runnable(model: GranularModel) -> None:

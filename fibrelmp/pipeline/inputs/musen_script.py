@@ -3,10 +3,11 @@
 The whole script is checked first (``plan_musen_script``: every scene read, every job's
 settings applied and its LAMMPS job built, every result located), then it becomes one
 ``RunPlan``: a ``RunRequest`` per SIMULATOR job and an ``Action`` per import/export, whose
-results are locked together.  ``.mdem`` files produced by an earlier job are handles:
-IMPORT_FROM_TEXT keeps the scene in memory, SIMULATOR keeps its frames in an on-disk spool
-(``pipeline.spool``), and EXPORT_TO_TEXT writes them as MUSEN text.  A SIMULATOR result
-nobody exports is written as text next to its ``.mdem`` name (said as a note).
+results are locked together.  Every job writes what cmusen writes: IMPORT_FROM_TEXT the
+``.mdem`` scene, SIMULATOR its result (``.mdem``, or text by its name), EXPORT_TO_TEXT MUSEN
+text.  Within a script, the scene an import made and the frames a simulation saved (in an
+on-disk spool, ``pipeline.spool``) are handed on in memory; a ``.mdem`` made elsewhere is read
+from its file (a scene to simulate, or a file to export with MUSEN's exporter).
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from typing import TYPE_CHECKING
 from fibrelmp.errors import InputError
 from fibrelmp.granmodel import GranularModel
 from fibrelmp.pipeline.inputs import InputFormat, RunSettings, Say, Warn, no_overrides
-from fibrelmp.pipeline.inputs.musen import check_musen_runnable, musen_result_path
+from fibrelmp.pipeline.inputs.musen import check_musen_runnable, is_mdem, musen_result_writer
 
 if TYPE_CHECKING:
     from fibrelmp.pipeline.request import RunOptions, RunPlan, Step
@@ -101,7 +102,6 @@ def _simulation(step: "ScriptStep", work: Path, spools: dict):
     """A SIMULATOR job: its frames go to a spool (exported later) and/or its MUSEN result."""
     from fibrelmp.pipeline.granular import granular_request
     from fibrelmp.pipeline.spool import FrameSpool
-    from fibrelmp.translate.musen.writer import MusenResultWriter
 
     def writers() -> list:
         made: list = []
@@ -109,16 +109,24 @@ def _simulation(step: "ScriptStep", work: Path, spools: dict):
             spools[step.handle] = FrameSpool(work / "frames")
             made.append(spools[step.handle])
         if step.written is not None:
-            made.append(MusenResultWriter(step.model, step.written))
+            made.append(musen_result_writer(step.model, step.written))
         return made
     return granular_request(step.model, work, writers)
 
 
 def _import(step: "ScriptStep", spools: dict, say: Say, rank0: bool) -> list[Path]:
+    """IMPORT_FROM_TEXT: the text scene as a ``.mdem`` (MUSEN's import)."""
+    from fibrelmp.translate.musen.mdem.convert import MdemDocumentWriter, MusenTextDocument
+
     job = step.job
+    written: list[Path] = []
+    if rank0:
+        with MdemDocumentWriter(step.written) as out:
+            out.add(MusenTextDocument.open(step.source))
+        written = [step.written]
     say(f"job {job.index}: imported {job.source_file} ({step.model.spheres.count} spheres) as "
-        f"{job.result_file} (kept in memory)")
-    return []
+        f"{step.written.name}")
+    return written
 
 
 def _export(step: "ScriptStep", spools: dict, say: Say, rank0: bool) -> list[Path]:
@@ -129,13 +137,31 @@ def _export(step: "ScriptStep", spools: dict, say: Say, rank0: bool) -> list[Pat
 
     job = step.job
     written: list[Path] = []
-    if rank0:
+    if rank0 and step.model is None:          # a .mdem made elsewhere: MUSEN's exporter
+        written = [_export_file(step.source, step.written, job)]
+    elif rank0:
         spool = spools.get(step.source)
         writer = MusenResultWriter(step.model, step.written, precision=job.precision,
                                    time_interval=job.time_interval, selectors=job.text_export)
         written = feed([writer])(iter(spool if spool is not None else [_initial_frame(step.model)]))
     say(f"job {job.index}: exported {job.source_file} as {step.written.name}")
     return written
+
+
+def _export_file(source: Path, target: Path, job) -> Path:
+    from fibrelmp.translate.musen.mdem.convert import MusenTextWriter
+    from fibrelmp.translate.musen.mdem.document import MdemFile
+    from fibrelmp.translate.musen.mdem.text_export import export
+
+    class _Export(MusenTextWriter):
+        def write(self, mdem) -> None:
+            export(mdem, self.open(self.target, "w", newline="\n"), self.precision,
+                   time_interval=job.time_interval, spool_dir=self.target.parent,
+                   selectors=job.text_export)
+
+    with MdemFile(source) as mdem, _Export(target, job.precision) as out:
+        out.add(mdem)
+    return target
 
 
 def _initial_frame(model: GranularModel):
@@ -176,21 +202,18 @@ def _script_model(job, handles: dict, path_of) -> GranularModel:
                              "result of an earlier job; continuing a result is not supported: "
                              "simulate the scene with a later END_TIME instead")
         return copy.deepcopy(value)
-    if source.suffix.lower() == ".mdem":
-        raise InputError(job.path, job.where("SOURCE_FILE"), f"{job.source_file}: no earlier job of "
-                         "this script produced this .mdem and fibrelmp cannot read binary MUSEN "
-                         "files: export it as text (COMPONENT EXPORT_TO_TEXT) or import a text scene "
-                         "first (COMPONENT IMPORT_FROM_TEXT)")
     return _read_scene(source, job, "SOURCE_FILE")
 
 
 def _read_scene(source: Path, job, key: str) -> GranularModel:
-    """A text scene named by a script line: a missing file is reported at that line."""
+    """A scene named by a script line (MUSEN text or ``.mdem``): a missing file is reported
+    at that line."""
     from fibrelmp.translate.musen import scene as musen
+    from fibrelmp.translate.musen.mdem.model import read_scene
 
     if not source.exists():
         raise InputError(job.path, job.where(key), f"{key} {source}: file not found")
-    return musen.read(source)
+    return read_scene(source) if is_mdem(source) else musen.read(source)
 
 
 def _path_resolver(script: Path):
@@ -212,9 +235,10 @@ class ScriptStep:
     job: object                          # MusenJob
     kind: str                            # "import" | "simulate" | "export"
     handle: Path | None = None           # the .mdem name it makes (import/simulate)
-    source: Path | None = None           # the handle it reads (export)
-    model: GranularModel | None = None   # import: the scene; simulate: scene + settings
-    written: Path | None = None          # the MUSEN text file it writes, if any
+    source: Path | None = None           # what it reads (import: the text; export: the handle or file)
+    model: GranularModel | None = None   # import: the scene; simulate: scene + settings;
+    #                                      export: the handle's (None: a .mdem file made elsewhere)
+    written: Path | None = None          # the file it writes, if any
     spool: bool = False                  # simulate: keep the frames for a later export
     notes: list[str] = field(default_factory=list)
 
@@ -223,7 +247,7 @@ class ScriptStep:
 class ScriptPlan:
     script: Path
     steps: list[ScriptStep]
-    inputs: list[Path]                   # the script and every text scene it reads
+    inputs: list[Path]                   # the script and every scene or file it reads
 
 
 def plan_musen_script(path: str | Path, out: str | Path | None = None) -> ScriptPlan:
@@ -275,7 +299,9 @@ class _Planner:
         self.inputs.append(source)
         handle = self.path_of(job.result_file, job, "RESULT_FILE")
         self.handles[handle] = ("scene", model)
-        return ScriptStep(job, "import", handle=handle, model=model)
+        step = ScriptStep(job, "import", handle=handle, source=source, model=model)
+        self.result(step)
+        return step
 
     def simulate(self, job) -> ScriptStep:
         from fibrelmp.textio import patched_reading
@@ -283,7 +309,7 @@ class _Planner:
         from fibrelmp.translate.musen.script import apply_simulator_settings
 
         source = self.path_of(job.source_file, job, "SOURCE_FILE")
-        if source not in self.handles and source.suffix.lower() != ".mdem":
+        if source not in self.handles:
             self.inputs.append(source)
         model = _script_model(job, self.handles, self.path_of)
         apply_simulator_settings(model, job)
@@ -292,29 +318,36 @@ class _Planner:
             build_granular_job(model, self.script.parent)  # translation errors now, not mid-script
         handle = self.path_of(job.result_file, job, "RESULT_FILE")
         step = ScriptStep(job, "simulate", handle=handle, model=model, spool=handle in self.exported)
-        if not (handle.suffix.lower() == ".mdem" and handle in self.exported):
-            # nobody exports this result: it is written as MUSEN text right away
-            self.result(step)
+        self.result(step)
         self.handles[handle] = ("result", model)
         return step
 
     def export(self, job) -> ScriptStep:
         source = self.path_of(job.source_file, job, "SOURCE_FILE")
-        if source not in self.handles:
+        if source in self.handles:
+            model = self.handles[source][1]
+        elif is_mdem(source) and source.exists():
+            from fibrelmp.translate.musen.mdem.document import MdemFile
+
+            MdemFile(source).close()                   # checked now, not mid-script
+            self.inputs.append(source)
+            model = None
+        else:
             raise InputError(job.path, job.where("SOURCE_FILE"),
                              f"{job.source_file}: no earlier job of this script produced it"
-                             + (" and fibrelmp cannot read binary MUSEN files"
-                                if source.suffix.lower() == ".mdem" else ""))
-        step = ScriptStep(job, "export", source=source, model=self.handles[source][1])
+                             + ("" if source.exists() else " and there is no such file")
+                             + ("" if is_mdem(source) else
+                                " (EXPORT_TO_TEXT exports a .mdem file)"))
+        step = ScriptStep(job, "export", source=source, model=model)
         self.result(step)
         return step
 
     def result(self, step: ScriptStep) -> None:
-        """Where the job's MUSEN text result goes (a renamed .mdem: with a note)."""
+        """Where the job's result goes."""
         job = step.job
         name = job.result_file
         if self.out is None:
-            step.written, note = musen_result_path(self.path_of(name, job, "RESULT_FILE"))
+            step.written = self.path_of(name, job, "RESULT_FILE")
         else:
             if not name:
                 self.path_of(name, job, "RESULT_FILE")       # the usual message
@@ -322,6 +355,4 @@ class _Planner:
             if rel.is_absolute() or ".." in rel.parts:
                 raise InputError(job.path, job.where("RESULT_FILE"), f"RESULT_FILE {name} cannot be "
                                  f"placed in -o {self.out}: use a relative name without '..', or leave out -o")
-            step.written, note = musen_result_path(self.out / rel)
-        if note:
-            step.notes.append(note)
+            step.written = (self.out / rel).resolve()

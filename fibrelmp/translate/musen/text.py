@@ -35,6 +35,7 @@ class TimePoints(NamedTuple):
     ids: np.ndarray                 # (n,) object ids, ascending
     types: np.ndarray               # (n,) 1 sphere, 9 solid bond, 13 liquid bond, 14 wall
     fields: dict[int, np.ndarray]   # tag -> (T, n, k) values as written; nan where absent
+    present: np.ndarray | None = None   # (T, n) the object has a `2 t` record at that time
 
 
 @dataclass
@@ -382,7 +383,13 @@ def read_time_points(path: str | Path, types: tuple[int, ...] | None = None,
 
     ``types``/``tags`` limit what is returned (memory: T x n x k floats per tag)."""
     path = Path(path)
-    scan = _scan(path, objects_only=True)
+    return time_points_of(_scan(path, objects_only=True), types, tags)
+
+
+def time_points_of(scan: _Scan, types: tuple[int, ...] | None = None,
+                   tags: tuple[int, ...] | None = None) -> TimePoints:
+    """``read_time_points`` of a scanned file."""
+    path = scan.path
     ids = np.array(scan.ids, np.int64)
     otypes = np.array(scan.types, np.int64)
     _check_duplicate_ids(scan, ids, path)
@@ -406,9 +413,12 @@ def read_time_points(path: str | Path, types: tuple[int, ...] | None = None,
     times = np.unique(np.concatenate(all_times)) if all_times else np.zeros(0)
     wanted = set(tags) if tags is not None else {t for _, lay, _ in stacks for t in lay.fields}
     fields = {t: np.full((len(times), len(rows), TD_SIZE[t]), np.nan) for t in sorted(wanted)}
+    present = np.zeros((len(times), len(rows)), bool)
     for members, lay, stack in stacks:
         tidx = np.searchsorted(times, stack[:, lay.time_idx])           # (m, T_lay)
         obj = np.broadcast_to(pos_of_row[members][:, None], tidx.shape)
+        present[tidx, obj] = True
         for t in wanted & set(lay.fields):
             fields[t][tidx, obj] = stack[:, lay.fields[t]]
-    return TimePoints(times=times, ids=ids[rows], types=otypes[rows], fields=fields)
+    return TimePoints(times=times, ids=ids[rows], types=otypes[rows], fields=fields,
+                      present=present)

@@ -117,13 +117,13 @@ class MusenResultWriter(Writer):
         return temp_name(self.path)
 
     # ------------------------------------------------------------------ frames
-    def write(self, frame: GranularFrame) -> None:
-        m = self.model
-        sp = m.spheres
+    def track_activity(self, frame: GranularFrame) -> bool:
+        """Note removed spheres and broken bonds (activity ends); whether the frame is in
+        the exported time interval."""
+        sp = self.model.spheres
         t = float(frame.time)
         rows = np.asarray(frame.sphere_rows, np.int64)
-        n = sp.count
-        present = np.zeros(n, bool)
+        present = np.zeros(sp.count, bool)
         present[rows] = True
         # a sphere active by its interval but missing from the frame was removed at this save
         gone = ~present & (sp.active_start <= t) & (self.sphere_end > t)
@@ -134,8 +134,13 @@ class MusenResultWriter(Writer):
                     else np.full(len(dead), t))
             when = np.where(np.isfinite(when), when, t)
             self.bond_end[dead] = np.minimum(self.bond_end[dead], when[dead])
-        if self.time_interval is not None and not (
-                self.time_interval[0] <= t <= self.time_interval[1]):
+        return self.time_interval is None or self.time_interval[0] <= t <= self.time_interval[1]
+
+    def write(self, frame: GranularFrame) -> None:
+        m = self.model
+        t = float(frame.time)
+        rows = np.asarray(frame.sphere_rows, np.int64)
+        if not self.track_activity(frame):
             return
         blocks = {"s": self._sphere_block(frame, rows)}
         if m.bonds is not None:

@@ -1,0 +1,232 @@
+"""A MUSEN ``.mdem`` file as a scene message plus a stream of time points.
+
+``MdemFile`` opens a file: the time-independent ``ProtoSimulationStorage`` (scene, materials,
+geometries, models, block descriptors) is decoded at once; time points are decoded one block
+at a time when asked for, so memory does not grow with their number.  ``copy_to`` writes the
+file back unchanged (same layout, same bytes).
+
+``MdemWriter`` writes a new file: time points are compressed and written as they come (one
+block each, as MUSEN saves them), the scene message at the end, with the descriptors, saved
+times and begin/end time of what was written.  Memory holds one time point at a time.
+"""
+
+from __future__ import annotations
+
+import bisect
+import os
+import zlib
+from pathlib import Path
+from typing import Any, BinaryIO, Iterator
+
+import numpy as np
+
+from fibrelmp.errors import InputError
+from fibrelmp.translate.musen.mdem import timepoints
+from fibrelmp.translate.musen.mdem.container import Container, ContainerWriter, Layout
+from fibrelmp.translate.musen.mdem.messages import new
+
+ZIPPED = 2            # ProtoBlockDescriptor.format: kZippedProtoBuff
+PLAIN = 1             # kProtoBuf
+_LEVEL = 1            # MUSEN's GzipOutputStream compression level
+
+
+def _inflate(data: bytes, limit: int | None, what: str, path: Path) -> bytes:
+    """zlib data, decompressed (at most ``limit`` bytes if given)."""
+    d = zlib.decompressobj()
+    try:
+        out = d.decompress(data, limit or 0)
+        if limit is not None and (d.unconsumed_tail or len(out) > limit):
+            raise InputError(path, None, f"corrupt .mdem file: {what} is larger than its "
+                             f"descriptor says ({limit} bytes)")
+        if not d.eof:
+            raise InputError(path, None, f"truncated .mdem file: {what} ends early")
+    except zlib.error as exc:
+        raise InputError(path, None, f"corrupt .mdem file: {what} cannot be decompressed ({exc})") from None
+    return out
+
+
+class MdemFile:
+    """An open ``.mdem`` file (use as a context manager, or ``close()``)."""
+
+    def __init__(self, path: str | os.PathLike):
+        from google.protobuf.message import DecodeError
+
+        self.path = Path(path)
+        self.container = Container(self.path)
+        try:
+            raw = _inflate(self.container.read(0, 0, self.container.sizes[0]), None,
+                           "the scene (file thread 0)", self.path)
+            try:
+                self.storage: Any = new("ProtoSimulationStorage", raw)
+            except DecodeError:
+                raise InputError(self.path, None, "corrupt .mdem file: the scene message cannot "
+                                 "be decoded") from None
+            self._check_blocks()
+            self._check_layout()
+        except BaseException:
+            self.container.close()
+            raise
+
+    def _check_blocks(self) -> None:
+        size = self.container.sizes[1]
+        if not len(self.storage.data_blocks):
+            raise InputError(self.path, None, "corrupt .mdem file: it lists no time-point blocks")
+        for i, d in enumerate(self.storage.data_blocks):
+            if d.offset_in_file < 0 or d.size < 0 or d.offset_in_file + d.size > size:
+                raise InputError(self.path, None, f"truncated .mdem file: time-point block {i} "
+                                 f"(bytes {d.offset_in_file}..{d.offset_in_file + d.size} of the "
+                                 f"time-dependent data) lies beyond its end ({size} bytes)")
+            if d.format not in (PLAIN, ZIPPED) and d.size:
+                raise InputError(self.path, None, f"unsupported .mdem file: time-point block {i} "
+                                 f"has storage format {d.format}")
+        self.block_times = [d.start_time for d in self.storage.data_blocks]
+
+    def _check_layout(self) -> None:
+        """Files of header version 0 may keep the oldest time-point layout (Euler angles,
+        wall vertices in ``angles``/``angle_accl``), which MUSEN converts with its file
+        converter on opening (``IsOldFileVersion``); fibrelmp reads only the current one."""
+        if self.container.version >= 1 or self.info.file_version >= 1:
+            return
+        first = next((i for i, p in enumerate(self.info.particles) if p.type in (1, 14)), None)
+        if first is None:
+            return
+        _, _, masks = next(self.time_points())
+        if first >= len(masks) or not masks[first] >> timepoints.FIELDS["quaternion"][0] & 1:
+            raise InputError(self.path, None, "a MUSEN file of the oldest layout (file version 0, "
+                             "orientations as angles): open it in MUSEN and save it once, which "
+                             "converts it to the current layout, then use that file")
+
+    # -- scene ----------------------------------------------------------------------------
+    @property
+    def info(self) -> Any:
+        return self.storage.info
+
+    @property
+    def version(self) -> int:
+        return self.container.version
+
+    def times(self) -> np.ndarray:
+        """The saved times (``savedTimePoints``; for old files without it, the blocks')."""
+        saved = np.array(self.info.savedTimePoints, dtype=float)
+        if saved.size:
+            return saved
+        return np.array([tp[0] for tp in self.time_points(decode=False)])
+
+    # -- time points ----------------------------------------------------------------------
+    def block_raw(self, index: int) -> bytes:
+        """Compressed bytes of time-point block ``index`` as stored."""
+        d = self.storage.data_blocks[index]
+        return self.container.read(1, d.offset_in_file, d.size)
+
+    def block(self, index: int) -> Any:
+        """The decoded ``ProtoBlockOfTimePoints`` of block ``index``."""
+        from google.protobuf.message import DecodeError
+
+        d = self.storage.data_blocks[index]
+        raw = self.block_raw(index)
+        if d.format == ZIPPED:
+            raw = _inflate(raw, d.uncompressed_size, f"time-point block {index}", self.path)
+        try:
+            return new("ProtoBlockOfTimePoints", raw)
+        except DecodeError:
+            raise InputError(self.path, None, f"corrupt .mdem file: time-point block {index} "
+                             "cannot be decoded") from None
+
+    def time_points(self, decode: bool = True) -> Iterator[tuple[float, np.ndarray, np.ndarray] | tuple[float]]:
+        """Every stored time point in order: (time, values (n, 34), masks (n,)) -- see
+        ``timepoints`` -- one block in memory at a time; ``decode=False`` gives (time,)."""
+        for index in range(len(self.storage.data_blocks)):
+            for tp in self.block(index).time_points:
+                if not decode:
+                    yield (tp.time,)
+                    continue
+                try:
+                    yield timepoints.decode(tp.SerializeToString())
+                except ValueError as exc:
+                    raise InputError(self.path, None, f"corrupt .mdem file: time point "
+                                     f"{tp.time:g} s: {exc}") from None
+
+    def time_point(self, time: float) -> tuple[float, np.ndarray, np.ndarray]:
+        """The stored time point at ``time`` (or the last one before it, as MUSEN picks the
+        left point of an interval)."""
+        index = max(0, bisect.bisect_right(self.block_times, time) - 1)
+        for i in (index, index - 1):
+            if i < 0:
+                continue
+            points = [tp for tp in self.block(i).time_points if tp.time <= time]
+            if points:
+                return timepoints.decode(points[-1].SerializeToString())
+        first = self.block(0).time_points
+        if not len(first):
+            raise InputError(self.path, None, "the file holds no time points")
+        return timepoints.decode(first[0].SerializeToString())
+
+    # -- whole file -----------------------------------------------------------------------
+    def copy_to(self, fh: BinaryIO) -> None:
+        """Write this file again: every message re-serialized, every block re-compressed
+        (MUSEN's zlib level 1), at the offsets they had; the result equals the input byte
+        for byte (tests show it)."""
+        layout: Layout = self.container.layout()
+        out = ContainerWriter(fh, layout)
+        for index, d in enumerate(self.storage.data_blocks):
+            block = self.block(index).SerializeToString()
+            out.write(1, d.offset_in_file, zlib.compress(block, _LEVEL) if d.format == ZIPPED else block)
+        out.write(0, 0, zlib.compress(self.storage.SerializeToString(), _LEVEL))
+        out.finish()
+
+    def close(self) -> None:
+        self.container.close()
+
+    def __enter__(self) -> "MdemFile":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+class MdemWriter:
+    """Writes a new ``.mdem`` to an open binary file: ``add`` time points (each compressed
+    and written at once), then ``finish(storage)`` with the scene message."""
+
+    def __init__(self, fh: BinaryIO):
+        self.out = ContainerWriter(fh)
+        self.out._block(0, 0)              # the scene's first block first, as MUSEN places it
+        self.end = 0                       # bytes of time-dependent data written
+        self.blocks: list[tuple[float, int, int, int]] = []   # time, offset, size, raw size
+
+    def add(self, time: float, values: np.ndarray, masks: np.ndarray) -> None:
+        """One time point (one block, as MUSEN's simulator saves)."""
+        block = _field2(timepoints.encode(time, values, masks))   # ProtoBlockOfTimePoints
+        packed = zlib.compress(block, _LEVEL)
+        self.out.write(1, self.end, packed)
+        self.blocks.append((float(time), self.end, len(packed), len(block)))
+        self.end += len(packed)
+
+    def finish(self, storage: Any) -> None:
+        """Write ``storage`` (its block descriptors, saved times and begin/end time are set
+        to what ``add`` wrote) and the headers."""
+        if not self.blocks:                                # MUSEN files always have a block
+            self.add(0.0, np.zeros((0, timepoints.NCOLS)), np.zeros(0, np.uint32))
+        del storage.data_blocks[:]
+        info = storage.info
+        del info.savedTimePoints[:]
+        for time, offset, size, raw in self.blocks:
+            d = storage.data_blocks.add()
+            d.start_time, d.offset_in_file, d.size, d.uncompressed_size = time, offset, size, raw
+            d.format = ZIPPED
+            info.savedTimePoints.append(time)
+        times = [b[0] for b in self.blocks]
+        info.begin_time = min(0.0, min(times))
+        info.end_time = max(times)
+        self.out.write(0, 0, zlib.compress(storage.SerializeToString(), _LEVEL))
+        self.out.finish()
+
+
+def _field2(payload: bytes) -> bytes:
+    """``payload`` as field 2 (length-delimited) of a message."""
+    n, head = len(payload), bytearray([0x12])
+    while n >= 0x80:
+        head.append(n & 0x7F | 0x80)
+        n >>= 7
+    head.append(n)
+    return bytes(head) + payload

@@ -1,0 +1,175 @@
+"""``MdemResultWriter``: GranularFrames -> a MUSEN ``.mdem`` result that MUSEN opens.
+
+Time points are written as they come (one compressed block each, as MUSEN's simulator saves),
+so memory holds one frame.  What MUSEN's simulator stores per save is stored: spheres
+``coord vel angle_vel force quaternion``; solid bonds ``force`` (on the first sphere),
+tangential overlap (in ``angle_vel``) and ``|total torque|``; walls their vertices (``coord``,
+``quaternion``, ``angle_vel``), ``vel`` and ``force``.  Removed spheres and broken bonds get
+the empty entry MUSEN writes for inactive objects, and their activity ends at the save that
+found them gone.  Stress tensors are not stored: fibrelmp does not compute them (MUSEN shows
+zeros, and its text export writes ``42``/``36`` zeros).
+
+The scene message at the end: the source ``.mdem``'s own (materials, geometries, volumes,
+generators, GUI data kept as they were) or, for text and dump sources, MUSEN's import of the
+same scene text the text result carries; plus the simulator settings and models that ran.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Any
+
+import numpy as np
+
+from fibrelmp.granmodel import GranularFrame, GranularModel
+from fibrelmp.translate.musen.mdem import timepoints as tp
+from fibrelmp.translate.musen.mdem.document import MdemFile, MdemWriter
+from fibrelmp.translate.musen.writer import MusenResultWriter
+
+MODEL_KEYS = {"ModelPPHertzMindlin": "B18A46C2786D4D44B925A8A04D0D1008",
+              "ModelPWHertzMindlin": "906949ACFFAE4B8C8B1B65509930EA6D",
+              "ModelSBElastic": "4CE31CB89C784476AC1971DFC5C39C10",
+              "ModelSBKelvin": "09405654485642A686561E1FC646DF1E"}
+SPHERE_FIELDS = tp.bit("coord", "vel", "angle_vel", "force", "quaternion")
+BOND_FIELDS = tp.bit("force", "angle_vel", "total_torque")
+WALL_FIELDS = tp.bit("coord", "vel", "angle_vel", "force", "quaternion")
+_Q = tp.FIELDS["quaternion"][1]
+_TORQUE = tp.FIELDS["total_torque"][1]
+
+
+class MdemResultWriter(MusenResultWriter):
+    """``add`` every frame, then ``close`` (or ``abort``); ``path`` ends in ``.mdem``."""
+
+    format = "mdem"
+
+    def __init__(self, model: GranularModel, path: str | os.PathLike, precision: int = 6,
+                 time_interval: tuple[float, float] | None = None, *, force: bool = True):
+        super().__init__(model, path, precision, time_interval, force=force)
+        self.fh = self.open(self.path, "w+b")
+        self.mdem = MdemWriter(self.fh)
+        m = model
+        self.n = 1 + max(int(np.max(ids)) if len(ids) else -1 for ids in self._id_sets())
+        self.sphere_ids = np.asarray(m.spheres.ids, np.int64)
+        self.bond_ids = None if m.bonds is None else np.asarray(m.bonds.ids, np.int64)
+        self.wall_ids = None if m.triangles is None else np.asarray(m.triangles.ids, np.int64)
+
+    def _id_sets(self) -> list[np.ndarray]:
+        m = self.model
+        sets = [m.spheres.ids]
+        if m.bonds is not None:
+            sets.append(m.bonds.ids)
+        if m.triangles is not None:
+            sets.append(m.triangles.ids)
+        liquid = m.passthrough.get("liquid_bonds") or []
+        if liquid:
+            sets.append(np.array([lb["id"] for lb in liquid], np.int64))
+        return sets
+
+    def write(self, frame: GranularFrame) -> None:
+        if not self.track_activity(frame):
+            return
+        values = np.zeros((self.n, tp.NCOLS))
+        masks = np.zeros(self.n, np.uint32)
+        rows = np.asarray(frame.sphere_rows, np.int64)
+        ids = self.sphere_ids[rows]
+        values[ids, 0:3] = frame.position
+        values[ids, 6:9] = frame.velocity
+        values[ids, 9:12] = frame.omega
+        values[ids, 18:21] = np.asarray(frame.force, np.float64).reshape(-1, 3)
+        values[ids, _Q:_Q + 4] = frame.quaternion
+        masks[ids] = SPHERE_FIELDS
+        if self.bond_ids is not None:
+            alive = (np.ones(len(self.bond_ids), bool) if frame.bond_alive is None
+                     else np.asarray(frame.bond_alive, bool))
+            ids = self.bond_ids[alive]
+            if frame.bond_force is not None:
+                values[ids, 18:21] = np.asarray(frame.bond_force, np.float64)[alive]
+            if frame.bond_tangential_overlap is not None:
+                values[ids, 9:12] = np.asarray(frame.bond_tangential_overlap, np.float64)[alive]
+            if frame.bond_torque is not None:
+                values[ids, _TORQUE] = np.asarray(frame.bond_torque, np.float64)[alive]
+            masks[ids] = BOND_FIELDS
+        if self.wall_ids is not None:
+            tri = self.model.triangles
+            vert = np.asarray(tri.vertices if frame.triangle_vertices is None
+                              else frame.triangle_vertices, np.float64).reshape(-1, 9)
+            ids = self.wall_ids
+            values[ids, 0:3] = vert[:, 0:3]
+            values[ids, _Q:_Q + 3] = vert[:, 3:6]
+            values[ids, 9:12] = vert[:, 6:9]
+            values[ids, 6:9] = tri.velocity if frame.triangle_velocity is None else frame.triangle_velocity
+            if frame.triangle_force is not None:
+                values[ids, 18:21] = frame.triangle_force
+            masks[ids] = WALL_FIELDS
+        try:
+            self.mdem.add(float(frame.time), values, masks)
+        except OSError as exc:
+            exc.output = self.path
+            raise
+        self.times.append(float(frame.time))
+
+    def finish(self) -> None:
+        self.mdem.finish(self.scene())
+
+    def scene(self) -> Any:
+        """The scene message: the source ``.mdem``'s, else MUSEN's import of the scene text."""
+        source = self.model.passthrough.get("mdem_source")
+        if source is not None:
+            with MdemFile(source) as mdem:
+                storage = mdem.storage
+            self._set_activity(storage)
+        else:
+            storage = self._imported_scene()
+        self._set_settings(storage)
+        return storage
+
+    def _imported_scene(self) -> Any:
+        from fibrelmp.translate.musen.mdem.text_import import import_text
+
+        ids, types, rows = self._objects()
+        text = self.spool / "scene.txt"
+        with open(text, "w", newline="\n") as out:
+            for t in (1, 9, 13, 14):
+                sel = types == t
+                if sel.any():
+                    out.write("".join(h + "\n" for h in self._headers(t, ids[sel], rows[sel])))
+            out.write(self._scene_text())
+        storage, _ = import_text(text)
+        return storage
+
+    def _set_activity(self, storage: Any) -> None:
+        particles = storage.info.particles
+        for ids, end in ((self.sphere_ids, self.sphere_end), (self.bond_ids, self.bond_end)):
+            if ids is None or end is None:
+                continue
+            for i in np.flatnonzero(np.isfinite(end)).tolist():
+                particles[int(ids[i])].activity_end = float(end[i])
+
+    def _set_settings(self, storage: Any) -> None:
+        m, plan = self.model, self.model.plan
+        sim = storage.modules_data.simulator
+        sim.end_time = plan.t_end if np.isfinite(plan.t_end) else (self.times[-1] if self.times else 0.0)
+        if np.isfinite(plan.dt):
+            sim.simulation_step = plan.dt
+        if plan.save_every_time is not None:
+            sim.saving_step = plan.save_every_time
+        sim.external_acceleration.SetInParent()
+        sim.external_acceleration.x, sim.external_acceleration.y, sim.external_acceleration.z = \
+            (float(g) for g in plan.gravity)
+        sim.simulator_type = sim.simulator_type or 1           # CPU
+        models = m.passthrough.get("musen_models") or {}
+        if models:
+            manager = storage.modules_data.model_manager
+            manager.version = 1
+            del manager.models[:]
+            for kind in ("PP", "PW", "SB", "LB", "EF"):
+                if kind not in models:
+                    continue
+                name, params = models[kind]
+                entry = manager.models.add()
+                entry.key = MODEL_KEYS.get(name, "")
+                entry.path = name
+                entry.params = "".join(f"{k} {v:g} " for k, v in params.items())
+            manager.connected_pp_contact = bool(plan.contacts_between_bonded)
+
+

@@ -62,6 +62,9 @@ BENCHES = [
     Bench("musen_styles", "MUSEN agglomerate loop per step: fibrelmp's styles / --stock-styles",
           r"ratio plugin / stock \(per-step cost\): ([0-9.]+)", "<= 1.0",
           ["--steps", "100", "--repeat", "1"]),
+    Bench("mdem_io", "reading 100k spheres x 50 saves: MUSEN .mdem / MUSEN text (fibrelmp's readers)",
+          r"mdem/text read time ratio: ([0-9.]+)", "<= 1.0",
+          ["--spheres", "20000", "--saves", "10", "--few", "5"]),
 ]
 
 

@@ -437,6 +437,8 @@ def mdem_decode(raw: bytes) -> tuple[float, np.ndarray, np.ndarray] | None:
     if lib is None or sys.byteorder != "little":
         return None
     buf = np.frombuffer(raw, np.uint8)
+    if not buf.size:
+        buf = np.zeros(1, np.uint8)
     n = lib.fp_mdem_count(buf.ctypes.data, len(raw))
     if n < 0:
         raise ValueError("malformed time point")

@@ -12,7 +12,6 @@ times and begin/end time of what was written.  Memory holds one time point at a 
 
 from __future__ import annotations
 
-import bisect
 import os
 import zlib
 from pathlib import Path
@@ -118,16 +117,20 @@ class MdemFile:
         d = self.storage.data_blocks[index]
         return self.container.read(1, d.offset_in_file, d.size)
 
-    def block(self, index: int) -> Any:
-        """The decoded ``ProtoBlockOfTimePoints`` of block ``index``."""
-        from google.protobuf.message import DecodeError
-
+    def block_bytes(self, index: int) -> bytes:
+        """The serialized ``ProtoBlockOfTimePoints`` of block ``index``."""
         d = self.storage.data_blocks[index]
         raw = self.block_raw(index)
         if d.format == ZIPPED:
             raw = _inflate(raw, d.uncompressed_size, f"time-point block {index}", self.path)
+        return raw
+
+    def block(self, index: int) -> Any:
+        """The decoded ``ProtoBlockOfTimePoints`` of block ``index``."""
+        from google.protobuf.message import DecodeError
+
         try:
-            return new("ProtoBlockOfTimePoints", raw)
+            return new("ProtoBlockOfTimePoints", self.block_bytes(index))
         except DecodeError:
             raise InputError(self.path, None, f"corrupt .mdem file: time-point block {index} "
                              "cannot be decoded") from None
@@ -136,30 +139,13 @@ class MdemFile:
         """Every stored time point in order: (time, values (n, 34), masks (n,)) -- see
         ``timepoints`` -- one block in memory at a time; ``decode=False`` gives (time,)."""
         for index in range(len(self.storage.data_blocks)):
-            for tp in self.block(index).time_points:
-                if not decode:
-                    yield (tp.time,)
-                    continue
-                try:
-                    yield timepoints.decode(tp.SerializeToString())
-                except ValueError as exc:
-                    raise InputError(self.path, None, f"corrupt .mdem file: time point "
-                                     f"{tp.time:g} s: {exc}") from None
-
-    def time_point(self, time: float) -> tuple[float, np.ndarray, np.ndarray]:
-        """The stored time point at ``time`` (or the last one before it, as MUSEN picks the
-        left point of an interval)."""
-        index = max(0, bisect.bisect_right(self.block_times, time) - 1)
-        for i in (index, index - 1):
-            if i < 0:
-                continue
-            points = [tp for tp in self.block(i).time_points if tp.time <= time]
-            if points:
-                return timepoints.decode(points[-1].SerializeToString())
-        first = self.block(0).time_points
-        if not len(first):
-            raise InputError(self.path, None, "the file holds no time points")
-        return timepoints.decode(first[0].SerializeToString())
+            try:
+                for payload in _messages(self.block_bytes(index), 2):
+                    point = timepoints.decode(payload) if decode else (timepoints.time_of(payload),)
+                    yield point
+            except ValueError as exc:
+                raise InputError(self.path, None, f"corrupt .mdem file: time-point block "
+                                 f"{index}: {exc}") from None
 
     # -- whole file -----------------------------------------------------------------------
     def copy_to(self, fh: BinaryIO) -> None:
@@ -220,6 +206,43 @@ class MdemWriter:
         info.end_time = max(times)
         self.out.write(0, 0, zlib.compress(storage.SerializeToString(), _LEVEL))
         self.out.finish()
+
+
+def _varint(data: bytes, at: int) -> tuple[int, int]:
+    value = shift = 0
+    while True:
+        if at >= len(data) or shift > 63:
+            raise ValueError("a varint runs past its message")
+        byte = data[at]
+        value |= (byte & 0x7F) << shift
+        at += 1
+        if byte < 0x80:
+            return value, at
+        shift += 7
+
+
+def _messages(data: bytes, field: int) -> Iterator[memoryview]:
+    """The payloads of length-delimited ``field`` of a serialized message (others skipped),
+    without decoding them: a block's time points go straight to the array decoder."""
+    view, at = memoryview(data), 0
+    while at < len(data):
+        tag, at = _varint(data, at)
+        kind = tag & 7
+        if kind == 2:
+            size, at = _varint(data, at)
+            if at + size > len(data):
+                raise ValueError("a field runs past its message")
+            if tag >> 3 == field:
+                yield view[at:at + size]
+            at += size
+        elif kind == 0:
+            _, at = _varint(data, at)
+        elif kind in (1, 5):
+            at += 8 if kind == 1 else 4
+        else:
+            raise ValueError(f"unknown wire type {kind}")
+    if at != len(data):
+        raise ValueError("the last field runs past its message")
 
 
 def _field2(payload: bytes) -> bytes:

@@ -1,13 +1,18 @@
-"""``.mdem`` scenes as the neutral GranularModel (run inputs)."""
+"""``.mdem`` scenes as the neutral GranularModel (run inputs), and their time points as
+GranularFrames (``MdemReader``)."""
 
 from __future__ import annotations
 
 import os
 import tempfile
 from pathlib import Path
+from typing import Iterator
+
+import numpy as np
 
 from fibrelmp.errors import InputError
-from fibrelmp.granmodel import GranularModel
+from fibrelmp.formatbase import Reader
+from fibrelmp.granmodel import GranularFrame, GranularModel
 
 
 def read_scene(path: str | os.PathLike) -> GranularModel:
@@ -34,3 +39,53 @@ def read_scene(path: str | os.PathLike) -> GranularModel:
     model.passthrough["mdem_source"] = path
     model.passthrough["mdem_version"] = mdem_version
     return model
+
+
+class MdemReader(Reader):
+    """A ``.mdem`` file through the abstract Reader: ``read()`` the scene (``read_scene``),
+    iterating its saved time points as ``GranularFrame``s, one block in memory at a time
+    (spheres and bonds with an empty entry, MUSEN's mark of inactive objects, are absent /
+    not alive)."""
+
+    format = "mdem"
+    what = "MUSEN .mdem file"
+
+    def read(self) -> GranularModel:
+        return read_scene(self.path)
+
+    def __iter__(self) -> Iterator[GranularFrame]:
+        from fibrelmp.translate.musen.mdem.document import MdemFile
+        from fibrelmp.translate.musen.mdem.objects import SOLID_BOND, SPHERE, WALL, read_objects
+        from fibrelmp.translate.musen.mdem.timepoints import columns
+
+        with MdemFile(self.path) as mdem:
+            obj = read_objects(mdem.info, mdem.version, self.path)
+            spheres = obj.ids[obj.types == SPHERE]
+            bonds = obj.ids[obj.types == SOLID_BOND]
+            walls = obj.ids[obj.types == WALL]
+            q = columns("quaternion").start
+            for step, (time, values, masks) in enumerate(mdem.time_points()):
+                n = len(values)
+                live = np.flatnonzero((spheres < n) & (masks[np.minimum(spheres, n - 1)] != 0)
+                                      if n else np.zeros(0, bool))
+                v = values[spheres[live]]
+                frame = GranularFrame(time=time, step=step, sphere_rows=live,
+                                      position=v[:, columns("coord")], velocity=v[:, columns("vel")],
+                                      omega=v[:, columns("angle_vel")], force=v[:, columns("force")],
+                                      quaternion=v[:, columns("quaternion")])
+                if len(bonds):
+                    b = np.zeros((len(bonds), values.shape[1]))
+                    inside = bonds < n
+                    b[inside] = values[bonds[inside]]
+                    frame.bond_alive = np.zeros(len(bonds), bool)
+                    frame.bond_alive[inside] = masks[bonds[inside]] != 0
+                    frame.bond_force = b[:, columns("force")]
+                    frame.bond_tangential_overlap = b[:, columns("angle_vel")]
+                    frame.bond_torque = b[:, columns("total_torque").start]
+                if len(walls):
+                    w = values[walls]
+                    frame.triangle_vertices = np.stack(
+                        [w[:, columns("coord")], w[:, q:q + 3], w[:, columns("angle_vel")]], axis=1)
+                    frame.triangle_velocity = w[:, columns("vel")]
+                    frame.triangle_force = w[:, columns("force")]
+                yield frame

@@ -12,6 +12,7 @@ every compound pair as MUSEN's database adds them) and generators (39/40/41).
 
 from __future__ import annotations
 
+import datetime
 from pathlib import Path
 from typing import Any, Iterator
 
@@ -162,6 +163,9 @@ def _scene(storage: Any, scan, path: Path) -> None:
     _vector(info.periodic_conditions_vel, (0.0,) * 3)
     db = mods.materials_database
     db.SetInParent()
+    mods.bonds_generator.SetInParent()              # the generators' SaveConfiguration after import
+    mods.package_generator.simulator_type = 1       # CPU, MUSEN's default
+    mods.package_generator.verlet_coeff = 2.0
     geometry = None
     for ln, tag, tok in scan.scene:
         if tag == 22:
@@ -292,6 +296,9 @@ def _pairs(tok: list[str], path: Path, ln: int, what: str) -> dict[int, float]:
 def _compound(db: Any, tok: list[str], path: Path, ln: int) -> None:
     c = db.compound.add()
     c.uniqueKey, c.compoundName = tok[0], tok[1]
+    c.authorName = "Unspecified"
+    today = datetime.date.today()                   # MUSEN stamps a new compound's creation date
+    c.creationDate.year, c.creationDate.month, c.creationDate.day = today.year, today.month, today.day
     c.color.SetInParent()
     c.color.b, c.color.a = 1.0, 1.0
     c.phase = 2                                      # solid

@@ -35,16 +35,26 @@ def bit(*names: str) -> int:
     return sum(1 << FIELDS[n][0] for n in names)
 
 
+def time_of(raw: bytes) -> float:
+    """The time of a serialized ``ProtoTimePoint`` (field 1; 0 when absent)."""
+    tp = new("ProtoTimePoint")
+    tp.MergeFromString(bytes(raw))
+    return tp.time
+
+
 def decode(raw: bytes) -> tuple[float, np.ndarray, np.ndarray]:
     """(time, values (n, 34), masks (n,)) of a serialized ``ProtoTimePoint``; ValueError if
     it is malformed."""
     done = fast.mdem_decode(raw)
-    if done is not None:
-        return done
+    return done if done is not None else decode_py(raw)
+
+
+def decode_py(raw: bytes) -> tuple[float, np.ndarray, np.ndarray]:
+    """``decode`` through the protobuf messages (the path without the C helpers)."""
     from google.protobuf.message import DecodeError
 
     try:
-        tp = new("ProtoTimePoint", raw)
+        tp = new("ProtoTimePoint", bytes(raw))
     except DecodeError as exc:
         raise ValueError(f"malformed time point ({exc})") from None
     n = len(tp.particles)
@@ -72,8 +82,11 @@ def decode(raw: bytes) -> tuple[float, np.ndarray, np.ndarray]:
 def encode(time: float, values: np.ndarray, masks: np.ndarray) -> bytes:
     """The serialized ``ProtoTimePoint`` (byte for byte what protobuf writes)."""
     done = fast.mdem_encode(time, values, masks)
-    if done is not None:
-        return done
+    return done if done is not None else encode_py(time, values, masks)
+
+
+def encode_py(time: float, values: np.ndarray, masks: np.ndarray) -> bytes:
+    """``encode`` through the protobuf messages (the path without the C helpers)."""
     tp = new("ProtoTimePoint")
     tp.time = time
     for row, mask in zip(np.asarray(values, float), np.asarray(masks, np.uint32)):

@@ -293,3 +293,37 @@ def test_reader_gives_the_scene_and_frames_of_the_file():
         assert np.array_equal(f.position[0], text.fields[12][k, sphere])
         assert np.array_equal(f.velocity[0], text.fields[15][k, sphere])
         assert np.array_equal(f.triangle_vertices.reshape(12, 9), text.fields[44][k, :12])
+
+
+def test_script_on_musens_compression_example_keeps_what_the_run_changed(tmp_path):
+    """MUSEN's Example 7 (scripts/"Example 7 - Modified material parameters.txt": its
+    CompressionTest.mdem with density 3000 and sliding friction 0.1), shortened: the file's
+    own models (Kelvin bonds), gravity and moving wall are used; the .mdem result carries the
+    changed values, the wall's motion in the current geometry list, and exports to the same
+    scene lines as fibrelmp's text result of the same run."""
+    shutil.copy(INPUTS / "CompressionTest.mdem", tmp_path)
+    (tmp_path / "job.txt").write_text(
+        "JOB\nSOURCE_FILE CompressionTest.mdem\nRESULT_FILE ./result.mdem\nCOMPONENT SIMULATOR\n"
+        "SIMULATION_STEP 2e-8\nSAVING_STEP 5e-7\nEND_TIME 1e-6\n"
+        "MATERIAL_PROPERTY DENSITY KF6843H84OPHH3017U3D 3000\n"
+        "INTERACTION_PROPERTY SLIDING_FRICTION KF6843H84OPHH3017U3D KF6843H84OPHH3017U3D 0.1\n"
+        "JOB\nSOURCE_FILE result.mdem\nRESULT_FILE ./result.txt\nCOMPONENT EXPORT_TO_TEXT\n"
+        "TEXT_EXPORT_PRECISION 17\n")
+    run = python_api.run(tmp_path / "job.txt")
+    kinds = {kind for kind, _ in run.warnings}
+    assert "musen-default-settings" not in kinds                 # the file's gravity was used
+    python_api.convert_file(tmp_path / "result.mdem", tmp_path / "export.txt", precision=17)
+    lines = [(tmp_path / n).read_text().splitlines() for n in ("export.txt", "result.txt")]
+    scene = [ln for ln in lines[0] if not ln.startswith("0 ")]
+    assert scene == [ln for ln in lines[1] if not ln.startswith("0 ")]
+    assert "32 KF6843H84OPHH3017U3D Glass 0 3000 " in "\n".join(scene)
+    assert "33 KF6843H84OPHH3017U3D KF6843H84OPHH3017U3D 200 0.9 201 0.1 202 0.05 " in scene
+    assert "26 1 1 0 99 0 0 -0.1 0 0 0 0 0 0  " in scene              # UpperWall moves down
+    with MdemFile(tmp_path / "result.mdem") as mdem:
+        assert mdem.info.version == 1 and len(mdem.info.real_geometry) == 2
+        assert [m.path for m in mdem.storage.modules_data.model_manager.models] == \
+               ["ModelPPHertzMindlin", "ModelPWHertzMindlin", "ModelSBKelvin"]
+        assert list(mdem.storage.modules_data.simulator.external_acceleration.ListFields())
+    ours, text = read_time_points(tmp_path / "export.txt"), read_time_points(tmp_path / "result.txt")
+    for tag in text.fields:
+        assert np.array_equal(ours.fields[tag], text.fields[tag], equal_nan=True), tag

@@ -134,29 +134,38 @@ def bare_scene_settings(model: GranularModel, end_time: float | None, step: floa
     """Settings for a bare MUSEN scene, as cmusen would simulate it after IMPORT_FROM_TEXT:
     Hertz-Mindlin particle-particle and particle-wall, elastic solid bonds (breakage on),
     gravity (0, 0, -9.81); step, saving step and end time from the command line (MUSEN's
-    defaults 1e-6 s, 1e-3 s and 1 s, with a warning, when not given)."""
+    defaults 1e-6 s, 1e-3 s and 1 s, with a warning, when not given).  A ``.mdem`` scene's own
+    models, steps and gravity (what MUSEN loads with the file) take the defaults' place."""
     from fibrelmp.translate.musen.script import (MUSEN_DEFAULTS, SUPPORTED_MODELS, MusenJob,
                                          MusenModelSpec, apply_simulator_settings)
 
     for name, value in (("end-time", end_time), ("step", step), ("save-step", save_step)):
         if value is not None and not value > 0:
             raise InputError(model.source, None, f"--{name} must be positive, got {value:g}")
+    file_set = model.passthrough.get("musen_gravity_set")          # a .mdem's own settings
     job = MusenJob(path=model.source, index=0, line=0, component="SIMULATOR",
                    simulation_step=step or 0.0, saving_step=save_step or 0.0,
-                   end_time=end_time or 0.0, ext_accel=tuple(MUSEN_DEFAULTS["gravity"]))
-    job.models = [MusenModelSpec(name=SUPPORTED_MODELS["PP"], params="", kind="PP", line=0)]
-    if model.triangles is not None and model.triangles.count:
-        job.models.append(MusenModelSpec(name=SUPPORTED_MODELS["PW"], params="", kind="PW", line=0))
-    if model.bonds is not None and model.bonds.count:
-        job.models.append(MusenModelSpec(name=SUPPORTED_MODELS["SB"], params="", kind="SB", line=0))
+                   end_time=end_time or 0.0,
+                   ext_accel=None if file_set else tuple(MUSEN_DEFAULTS["gravity"]))
+    stored = {spec.kind for spec in model.passthrough.get("mdem_models", [])}
+    job.models = [MusenModelSpec(name=SUPPORTED_MODELS[kind], params="", kind=kind, line=0)
+                  for kind, wanted in (("PP", True),
+                                       ("PW", model.triangles is not None and model.triangles.count),
+                                       ("SB", model.bonds is not None and model.bonds.count))
+                  if wanted and kind not in stored]
     apply_simulator_settings(model, job)
     plan = model.plan
     model.warnings = [(kind, f"no --step/--save-step/--end-time given: MUSEN's defaults are used "
                               f"(step {plan.dt:g} s, saving step {plan.save_every_time:g} s, end "
                               f"{plan.t_end:g} s)") if kind == "musen-default-settings" else (kind, text)
                       for kind, text in model.warnings]
-    said = [f"models {', '.join(spec.name for spec in job.models)} (MUSEN's for a bare scene)",
-            "gravity 0 0 -9.81 m/s^2 (MUSEN's default)"]
+    said = []
+    if job.models:
+        said.append(f"models {', '.join(spec.name for spec in job.models)} (MUSEN's for a bare scene)")
+    if stored:
+        said.append(f"models {', '.join(s.name for s in model.passthrough['mdem_models'])} (the file's)")
+    said.append("gravity 0 0 -9.81 m/s^2 (MUSEN's default)" if not file_set else
+                f"gravity {' '.join('%g' % g for g in model.plan.gravity)} m/s^2 (the file's)")
     for name, value in (("end time", end_time), ("simulation step", step), ("saving step", save_step)):
         if value is not None:
             said.append(f"{name} {value:g} s")

@@ -25,45 +25,61 @@ MUSEN_DEFAULTS = {"dt": 1e-6, "save": 1e-3, "t_end": 1.0, "gravity": (0.0, 0.0, 
 
 
 def _resolve_models(model: GranularModel, job: MusenJob) -> dict[str, tuple[str, dict]]:
+    """The models a SIMULATOR job runs: the scene's (a ``.mdem`` stores its models, as MUSEN
+    loads them with the file; a kind the job names again is replaced), then the job's."""
     chosen: dict[str, tuple[str, dict]] = dict(model.passthrough.get("musen_models", {}))
+    given = {model_kind(spec) for spec in job.models}
+    for spec in model.passthrough.get("mdem_models", []):
+        if model_kind(spec) not in given:
+            kind, choice = _model_choice(model, spec, model.source, None)
+            chosen[kind] = choice
     for spec in job.models:
-        kind = model_kind(spec)
-        known = [n for names in MUSEN_MODELS.values() for n in names]
-        if spec.name not in known:
-            near = difflib.get_close_matches(spec.name, known, n=1)
-            raise InputError(job.path, spec.line, f"unknown MUSEN model {spec.name!r}"
-                             + (f"; did you mean {near[0]}?" if near else ""))
-        if spec.kind and spec.kind != kind:
-            raise InputError(job.path, spec.line, f"{spec.name} is a {kind} model, given as "
-                             f"MODEL_{spec.kind}")
-        if spec.name in STYLE_MODELS.get(kind, {}):
-            styles = lammps_styles.plugin()
-            if not styles.available:
-                raise InputError(job.path, spec.line, f"{spec.name} needs fibrelmp's LAMMPS styles "
-                                 f"({STYLE_MODELS[kind][spec.name]}), which are not available here "
-                                 f"({styles.how}); stock LAMMPS has no such solid bond, so fibrelmp "
-                                 "translates ModelSBElastic only without them")
-        elif SUPPORTED_MODELS.get(kind) != spec.name:
-            what = {"PP": "particle-particle", "PW": "particle-wall", "SB": "solid-bond",
-                    "LB": "liquid-bond", "EF": "external-force"}[kind]
-            ok = SUPPORTED_MODELS.get(kind)
-            raise InputError(job.path, spec.line, f"{spec.name}: this {what} model is not "
-                             "supported" + (f"; fibrelmp translates {ok} only" if ok else ""))
-        params = dict(MODEL_PARAMETERS.get(spec.name, {}))
-        tok = spec.params.split()
-        for j in range(0, len(tok), 2):
-            name = tok[j]
-            if name not in params:
-                model.warn("musen-unknown-model-parameter", f"{job.path}:{spec.line}: "
-                           f"{spec.name} has no parameter {name}; ignored as MUSEN does")
-                continue
-            try:
-                params[name] = float(tok[j + 1])
-            except (IndexError, ValueError):
-                raise InputError(job.path, spec.line, f"{spec.name} parameter {name}: expected "
-                                 "a number") from None
-        chosen[kind] = (spec.name, params)
+        kind, choice = _model_choice(model, spec, job.path, spec.line)
+        chosen[kind] = choice
     return chosen
+
+
+def _model_choice(model: GranularModel, spec, path, line: int | None) -> tuple[str, tuple[str, dict]]:
+    """(kind, (name, parameters)) of one model named at ``path``:``line``, checked."""
+    kind = model_kind(spec)
+    where = "" if line is not None else "the file's model "
+    known = [n for names in MUSEN_MODELS.values() for n in names]
+    if spec.name not in known:
+        near = difflib.get_close_matches(spec.name, known, n=1)
+        raise InputError(path, line, f"unknown MUSEN model {where}{spec.name!r}"
+                         + (f"; did you mean {near[0]}?" if near else ""))
+    if spec.kind and spec.kind != kind:
+        raise InputError(path, line, f"{spec.name} is a {kind} model, given as "
+                         f"MODEL_{spec.kind}")
+    if spec.name in STYLE_MODELS.get(kind, {}):
+        styles = lammps_styles.plugin()
+        if not styles.available:
+            raise InputError(path, line, f"{where}{spec.name} needs fibrelmp's LAMMPS styles "
+                             f"({STYLE_MODELS[kind][spec.name]}), which are not available here "
+                             f"({styles.how}); stock LAMMPS has no such solid bond, so fibrelmp "
+                             "translates ModelSBElastic only without them")
+    elif SUPPORTED_MODELS.get(kind) != spec.name:
+        what = {"PP": "particle-particle", "PW": "particle-wall", "SB": "solid-bond",
+                "LB": "liquid-bond", "EF": "external-force"}[kind]
+        ok = SUPPORTED_MODELS.get(kind)
+        raise InputError(path, line, f"{where}{spec.name}: this {what} model is not supported"
+                         + (f"; fibrelmp translates {ok} only" if ok else "")
+                         + ("; name another in the job script (MODEL_" + kind + ")" if line is None else ""))
+    params = dict(MODEL_PARAMETERS.get(spec.name, {}))
+    tok = spec.params.split()
+    for j in range(0, len(tok), 2):
+        name = tok[j]
+        if name not in params:
+            at = f"{path}:{line}" if line is not None else f"{path} (its model manager)"
+            model.warn("musen-unknown-model-parameter", f"{at}: {spec.name} has no parameter "
+                       f"{name}; ignored as MUSEN does")
+            continue
+        try:
+            params[name] = float(tok[j + 1])
+        except (IndexError, ValueError):
+            raise InputError(path, line, f"{spec.name} parameter {name}: expected "
+                             "a number") from None
+    return kind, (spec.name, params)
 
 
 def apply_simulator_settings(model: GranularModel, job: MusenJob) -> None:

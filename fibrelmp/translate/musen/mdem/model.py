@@ -34,11 +34,41 @@ def read_scene(path: str | os.PathLike) -> GranularModel:
         except InputError as exc:
             where = f" (its text form, line {exc.line})" if exc.line else ""
             raise InputError(path, None, f"{exc.message}{where}") from None
-        mdem_version = mdem.version
+        _settings(model, mdem.storage.modules_data)
     model.source = path
     model.passthrough["mdem_source"] = path
-    model.passthrough["mdem_version"] = mdem_version
     return model
+
+
+def _settings(model: GranularModel, modules) -> None:
+    """What MUSEN loads with a file besides the scene: the simulator's step, saving step, end
+    time and gravity (a job script may set them again) and the selected models."""
+    from fibrelmp.translate.musen.script_parse import MUSEN_MODELS, MusenModelSpec
+
+    sim = modules.simulator
+    plan = model.plan
+    if sim.simulation_step > 0:
+        plan.dt = sim.simulation_step
+    if sim.saving_step > 0:
+        plan.save_every_time = sim.saving_step
+    if sim.end_time > 0:
+        plan.t_end = sim.end_time
+    if modules.HasField("simulator"):
+        g = sim.external_acceleration
+        plan.gravity = np.array([g.x, g.y, g.z])
+        model.passthrough["musen_gravity_set"] = True
+    manager = modules.model_manager
+    entries = list(manager.models) or [manager.pp_model, manager.pw_model, manager.sb_model,
+                                       manager.lb_model, manager.ef_model]
+    specs = []
+    for entry in entries:
+        name = Path(entry.path.replace("\\", "/")).stem          # a custom model's library path
+        if not name:
+            continue
+        kind = next((k for k, names in MUSEN_MODELS.items() if name in names), name[5:7])
+        specs.append(MusenModelSpec(name=name, params=entry.params, kind=kind, line=0))
+    if specs:
+        model.passthrough["mdem_models"] = specs
 
 
 class MdemReader(Reader):

@@ -118,6 +118,7 @@ class MdemResultWriter(MusenResultWriter):
             with MdemFile(source) as mdem:
                 storage = mdem.storage
             self._set_activity(storage)
+            self._set_scene(storage)
         else:
             storage = self._imported_scene()
         self._set_settings(storage)
@@ -144,6 +145,63 @@ class MdemResultWriter(MusenResultWriter):
                 continue
             for i in np.flatnonzero(np.isfinite(end)).tolist():
                 particles[int(ids[i])].activity_end = float(end[i])
+
+    def _set_scene(self, storage: Any) -> None:
+        """What the run changed in a ``.mdem`` source's scene, as the text result writes it:
+        materials and interactions (script material lines), domain, periodic boundaries and
+        time-dependent geometry motion; version-0 geometries are saved in the current list,
+        as MUSEN saves them (the old list stays, unread)."""
+        from fibrelmp.translate.musen.mdem.text_export import (ACTIVE_INTERACTIONS, ACTIVE_PROPERTIES,
+                                                               property_value)
+        from fibrelmp.translate.musen.mdem.text_import import set_constant
+        from fibrelmp.translate.musen.writer import _property
+
+        m, info = self.model, storage.info
+        by_key = {mat.key: k for k, mat in enumerate(m.materials)}
+        db = storage.modules_data.materials_database
+        for c in db.compound:
+            if c.uniqueKey not in by_key:
+                continue
+            mat = m.materials[by_key[c.uniqueKey]]
+            for pid in ACTIVE_PROPERTIES:
+                want = _property(mat, pid)
+                if want == want and want != property_value(c.property, pid, c.constProperty):
+                    _replace_property(c.property, pid, want, set_constant)
+        inter = m.passthrough.get("interactions", {})
+        for i in db.interaction:
+            if i.compoundKey1 not in by_key or i.compoundKey2 not in by_key:
+                continue
+            a, b = sorted((by_key[i.compoundKey1], by_key[i.compoundKey2]))
+            values = dict(inter.get((a, b), {}))
+            law = m.contacts.get((a, b))
+            if law is not None:
+                values.update({200: law.restitution, 201: law.friction, 202: law.rolling_friction})
+            for pid in ACTIVE_INTERACTIONS:
+                if pid in values and values[pid] != property_value(i.property, pid):
+                    _replace_property(i.property, pid, values[pid], set_constant)
+        plan = m.plan
+        if plan.domain is not None:
+            _vector(info.simulation_volume_min, plan.domain[0])
+            _vector(info.simulation_volume_max, plan.domain[1])
+        periodic = tuple(bool(p) for p in plan.periodic)
+        info.periodic_conditions_enabled = any(periodic)
+        info.periodic_conditions_x, info.periodic_conditions_y, info.periodic_conditions_z = periodic
+        if plan.periodic_box is not None:
+            _vector(info.periodic_conditions_min, plan.periodic_box[0])
+            _vector(info.periodic_conditions_max, plan.periodic_box[1])
+        if info.version == 0:
+            _geometries_v1(info)
+        for geo, g in zip(info.real_geometry, m.geometries):
+            if g.motion_type == 1:
+                motion = geo.base_geometry.motion
+                motion.type = 1
+                del motion.intervals[:]
+                for iv in g.motion:
+                    new = motion.intervals.add()
+                    _vector(new.velocity, iv.velocity)
+                    _vector(new.rot_velocity, iv.angular_velocity)
+                    _vector(new.rot_center, iv.centre)
+                    new.limit1, new.limit2 = iv.t_begin, iv.t_end
 
     def _set_settings(self, storage: Any) -> None:
         m, plan = self.model, self.model.plan
@@ -173,3 +231,73 @@ class MdemResultWriter(MusenResultWriter):
             manager.connected_pp_contact = bool(plan.contacts_between_bonded)
 
 
+
+
+def _vector(msg: Any, values) -> None:
+    msg.SetInParent()
+    msg.x, msg.y, msg.z = (float(v) for v in values)
+
+
+def _replace_property(props: Any, pid: int, value: float, set_constant) -> None:
+    """A TP property's value as one constant correlation (``SetPropertyValue``)."""
+    for prop in props:
+        if prop.propertyType == pid:
+            set_constant(prop, pid, value)
+            return
+    set_constant(props.add(), pid, value)
+
+
+def _geometries_v1(info: Any) -> None:
+    """Version-0 geometries and analysis volumes in the current lists (``FlushToStorage``)."""
+    from fibrelmp.translate.musen.mdem.text_export import geometries, volumes
+
+    del info.real_geometry[:]
+    for old, geo in zip(info.real_geometry_v0, geometries(info)):
+        new = info.real_geometry.add()
+        base = new.base_geometry
+        base.name, base.key, base.shape = geo["name"], geo["key"], old.type
+        _motion(base.motion, geo["motion_type"], geo["intervals"])
+        if old.HasField("color"):
+            base.color.CopyFrom(old.color)
+        if old.HasField("rotation"):
+            base.rotation.CopyFrom(old.rotation)
+        base.sizes.extend(old.props)
+        base.scaling = 1.0
+        new.planes.extend(geo["planes"])
+        _vector(new.free_motion, geo["free"])
+        new.mass = geo["mass"]
+        new.rotate_around_center = bool(geo["rotate"])
+    del info.analysis_volume[:]
+    for vol in volumes(info):
+        new = info.analysis_volume.add()
+        base = new.base_geometry
+        base.name, base.key, base.shape = vol["name"], vol["key"], vol["shape"]
+        base.color.r, base.color.g, base.color.b, base.color.a = vol["colour"]
+        w, d, h, r, ri = vol["sizes"]
+        base.sizes.extend({0: [r], 1: [w, d, h], 2: [r, h], 3: [r, ri]}.get(vol["shape"], []))
+        base.scaling = vol["scaling"]
+        rot = vol["rotation"]
+        for row, msg in enumerate((base.rotation.v1, base.rotation.v2, base.rotation.v3)):
+            _vector(msg, rot[3 * row:3 * row + 3])
+        _motion(base.motion, vol["motion_type"], vol["intervals"])
+        for tri in vol["triangles"]:
+            t = new.triangles.add()
+            _vector(t.vert1, tri[0:3])
+            _vector(t.vert2, tri[3:6])
+            _vector(t.vert3, tri[6:9])
+    info.version = 1
+
+
+def _motion(motion: Any, kind: int, intervals: list[tuple]) -> None:
+    motion.SetInParent()
+    motion.type = kind
+    for a, b, vel, centre, rot in intervals:
+        iv = motion.intervals.add()
+        _vector(iv.velocity, vel)
+        _vector(iv.rot_velocity, rot)
+        _vector(iv.rot_center, centre)
+        iv.limit1 = a
+        if kind == 1:
+            iv.limit2 = b
+        else:
+            iv.limit_type = int(b)

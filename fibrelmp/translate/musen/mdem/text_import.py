@@ -276,7 +276,8 @@ def _volume(vol: Any, tok: list[str], path: Path, ln: int) -> None:
         _vector(t.vert3, values[9 * i + 6:9 * i + 9])
 
 
-def _constant(prop: Any, pid: int, value: float) -> None:
+def set_constant(prop: Any, pid: int, value: float) -> None:
+    """``SetPropertyValue``: one constant correlation over MUSEN's default T and p range."""
     prop.propertyType = pid
     del prop.correlation[:]
     cor = prop.correlation.add()
@@ -306,12 +307,12 @@ def _compound(db: Any, tok: list[str], path: Path, ln: int) -> None:
     const.propertyType, const.value = MOLAR_MASS, MOLAR_MASS_DEFAULT
     given = _pairs(tok[2:], path, ln, "32")
     for pid in COMPOUND_PROPERTIES:
-        _constant(c.property.add(), pid, given.get(pid, PROPERTY_DEFAULTS[pid]))
+        set_constant(c.property.add(), pid, given.get(pid, PROPERTY_DEFAULTS[pid]))
     for other in db.compound:                        # ConformInteractionsAdd
         i = db.interaction.add()
         i.compoundKey1, i.compoundKey2 = c.uniqueKey, other.uniqueKey
         for pid in INTERACTION_PROPERTIES:
-            _constant(i.property.add(), pid, PROPERTY_DEFAULTS[pid])
+            set_constant(i.property.add(), pid, PROPERTY_DEFAULTS[pid])
 
 
 def _interaction(db: Any, tok: list[str], path: Path, ln: int) -> None:
@@ -321,7 +322,7 @@ def _interaction(db: Any, tok: list[str], path: Path, ln: int) -> None:
             for pid, value in _pairs(tok[2:], path, ln, "33").items():
                 for prop in i.property:
                     if prop.propertyType == pid:
-                        _constant(prop, pid, value)
+                        set_constant(prop, pid, value)
             return
     raise InputError(path, ln, f"`33`: no compounds {a} and {b} (their `32` lines come first)")
 

@@ -40,6 +40,10 @@ def run(plan: RunPlan, warn: Warn | None = None) -> Outcome:
     # resuming continues this run's own (locked) work: its partial results are not "earlier" ones
     with locked(plan.outputs, options.force or options.resume, rank):
         try:
+            if size > 1:
+                from fibrelmp._lammps import mpi_barrier
+
+                mpi_barrier()     # every rank checked the outputs before rank 0 writes any
             for step in plan.steps:
                 if isinstance(step, Action):
                     outcome.outputs += step.run(rank == 0)

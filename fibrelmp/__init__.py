@@ -1,7 +1,8 @@
 """fibrelmp: run FibreNet, MUSEN and DEMDF inputs on LAMMPS.
 
 The Python API (docs/python.md): ``read``, ``check``, ``translate`` (= ``translate_job``),
-``run``, ``convert`` (dumps), ``convert_file`` (MUSEN .mdem <-> text), ``describe``; errors are
+``run``, ``convert`` (dumps), ``convert_file`` (MUSEN .mdem <-> text), ``describe``, ``plot``
+and ``snapshot`` (PNG pictures of results, with matplotlib); errors are
 ``InputError`` (bad input, ``path:line: message``) and ``RunError`` (LAMMPS or the machine);
 nothing here exits the interpreter.
 
@@ -15,8 +16,8 @@ from __future__ import annotations
 
 __version__ = "0.1.0"
 
-_API = ("read", "check", "translate_job", "run", "convert", "convert_file", "describe", "RunResult",
-        "CheckReport")
+_API = ("read", "check", "translate_job", "run", "convert", "convert_file", "describe", "plot",
+        "snapshot", "RunResult", "CheckReport")
 __all__ = [*_API, "translate", "InputError", "InputErrors", "RunError", "lammps_instance", "lammps_module",
            "__version__"]
 

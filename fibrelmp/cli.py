@@ -13,7 +13,7 @@ import typer
 
 from fibrelmp import __version__
 
-from fibrelmp.registry import DOCUMENT, FRAMES, INPUT, TARGET, formats, names
+from fibrelmp.registry import DOCUMENT, FRAMES, INPUT, RESULT, TARGET, formats, names
 
 _INPUTS = formats(INPUT)
 _TITLES = ", ".join(f.title for f in _INPUTS[:-1]) + " or " + _INPUTS[-1].title
@@ -22,6 +22,22 @@ _TITLES = ", ".join(f.title for f in _INPUTS[:-1]) + " or " + _INPUTS[-1].title
 def _examples(command: str, tail: str = "", role: str = INPUT) -> str:
     """Example command lines for a help text, one per registered format that has one."""
     return "\n".join(f"  fibrelmp {command} {f.example}{tail}" for f in formats(role) if f.example)
+
+
+class _Command(typer.core.TyperCommand):
+    """Help in the usual form: ``Usage: fibrelmp post [OPTIONS] DUMP``, ``DUMP  help`` and
+    ``--to NAME`` (typer writes ``{dump}``, ``dump <path>`` and ``--to <str>``)."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        for param in self.params:
+            if param.param_type_name == "argument":
+                name = param.metavar = (param.metavar or param.name).upper()
+                param.display_type_rich = lambda ctx: None
+                param._usage_display_name = lambda n=name, required=param.required: (
+                    n if required else f"[{n}]")
+            elif not getattr(param, "is_flag", False) and param.metavar is None:
+                param.metavar = param.name.upper()
 
 
 app = typer.Typer(add_completion=True, no_args_is_help=True, rich_markup_mode=None,
@@ -198,7 +214,7 @@ def main_options(
     _state["quiet"], _state["verbose"] = quiet, verbose
 
 
-@app.command(help=f"""Parse and validate INPUT without running LAMMPS; print a summary, the unit
+@app.command(cls=_Command, help=f"""Parse and validate INPUT without running LAMMPS; print a summary, the unit
 system and the time step against the fastest spring / contact it has to resolve.
 
 Every error of a line-oriented input is listed (run stops at the first); exit code 2 on
@@ -227,7 +243,7 @@ def _summary(lines: list[str]) -> None:
         typer.echo("\n".join(lines))
 
 
-@app.command(help=f"""Write a LAMMPS job (in.lammps + data file) for INPUT into a folder
+@app.command(cls=_Command, help=f"""Write a LAMMPS job (in.lammps + data file) for INPUT into a folder
 (replay: cd job && lmp -in in.lammps; it loads fibrelmp's styles plugin unless --stock-styles).
 
 \b
@@ -236,7 +252,7 @@ Examples:
 """)
 @_guard
 def translate(input: Path = typer.Argument(..., help="Any supported input file.", readable=False),
-              out: Path = typer.Option(..., "-o", "--out", help="Folder for in.lammps and the data file."),
+              out: Path = typer.Option(..., "-o", "--out", metavar="DIR", help="Folder for in.lammps and the data file."),
               stock_styles: bool = _STOCK, quiet: bool = _QUIET, verbose: bool = _VERBOSE) -> None:
     from fibrelmp.python_api import write_job
 
@@ -245,7 +261,7 @@ def translate(input: Path = typer.Argument(..., help="Any supported input file."
     _say(f"wrote {job.script} and {job.data}")
 
 
-@app.command(help=f"""Translate INPUT, run it on LAMMPS and write the results in the input's own
+@app.command(cls=_Command, help=f"""Translate INPUT, run it on LAMMPS and write the results in the input's own
 format.
 
 Results are never overwritten silently: an existing result needs --force.  The output and
@@ -257,21 +273,23 @@ Examples:
 """)
 @_guard
 def run(input: Path = typer.Argument(..., help=f"{_TITLES[0].upper()}{_TITLES[1:]}.", readable=False),
-        out: Optional[Path] = typer.Option(None, "--out", "-o", help="Where results go: a folder, or "
+        out: Optional[Path] = typer.Option(None, "--out", "-o", metavar="PATH", help="Where results go: a folder, or "
                                            "the result file for inputs with a single result. "
                                            "Default: next to the input."),
-        work: Optional[Path] = typer.Option(None, "--work", help="Folder for the rendered LAMMPS job."),
-        end_time: Optional[float] = typer.Option(None, "--end-time", "--time-end",
+        work: Optional[Path] = typer.Option(None, "--work", metavar="DIR", help="Folder for the rendered LAMMPS job."),
+        end_time: Optional[float] = typer.Option(None, "--end-time", "--time-end", metavar="T",
                                                  help="Simulated end time (overrides the input's)."),
-        step: Optional[float] = typer.Option(None, "--step", help="Simulation time step, for inputs "
+        step: Optional[float] = typer.Option(None, "--step", metavar="DT", help="Simulation time step, for inputs "
                                              "that do not set one."),
-        save_step: Optional[float] = typer.Option(None, "--save-step", "--save-every",
+        save_step: Optional[float] = typer.Option(None, "--save-step", "--save-every", metavar="T",
                                                   help="Time between saved states (overrides the input's)."),
-        steps: Optional[int] = typer.Option(None, "--steps", help="Number of time steps to run, "
+        steps: Optional[int] = typer.Option(None, "--steps", metavar="N", help="Number of time steps to run, "
                                             "for inputs that count steps."),
-        precision: int = typer.Option(6, "--precision", help="Significant digits of text results "
-                                      "that take it (6 as the source code; 17 for exact round trips)."),
-        checkpoint_every: Optional[int] = typer.Option(None, "--checkpoint-every", help="Write a "
+        precision: Optional[int] = typer.Option(None, "--precision", metavar="DIGITS",
+                                                help="Significant digits of text results that take "
+                                                "it (default 6, as the source code; 17 for exact "
+                                                "round trips); an error for the others."),
+        checkpoint_every: Optional[int] = typer.Option(None, "--checkpoint-every", metavar="N", help="Write a "
                                                        "checkpoint every N steps (one is always "
                                                        "written on SIGTERM/Ctrl-C)."),
         resume: bool = typer.Option(False, "--resume", help="Continue an interrupted run from the "
@@ -298,7 +316,7 @@ def run(input: Path = typer.Argument(..., help=f"{_TITLES[0].upper()}{_TITLES[1:
     _say(f"done in {time.monotonic() - start:.1f} s (LAMMPS job: {script})")
 
 
-@app.command("post", help=f"""Convert an existing dump into another code's files ({", ".join(
+@app.command("post", cls=_Command, help=f"""Convert an existing dump into another code's files ({", ".join(
     f"{f.name}: {f.title}" for f in formats(TARGET))}).
 
 Outputs are written only when the whole conversion succeeded; existing ones are kept unless
@@ -314,23 +332,26 @@ Examples:
 @_guard
 def post(dump: Path = typer.Argument(..., help=" or ".join(f.title for f in formats(FRAMES)) + ".",
                                      readable=False),
-         to: Optional[str] = typer.Option(None, "--to", help=f"One of: {', '.join(names(TARGET))}.",
+         to: Optional[str] = typer.Option(None, "--to", metavar="NAME", help=f"One of: {', '.join(names(TARGET))}.",
                                           autocompletion=lambda: names(TARGET)),
-         out: Optional[Path] = typer.Option(None, "-o", "--out", help="Output base name (folder/name)."),
+         out: Optional[Path] = typer.Option(None, "-o", "--out", metavar="PATH", help="Output base name (folder/name)."),
          info: bool = typer.Option(False, "--info", help="Describe the dump (frames, atoms, columns, box)."),
-         frames: Optional[str] = typer.Option(None, "--frames", help="Frames to convert: i, start:stop:step, "
+         frames: Optional[str] = typer.Option(None, "--frames", metavar="SPEC", help="Frames to convert: i, start:stop:step, "
                                               "or a comma list (default all; single-frame targets: the last)."),
-         types: Optional[list[str]] = typer.Option(None, "--types", help="Only these atom types (numbers "
+         types: Optional[list[str]] = typer.Option(None, "--types", metavar="TYPES", help="Only these atom types (numbers "
                                                    "or names; repeat or comma-separate)."),
-         data: Optional[Path] = typer.Option(None, "--data", help="LAMMPS data file: type names, radii, "
+         data: Optional[Path] = typer.Option(None, "--data", metavar="FILE", help="LAMMPS data file: type names, radii, "
                                              "masses, bonds the dump lacks."),
-         local: Optional[Path] = typer.Option(None, "--local", help="dump local file with per-contact data "
+         local: Optional[Path] = typer.Option(None, "--local", metavar="FILE", help="dump local file with per-contact data "
                                               "(for targets that write contacts)."),
-         gravity: Optional[tuple[float, float, float]] = typer.Option(None, "--gravity", help="gx gy gz for "
+         gravity: Optional[tuple[float, float, float]] = typer.Option(None, "--gravity", metavar="GX GY GZ", help="gx gy gz for "
                                                                       "the gravitational energy."),
          force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
-         topology: Optional[Path] = typer.Option(None, "--topology", help="Topology file, for "
+         topology: Optional[Path] = typer.Option(None, "--topology", metavar="FILE", help="Topology file, for "
                                                  "trajectory formats that need one."),
+         precision: Optional[int] = typer.Option(None, "--precision", metavar="DIGITS", help="Significant "
+                                                 "digits, for targets that write text with a chosen "
+                                                 "number of them (default 6); an error for the others."),
          quiet: bool = _QUIET, verbose: bool = _VERBOSE) -> None:
     from fibrelmp.python_api import convert, describe
 
@@ -340,7 +361,7 @@ def post(dump: Path = typer.Argument(..., help=" or ".join(f.title for f in form
         return
     written = convert(dump, to, out, frames=frames, types=types, data=data, local=local,
                       gravity=gravity, force=force, topology=topology, say=_say,
-                      warn=_report_warnings)
+                      warn=_report_warnings, precision=precision)
     for path in written:
         _say(f"wrote {path}")
 
@@ -357,7 +378,7 @@ def _convert_examples() -> str:
     return "\n".join(lines)
 
 
-@app.command("convert", help=f"""Convert a scene or result file into another form of the same code
+@app.command("convert", cls=_Command, help=f"""Convert a scene or result file into another form of the same code
 ({"; ".join(f"{f.name}: {f.title}" for f in formats(DOCUMENT))}), e.g. a binary scene into text
 to diff or version-control it, and back.
 
@@ -370,11 +391,11 @@ Examples:
 """)
 @_guard
 def convert_command(source: Path = typer.Argument(..., help="The file to convert.", readable=False),
-                    out: Path = typer.Option(..., "-o", "--out", help="The file to write."),
-                    to: Optional[str] = typer.Option(None, "--to", help=f"One of: {', '.join(names(DOCUMENT))} "
+                    out: Path = typer.Option(..., "-o", "--out", metavar="FILE", help="The file to write."),
+                    to: Optional[str] = typer.Option(None, "--to", metavar="NAME", help=f"One of: {', '.join(names(DOCUMENT))} "
                                                      "(default: from the output's name).",
                                                      autocompletion=lambda: names(DOCUMENT)),
-                    precision: Optional[int] = typer.Option(None, "--precision", help="Significant digits of "
+                    precision: Optional[int] = typer.Option(None, "--precision", metavar="DIGITS", help="Significant digits of "
                                                             "time-point values in text (default 6, as the code writes; "
                                                             "17 keeps every double)."),
                     force: bool = typer.Option(False, "--force", help="Overwrite an existing output."),
@@ -384,6 +405,84 @@ def convert_command(source: Path = typer.Argument(..., help="The file to convert
     _set_flags(quiet, verbose)
     for path in convert_file(source, out, to=to, precision=precision, force=force):
         _say(f"wrote {path}")
+
+
+_RESULT_HELP = ("A run's work folder, its log.lammps, or a result file ("
+                + ", ".join(f.title for f in formats(RESULT) + formats(FRAMES)[:1]) + ").")
+
+
+def _result_examples(command: str, tail: str) -> str:
+    """``fibrelmp COMMAND out/result.EXT`` for each result format with an extension."""
+    return "\n".join(f"  fibrelmp {command} out/result{f.extensions[0]}{tail}"
+                     for f in formats(RESULT) if f.extensions)
+
+
+_SIZE = typer.Option(None, "--size", metavar="WxH", help="Picture size in pixels (default 800x600).")
+_PNG_FORCE = typer.Option(False, "--force", help="Overwrite an existing picture.")
+
+
+@app.command("plot", cls=_Command, help="""Draw the energy and thermo history of a run into a PNG: LAMMPS's thermo
+from the run's log.lammps (energies; for granular runs contacts, broken bonds, particles),
+else what the result files hold (kinetic energy from masses and velocities, particles,
+bonds whose activity ended).  The first line of the output says which source was used.
+Needs matplotlib (pip install 'fibrelmp[plot]').
+
+\b
+Examples:
+  fibrelmp plot out/run_work
+  fibrelmp plot out/run_work/log.lammps -o energy.png
+""" + _result_examples("plot", " --source result") + """
+""")
+@_guard
+def plot_command(result: Path = typer.Argument(..., help=_RESULT_HELP, readable=False),
+                 out: Optional[Path] = typer.Option(None, "-o", "--out", metavar="FILE.png",
+                                                    help="The picture (default: RESULT_plot.png "
+                                                    "beside it; plot.png in a work folder)."),
+                 source: str = typer.Option("auto", "--source", metavar="auto|log|result",
+                                            help="Where the numbers come from: LAMMPS's log, the "
+                                            "result's frames, or the log when found (auto).",
+                                            autocompletion=lambda: ["auto", "log", "result"]),
+                 size: Optional[str] = _SIZE, force: bool = _PNG_FORCE,
+                 quiet: bool = _QUIET, verbose: bool = _VERBOSE) -> None:
+    from fibrelmp.python_api import plot
+
+    _set_flags(quiet, verbose)
+    drawn = plot(result, out, source=source, size=size, force=force)
+    _say(f"plotted {', '.join(drawn.lines)} over {drawn.x_name}, from {drawn.source}")
+    for note in drawn.notes:
+        _say(f"  {note}")
+    _say(f"wrote {drawn.path}")
+
+
+@app.command("snapshot", cls=_Command, help="""Draw one frame of a result into a PNG: spheres at their radii,
+bonds and fibres as lines, walls as translucent faces, the box when there is one.  Needs
+matplotlib (pip install 'fibrelmp[plot]').
+
+\b
+Examples:
+""" + _result_examples("snapshot", " --frame 0 -o start.png") + """
+  fibrelmp snapshot out/run_work --frame -2 --size 400x300
+""")
+@_guard
+def snapshot_command(result: Path = typer.Argument(..., help=_RESULT_HELP, readable=False),
+                     out: Optional[Path] = typer.Option(None, "-o", "--out", metavar="FILE.png",
+                                                        help="The picture (default: "
+                                                        "RESULT_snapshot.png beside it)."),
+                     frame: Optional[int] = typer.Option(None, "--frame", metavar="N",
+                                                         help="Frame index, negative from the end "
+                                                         "(default: the last; for a one-file "
+                                                         "snapshot, that file's frame)."),
+                     size: Optional[str] = _SIZE, force: bool = _PNG_FORCE,
+                     quiet: bool = _QUIET, verbose: bool = _VERBOSE) -> None:
+    from fibrelmp.python_api import snapshot
+
+    _set_flags(quiet, verbose)
+    drawn = snapshot(result, out, frame=frame, size=size, force=force)
+    _say(f"frame {drawn.frame} of {drawn.frames}: {drawn.points} particles, {drawn.bonds} bond "
+         f"lines, {drawn.walls} wall faces")
+    for note in drawn.notes:
+        _say(f"  {note}")
+    _say(f"wrote {drawn.path}")
 
 
 def main() -> None:

@@ -61,6 +61,7 @@ class DocumentFormat(ABC):
     (``writer``: a ``Writer`` whose one ``add`` is the document)."""
 
     suffixes: ClassVar[tuple[str, ...]] = ()       # output names that mean this format
+    takes_precision: ClassVar[bool] = False        # written as text with chosen digits
 
     @staticmethod
     @abstractmethod

@@ -92,14 +92,15 @@ class RunResult:
 def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | None = None,
         force: bool = False, checkpoint_every: int | None = None, resume: bool = False,
         end_time: float | None = None, step: float | None = None, save_step: float | None = None,
-        steps: int | None = None, precision: int = 6, progress: bool = False,
+        steps: int | None = None, precision: int | None = None, progress: bool = False,
         stock_styles: bool = False, say: Say = _quiet, warn: Warn | None = None) -> RunResult:
     """Run any supported input on LAMMPS and write its results in the input's own format.
 
     ``out``: the results' folder, or the result file of an input with a single result;
     default next to the input.  Existing results are replaced, completely, only with
     ``force``.  ``end_time``/``step``/``save_step`` and ``steps`` override the
-    input's (an input that sets them itself refuses them).  ``stock_styles``: stock LAMMPS
+    input's (an input that sets them itself refuses them).  ``precision``: significant
+    digits of text results that take it (default 6; refused for the others).  ``stock_styles``: stock LAMMPS
     styles instead of fibrelmp's own (see ``translate_job``).  ``say`` receives progress notes, ``warn`` lists of
     ``(kind, text)`` warnings as they are found (they are also in the result)."""
     from fibrelmp.checkpoint import check_every
@@ -109,6 +110,11 @@ def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | N
     path = Path(path)
     hook = _input(path)
     check_every(checkpoint_every)         # before any folder is made
+    if precision is not None:
+        _check_precision(precision)
+        unused = hook.precision_unused(path, None if out is None else Path(out))
+        if unused is not None:
+            raise InputError(path, None, f"--precision has no meaning here: {unused}")
     result = RunResult()
 
     def warned(items: list[tuple[str, str]]) -> None:
@@ -117,7 +123,7 @@ def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | N
             warn(list(items))
 
     settings = RunSettings(None if out is None else Path(out), None if work is None else Path(work),
-                           end_time, step, save_step, steps, precision)
+                           end_time, step, save_step, steps, 6 if precision is None else precision)
     if resume and not hook.has_checkpoint(path, settings.out, settings.work):    # before reading
         from .checkpoint import NO_CHECKPOINT
 
@@ -137,17 +143,18 @@ def convert(dump: str | Path, to: str | None, out: str | Path | None, *, frames:
             types: list[str] | None = None, data: str | Path | None = None,
             local: str | Path | None = None, gravity: tuple[float, float, float] | None = None,
             force: bool = False, topology: str | Path | None = None, say: Say = _quiet,
-            warn: Warn | None = None) -> list[Path]:
+            warn: Warn | None = None, precision: int | None = None) -> list[Path]:
     """Convert a trajectory (``fibrelmp.registry.formats("frames")``; ``topology`` for those
     that need one) into ``to``, any of ``fibrelmp.registry.names("target")``; returns the
-    files written (docs/post.md).  ``warn`` receives the conversion's ``(kind, text)``
+    files written (docs/post.md).  ``precision``: significant digits, for targets that write
+    text with a chosen number of them (refused for the others).  ``warn`` receives the conversion's ``(kind, text)``
     warnings (without it they go to ``say`` as text)."""
     from fibrelmp.post.convert import post_command
 
     return post_command(Path(dump), to, None if out is None else Path(out), False, frames, types,
                         None if data is None else Path(data), None if local is None else Path(local),
                         gravity, force, None if topology is None else Path(topology), say,
-                        report=warn)
+                        report=warn, precision=precision)
 
 
 def convert_file(source: str | Path, target: str | Path, *, to: str | None = None,
@@ -173,8 +180,11 @@ def convert_file(source: str | Path, target: str | Path, *, to: str | None = Non
         out_fmt = hits[0]
     if target.resolve() == source.resolve():
         raise InputError(target, None, "the output would overwrite the input; choose another name")
-    if precision is not None and not 1 <= precision <= 17:
-        raise InputError(None, None, f"--precision must be 1..17, got {precision}")
+    if precision is not None:
+        _check_precision(precision)
+        if not out_fmt.load(DOCUMENT).takes_precision:
+            raise InputError(target, None, f"--precision has no meaning for {out_fmt.title}: it "
+                             "stores every number exactly")
     doc = fmt.load(DOCUMENT).open(source)
     try:
         with out_fmt.load(DOCUMENT).writer(target, precision, force=force) as writer:
@@ -182,6 +192,11 @@ def convert_file(source: str | Path, target: str | Path, *, to: str | None = Non
     finally:
         doc.close()
     return [target]
+
+
+def _check_precision(precision: int) -> None:
+    if not 1 <= precision <= 17:
+        raise InputError(None, None, f"--precision must be 1..17, got {precision}")
 
 
 @dataclass
@@ -239,3 +254,22 @@ def describe(dump: str | Path, topology: str | Path | None = None, say: Say = pr
 
     post_command(Path(dump), None, None, True, None, None, None, None, None, False,
                  None if topology is None else Path(topology), say, report=warn)
+
+
+def plot(result: str | Path, out: str | Path | None = None, *, source: str = "auto",
+         size: tuple[int, int] | str | None = None, force: bool = False):
+    """``fibrelmp plot``: the energy/thermo history of a result (a run's work folder, its
+    ``log.lammps`` or a result file) as a PNG; returns a ``fibrelmp.pictures.Plot`` (the
+    file, the data source used and every line as drawn).  Needs matplotlib."""
+    from fibrelmp.pictures import plot as draw
+
+    return draw(result, out, source=source, size=size, force=force)
+
+
+def snapshot(result: str | Path, out: str | Path | None = None, *, frame: int | None = None,
+             size: tuple[int, int] | str | None = None, force: bool = False):
+    """``fibrelmp snapshot``: one frame of a result as a PNG (``frame`` negative: from the
+    end; default the last); returns a ``fibrelmp.pictures.Snapshot`` (what was drawn)."""
+    from fibrelmp.pictures import snapshot as draw
+
+    return draw(result, out, frame=frame, size=size, force=force)

@@ -24,13 +24,15 @@ def post_command(dump: Path, to: str | None, out: Path | None, info: bool, frame
                  types: list[str] | None, data: Path | None, local: Path | None,
                  gravity: tuple | None, force: bool, topology: Path | None,
                  say: Callable[[str], None],
-                 report: Callable[[list[tuple[str, str]]], None] | None = None) -> list[Path]:
+                 report: Callable[[list[tuple[str, str]]], None] | None = None,
+                 precision: int | None = None) -> list[Path]:
     """Convert ``dump`` (see docs/post.md); returns the files written.  Warnings go to
     ``report`` (the CLI's grouped, coloured report) or, without one, to ``say``."""
     dump = Path(dump)
     warnings: list[tuple[str, str]] = []
     try:
-        return _post(dump, to, out, info, frames, types, data, local, gravity, force, topology, say, warnings)
+        return _post(dump, to, out, info, frames, types, data, local, gravity, force, topology, say,
+                     warnings, precision)
     finally:
         if report is not None:
             report(warnings)
@@ -58,7 +60,8 @@ def open_frames(path: Path, topology: Path | None, warnings: list):
     return kind(path, topology, warnings)
 
 
-def _post(dump, to, out, info, frames, types, data, local, gravity, force, topology, say, warnings):
+def _post(dump, to, out, info, frames, types, data, local, gravity, force, topology, say, warnings,
+          precision=None):
     reader = open_frames(dump, topology, warnings)
     if info:
         for ln in reader.describe():
@@ -74,9 +77,16 @@ def _post(dump, to, out, info, frames, types, data, local, gravity, force, topol
     if local is not None and not kind.uses_local:
         users = " or ".join(f.name for f in formats(TARGET) if f.load(TARGET).uses_local)
         raise InputError(local, None, f"--local (per-contact data) is used by --to {users} only")
+    if precision is not None:
+        if not 1 <= precision <= 17:
+            raise InputError(None, None, f"--precision must be 1..17, got {precision}")
+        if not kind.takes_precision:
+            users = " or ".join(f.name for f in formats(TARGET) if f.load(TARGET).takes_precision)
+            raise InputError(None, None, f"--precision has no meaning for --to {to.lower()}: only "
+                             f"--to {users} writes numbers with a chosen number of digits")
     out = Path(out)
     base = out / dump.name.split(".")[0] if out.is_dir() else out
-    context = PostContext(dump, local=local, gravity=gravity, warnings=warnings)
+    context = PostContext(dump, local=local, gravity=gravity, warnings=warnings, precision=precision)
     target = kind(base, context, force=force)        # refuses existing outputs without force
     created = [p for p in (base.parent, *base.parent.parents) if not p.exists()]
     if created:
@@ -121,5 +131,16 @@ def _selected(reader, sel: Selection, last_only: bool) -> Iterator:
         if last is not None:
             yield last
         return
-    want = sel.resolve(reader.count() if sel.needs_count else None)
+    total = reader.count() if sel.needs_count else None
+    if total is not None and sel.spec is not None:
+        sel.check(total, reader.what, reader.path)
+    chosen = sel.resolve(total)
+    last = [-1]                         # the highest frame index the reader came to
+
+    def want(i: int) -> bool:
+        last[0] = max(last[0], i)
+        return chosen(i)
+
     yield from reader.frames(want, sel.stop)
+    if total is None and sel.spec is not None and (sel.stop is None or last[0] + 1 < sel.stop):
+        sel.check(last[0] + 1, reader.what, reader.path)     # the reader met the end: last + 1 frames

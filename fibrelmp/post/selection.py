@@ -40,6 +40,19 @@ class Selection:
         return any((p < 0) if isinstance(p, int) else any(v is not None and v < 0 for v in p[:2])
                    for p in self.parts)
 
+    def check(self, total: int, what: str, path=None) -> None:
+        """An InputError saying how many frames there are, if an index given is not one of
+        the ``total`` frames or the selection selects none."""
+        singles = [p for p in self.parts if isinstance(p, int)]
+        bad = [p for p in singles if not -total <= p < total]
+        picked = (any(-total <= p < total for p in singles)
+                  or any(len(range(*slice(*p).indices(total))) for p in self.parts if not isinstance(p, int)))
+        if bad or not picked:
+            which = f"frame {bad[0]} does not exist" if bad else "selects no frame"
+            have = (f"{total} frame{'s' if total != 1 else ''} (indices 0..{total - 1}, or "
+                    f"-{total}..-1 from the end)") if total else "no frames"
+            raise InputError(path, None, f"--frames {self.spec!r}: {which}: the {what} has {have}")
+
     def resolve(self, total: int | None) -> Callable[[int], bool]:
         singles, slices = set(), []
         for p in self.parts:

@@ -64,6 +64,7 @@ class PostContext:
     local: Path | None = None                      # --local contact dump
     gravity: tuple[float, float, float] | None = None
     warnings: list[tuple[str, str]] = field(default_factory=list)
+    precision: int | None = None                   # --precision (targets that take it)
 
     def warn(self, kind: str, text: str) -> None:
         """One warning per kind."""
@@ -91,6 +92,7 @@ class DumpTarget(Writer):
     units: ClassVar[tuple[str, Any] | None] = None    # (format title, units.UnitSystem) of its numbers
     last_frame_by_default: ClassVar[bool] = False     # without --frames: the last frame only
     uses_local: ClassVar[bool] = False                # reads --local contact dumps
+    takes_precision: ClassVar[bool] = False           # writes text with --precision digits
     lookahead: ClassVar[int] = 1                      # frames ``start`` sees
     replaces_earlier: ClassVar[bool] = True           # --force: old frame files go too
 

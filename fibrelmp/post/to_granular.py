@@ -146,11 +146,13 @@ class MusenTarget(_GranularTarget):
     kind = "musen"
     keeps_ids = True                 # MUSEN objects keep their ids
     units = ("MUSEN", SI)
+    takes_precision = True
 
     def result_writer(self, model: GranularModel, dt: float) -> Writer:
         from fibrelmp.translate.musen.writer import MusenResultWriter
 
-        return MusenResultWriter(model, self.target)
+        precision = self.context.precision
+        return MusenResultWriter(model, self.target, precision=6 if precision is None else precision)
 
     @classmethod
     def read_back(cls, files: list[Path]) -> list[ReadBack]:

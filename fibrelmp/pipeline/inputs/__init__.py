@@ -75,6 +75,11 @@ class InputFormat(ABC):
     def work_folder(self, path: Path, out: Path | None, work: Path | None) -> Path:
         """The work folder a run with these options uses."""
 
+    def precision_unused(self, path: Path, out: Path | None) -> str | None:
+        """Why ``--precision`` has no meaning for this input's results, or None when they
+        take it (text results written with that many significant digits)."""
+        return "its results are not written with a chosen number of significant digits"
+
     def has_checkpoint(self, path: Path, out: Path | None = None, work: Path | None = None) -> bool:
         """Is there a checkpoint to ``--resume`` from?"""
         from fibrelmp.pipeline.run import has_checkpoint

@@ -26,6 +26,9 @@ class DemdfInput(InputFormat):
         return demdf.read(path, time_end=settings.end_time, steps=settings.steps,
                           save_every=settings.save_step)
 
+    def precision_unused(self, path: Path, out: Path | None) -> str | None:
+        return "DEMDF snapshots keep every number exactly (shortest round-trip digits)"
+
     def check_lines(self, path: Path, model: "GranularModel") -> list[str]:
         from fibrelmp.granular_check import summary
 

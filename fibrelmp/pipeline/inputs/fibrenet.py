@@ -27,6 +27,10 @@ class FibreNetInput(InputFormat):
 
         return check_patch(path)
 
+    def precision_unused(self, path: Path, out: Path | None) -> str | None:
+        return ("FibreNet's results have FibreNet's own digits (xyz: 5 decimals, restart: 6 "
+                "significant digits)")
+
     def check_lines(self, path: Path, model: "Model") -> list[str]:
         from fibrelmp.pipeline.fibrenet import fibrenet_outputs
         from fibrelmp.sanity import spring_check, units_line

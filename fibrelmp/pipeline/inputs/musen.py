@@ -66,6 +66,13 @@ class SceneInput(InputFormat):
     def work_folder(self, path: Path, out: Path | None, work: Path | None) -> Path:
         return _work_folder(scene_result_path(path, out), work)
 
+    def precision_unused(self, path: Path, out: Path | None) -> str | None:
+        result = scene_result_path(path, out)
+        if is_mdem(result):
+            return (f"the result {result.name} is a .mdem file, which stores every number exactly "
+                    "(a result named .txt is MUSEN text, whose digits --precision sets)")
+        return None
+
 
 def scene_plan(model: "GranularModel", result: str | Path, work: str | Path | None = None,
                precision: int = 6, options: "RunOptions | None" = None) -> "RunPlan":

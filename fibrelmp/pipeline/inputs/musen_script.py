@@ -49,6 +49,10 @@ class ScriptInput(InputFormat):
 
         return check_patch
 
+    def precision_unused(self, path: Path, out: Path | None) -> str | None:
+        return ("a cmusen script sets the digits of its text exports itself "
+                "(TEXT_EXPORT_PRECISION in the EXPORT_TO_TEXT job)")
+
     def check_lines(self, path: Path, model: GranularModel) -> list[str]:
         from fibrelmp.granular_check import summary
 

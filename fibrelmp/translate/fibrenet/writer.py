@@ -8,13 +8,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import NamedTuple, Sequence
+from typing import Iterator, NamedTuple, Sequence
 
 import numpy as np
 
 from fibrelmp.errors import InputError
 from fibrelmp.formatbase import Writer
-from fibrelmp.textio import format_rows, parse_table, read_text
+from fibrelmp.textio import check_text_file, format_rows, parse_table, read_text
 from fibrelmp.numtext.fast import format_g_rows, format_xyz_parts
 from fibrelmp.numtext.printf import fixed_chars, join_fields, name_chars
 
@@ -210,28 +210,50 @@ class XyzFrame:
 
 def read_xyz(path: str | Path) -> list[XyzFrame]:
     """Read every frame of a FibreNet xyz file."""
+    return list(iter_xyz(path))
+
+
+def iter_xyz(path: str | Path) -> Iterator[XyzFrame]:
+    """The frames of a FibreNet xyz file, one at a time (memory holds one frame)."""
     path = Path(path)
-    lines = read_text(path, "FibreNet xyz file").splitlines()
-    frames, i = [], 0
-    while i < len(lines):
-        if not lines[i].strip():
-            i += 1
-            continue
-        try:
-            n = int(lines[i])
-        except ValueError:
-            raise InputError(path, i + 1, f"expected a bead count, got {lines[i]!r}") from None
-        head = lines[i + 1].split() if i + 1 < len(lines) else []
-        if len(head) != 6 or head[0] != "FRAME":
-            raise InputError(path, i + 2, "expected 'FRAME step dt Lx Ly Lz'")
-        body = lines[i + 2:i + 2 + n]
-        if len(body) < n:
-            raise InputError(path, i + 3 + len(body), f"frame has {len(body)} of {n} rows")
-        table, val = parse_table(body, list(range(i + 3, i + 3 + n)), 4, path, "xyz", text_cols=(0,))
-        frames.append(XyzFrame(int(head[1]), float(head[2]), np.array(head[3:], float),
-                               list(table[:, 0]), val[:, 1:4]))
-        i += 2 + n
-    return frames
+    check_text_file(path, "FibreNet xyz file")       # exists, regular, UTF-8 text (in blocks)
+    with open(path, encoding="utf-8-sig") as fh:
+        number = 0
+
+        def line() -> str | None:
+            nonlocal number
+            text = fh.readline()
+            if not text:
+                return None
+            number += 1
+            return text
+
+        while True:
+            first = line()
+            if first is None:
+                return
+            if not first.strip():
+                continue
+            try:
+                n = int(first)
+            except ValueError:
+                raise InputError(path, number, f"expected a bead count, got {first.strip()!r}") from None
+            head_text = line()
+            head = head_text.split() if head_text is not None else []
+            if len(head) != 6 or head[0] != "FRAME":
+                raise InputError(path, number + (head_text is None), "expected 'FRAME step dt Lx Ly Lz'")
+            start = number + 1
+            body = []
+            for _ in range(n):
+                text = line()
+                if text is None:
+                    break
+                body.append(text)
+            if len(body) < n:
+                raise InputError(path, start + len(body), f"frame has {len(body)} of {n} rows")
+            table, val = parse_table(body, list(range(start, start + n)), 4, path, "xyz", text_cols=(0,))
+            yield XyzFrame(int(head[1]), float(head[2]), np.array(head[3:], float),
+                           list(table[:, 0]), val[:, 1:4])
 
 
 def read_restart(path: str | Path) -> tuple[list[str], np.ndarray]:

@@ -52,6 +52,7 @@ class MdemDocument(DocumentFormat):
 
 class MusenTextDocument(DocumentFormat):
     suffixes: ClassVar[tuple[str, ...]] = (".txt",)
+    takes_precision: ClassVar[bool] = True
 
     @staticmethod
     def open(path: Path) -> Document:

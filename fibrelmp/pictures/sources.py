@@ -1,0 +1,343 @@
+"""Frames of any result, as what a picture needs: ``SceneFrame``s.
+
+One source class per kind of result (``open_source`` picks it from ``locate``), each reading
+through the format's own reader: FibreNet xyz (``translate.fibrenet.writer.iter_xyz``), MUSEN
+``.mdem`` (``MdemReader``) and text results (``scene.read`` + ``read_time_points``), DEMDF
+snapshots (``read_snapshot``, one file per frame), LAMMPS dumps (``post.lammps_dump``, with the
+run's ``data.lammps`` for radii, masses, type names and bonds).  Sources stream: one frame is
+in memory at a time (a MUSEN text result is read whole, as its reader does).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Iterator
+
+import numpy as np
+
+from fibrelmp.errors import InputError
+from fibrelmp.pictures.locate import DATA_NAME, DUMP_NAME, WORK, Located, family_prefix, run_folder
+
+
+@dataclass
+class SceneFrame:
+    """One saved state, ready to draw or to sum up."""
+
+    index: int                          # position among the source's frames
+    time: float | None                  # simulated time (None: unknown)
+    step: int | None
+    position: np.ndarray                # (n,3)
+    radius: np.ndarray | None           # (n,) None: unknown
+    kind: np.ndarray                    # (n,) int: type / material index, for colours
+    kind_names: list[str]               # name of each kind index
+    velocity: np.ndarray | None = None  # (n,3)
+    mass: np.ndarray | None = None      # (n,)
+    bonds: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))  # rows, intact
+    broken_bonds: int | None = None     # bonds whose activity ended by ``time``
+    triangles: np.ndarray | None = None # (k,3,3) wall triangles
+    planes: list[tuple[np.ndarray, np.ndarray]] = field(default_factory=list)   # (normal, point)
+    box: tuple[np.ndarray, np.ndarray] | None = None      # (lo, hi)
+    dimension: int = 3
+
+    @property
+    def count(self) -> int:
+        return len(self.position)
+
+
+class Source:
+    """The frames of one result."""
+
+    what = "result"
+    time_unit = ""                      # "s", "τ" (LAMMPS lj) or "" (dimensionless)
+    energy_unit = ""
+
+    def __init__(self, path: Path):
+        self.path = path
+        self.notes: list[str] = []      # what the pictures are based on, for the user
+
+    def frames(self) -> Iterator[SceneFrame]:
+        raise NotImplementedError
+
+    def count(self) -> int:
+        return sum(1 for _ in self.frames())
+
+    def frame(self, index: int | None) -> SceneFrame:
+        """Frame ``index`` (negative: from the end; None: the last)."""
+        total = self.count()
+        i = total - 1 if index is None else index + total if index < 0 else index
+        if not 0 <= i < total:
+            raise InputError(self.path, None, f"--frame {index}: the {self.what} has {total} "
+                             f"frame(s) (0..{total - 1}, or -{total}..-1 from the end)"
+                             if total else f"the {self.what} has no frames")
+        for frame in self.frames():
+            if frame.index == i:
+                return frame
+        raise InputError(self.path, None, f"frame {i} could not be read")     # file changed
+
+
+def _names(names: list[str], kinds: np.ndarray) -> tuple[np.ndarray, list[str]]:
+    """Kind indices 0..k-1 of the kinds present, and their names (legend order)."""
+    used = np.unique(kinds)
+    lookup = {int(k): i for i, k in enumerate(used)}
+    return (np.array([lookup[int(k)] for k in kinds], np.int64),
+            [names[int(k)] if 0 <= int(k) < len(names) else str(int(k)) for k in used])
+
+
+# -- FibreNet --------------------------------------------------------------------------------
+class FibreNetSource(Source):
+    """``<prefix>_coord.xyz`` (and ``_vel.xyz``); beads' radii, masses and the springs come
+    from the run's ``data.lammps`` when its work folder is found."""
+
+    what = "FibreNet xyz result"
+    time_unit, energy_unit = "τ", "ε"
+
+    def __init__(self, path: Path):
+        super().__init__(path)
+        prefix = family_prefix(path)
+        self.coord = path.with_name(f"{prefix}_coord.xyz")
+        if not self.coord.is_file():
+            raise InputError(path, None, f"the positions are in {self.coord.name}, which is not here")
+        vel = path.with_name(f"{prefix}_vel.xyz")
+        self.vel = vel if vel.is_file() else None
+        self.radius_by_name: dict[str, float] = {}
+        self.mass_by_name: dict[str, float] = {}
+        self.bonds = np.zeros((0, 2), np.int64)
+        folder, how = run_folder(path)
+        data = folder / DATA_NAME if folder is not None else None
+        if data is not None and data.is_file():
+            self._read_data(data)
+            self.notes.append(f"springs, radii and masses from {data} ({how})")
+        else:
+            self.notes.append(f"no springs, radii or masses: {how}")
+
+    def _read_data(self, data: Path) -> None:
+        from fibrelmp.post.lammps_data.reader import read_data
+
+        facts = read_data(data)
+        for t, name in facts.type_names.items():
+            if t in facts.type_masses:
+                self.mass_by_name[name] = facts.type_masses[t]
+        # fibrelmp's data files note each type's radius: "1 1.0  # F1 m=1 R=0.42"
+        for line in data.read_text(errors="replace").splitlines():
+            hit = re.match(r"\s*\d+\s+\S+\s*#\s*(\S+)\s.*\bR=(\S+)", line)
+            if hit:
+                self.radius_by_name[hit.group(1)] = float(hit.group(2))
+        self.bonds = facts.rows(facts.bonds.ravel(), "springs").reshape(-1, 2) if len(facts.bonds) else self.bonds
+
+    def frames(self) -> Iterator[SceneFrame]:
+        from fibrelmp.translate.fibrenet.writer import iter_xyz
+
+        velocities = iter_xyz(self.vel) if self.vel is not None else None
+        for i, frame in enumerate(iter_xyz(self.coord)):
+            v = next(velocities, None) if velocities is not None else None
+            names = sorted(set(frame.names))
+            kinds = np.array([names.index(n) for n in frame.names], np.int64)
+            radius = np.array([self.radius_by_name.get(n, math.nan) for n in frame.names])
+            mass = np.array([self.mass_by_name.get(n, math.nan) for n in frame.names])
+            bonds = self.bonds if len(self.bonds) and self.bonds.max() < len(frame.names) else self.bonds[:0]
+            yield SceneFrame(i, frame.step * frame.dt, frame.step, frame.values, radius
+                             if np.isfinite(radius).all() else None, kinds, names,
+                             velocity=None if v is None or v.step != frame.step else v.values,
+                             mass=mass if np.isfinite(mass).all() else None, bonds=bonds,
+                             box=(np.zeros(3), np.asarray(frame.lengths, float)))
+
+
+# -- MUSEN -----------------------------------------------------------------------------------
+def _musen_frame(model, index: int, time: float, rows: np.ndarray, position: np.ndarray,
+                 velocity: np.ndarray | None, triangles: np.ndarray | None) -> SceneFrame:
+    """A frame of the spheres at ``rows`` of the model (bonds between them, if intact)."""
+    s = model.spheres
+    kinds, names = _names([m.name for m in model.materials], s.material[rows])
+    bonds, broken = np.zeros((0, 2), np.int64), None
+    if model.bonds is not None and model.bonds.count:
+        b = model.bonds
+        where = np.full(s.count, -1)
+        where[rows] = np.arange(len(rows))
+        intact = (b.active_start <= time) & (time < b.active_end)
+        ends = where[b.pair]
+        bonds = ends[intact & (ends >= 0).all(axis=1)]
+        broken = int(np.count_nonzero(b.active_end <= time))
+    domain = model.plan.domain
+    return SceneFrame(index, time, None, position, s.radius[rows], kinds, names,
+                      velocity=velocity, mass=s.mass[rows], bonds=bonds, broken_bonds=broken,
+                      triangles=triangles, box=domain)
+
+
+class MdemSource(Source):
+    what = "MUSEN .mdem result"
+    time_unit, energy_unit = "s", "J"
+
+    def __init__(self, path: Path):
+        from fibrelmp.translate.musen.mdem.model import MdemReader
+
+        super().__init__(path)
+        self.reader = MdemReader(path)
+        self.model = self.reader.read()
+
+    def count(self) -> int:
+        from fibrelmp.translate.musen.mdem.document import MdemFile
+
+        with MdemFile(self.path) as mdem:
+            return sum(1 for _ in mdem.time_points())
+
+    def frames(self) -> Iterator[SceneFrame]:
+        for i, f in enumerate(self.reader):
+            yield _musen_frame(self.model, i, f.time, f.sphere_rows, f.position, f.velocity,
+                               f.triangle_vertices)
+
+
+class MusenTextSource(Source):
+    what = "MUSEN text result"
+    time_unit, energy_unit = "s", "J"
+
+    def __init__(self, path: Path):
+        from fibrelmp.translate.musen import scene
+        from fibrelmp.translate.musen.text import SPHERE, WALL, read_time_points
+
+        super().__init__(path)
+        self.model = scene.read(path)
+        self.tp = read_time_points(path, types=(SPHERE, WALL), tags=(12, 15, 44))
+        ids = self.tp.ids
+        self.sphere_cols = np.searchsorted(ids, self.model.spheres.ids)
+        t = self.model.triangles
+        self.wall_cols = np.searchsorted(ids, t.ids) if t is not None and t.count else None
+
+    def count(self) -> int:
+        return len(self.tp.times)
+
+    def frames(self) -> Iterator[SceneFrame]:
+        f = self.tp.fields
+        for k, time in enumerate(self.tp.times):
+            pos = f[12][k, self.sphere_cols]
+            rows = np.flatnonzero(self.tp.present[k, self.sphere_cols] & np.isfinite(pos).all(axis=1))
+            vel = f[15][k, self.sphere_cols][rows] if 15 in f else None
+            tri = None
+            if self.wall_cols is not None and 44 in f:
+                tri = f[44][k, self.wall_cols].reshape(-1, 3, 3)
+                tri = tri[np.isfinite(tri).all(axis=(1, 2))]
+            yield _musen_frame(self.model, k, float(time), rows, pos[rows], vel, tri)
+
+
+# -- DEMDF -----------------------------------------------------------------------------------
+class DemdfSource(Source):
+    """A DEMDF snapshot and the other snapshots of its family (``<name>_<n>.json``), in
+    ``n`` order; any other DEMDF document is one frame."""
+
+    what = "DEMDF snapshot series"
+
+    def __init__(self, path: Path):
+        super().__init__(path)
+        hit = re.fullmatch(r"(.*)_(\d+)", path.stem)
+        if hit:
+            same = [p for p in path.parent.glob(f"{hit.group(1)}_*.json")
+                    if re.fullmatch(rf"{re.escape(hit.group(1))}_\d+", p.stem)]
+            self.files = sorted(same, key=lambda p: int(p.stem.rsplit("_", 1)[1]))
+        else:
+            self.files = [path]
+        self.own = self.files.index(path) if path in self.files else 0
+
+    def count(self) -> int:
+        return len(self.files)
+
+    def frame(self, index: int | None) -> SceneFrame:
+        return super().frame(self.own if index is None else index)
+
+    def frames(self) -> Iterator[SceneFrame]:
+        from fibrelmp.translate.demdf.reader import read_snapshot
+
+        for i, file in enumerate(self.files):
+            m = read_snapshot(file)
+            s = m.spheres
+            kinds, names = _names([x.name for x in m.materials], s.material)
+            yield SceneFrame(i, m.plan.t_start, None, s.position, s.radius, kinds, names,
+                             velocity=s.velocity, mass=s.mass,
+                             planes=[(p.normal, p.point) for p in m.planes], box=m.plan.domain,
+                             dimension=m.plan.dimension)
+
+
+# -- LAMMPS dumps ----------------------------------------------------------------------------
+class DumpSource(Source):
+    """A LAMMPS text dump; per-atom facts it lacks (radius, mass, type names, bonds) from the
+    ``data.lammps`` beside it (a run's work folder has both)."""
+
+    what = "LAMMPS dump"
+
+    def __init__(self, path: Path):
+        from fibrelmp.post.lammps_dump import DumpReader
+
+        super().__init__(path)
+        self.warnings: list[tuple[str, str]] = []
+        self.reader = DumpReader(path, None, self.warnings)
+        data = path.with_name(DATA_NAME)
+        self.data = None
+        if data.is_file():
+            from fibrelmp.post.lammps_data.reader import read_data
+
+            self.data = read_data(data)
+            self.notes.append(f"radii, masses, type names and bonds from {data}"
+                              + (" (bonds as at the start: breakage is not in the dump)"
+                                 if len(self.data.bonds) and self.data.radius is not None else ""))
+
+    def count(self) -> int:
+        return self.reader.count()
+
+    def frames(self) -> Iterator[SceneFrame]:
+        for i, f in enumerate(self.reader):
+            yield self._frame(i, f)
+
+    def _frame(self, i: int, f) -> SceneFrame:
+        d = self.data
+        ids = f.column("id").astype(np.int64) if f.has("id") else np.arange(1, f.count + 1)
+        rows = d.rows(ids, "pictures") if d is not None else None
+        if f.has("type"):
+            types = f.column("type").astype(np.int64)
+        else:
+            types = d.types[rows] if d is not None else np.ones(f.count, np.int64)
+        radius = mass = None
+        if f.has("radius"):
+            radius = f.vector("radius")[:, 0]
+        elif f.has("diameter"):
+            radius = f.vector("diameter")[:, 0] / 2
+        elif d is not None and d.radius is not None:
+            radius = d.radius[rows]
+        if f.has("mass"):
+            mass = f.vector("mass")[:, 0]
+        elif d is not None and d.mass is not None:
+            mass = d.mass[rows]
+        top = int(types.max(initial=0))
+        names = [d.name(t) if d is not None else str(t) for t in range(top + 1)]
+        kinds, kind_names = _names(names, types)
+        bonds = np.zeros((0, 2), np.int64)
+        if d is not None and len(d.bonds):
+            where = {int(a): k for k, a in enumerate(ids)}
+            pairs = [(where.get(int(a), -1), where.get(int(b), -1)) for a, b in d.bonds]
+            bonds = np.array([p for p in pairs if min(p) >= 0], np.int64).reshape(-1, 2)
+        velocity = f.vector("vx", "vy", "vz") if f.has("vx", "vy", "vz") else None
+        return SceneFrame(i, f.time, f.step, f.wrapped(), radius, kinds, kind_names,
+                          velocity=velocity, mass=mass, bonds=bonds, box=(f.lo, f.hi))
+
+
+class WorkFolderSource(DumpSource):
+    """A run's work folder: its frame dump (``frames.dump``) and data file."""
+
+    def __init__(self, path: Path):
+        dump = path / DUMP_NAME
+        if not dump.is_file():
+            raise InputError(path, None, f"this work folder has no {DUMP_NAME} (frames) to draw")
+        super().__init__(dump)
+
+
+_SOURCES = {"xyz": FibreNetSource, "res": FibreNetSource, "mdem": MdemSource, "musen": MusenTextSource,
+            "demdf": DemdfSource, "lammps-dump": DumpSource, WORK: WorkFolderSource}
+
+
+def open_source(located: Located) -> Source:
+    """The frame source of a located result (a log has no frames: an InputError)."""
+    kind = _SOURCES.get(located.kind)
+    if kind is None:
+        raise InputError(located.path, None, "a LAMMPS log has no frames: give a result file or "
+                         "the run's work folder")
+    return kind(located.path)

@@ -2,8 +2,9 @@
 
 - the CLI and the Python API name no format: every format choice comes from the registry;
 - ``fibrelmp.translate`` (the formats' homes and the job renderers) imports neither
-  ``fibrelmp.post`` nor ``fibrelmp.pipeline``, and ``post`` does not import the pipeline, so
-  the packages form no cycle;
+  ``fibrelmp.post`` nor ``fibrelmp.pipeline``, ``post`` does not import the pipeline and
+  ``pictures`` (which reads results through both) neither the pipeline nor the API, so the
+  packages form no cycle;
 - every registry hook loads and derives from its role's base class;
 - docs/architecture.md lists every registered format.
 """
@@ -59,6 +60,7 @@ def _imports(path: Path) -> set[str]:
 @pytest.mark.parametrize("package, forbidden", [
     ("translate", ("fibrelmp.post", "fibrelmp.pipeline", "fibrelmp.python_api", "fibrelmp.cli")),
     ("post", ("fibrelmp.pipeline", "fibrelmp.cli")),
+    ("pictures", ("fibrelmp.pipeline", "fibrelmp.cli", "fibrelmp.python_api")),
     ("numtext", ("fibrelmp.",)),
 ])
 def test_packages_form_no_cycle(package, forbidden):

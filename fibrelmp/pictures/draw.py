@@ -62,6 +62,8 @@ def draw_history(hist: History, width: int, height: int, dpi: int = 100):
             from matplotlib.ticker import MaxNLocator
 
             ax.yaxis.set_major_locator(MaxNLocator(integer=True))
+            top = max((float(np.nanmax(hist.series[n], initial=0)) for n in hist.panels[title]), default=0)
+            ax.set_ylim(0, max(top, 1.0) * 1.15)          # counts from zero
         ax.tick_params(labelsize=8)
         if len(hist.panels[title]) > 1 or title in ("counts",) or title.startswith("energy"):
             ax.legend(fontsize=8, loc="best", frameon=False)
@@ -184,6 +186,9 @@ def draw_frame(frame: SceneFrame, width: int, height: int, title: str, dpi: int 
     ax.set_box_aspect(span / span.max(), zoom=0.95)
     ax.view_init(elev=elev, azim=azim)
     ax.set_axis_off()
+    # walls under bonds under spheres: matplotlib orders whole collections by their mean
+    # depth, which would hide a sphere resting on a plate behind the plate's faces
+    ax.computed_zorder = False
     notes = [note] if note else []
 
     triangles = 0
@@ -198,7 +203,7 @@ def draw_frame(frame: SceneFrame, width: int, height: int, title: str, dpi: int 
             faces.append(poly)
     if faces:
         walls = Poly3DCollection(faces, facecolors=WALL_COLOUR, edgecolors="#5b6068",
-                                 linewidths=0.3, alpha=0.35)
+                                 linewidths=0.3, alpha=0.35, zorder=1)
         ax.add_collection3d(walls)
         triangles = len(faces)
     if show_box:
@@ -206,7 +211,8 @@ def draw_frame(frame: SceneFrame, width: int, height: int, title: str, dpi: int 
 
     segments = _bond_segments(frame)
     if len(segments):
-        ax.add_collection3d(Line3DCollection(segments, colors=BOND_COLOUR, linewidths=0.8, alpha=0.8))
+        ax.add_collection3d(Line3DCollection(segments, colors=BOND_COLOUR, linewidths=0.8, alpha=0.8,
+                                             zorder=2))
 
     # pixels per data unit: ortho projection with equal scales, so any screen-parallel offset
     # works; measure one along the screen's horizontal
@@ -222,7 +228,8 @@ def draw_frame(frame: SceneFrame, width: int, height: int, title: str, dpi: int 
     sizes = np.maximum(diameter_pt, 0.5) ** 2
     pos = frame.position
     scatter = ax.scatter(pos[:, 0], pos[:, 1], pos[:, 2], s=sizes, c=_colours(frame.kind),
-                         edgecolors="#222222", linewidths=0.2, depthshade=True, alpha=1.0)
+                         edgecolors="#222222", linewidths=0.2, depthshade=len(pos) > 1, alpha=1.0,
+                         zorder=3)
     if len(frame.kind_names) > 1:
         from matplotlib.lines import Line2D
 

@@ -29,7 +29,7 @@ def _run(folder, job: str) -> None:
     if not found.available:
         pytest.skip(f"fibrelmp's LAMMPS styles are not available: {found.how}")
     proc = subprocess.run([sys.executable, "-m", "fibrelmp.cli", "-q", "run", job, "-o", "out",
-                           "--work", "work", "--precision", "17"], cwd=folder, capture_output=True,
+                           "--work", "work"], cwd=folder, capture_output=True,
                           text=True, timeout=7200, env=dict(os.environ, OMP_NUM_THREADS="1"))
     assert proc.returncode == 0, proc.stdout + proc.stderr
 

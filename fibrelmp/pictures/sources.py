@@ -288,6 +288,15 @@ class DumpSource(Source):
         for i, f in enumerate(self.reader):
             yield self._frame(i, f)
 
+    def frame(self, index: int | None) -> SceneFrame:
+        total = self.count()
+        i = total - 1 if index is None else index + total if index < 0 else index
+        if not 0 <= i < total:
+            return super().frame(index)             # the error, with the frame count
+        for f in self.reader.frames(lambda k: k == i, i + 1):   # other frames are not parsed
+            return self._frame(i, f)
+        raise InputError(self.path, None, f"frame {i} could not be read")
+
     def _frame(self, i: int, f) -> SceneFrame:
         d = self.data
         ids = f.column("id").astype(np.int64) if f.has("id") else np.arange(1, f.count + 1)

@@ -3,7 +3,8 @@
 LAMMPS prints a header line (``Step Time KinEng ...``) and then one row per thermo output
 for every ``run`` command; fibrelmp's jobs are many short runs, so the table comes in many
 sections whose first row repeats the previous section's last step.  ``read_thermo`` joins the
-sections, drops those repeats, keeps rows of a run cut short (a log of a run that failed or
+sections, keeps one row per repeated step (the later: commands between the runs may have
+changed the state), keeps rows of a run cut short (a log of a run that failed or
 is still going has no ``Loop time`` line for its last section) and skips the other lines
 LAMMPS mixes in (warnings, commands).  Only the default one-line thermo style is read
 (``thermo_style multi`` / ``yaml`` logs are refused with that reason).
@@ -26,6 +27,7 @@ class Thermo:
     columns: dict[str, np.ndarray]    # column name (as in the header) -> values, row order
     sections: int                     # thermo tables joined (one per ``run`` with output)
     units: str | None = None          # the log's ``units`` command, if it has one
+    per_atom: bool = False            # extensive values divided by the atom count (norm yes)
 
     @property
     def rows(self) -> int:
@@ -48,7 +50,7 @@ def read_thermo(path: str | Path) -> Thermo:
     check_regular_file(path, "LAMMPS log")
     columns: dict[str, list[float]] = {}
     header: list[str] | None = None
-    sections, rows, units = 0, 0, None
+    sections, rows, units, norm = 0, 0, None, None
     last_step: float | None = None
     first_of_section = False
     with open(path, encoding="utf-8", errors="replace") as fh:
@@ -62,6 +64,8 @@ def read_thermo(path: str | Path) -> Thermo:
                 continue
             if words[0] == "units" and len(words) == 2:
                 units = words[1]
+            if words[0] == "thermo_modify" and "norm" in words[:-1]:
+                norm = words[words.index("norm") + 1] == "yes"
             if words[0].startswith("-----") and "Step" in words:
                 raise InputError(path, None, "thermo in 'multi' style; fibrelmp reads the default "
                                  "one-line style (thermo_style custom/one)")
@@ -78,7 +82,13 @@ def read_thermo(path: str | Path) -> Thermo:
                 continue                    # a warning or command line inside the section
             step = values[0]
             if first_of_section and last_step is not None and step == last_step:
-                first_of_section = False    # the previous run's last row, printed again
+                # the previous run's last step again; the new row wins: commands between the
+                # runs (a FibreNet start sets the velocities) may have changed the state
+                first_of_section = False
+                for name, value in zip(header, values):
+                    if name not in columns:
+                        columns[name] = [math.nan] * rows
+                    columns[name][-1] = value
                 continue
             first_of_section = False
             for name in header:
@@ -94,4 +104,6 @@ def read_thermo(path: str | Path) -> Thermo:
     if not rows:
         raise InputError(path, None, "no thermo output in this log (no 'Step ...' table): "
                          "the run printed none (thermo 0)")
-    return Thermo(path, {k: np.asarray(v, float) for k, v in columns.items()}, sections, units)
+    per_atom = norm if norm is not None else units == "lj"      # LAMMPS's default: lj only
+    return Thermo(path, {k: np.asarray(v, float) for k, v in columns.items()}, sections, units,
+                  per_atom)

@@ -377,3 +377,13 @@ def test_thermo_reader_keeps_cut_runs_and_new_columns_and_refuses_other_styles(t
         log.write_text(text)
         with pytest.raises(InputError, match=says):
             read_thermo(log)
+
+
+def test_snapshot_of_a_fibrenet_work_folder_has_the_springs_and_radii(runs, tmp_path):
+    folder, _ = runs["fibrenet"]
+    via_xyz = python_api.snapshot(folder / "fibre_network_coord.xyz", tmp_path / "a.png")
+    via_work = python_api.snapshot(folder / "fibre_network_work", tmp_path / "b.png")
+    assert via_work.frames == via_xyz.frames == 6 and via_work.bonds == via_xyz.bonds
+    # the dump keeps 17 digits, the xyz file 5 decimals
+    np.testing.assert_allclose(via_work.positions, via_xyz.positions, atol=5.1e-6)
+    np.testing.assert_allclose(via_work.sizes, via_xyz.sizes, rtol=1e-6)      # same radii, same view

@@ -155,8 +155,18 @@ def _radii(frame: SceneFrame, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarra
         return np.asarray(frame.radius, float), None
     n = max(frame.count, 1)
     volume = float(np.prod(np.maximum(hi - lo, 1e-300)))
-    r = 0.25 * (volume / n) ** (1 / 3)          # a quarter of the mean spacing
-    return np.full(frame.count, r), f"radii unknown: drawn as {r:.3g} (a quarter of the mean spacing)"
+    r, how = 0.25 * (volume / n) ** (1 / 3), "a quarter of the mean spacing"
+    if frame.count > 1:
+        try:
+            from scipy.spatial import cKDTree          # with MDAnalysis, scipy is installed
+        except ImportError:
+            cKDTree = None
+        if cKDTree is not None:
+            gap = cKDTree(frame.position).query(frame.position, k=2)[0][:, 1]
+            gap = gap[np.isfinite(gap) & (gap > 0)]
+            if len(gap) and 0.4 * float(np.median(gap)) < r:
+                r, how = 0.4 * float(np.median(gap)), "0.4 of the median nearest-neighbour distance"
+    return np.full(frame.count, r), f"radii unknown: drawn as {r:.3g} ({how})"
 
 
 def _colours(kinds: np.ndarray):

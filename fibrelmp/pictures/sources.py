@@ -86,6 +86,18 @@ def _names(names: list[str], kinds: np.ndarray) -> tuple[np.ndarray, list[str]]:
             [names[int(k)] if 0 <= int(k) < len(names) else str(int(k)) for k in used])
 
 
+def noted_radii(data: Path) -> dict[str, float]:
+    """Type name -> radius, where fibrelmp's data file notes it in the Masses comments
+    (``1 1.0  # F1 m=1 R=0.42``: FibreNet beads, whose atom style has no radius)."""
+    radii = {}
+    with open(data, encoding="utf-8", errors="replace") as fh:
+        for line in fh:
+            hit = re.match(r"\s*\d+\s+\S+\s*#\s*(\S+)\s.*\bR=([-+.\deE]+)", line)
+            if hit:
+                radii[hit.group(1)] = float(hit.group(2))
+    return radii
+
+
 # -- FibreNet --------------------------------------------------------------------------------
 class FibreNetSource(Source):
     """``<prefix>_coord.xyz`` (and ``_vel.xyz``); beads' radii, masses and the springs come
@@ -100,6 +112,8 @@ class FibreNetSource(Source):
         self.coord = path.with_name(f"{prefix}_coord.xyz")
         if not self.coord.is_file():
             raise InputError(path, None, f"the positions are in {self.coord.name}, which is not here")
+        if self.coord != path:
+            self.notes.append(f"frames from {self.coord.name}")
         vel = path.with_name(f"{prefix}_vel.xyz")
         self.vel = vel if vel.is_file() else None
         self.radius_by_name: dict[str, float] = {}
@@ -120,11 +134,7 @@ class FibreNetSource(Source):
         for t, name in facts.type_names.items():
             if t in facts.type_masses:
                 self.mass_by_name[name] = facts.type_masses[t]
-        # fibrelmp's data files note each type's radius: "1 1.0  # F1 m=1 R=0.42"
-        for line in data.read_text(errors="replace").splitlines():
-            hit = re.match(r"\s*\d+\s+\S+\s*#\s*(\S+)\s.*\bR=(\S+)", line)
-            if hit:
-                self.radius_by_name[hit.group(1)] = float(hit.group(2))
+        self.radius_by_name = noted_radii(data)
         self.bonds = facts.rows(facts.bonds.ravel(), "springs").reshape(-1, 2) if len(facts.bonds) else self.bonds
 
     def frames(self) -> Iterator[SceneFrame]:
@@ -273,10 +283,12 @@ class DumpSource(Source):
         self.reader = DumpReader(path, None, self.warnings)
         data = path.with_name(DATA_NAME)
         self.data = None
+        self.radius_by_name: dict[str, float] = {}
         if data.is_file():
             from fibrelmp.post.lammps_data.reader import read_data
 
             self.data = read_data(data)
+            self.radius_by_name = noted_radii(data) if self.data.radius is None else {}
             self.notes.append(f"radii, masses, type names and bonds from {data}"
                               + (" (bonds as at the start: breakage is not in the dump)"
                                  if len(self.data.bonds) and self.data.radius is not None else ""))
@@ -301,8 +313,14 @@ class DumpSource(Source):
         d = self.data
         ids = f.column("id").astype(np.int64) if f.has("id") else np.arange(1, f.count + 1)
         rows = d.rows(ids, "pictures") if d is not None else None
+        labels = None
         if f.has("type"):
-            types = f.column("type").astype(np.int64)
+            raw = f.column("type")
+            try:
+                types = raw.astype(np.int64)
+            except (TypeError, ValueError):          # type labels (dump_modify types labels)
+                labels, types = np.unique(raw.astype(str), return_inverse=True)
+                types = types.astype(np.int64) + 1
         else:
             types = d.types[rows] if d is not None else np.ones(f.count, np.int64)
         radius = mass = None
@@ -312,18 +330,25 @@ class DumpSource(Source):
             radius = f.vector("diameter")[:, 0] / 2
         elif d is not None and d.radius is not None:
             radius = d.radius[rows]
+        elif d is not None and self.radius_by_name and labels is None:
+            noted = np.array([self.radius_by_name.get(d.name(t), math.nan) for t in types])
+            radius = noted if np.isfinite(noted).all() else None
         if f.has("mass"):
             mass = f.vector("mass")[:, 0]
         elif d is not None and d.mass is not None:
             mass = d.mass[rows]
         top = int(types.max(initial=0))
-        names = [d.name(t) if d is not None else str(t) for t in range(top + 1)]
+        if labels is not None:
+            names = ["", *labels]
+        else:
+            names = [d.name(t) if d is not None else str(t) for t in range(top + 1)]
         kinds, kind_names = _names(names, types)
         bonds = np.zeros((0, 2), np.int64)
-        if d is not None and len(d.bonds):
-            where = {int(a): k for k, a in enumerate(ids)}
-            pairs = [(where.get(int(a), -1), where.get(int(b), -1)) for a, b in d.bonds]
-            bonds = np.array([p for p in pairs if min(p) >= 0], np.int64).reshape(-1, 2)
+        if d is not None and len(d.bonds) and len(ids):
+            order = np.argsort(ids, kind="stable")
+            at = np.minimum(np.searchsorted(ids[order], d.bonds), len(ids) - 1)
+            found = (ids[order][at] == d.bonds).all(axis=1)        # both atoms in this frame
+            bonds = order[at[found]]
         velocity = f.vector("vx", "vy", "vz") if f.has("vx", "vy", "vz") else None
         return SceneFrame(i, f.time, f.step, f.wrapped(), radius, kinds, kind_names,
                           velocity=velocity, mass=mass, bonds=bonds, box=(f.lo, f.hi))

@@ -201,9 +201,10 @@ register_format(Format(
     {TARGET: "fibrelmp.post.mercury:MercuryTarget"},
     extensions=(".data", ".ene", ".fstat"), home="fibrelmp.post.mercury"))
 register_format(Format(
-    "vtk", "VTK .vtu frames with a ParaView .pvd index", "any",
+    # also written by ``run --vtk`` beside the results (fibrelmp.pipeline.viewer)
+    "vtk", "VTK .vtp/.vtm frames with a .pvd index (ParaView, OVITO)", "any",
     {TARGET: "fibrelmp.post.vtk:VtkTarget"},
-    extensions=(".vtu", ".pvd"), home="fibrelmp.post.vtk"))
+    extensions=(".pvd", ".vtp", ".vtm"), home="fibrelmp.post.vtk"))
 register_format(Format(
     "lammps-dump", "a LAMMPS text dump (plain or .gz)", "any",
     {FRAMES: "fibrelmp.post.lammps_dump:DumpReader"},

@@ -296,6 +296,9 @@ def run(input: Path = typer.Argument(..., help=f"{_TITLES[0].upper()}{_TITLES[1:
                                     "checkpoint in its work folder."),
         force: bool = typer.Option(False, "--force", help="Replace the results of an earlier run "
                                    "(all of them: stale files are removed)."),
+        viewer_files: bool = typer.Option(False, "--vtk", help="Also write every saved frame "
+                                          "as files 3D viewers open (OVITO and others; "
+                                          "docs/post.md), next to the results."),
         stock_styles: bool = _STOCK, quiet: bool = _QUIET, verbose: bool = _VERBOSE,
         ) -> None:
     import time
@@ -306,12 +309,13 @@ def run(input: Path = typer.Argument(..., help=f"{_TITLES[0].upper()}{_TITLES[1:
     start = time.monotonic()
     result = run_any(input, out, work=work, force=force, checkpoint_every=checkpoint_every,
                      resume=resume, end_time=end_time, step=step, save_step=save_step, steps=steps,
-                     precision=precision, progress=not _state["quiet"], stock_styles=stock_styles, say=_say,
+                     precision=precision, progress=not _state["quiet"], stock_styles=stock_styles,
+                     viewer_files=viewer_files, say=_say,
                      warn=_report_warnings)
     for note in result.notes:
         _say(note)
-    for path in result.outputs:
-        _say(f"wrote {path}")
+    for line in _written(result.outputs):
+        _say(line)
     script = result.scripts[-1] if result.scripts else None
     _say(f"done in {time.monotonic() - start:.1f} s (LAMMPS job: {script})")
 
@@ -364,6 +368,20 @@ def post(dump: Path = typer.Argument(..., help=" or ".join(f.title for f in form
                       warn=_report_warnings, precision=precision)
     for path in written:
         _say(f"wrote {path}")
+
+
+def _written(paths: list[Path]) -> list[str]:
+    """``wrote PATH`` lines; numbered frame files (``<name>_NNNNNN<tail>``) as one line per
+    name and tail, so a run with many frames does not list every file."""
+    import re
+
+    lines: dict[str, list[Path]] = {}
+    for path in paths:
+        m = re.fullmatch(r"(.*_)\d{6}(\D.*)", path.name)
+        key = str(path.with_name(f"{m[1]}NNNNNN{m[2]}")) if m else str(path)
+        lines.setdefault(key, []).append(path)
+    return [f"wrote {key}" if len(group) == 1 and group[0] == Path(key) else
+            f"wrote {key} ({len(group)} files)" for key, group in lines.items()]
 
 
 def _convert_examples() -> str:

@@ -93,7 +93,8 @@ def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | N
         force: bool = False, checkpoint_every: int | None = None, resume: bool = False,
         end_time: float | None = None, step: float | None = None, save_step: float | None = None,
         steps: int | None = None, precision: int | None = None, progress: bool = False,
-        stock_styles: bool = False, say: Say = _quiet, warn: Warn | None = None) -> RunResult:
+        stock_styles: bool = False, viewer_files: bool = False, say: Say = _quiet,
+        warn: Warn | None = None) -> RunResult:
     """Run any supported input on LAMMPS and write its results in the input's own format.
 
     ``out``: the results' folder, or the result file of an input with a single result;
@@ -101,7 +102,9 @@ def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | N
     ``force``.  ``end_time``/``step``/``save_step`` and ``steps`` override the
     input's (an input that sets them itself refuses them).  ``precision``: significant
     digits of text results that take it (default 6; refused for the others).  ``stock_styles``: stock LAMMPS
-    styles instead of fibrelmp's own (see ``translate_job``).  ``say`` receives progress notes, ``warn`` lists of
+    styles instead of fibrelmp's own (see ``translate_job``).  ``viewer_files`` (``run --vtk``):
+    also write every saved frame as files 3D viewers open, beside the results
+    (``fibrelmp.pipeline.viewer``; they are in ``outputs``).  ``say`` receives progress notes, ``warn`` lists of
     ``(kind, text)`` warnings as they are found (they are also in the result)."""
     from fibrelmp.checkpoint import check_every
     from fibrelmp.pipeline import RunOptions, run as run_plan
@@ -123,7 +126,8 @@ def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | N
             warn(list(items))
 
     settings = RunSettings(None if out is None else Path(out), None if work is None else Path(work),
-                           end_time, step, save_step, steps, 6 if precision is None else precision)
+                           end_time, step, save_step, steps, 6 if precision is None else precision,
+                           viewer_files=viewer_files)
     if resume and not hook.has_checkpoint(path, settings.out, settings.work):    # before reading
         from .checkpoint import NO_CHECKPOINT
 

@@ -19,6 +19,8 @@ Roles
   ``frames``  a trajectory ``post`` reads; its hook is a frame ``Reader``.
   ``document`` a whole scene/result file ``fibrelmp convert`` reads and writes; its hook
               has ``open(path)`` (a document) and ``writer(target, precision, force=)``.
+  ``mesh``    a finite-element mesh; its hook is a ``mesh.model.MeshFormat`` (reader, writer).
+  ``motion``  mesh node positions over time; its hook is a frame ``Reader``.
 
 Adding a format: one module with its Reader/Writer subclass, one ``register_format`` call
 below (docs/architecture.md shows an example).  Like meshio's ``register_format`` and ASE's
@@ -36,7 +38,8 @@ from typing import Any
 from .errors import InputError
 
 INPUT, RESULT, TARGET, FRAMES, DOCUMENT = "input", "result", "target", "frames", "document"
-ROLES = (INPUT, RESULT, TARGET, FRAMES, DOCUMENT)
+MESH, MOTION = "mesh", "motion"
+ROLES = (INPUT, RESULT, TARGET, FRAMES, DOCUMENT, MESH, MOTION)
 
 
 @dataclass(frozen=True)
@@ -201,9 +204,10 @@ register_format(Format(
     {TARGET: "fibrelmp.post.mercury:MercuryTarget"},
     extensions=(".data", ".ene", ".fstat"), home="fibrelmp.post.mercury"))
 register_format(Format(
-    "vtk", "VTK .vtu frames with a ParaView .pvd index", "any",
+    # also written by ``run --vtk`` beside the results (fibrelmp.pipeline.viewer)
+    "vtk", "VTK .vtp/.vtm frames with a .pvd index (ParaView, OVITO)", "any",
     {TARGET: "fibrelmp.post.vtk:VtkTarget"},
-    extensions=(".vtu", ".pvd"), home="fibrelmp.post.vtk"))
+    extensions=(".pvd", ".vtp", ".vtm"), home="fibrelmp.post.vtk"))
 register_format(Format(
     "lammps-dump", "a LAMMPS text dump (plain or .gz)", "any",
     {FRAMES: "fibrelmp.post.lammps_dump:DumpReader"},
@@ -213,3 +217,15 @@ register_format(Format(
     "mdanalysis", "any trajectory MDAnalysis reads (with --topology)", "any",
     {FRAMES: "fibrelmp.post.mdanalysis:UniverseReader"},
     home="fibrelmp.post.mdanalysis"))
+register_format(Format(
+    "opencarp", "an openCARP mesh (.pts/.elem text, .bpts/.belem binary; µm)", "si",
+    {MESH: "fibrelmp.mesh.opencarp.mesh:OpenCarpMesh"},
+    extensions=(".pts", ".elem", ".bpts", ".belem"), home="fibrelmp.mesh.opencarp"))
+register_format(Format(
+    "vtk-mesh", "a VTK unstructured-grid mesh (.vtu, .vtk)", "any",
+    {MESH: "fibrelmp.mesh.vtkmesh.mesh:VtkMesh"},
+    extensions=(".vtu", ".vtk"), home="fibrelmp.mesh.vtkmesh"))
+register_format(Format(
+    "dynpt", "openCARP node positions over time (.dynpt, IGB vec3f; µm)", "si",
+    {MOTION: "fibrelmp.mesh.opencarp.dynpt:DynptReader"},
+    extensions=(".dynpt",), home="fibrelmp.mesh.opencarp"))

@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 
 from fibrelmp import registry
-from fibrelmp.registry import DOCUMENT, FRAMES, INPUT, RESULT, TARGET
+from fibrelmp.registry import DOCUMENT, FRAMES, INPUT, MESH, MOTION, RESULT, TARGET
 
 REPO = Path(__file__).resolve().parents[1]
 PACKAGE = REPO / "fibrelmp"
@@ -81,6 +81,8 @@ BASES = {
     TARGET: ("fibrelmp.post.target", "DumpTarget"),
     FRAMES: ("fibrelmp.formatbase", "Reader"),
     DOCUMENT: ("fibrelmp.formatbase", "DocumentFormat"),
+    MESH: ("fibrelmp.mesh.model", "MeshFormat"),
+    MOTION: ("fibrelmp.formatbase", "Reader"),
 }
 
 

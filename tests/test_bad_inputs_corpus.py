@@ -144,7 +144,7 @@ def test_run_writes_nothing_and_keeps_outputs(tmp_path, case, copies, outputs, e
 
 
 @pytest.mark.parametrize("to, outputs", [
-    ("xyz", ["out_coord.xyz"]), ("vtk", ["out.pvd", "out_000000.vtu", "out_000001.vtu"]),
+    ("xyz", ["out_coord.xyz"]), ("vtk", ["out.pvd", "out_000000.vtp", "out_000001.vtp"]),
     ("demdf", ["out_0.json", "out_1.json"]), ("res", ["out_restart.res"]),
 ])
 def test_post_force_keeps_outputs_when_a_later_frame_is_bad(tmp_path, to, outputs):
@@ -160,11 +160,12 @@ def test_post_force_keeps_outputs_when_a_later_frame_is_bad(tmp_path, to, output
 
 
 def test_post_force_replaces_outputs_after_success(tmp_path):
-    (tmp_path / "out_000007.vtu").write_text(SENTINEL)      # a frame of an earlier conversion
+    (tmp_path / "out_000007.vtp").write_text(SENTINEL)      # frames of an earlier conversion
+    (tmp_path / "out_000003.vtu").write_text(SENTINEL)      # (as fibrelmp wrote them before)
     (tmp_path / "out.pvd").write_text(SENTINEL)
     proc = _cli("post", str(CORPUS / "dump" / "good.dump"), "--to", "vtk", "-o",
                 str(tmp_path / "out"), "--force", cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.pvd", "out_000000.vtu",
-                                                           "out_000001.vtu"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.pvd", "out_000000.vtp",
+                                                           "out_000001.vtp"]
     assert (tmp_path / "out.pvd").read_text() != SENTINEL

@@ -18,7 +18,7 @@ from fibrelmp.post.convert import post_command
 from fibrelmp.translate.fibrenet.writer import read_restart, read_xyz
 from fibrelmp.post.lammps_dump.reader import iter_frames
 from fibrelmp.post.mercury import ENE_HEADER, read_data_file, read_ene, read_fstat
-from fibrelmp.post.vtk import read_pvd, read_vtu
+from fibrelmp.post.vtk import read_frame, read_pvd
 
 GRANULAR = """
 units si
@@ -258,21 +258,26 @@ def test_vtk_round_trip(granular, tmp_path, ascii_):
         post(granular / "atoms.dump", "vtk", tmp_path / "run")
     entries = read_pvd(tmp_path / "run.pvd")
     assert [t for t, _ in entries] == pytest.approx([f.time for f in frames])
+    assert [p.name for _, p in entries] == [f"run_{k:06d}.vtp" for k in range(len(frames))]
     for (_, path), f in zip(entries, frames):
-        v = read_vtu(path)
+        v = read_frame(path)["Particles"]
+        assert v.kind == "PolyData" and set(read_frame(path)) == {"Particles"}    # no bonds: no .vtm
         np.testing.assert_array_equal(v.points, f.vector("x", "y", "z"))
         np.testing.assert_array_equal(v.point_data["id"], f.column("id"))
-        np.testing.assert_array_equal(v.point_data["velocity"], f.vector("vx", "vy", "vz"))
-        np.testing.assert_array_equal(v.point_data["radius"], f.column("radius"))
-        assert v.step == f.step and np.all(v.types == 1)
-    meshio = pytest.importorskip("meshio")
-    mesh = meshio.read(entries[-1][1])
-    np.testing.assert_array_equal(mesh.points, frames[-1].vector("x", "y", "z"))
-    np.testing.assert_array_equal(mesh.point_data["force"], frames[-1].vector("fx", "fy", "fz"))
+        np.testing.assert_array_equal(v.point_data["Velocity"], f.vector("vx", "vy", "vz"))
+        np.testing.assert_array_equal(v.point_data["Force"], f.vector("fx", "fy", "fz"))
+        np.testing.assert_array_equal(v.point_data["Angular Velocity"], f.vector("omegax", "omegay", "omegaz"))
+        np.testing.assert_array_equal(v.point_data["Radius"], f.column("radius"))
+        np.testing.assert_array_equal(v.point_data["Mass"], f.column("mass"))
+        assert v.point_data["type"].dtype == np.int32 and v.point_data["id"].dtype == np.int64
+        assert v.step == f.step and v.time == f.time
+        np.testing.assert_array_equal(v.cells["Verts"]["connectivity"], np.arange(f.count))
+        np.testing.assert_array_equal(v.cells["Verts"]["offsets"], np.arange(1, f.count + 1))
 
 
 def test_vtk_bonds_as_lines(tmp_path):
-    """Bonds from --data become VTK_LINE cells; one crossing the periodic boundary is left out."""
+    """Bonds from --data become lines in a bonds file beside the particles (a .vtm per frame);
+    the one crossing the periodic x face is drawn as two pieces ending on the faces."""
     (tmp_path / "data.lammps").write_text(
         "test\n\n4 atoms\n3 bonds\n1 atom types\n1 bond types\n\n0 10 xlo xhi\n0 10 ylo yhi\n0 10 zlo zhi\n\n"
         "Masses\n\n1 2.0 # bead\n\nAtoms # bond\n\n1 1 1 1 1 1\n2 1 1 2 1 1\n3 1 1 3 1 1\n4 1 1 9.5 1 1\n\n"
@@ -281,12 +286,18 @@ def test_vtk_bonds_as_lines(tmp_path):
         "ITEM: TIMESTEP\n5\nITEM: NUMBER OF ATOMS\n4\nITEM: BOX BOUNDS pp pp pp\n0 10\n0 10\n0 10\n"
         "ITEM: ATOMS id x y z\n3 3 1 1\n1 1 1 1\n4 9.5 1 1\n2 2 1 1\n")
     post(tmp_path / "d.dump", "vtk", tmp_path / "b", data=tmp_path / "data.lammps")
-    v = read_vtu(tmp_path / "b_000000.vtu")
-    np.testing.assert_array_equal(v.point_data["id"], [1, 2, 3, 4])
-    np.testing.assert_array_equal(v.point_data["mass"], [2.0] * 4)
-    assert list(v.types) == [1, 1, 1, 1, 3, 3]
-    np.testing.assert_array_equal(v.connectivity[4:].reshape(-1, 2), [[0, 1], [1, 2]])
-    np.testing.assert_array_equal(v.offsets, [1, 2, 3, 4, 6, 8])
+    assert read_pvd(tmp_path / "b.pvd")[0][1].name == "b_000000.vtm"
+    blocks = read_frame(tmp_path / "b_000000.vtm")
+    v, lines = blocks["Particles"], blocks["Bonds"]
+    np.testing.assert_array_equal(v.point_data["id"], [1, 2, 3, 4])         # sorted by post
+    np.testing.assert_array_equal(v.point_data["Mass"], [2.0] * 4)
+    np.testing.assert_array_equal(lines.cell_data["id1"], [1, 2, 4, 4])
+    np.testing.assert_array_equal(lines.cell_data["id2"], [2, 3, 1, 1])
+    np.testing.assert_array_equal(lines.points.reshape(-1, 2, 3),
+                                  [[[1, 1, 1], [2, 1, 1]], [[2, 1, 1], [3, 1, 1]],
+                                   [[9.5, 1, 1], [10, 1, 1]], [[0, 1, 1], [1, 1, 1]]])
+    np.testing.assert_array_equal(lines.cells["Lines"]["offsets"], [2, 4, 6, 8])
+    assert lines.attributes["NumberOfVerts"] == "0" and v.attributes["NumberOfLines"] == "0"
 
 
 # -- CLI ------------------------------------------------------------------------------------------

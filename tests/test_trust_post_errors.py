@@ -261,7 +261,7 @@ def test_xyz_writer_on_a_full_disk(tmp_path, monkeypatch, full_disk):
 
 
 @pytest.mark.parametrize("to,output", [("xyz", "o_coord.xyz"), ("res", "o_restart.res"),
-                                       ("vtk", "o_000000.vtu"), ("musen", "o"),
+                                       ("vtk", "o_000000.vtp"), ("musen", "o"),
                                        ("demdf", "o_0.json"), ("mercury", "o")])
 def test_post_on_a_full_disk_names_the_output_and_leaves_nothing(tmp_path, full_disk, to, output):
     rows = [r + (0.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.1, 1.0) for r in ROWS]

@@ -19,7 +19,7 @@ from typing import Iterator
 import numpy as np
 
 from fibrelmp.errors import InputError
-from fibrelmp.pictures.locate import DATA_NAME, DUMP_NAME, WORK, Located, family_prefix, run_folder
+from fibrelmp.pictures.locate import DATA_NAME, DUMP_NAME, LOG, WORK, Located, family_prefix, run_folder
 
 
 @dataclass
@@ -372,6 +372,8 @@ def open_source(located: Located) -> Source:
     """The frame source of a located result (a log has no frames: an InputError)."""
     kind = _SOURCES.get(located.kind)
     if kind is None:
-        raise InputError(located.path, None, "a LAMMPS log has no frames: give a result file or "
-                         "the run's work folder")
+        if located.kind == LOG:
+            raise InputError(located.path, None, "a LAMMPS log has no frames: give a result file "
+                             "or the run's work folder")
+        raise InputError(located.path, None, f"fibrelmp does not draw {located.kind} files")
     return kind(located.path)

@@ -121,17 +121,22 @@ class WrittenFrames:
         pass
 
 
-def results(model: "Model", folder: Path, prefix: str):
-    """The FibreNet writers of a rendered job: a consumer of its frames."""
+def results(model: "Model", folder: Path, prefix: str, viewer_files: bool = False):
+    """The FibreNet writers of a rendered job: a consumer of its frames (and, with
+    ``viewer_files``, of the dump frames the viewer files are made of)."""
     spec = model.plan.output
 
     def make(rendered: Rendered) -> Consumer:
         job = rendered.job
         if job.native is not None:
-            return _move_native(job.native, folder, prefix, spec.fields)
+            consume = _move_native(job.native, folder, prefix, spec.fields)
+        else:
+            def consume(frames: Iterator["Frame"]) -> list[Path]:
+                return convert_frames(model, job, frames, folder, prefix)
+        if viewer_files:
+            from fibrelmp.pipeline import viewer
 
-        def consume(frames: Iterator["Frame"]) -> list[Path]:
-            return convert_frames(model, job, frames, folder, prefix)
+            return viewer.also_to(consume, viewer.fibrenet_writer(model, folder / prefix))
         return consume
     return make
 
@@ -195,14 +200,23 @@ def move_file(src: Path, dst: Path) -> None:
 
 
 def fibrenet_plan(model: "Model", out: str | Path | None = None, work: str | Path | None = None,
-                  options: RunOptions = RunOptions()) -> RunPlan:
+                  options: RunOptions = RunOptions(), viewer_files: bool = False) -> RunPlan:
     """The run of a FibreNet model: one simulation, its results next to the input (or in
-    ``out``), its job in ``work`` (default ``<prefix>_work`` beside the results)."""
+    ``out``), its job in ``work`` (default ``<prefix>_work`` beside the results);
+    ``viewer_files``: also ``<prefix>.pvd`` and its frames (``pipeline.viewer``)."""
     outputs, folder, prefix = fibrenet_outputs(model, out, work)
-    def frames(rendered: Rendered):
-        return WrittenFrames() if rendered.job.native is not None else DumpFrames(rendered.job.frames)
+    if viewer_files:
+        from fibrelmp.pipeline.viewer import declare
 
-    request = RunRequest(model, render(model), frames, results(model, folder, prefix), outputs.work)
+        declare(outputs, folder / prefix)
+
+    def frames(rendered: Rendered):
+        if rendered.job.native is not None and not viewer_files:
+            return WrittenFrames()
+        return DumpFrames(rendered.job.frames)
+
+    request = RunRequest(model, render(model), frames, results(model, folder, prefix, viewer_files),
+                         outputs.work)
     return RunPlan(outputs, [request], options)
 
 

@@ -23,6 +23,7 @@ from fibrelmp.pipeline.inputs import InputFormat, RunSettings, Say, Warn, no_ove
 from fibrelmp.pipeline.inputs.musen import check_musen_runnable, is_mdem, musen_result_writer
 
 if TYPE_CHECKING:
+    from fibrelmp.outputs import Outputs
     from fibrelmp.pipeline.request import RunOptions, RunPlan, Step
     from fibrelmp.pipeline.spool import FrameSpool
     from fibrelmp.textio import Patch
@@ -80,7 +81,8 @@ class ScriptInput(InputFormat):
         for st in plan.steps:
             if st.kind == "simulate":
                 steps.append(Action(partial(_announce, st, say, warn)))
-                steps.append(_simulation(st, work / f"job{st.job.index}", spools))
+                steps.append(_simulation(st, work / f"job{st.job.index}", spools,
+                                         outputs, settings.viewer_files))
             else:
                 steps.append(Action(partial(_import if st.kind == "import" else _export, st, spools, say)))
 
@@ -102,10 +104,15 @@ def _announce(step: "ScriptStep", say: Say, warn: Warn, rank0: bool) -> list[Pat
     return []
 
 
-def _simulation(step: "ScriptStep", work: Path, spools: dict):
-    """A SIMULATOR job: its frames go to a spool (exported later) and/or its MUSEN result."""
+def _simulation(step: "ScriptStep", work: Path, spools: dict, outputs: "Outputs",
+                viewer_files: bool):
+    """A SIMULATOR job: its frames go to a spool (exported later) and/or its MUSEN result
+    (and with ``viewer_files`` to ParaView/OVITO files named after its RESULT_FILE)."""
     from fibrelmp.pipeline.granular import granular_request
     from fibrelmp.pipeline.spool import FrameSpool
+    from fibrelmp.pipeline.viewer import viewer_base, viewer_writers
+
+    extra = viewer_writers(step.model, outputs, viewer_base(step.written or step.handle), viewer_files)
 
     def writers() -> list:
         made: list = []
@@ -114,7 +121,7 @@ def _simulation(step: "ScriptStep", work: Path, spools: dict):
             made.append(spools[step.handle])
         if step.written is not None:
             made.append(musen_result_writer(step.model, step.written))
-        return made
+        return made + extra()
     return granular_request(step.model, work, writers)
 
 

@@ -1,7 +1,10 @@
-"""ParaView output (``.vtu`` per frame, ``.pvd`` index): written from LAMMPS dumps, read back."""
+"""ParaView/OVITO output: a ``.pvd`` series of ``.vtp`` particle frames (and ``.vtm`` frames
+with bonds), written from LAMMPS dumps or a run's frames, and read back."""
 
-from fibrelmp.post.vtk.reader import Vtu, read_pvd, read_vtu
+from fibrelmp.post.vtk.frame import ViewerFrame, bond_segments, from_dump
+from fibrelmp.post.vtk.reader import Piece, read_frame, read_piece, read_pvd, read_vtm
 from fibrelmp.post.vtk.target import VtkTarget
-from fibrelmp.post.vtk.writer import VtkWriter, vtu_text
+from fibrelmp.post.vtk.writer import VtkWriter
 
-__all__ = ["Vtu", "VtkTarget", "VtkWriter", "read_pvd", "read_vtu", "vtu_text"]
+__all__ = ["Piece", "ViewerFrame", "VtkTarget", "VtkWriter", "bond_segments", "from_dump",
+           "read_frame", "read_piece", "read_pvd", "read_vtm"]

@@ -1,43 +1,48 @@
-"""``fibrelmp post --to vtk``: ParaView ``.vtu`` frames and their ``.pvd`` index."""
+"""``fibrelmp post --to vtk``: a ``.pvd`` series of particle (and bond) frames."""
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 from fibrelmp.post.lammps_dump.reader import Frame
 from fibrelmp.post.target import DumpTarget, ReadBack
-from fibrelmp.post.vtk.reader import read_pvd, read_vtu
+from fibrelmp.post.vtk.frame import VECTORS, from_dump
+from fibrelmp.post.vtk.reader import read_frame, read_pvd
 from fibrelmp.post.vtk.writer import VtkWriter
 
 
-def _vtus(base: Path) -> list[Path]:
-    return sorted(base.parent.glob(f"{base.name}_[0-9][0-9][0-9][0-9][0-9][0-9].vtu"))
+def frame_pattern(base: Path) -> re.Pattern:
+    """The names of a base's frame files (``.vtu``: what earlier fibrelmp versions wrote)."""
+    return re.compile(re.escape(base.name) + r"_\d{6}(\.vtp|_bonds\.vtp|\.vtm|\.vtu)")
 
 
 class VtkTarget(DumpTarget):
-    """``<base>_NNNNNN.vtu`` per frame (bonds of ``--data`` as lines), ``<base>.pvd``; frames
-    of an earlier conversion to the same base are removed."""
+    """``<base>.pvd`` and its frames (writer.py); bonds of ``--data`` as lines; frames of an
+    earlier conversion to the same base are removed."""
 
     @classmethod
     def files(cls, base: Path) -> list[Path]:
-        return [base.with_name(base.name + ".pvd")] + _vtus(base)
+        pattern = frame_pattern(base)
+        frames = sorted(p for p in base.parent.glob(f"{base.name}_*") if pattern.fullmatch(p.name)) \
+            if base.parent.is_dir() else []
+        return [base.with_name(base.name + ".pvd")] + frames
 
     def start(self, first: list[Frame]) -> None:
         data = self.context.datafile
         self.out = self.adopt(VtkWriter(self.target, data.bonds if data is not None else None))
 
     def write_frame(self, frame: Frame) -> None:
-        self.time_of(frame)                  # (warns when the dump has no times)
-        self.out.add(frame)
+        self.out.add(from_dump(frame, self.out.bonds, self.time_of(frame)))   # warns without times
 
     @classmethod
     def read_back(cls, files: list[Path]) -> list[ReadBack]:
         pvd = next(p for p in files if p.suffix == ".pvd")
         out = []
         for _, path in read_pvd(pvd):
-            v = read_vtu(path)
-            values = {cols: v.point_data[name] for name, cols in
-                      (("velocity", ("vx", "vy", "vz")), ("force", ("fx", "fy", "fz")))
-                      if name in v.point_data}
-            out.append(ReadBack(v.points, values=values))         # float64 as dumped
+            piece = read_frame(path)["Particles"]
+            order = piece.point_data["id"].argsort(kind="stable")
+            values = {VECTORS[name]: piece.point_data[name][order] for name in ("Velocity", "Force")
+                      if name in piece.point_data}
+            out.append(ReadBack(piece.points[order], values=values))     # float64 as dumped
         return out

@@ -1,11 +1,21 @@
-"""ParaView output: one XML UnstructuredGrid ``.vtu`` per frame and a ``.pvd`` collection.
+"""Files ParaView and OVITO both open: a ``.pvd`` time series of VTK XML PolyData frames.
 
-Each atom is a VTK_VERTEX cell at its position (as dumped: wrapped into the box on
-periodic axes); bonds (from ``--data``) are VTK_LINE cells, except those that span more
-than half a periodic box length (they cross the boundary and would be drawn across the
-box).  Point data: id, type, radius, mass, velocity, force, omega when known, and every
-other numeric dump column as a scalar.  Arrays are base64 "binary" (VTK XML version 1.0,
-UInt64 headers) or ascii.  The ``.pvd`` lists every ``.vtu`` with its time.
+Layout (``<base>`` = the output name without suffix)::
+
+    <base>.pvd                  the frames with their simulation times (open this)
+    <base>_NNNNNN.vtp           the particles of frame NNNNNN: points with one vertex each
+    <base>_NNNNNN_bonds.vtp     its bonds as lines (output with bonds; none in a frame without)
+    <base>_NNNNNN.vtm           the two above as one multiblock frame (output with bonds)
+
+Why PolyData and not an UnstructuredGrid (``.vtu``): OVITO (3.17) reads particles only from
+PolyData made of vertices (its ``.vtu`` reader takes a simulation cell: 8 points, 1 cell),
+and bonds from a PolyData file of lines with the cell arrays ``id1``/``id2``, joined per
+frame by a ``.vtm`` (the layout of Aspherix's output).  ParaView reads all of them.  Arrays
+are inline base64 (``format="binary"``) or ascii, never compressed (OVITO reads no
+compressed arrays), with UInt64 headers (VTK XML version 1.0).
+
+Bonds that cross a periodic face are drawn cut at the face (``frame.bond_segments``): each
+piece is its own line with the bond's ``id1``/``id2``, so a bond is one or more lines.
 """
 
 from __future__ import annotations
@@ -17,94 +27,116 @@ import numpy as np
 
 from fibrelmp.formatbase import Writer
 from fibrelmp.post.lammps_dump.reader import Frame
+from fibrelmp.post.vtk.frame import ViewerFrame, bond_rows, bond_segments, from_dump
 
-VTK_VERTEX, VTK_LINE = 1, 3
 _TYPES = {np.dtype(np.float64): "Float64", np.dtype(np.float32): "Float32", np.dtype(np.int64): "Int64",
           np.dtype(np.int32): "Int32", np.dtype(np.uint8): "UInt8"}
-VECTORS = {"velocity": ("vx", "vy", "vz"), "force": ("fx", "fy", "fz"),
-           "omega": ("omegax", "omegay", "omegaz"), "angmom": ("angmomx", "angmomy", "angmomz"),
-           "torque": ("tqx", "tqy", "tqz"), "orientation": ("quatw", "quati", "quatj", "quatk")}
-SKIP = {"x", "y", "z", "xs", "ys", "zs", "xu", "yu", "zu", "xsu", "ysu", "zsu", "id", "type"}
+COMPONENTS = {3: ("X", "Y", "Z"), 4: ("X", "Y", "Z", "W")}     # named, as OVITO shows them
+HEAD = ('<?xml version="1.0"?>\n<VTKFile type="{kind}" version="1.0" byte_order="LittleEndian" '
+        'header_type="UInt64">\n')
 
 
-def _array_xml(name: str, data: np.ndarray, ascii_: bool) -> str:
+def data_array(name: str, data: np.ndarray, ascii_: bool = False) -> str:
+    """One ``<DataArray>``: (n,) or (n, k) numbers, k components named X Y Z (W)."""
     data = np.ascontiguousarray(data)
+    if data.dtype not in _TYPES:
+        data = data.astype(np.int64 if data.dtype.kind in "iub" else np.float64)
     ncomp = data.shape[1] if data.ndim == 2 else 1
-    kind = _TYPES[data.dtype]
-    comp = f' NumberOfComponents="{ncomp}"' if ncomp > 1 else ""
+    attrs = f'type="{_TYPES[data.dtype]}" Name="{name}"'
+    if ncomp > 1:
+        attrs += f' NumberOfComponents="{ncomp}"'
+        attrs += "".join(f' ComponentName{k}="{c}"' for k, c in enumerate(COMPONENTS.get(ncomp, ())))
     if ascii_:
-        flat = data.ravel()
-        text = " ".join(map(repr, flat.tolist())) if data.dtype.kind == "f" else " ".join(map(str, flat.tolist()))
-        return f'<DataArray type="{kind}" Name="{name}"{comp} format="ascii">{text}</DataArray>\n'
+        flat = data.ravel().tolist()
+        text = " ".join(map(repr, flat)) if data.dtype.kind == "f" else " ".join(map(str, flat))
+        return f'<DataArray {attrs} format="ascii">{text}</DataArray>\n'
     raw = data.astype(data.dtype.newbyteorder("<"), copy=False).tobytes()
     payload = base64.b64encode(np.uint64(len(raw)).tobytes() + raw).decode()
-    return f'<DataArray type="{kind}" Name="{name}"{comp} format="binary">{payload}</DataArray>\n'
+    return f'<DataArray {attrs} format="binary">{payload}</DataArray>\n'
 
 
-def bond_cells(ids: np.ndarray, bonds: np.ndarray, x: np.ndarray, frame: Frame) -> np.ndarray:
-    """(m, 2) point indices of the bonds whose atoms are both in the frame."""
-    if len(bonds) == 0 or len(ids) == 0:
-        return np.zeros((0, 2), np.int64)
-    k = np.searchsorted(ids, bonds)
-    k = np.minimum(k, len(ids) - 1)
-    ok = np.all(ids[k] == bonds, axis=1)
-    pairs = k[ok]
-    d = x[pairs[:, 1]] - x[pairs[:, 0]]
-    per = frame.periodic
-    if per.any():
-        s = np.linalg.solve(frame.cell, d.T).T
-        pairs = pairs[~np.any(np.abs(s[:, per]) > 0.5, axis=1)]
-    return pairs
+def _field_data(frame: ViewerFrame) -> str:
+    # TimeValue: the name VTK readers take as the dataset's time
+    return ("<FieldData>\n"
+            f'<DataArray type="Float64" Name="TimeValue" NumberOfTuples="1" format="ascii">{float(frame.time)!r}</DataArray>\n'
+            f'<DataArray type="Int64" Name="TimeStep" NumberOfTuples="1" format="ascii">{int(frame.step)}</DataArray>\n'
+            "</FieldData>\n")
 
 
-def vtu_text(frame: Frame, bonds: np.ndarray | None = None, ascii_: bool = False) -> str:
-    """The .vtu document of one frame (atoms sorted by id)."""
-    n = frame.count
-    x = frame.wrapped()
-    ids = frame.column("id").astype(np.int64)
-    lines = bond_cells(ids, bonds, x, frame) if bonds is not None else np.zeros((0, 2), np.int64)
-    m = len(lines)
-    connectivity = np.concatenate([np.arange(n, dtype=np.int64), lines.ravel()])
-    offsets = np.concatenate([np.arange(1, n + 1, dtype=np.int64), n + 2 * np.arange(1, m + 1, dtype=np.int64)])
-    types = np.concatenate([np.full(n, VTK_VERTEX, np.uint8), np.full(m, VTK_LINE, np.uint8)])
-    point = [_array_xml("id", ids, ascii_)]
-    if "type" in frame.columns and np.asarray(frame.columns["type"]).dtype.kind in "fiu":
-        point.append(_array_xml("type", frame.columns["type"].astype(np.int32), ascii_))
-    used = set(SKIP)
-    for name, cols in VECTORS.items():
-        if frame.has(*cols):
-            point.append(_array_xml(name, frame.vector(*cols), ascii_))
-            used.update(cols)
-    for name, col in frame.columns.items():
-        if name in used or np.asarray(col).dtype.kind != "f":
-            continue
-        point.append(_array_xml(name, np.asarray(col, np.float64), ascii_))
-    parts = [
-        '<?xml version="1.0"?>\n',
-        '<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" header_type="UInt64">\n',
-        "<UnstructuredGrid>\n",
-        '<FieldData><DataArray type="Int64" Name="TimeStep" NumberOfTuples="1" format="ascii">'
-        f"{frame.step}</DataArray></FieldData>\n",
-        f'<Piece NumberOfPoints="{n}" NumberOfCells="{n + m}">\n',
-        "<PointData>\n", *point, "</PointData>\n",
-        "<Points>\n", _array_xml("Points", x.reshape(n, 3), ascii_), "</Points>\n",
-        "<Cells>\n", _array_xml("connectivity", connectivity, ascii_),
-        _array_xml("offsets", offsets, ascii_), _array_xml("types", types, ascii_), "</Cells>\n",
-        "</Piece>\n</UnstructuredGrid>\n</VTKFile>\n",
-    ]
-    return "".join(parts)
+def _cells(tag: str, per_cell: int, count: int, ascii_: bool) -> str:
+    return (f"<{tag}>\n" + data_array("connectivity", np.arange(per_cell * count, dtype=np.int64), ascii_)
+            + data_array("offsets", per_cell * np.arange(1, count + 1, dtype=np.int64), ascii_)
+            + f"</{tag}>\n")
+
+
+def _piece(frame: ViewerFrame, points: np.ndarray, verts: int, lines: int, data: str,
+           cells: str, ascii_: bool) -> bytes:
+    # FieldData after the Piece: OVITO recognises the file by the first element inside
+    # <PolyData>, which must be the Piece (VTK finds FieldData anywhere in it)
+    return (HEAD.format(kind="PolyData") + "<PolyData>\n" +
+            f'<Piece NumberOfPoints="{len(points)}" NumberOfVerts="{verts}" NumberOfLines="{lines}" '
+            'NumberOfStrips="0" NumberOfPolys="0">\n' + data +
+            "<Points>\n" + data_array("Points", points.reshape(-1, 3), ascii_) + "</Points>\n" +
+            cells + "</Piece>\n" + _field_data(frame) + "</PolyData>\n</VTKFile>\n").encode()
+
+
+def particles_vtp(frame: ViewerFrame, ascii_: bool = False) -> bytes:
+    """The particles: one vertex per point; point data ``id`` then the frame's arrays."""
+    n = len(frame.ids)
+    arrays = [data_array("id", frame.ids.astype(np.int64), ascii_)]
+    arrays += [data_array(name, values, ascii_) for name, values in frame.point_data.items()]
+    return _piece(frame, frame.positions, n, 0, "<PointData>\n" + "".join(arrays) + "</PointData>\n",
+                  _cells("Verts", 1, n, ascii_), ascii_)
+
+
+def bonds_vtp(frame: ViewerFrame, ascii_: bool = False) -> bytes | None:
+    """The bonds whose atoms are in the frame, as lines (two points each, cut at periodic
+    faces); cell data ``id1``/``id2`` (atom ids) and the frame's bond arrays.  None when
+    the frame has no such bond."""
+    rows, which = bond_rows(frame.ids, frame.bonds)
+    if len(rows) == 0:
+        return None
+    x = frame.positions
+    seg = bond_segments(x[rows[:, 0]], x[rows[:, 1]], frame.origin, frame.cell, frame.periodic)
+    bond = which[seg.bond]
+    pairs = frame.bonds[bond]
+    arrays = [data_array("id1", pairs[:, 0].astype(np.int64), ascii_),
+              data_array("id2", pairs[:, 1].astype(np.int64), ascii_)]
+    arrays += [data_array(name, values[bond], ascii_) for name, values in frame.bond_data.items()]
+    points = np.stack([seg.start, seg.end], axis=1).reshape(-1, 3)
+    return _piece(frame, points, 0, len(bond), "<CellData>\n" + "".join(arrays) + "</CellData>\n",
+                  _cells("Lines", 2, len(bond), ascii_), ascii_)
+
+
+def vtm_text(blocks: list[tuple[str, str | None]]) -> bytes:
+    """A multiblock file naming each block's file (relative to the ``.vtm``); a block
+    without a file is an empty block."""
+    rows = "".join(f'<DataSet index="{k}" name="{name}"' + (f' file="{file}"' if file else "") + "/>\n"
+                   for k, (name, file) in enumerate(blocks))
+    return (HEAD.format(kind="vtkMultiBlockDataSet") + "<vtkMultiBlockDataSet>\n" + rows +
+            "</vtkMultiBlockDataSet>\n</VTKFile>\n").encode()
+
+
+def pvd_text(entries: list[tuple[float, Path]]) -> bytes:
+    rows = "".join(f'<DataSet timestep="{float(t)!r}" group="" part="0" file="{p.name}"/>\n'
+                   for t, p in entries)
+    return ('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">\n'
+            "<Collection>\n" + rows + "</Collection>\n</VTKFile>\n").encode()
 
 
 class VtkWriter(Writer):
-    """``<base>_NNNNNN.vtu`` per frame and the ``<base>.pvd`` index (at close), all renamed
-    into place by ``close``.  A frame's time is its ITEM: TIME, else its step."""
+    """``<base>.pvd`` and per frame ``<base>_NNNNNN.vtp`` (+ ``_bonds.vtp`` and ``.vtm`` when
+    ``bonded``), all renamed into place by ``close``.  ``add`` takes a ``ViewerFrame`` or a
+    LAMMPS dump ``Frame`` (its bonds: ``bonds``, atom-id pairs; its time: ITEM: TIME, else
+    its step)."""
 
     format = "vtk"
 
     def __init__(self, base: Path, bonds: np.ndarray | None = None, ascii_: bool = False, *,
-                 force: bool = True):
+                 bonded: bool | None = None, force: bool = True):
         super().__init__(base, force=force)
         self.bonds = bonds
+        self.bonded = bonded if bonded is not None else bonds is not None and len(bonds) > 0
         self.ascii = ascii_
         self.entries: list[tuple[float, Path]] = []
         self.stage(self.pvd_path)             # listed first, written at close
@@ -120,17 +152,27 @@ class VtkWriter(Writer):
     def outputs(self) -> list[Path]:
         return [self.pvd_path]
 
-    def vtu_path(self, index: int) -> Path:
-        return self.target.with_name(f"{self.target.name}_{index:06d}.vtu")
+    def frame_path(self, index: int, suffix: str) -> Path:
+        return self.target.with_name(f"{self.target.name}_{index:06d}{suffix}")
 
-    def write(self, frame: Frame) -> None:
-        path = self.vtu_path(len(self.entries))
-        self.write_file(path, vtu_text(frame, self.bonds, self.ascii).encode())
-        self.entries.append((float(frame.step) if frame.time is None else frame.time, path))
+    def write(self, frame: ViewerFrame | Frame) -> None:
+        if not isinstance(frame, ViewerFrame):
+            frame = from_dump(frame, self.bonds)
+        k = len(self.entries)
+        particles = self.frame_path(k, ".vtp")
+        self.write_file(particles, particles_vtp(frame, self.ascii))
+        listed = particles
+        if self.bonded:
+            # a frame without bonds has an empty Bonds block and no bonds file: OVITO would
+            # read an empty PolyData file as (no) particles
+            lines = bonds_vtp(frame, self.ascii)
+            bonds = self.frame_path(k, "_bonds.vtp") if lines is not None else None
+            if bonds is not None:
+                self.write_file(bonds, lines)
+            listed = self.frame_path(k, ".vtm")
+            self.write_file(listed, vtm_text([("Particles", particles.name),
+                                              ("Bonds", bonds.name if bonds else None)]))
+        self.entries.append((frame.time, listed))
 
     def finish(self) -> None:
-        rows = "".join(f'<DataSet timestep="{t!r}" group="" part="0" file="{p.name}"/>\n'
-                       for t, p in self.entries)
-        self.write_file(self.pvd_path, ('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1" '
-                                        'byte_order="LittleEndian">\n<Collection>\n' + rows +
-                                        "</Collection>\n</VTKFile>\n").encode())
+        self.write_file(self.pvd_path, pvd_text(self.entries))

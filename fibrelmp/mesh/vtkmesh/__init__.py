@@ -1,0 +1,1 @@
+"""VTK unstructured-grid meshes (``.vtu`` XML, ``.vtk`` legacy) through meshio."""

@@ -1,0 +1,164 @@
+"""Finite-element mesh formats (CardioProof): openCARP text/binary and VTK round trips, the
+openCARP layouts checked byte by byte against hand-made files, .dynpt frames."""
+
+from __future__ import annotations
+
+import struct
+
+import numpy as np
+import pytest
+
+from fibrelmp import registry
+from fibrelmp.errors import InputError
+from fibrelmp.mesh.model import CellBlock, Mesh
+from fibrelmp.mesh.opencarp.dynpt import HEADER, DynptReader, DynptWriter, igb_header
+from fibrelmp.mesh.opencarp.mesh import OpenCarpMeshReader, OpenCarpMeshWriter
+
+MESHES = [f for f in registry.formats(registry.MESH)]
+
+
+def _mesh() -> Mesh:
+    """A tetra, a prism and two triangles (mixed kinds, element order kept) in µm."""
+    rng = np.random.default_rng(3)
+    points = rng.random((9, 3)) * 1000.0          # µm, arbitrary doubles
+    points[0] = (10.34, -15.0023, 12.023)
+    cells = [CellBlock("tetra", [[0, 1, 2, 3]], [1]),
+             CellBlock("wedge", [[1, 2, 3, 4, 5, 6]], [2]),
+             CellBlock("triangle", [[6, 7, 8], [0, 7, 8]], [3, 3]),
+             CellBlock("tetra", [[2, 3, 4, 5]], [1])]
+    return Mesh(points.astype(np.float32).astype(np.float64), cells, unit=1e-6)
+
+
+@pytest.mark.parametrize("binary", [False, True], ids=["text", "binary"])
+def test_opencarp_round_trip(tmp_path, binary):
+    mesh = _mesh()
+    with OpenCarpMeshWriter(tmp_path / "heart", binary=binary) as w:
+        w.add(mesh)
+    again = OpenCarpMeshReader(tmp_path / ("heart.belem" if binary else "heart.elem")).read()
+    assert again.equals(mesh) and again.unit == 1e-6
+    # written again: the same bytes
+    with OpenCarpMeshWriter(tmp_path / "again", binary=binary) as w:
+        w.add(again)
+    ext = (".bpts", ".belem") if binary else (".pts", ".elem")
+    for e in ext:
+        assert (tmp_path / f"again{e}").read_bytes() == (tmp_path / f"heart{e}").read_bytes()
+
+
+def test_opencarp_text_layout_and_units(tmp_path):
+    (tmp_path / "m.pts").write_text("4\n0 0 0\n1000 0 0\n0 2000.5 0\n0 0 3000\n")
+    (tmp_path / "m.elem").write_text("3\nTt 0 1 2 3 7\nTr 0 1 2\nCx 2 3 1\n")
+    mesh = OpenCarpMeshReader(tmp_path / "m.pts").read()
+    np.testing.assert_array_equal(mesh.points_m[2], [0.0, 2000.5e-6, 0.0])
+    assert [(b.kind, b.nodes.tolist(), b.tags.tolist()) for b in mesh.cells] == \
+           [("tetra", [[0, 1, 2, 3]], [7]), ("triangle", [[0, 1, 2]], [0]), ("line", [[2, 3]], [1])]
+
+
+def test_opencarp_binary_layout(tmp_path):
+    """meshtool's layout, built by hand: header "count 0 666" NUL-padded to 1024 bytes,
+    float32 points, per element int32 type code, nodes, region."""
+    pts = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], "<f4") * 1000
+    (tmp_path / "m.bpts").write_bytes(b"4 0 666".ljust(1024, b"\0") + pts.tobytes())
+    elems = struct.pack("<6i", 0, 0, 1, 2, 3, 5) + struct.pack("<5i", 6, 0, 1, 2, 9)
+    (tmp_path / "m.belem").write_bytes(b"2 0 666".ljust(1024, b"\0") + elems)
+    mesh = OpenCarpMeshReader(tmp_path / "m").read()           # a base name: binary preferred
+    assert [(b.kind, b.nodes.tolist(), b.tags.tolist()) for b in mesh.cells] == \
+           [("tetra", [[0, 1, 2, 3]], [5]), ("triangle", [[0, 1, 2]], [9])]
+    with OpenCarpMeshWriter(tmp_path / "w", binary=True) as w:
+        w.add(mesh)
+    assert (tmp_path / "w.bpts").read_bytes() == (tmp_path / "m.bpts").read_bytes()
+    assert (tmp_path / "w.belem").read_bytes() == (tmp_path / "m.belem").read_bytes()
+
+
+@pytest.mark.parametrize("files, message", [
+    ({"m.pts": "3\n0 0 0\n1 1 1\n", "m.elem": "0\n"}, "says 3 entries but has 2 lines"),
+    ({"m.pts": "1\n0 0 x\n", "m.elem": "0\n"}, "expected x y z"),
+    ({"m.pts": "1\n0 0 0\n", "m.elem": "1\nZz 0 0 0\n"}, "unknown element type 'Zz'"),
+    ({"m.pts": "1\n0 0 0\n", "m.elem": "1\nTr 0 0 5\n"}, "node index outside 0..0"),
+    ({"m.pts": "1\n0 0 0\n", "m.elem": "1\nTr 0 0\n"}, "Tr needs 3 node indices"),
+])
+def test_bad_opencarp_files_are_input_errors(tmp_path, files, message):
+    for name, text in files.items():
+        (tmp_path / name).write_text(text)
+    with pytest.raises(InputError) as err:
+        OpenCarpMeshReader(tmp_path / "m.pts").read()
+    assert message in err.value.message and err.value.line is not None
+
+
+def test_truncated_binary_mesh(tmp_path):
+    (tmp_path / "m.bpts").write_bytes(b"4 0 666".ljust(1024, b"\0") + bytes(12 * 3))
+    (tmp_path / "m.belem").write_bytes(b"0 0 666".ljust(1024, b"\0"))
+    with pytest.raises(InputError, match="header says 4 points"):
+        OpenCarpMeshReader(tmp_path / "m").read()
+
+
+def test_vtk_mesh_round_trip(tmp_path):
+    pytest.importorskip("meshio")
+    from fibrelmp.mesh.vtkmesh.mesh import VtkMeshReader, VtkMeshWriter
+
+    mesh = _mesh()
+    for name in ("m.vtu", "m.vtk"):
+        with VtkMeshWriter(tmp_path / name) as w:             # written in metres
+            w.add(mesh)
+        again = VtkMeshReader(tmp_path / name).read()
+        np.testing.assert_allclose(again.points_m, mesh.points_m, rtol=1e-15)
+        assert [(b.kind, b.nodes.tolist(), b.tags.tolist()) for b in again.cells] == \
+               [(b.kind, b.nodes.tolist(), b.tags.tolist()) for b in mesh.cells]
+        with VtkMeshWriter(tmp_path / f"again_{name}") as w:
+            w.add(again)
+        assert VtkMeshReader(tmp_path / f"again_{name}").read().equals(again)
+
+
+@pytest.mark.parametrize("fmt", MESHES, ids=[f.name for f in MESHES])
+def test_every_mesh_format_round_trips(tmp_path, fmt):
+    """Conformance over the registry's mesh formats: written, read, written again, read: equal."""
+    if fmt.name == "vtk-mesh":
+        pytest.importorskip("meshio")
+    hook = fmt.load(registry.MESH)
+    target = tmp_path / ("m" + (fmt.extensions[0] if fmt.name == "vtk-mesh" else ""))
+    with hook.writer(target) as w:
+        w.add(_mesh())
+    first = hook.reader(w.outputs()[0]).read()
+    with hook.writer(tmp_path / ("n" + (fmt.extensions[0] if fmt.name == "vtk-mesh" else ""))) as w2:
+        w2.add(first)
+    assert hook.reader(w2.outputs()[0]).read().equals(first)
+
+
+def test_dynpt_frames_and_header(tmp_path):
+    rng = np.random.default_rng(5)
+    frames = [(rng.random((7, 3)) * 1e3).astype(np.float32).astype(np.float64) for _ in range(4)]
+    with DynptWriter(tmp_path / "move.dynpt", inc_t=2.5, org_t=1.0) as w:
+        for f in frames:
+            w.add(f)
+    data = (tmp_path / "move.dynpt").read_bytes()
+    assert len(data) == HEADER + 4 * 7 * 12 and data[HEADER - 1:HEADER] == b"\f"
+    assert data.startswith(b"x:7 y:1 z:1 t:4 type:vec3f systeme:little_endian ")
+    reader = DynptReader(tmp_path / "move.dynpt")
+    read = list(reader)
+    assert reader.count == len(read) == 4 and reader.nodes == 7       # the header's t
+    assert [f.time for f in read] == [1.0, 3.5, 6.0, 8.5]
+    for a, b in zip(read, frames):
+        assert np.array_equal(a.points, b)
+
+
+def test_dynpt_written_by_another_tool(tmp_path):
+    """A header as meshalyzer writes it (items on CRLF lines, space padding, form feed)."""
+    head = (b"x:2 y:1 z:1 t:3 type:vec3f systeme:little_endian \r\norg_t:0 dim_t:2 inc_t:1 "
+            b"unites_t:ms \r\n")
+    head = head + b" " * (HEADER - len(head) - 1) + b"\f"
+    values = np.arange(18, dtype="<f4")
+    (tmp_path / "a.dynpt").write_bytes(head + values.tobytes())
+    read = list(DynptReader(tmp_path / "a.dynpt"))
+    assert len(read) == 3 and np.array_equal(read[2].points, values[12:].reshape(2, 3))
+
+
+@pytest.mark.parametrize("edit, message", [
+    (lambda d: d[:HEADER + 10], "header says 3 frames"),
+    (lambda d: d.replace(b"vec3f", b"float"), "a .dynpt holds positions"),
+    (lambda d: d.replace(b"t:3", b"t:x"), "integer x, y, z and t"),
+    (lambda d: d[:500], "shorter than the IGB header"),
+])
+def test_bad_dynpt_files(tmp_path, edit, message):
+    good = igb_header(2, 3, 1.0, 0.0, "ms") + np.zeros(18, "<f4").tobytes()
+    (tmp_path / "b.dynpt").write_bytes(edit(good))
+    with pytest.raises(InputError, match=message):
+        list(DynptReader(tmp_path / "b.dynpt"))

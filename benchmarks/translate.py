@@ -6,9 +6,10 @@ temporary folder, then in the same process measures, best of --repeat:
 
   (a) translate = fibrelmp.translate.fibrenet.reader.read(input.txt) +
       fibrelmp.translate.lammps_job.write_job(model, job)
-      (parse the FibreNet input and model, write data.lammps and in.lammps);
-  (b) read_data = LAMMPS executing the ``read_data`` line of that in.lammps (the set-up
-      commands before it are issued first, untimed, in a fresh instance).
+      (parse the FibreNet input and model, write data.lammps, fibrenet_state.txt and in.lammps);
+  (b) read_data = LAMMPS executing the ``read_data`` line of that in.lammps and the commands
+      that load the per-bead state after it (the set-up commands before it are issued first,
+      untimed, in a fresh instance).
 
 Goal: translate / read_data <= 1.0, i.e. fibrelmp's whole translation costs no more than
 LAMMPS reading the file it produces.
@@ -34,14 +35,16 @@ from _common import load_generator  # noqa: E402
 
 
 
-def setup_and_read_data(script: Path) -> tuple[list[str], str]:
-    """The commands of in.lammps before ``read_data`` and the read_data line itself."""
+def setup_and_read_data(script: Path) -> tuple[list[str], list[str]]:
+    """The commands of in.lammps before ``read_data``, and the commands that load the job's
+    files: the read_data line and the per-bead state (atomfile) commands after it."""
     from fibrelmp.lammps_text import input_lines, read_script
 
     lines = [ln.strip() for ln in input_lines(read_script(script), script)]
     lines = [ln for ln in lines if ln and not ln.startswith("#")]
     k = next(i for i, ln in enumerate(lines) if ln.split()[0] == "read_data")
-    return lines[:k], lines[k]
+    end = next((i for i, ln in enumerate(lines) if ln.split() == ["variable", "fn_state", "delete"]), k)
+    return lines[:k], lines[k:end + 1]
 
 
 def time_translate(input_path: Path, job_dir: Path) -> tuple[float, float, object]:
@@ -58,7 +61,7 @@ def time_translate(input_path: Path, job_dir: Path) -> tuple[float, float, objec
     return t1 - t0, t2 - t1, job
 
 
-def time_read_data(job_dir: Path, setup: list[str], read_data: str) -> float:
+def time_read_data(job_dir: Path, setup: list[str], read_data: list[str]) -> float:
     from fibrelmp._lammps import new_lammps
 
     cwd = os.getcwd()
@@ -69,7 +72,8 @@ def time_read_data(job_dir: Path, setup: list[str], read_data: str) -> float:
             lmp.command(ln)
         gc.collect()
         t0 = time.perf_counter()
-        lmp.command(read_data)
+        for ln in read_data:
+            lmp.command(ln)
         return time.perf_counter() - t0
     finally:
         os.chdir(cwd)

@@ -191,6 +191,17 @@ class GranularModel:
         return self.contacts[(min(a, b), max(a, b))]
 
 
+def quat_multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Hamilton product a (x) b of (n,4) w,x,y,z quaternions (a sphere's orientation is its
+    LAMMPS rotation since the start times its initial orientation: the run and ``post`` use
+    this one function, so both give the same bits)."""
+    w1, v1 = a[:, :1], a[:, 1:]
+    w2, v2 = b[:, :1], b[:, 1:]
+    w = w1 * w2 - (v1 * v2).sum(1, keepdims=True)
+    v = w1 * v2 + w2 * v1 + np.cross(v1, v2)
+    return np.hstack([w, v])
+
+
 def hertz_effective(m1: Material, m2: Material) -> tuple[float, float]:
     """MUSEN's mixing (SimplifiedScene::CalculateInteractionProperty): E*, G*."""
     e_star = 1.0 / ((1 - m1.poisson ** 2) / m1.youngs + (1 - m2.poisson ** 2) / m2.youngs)

@@ -83,10 +83,10 @@ class RunResult:
         return iter_frames(self.dumps[simulation])
 
     def universe(self, simulation: int = -1):
-        """The frames as an MDAnalysis ``Universe`` (needs MDAnalysis)."""
-        import MDAnalysis
+        """The frames as an MDAnalysis ``Universe`` (``ts.time`` is the dump's ITEM: TIME)."""
+        from fibrelmp.post.lammps_dump.universe import dump_universe
 
-        return MDAnalysis.Universe(str(self.dumps[simulation]), format="LAMMPSDUMP")
+        return dump_universe(self.dumps[simulation])
 
 
 def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | None = None,

@@ -92,6 +92,7 @@ def execute(commands: list[Command], labels: dict[str, int], where: str = "in.la
     skipped), ``jump SELF L`` continues after ``label L``.  Yields every command (the caller
     sends all but ``label``/``jump`` to LAMMPS, whose ``next`` keeps its own copy in step)."""
     loops: dict[str, list[int]] = {}
+    files: set[str] = set()          # atomfile variables: 'next' reads their next block
     skip_jump = False
     pc = 0
     while pc < len(commands):
@@ -101,6 +102,10 @@ def execute(commands: list[Command], labels: dict[str, int], where: str = "in.la
         if w[0] == "variable" and len(w) >= 4 and w[2] == "loop":
             lo, hi = (1, int(w[3])) if len(w) == 4 or not w[4].isdigit() else (int(w[3]), int(w[4]))
             loops[w[1]] = [lo, hi]
+        elif w[0] == "variable" and len(w) >= 4 and w[2] == "atomfile":
+            files.add(w[1])
+        elif w[0] == "next" and all(name in files for name in w[1:]):
+            pass                     # LAMMPS's own: no loop to follow
         elif w[0] == "next":
             for name in w[1:]:
                 state = loops.get(name)

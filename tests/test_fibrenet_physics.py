@@ -140,8 +140,8 @@ def _dump_frames(job_folder):
         x = np.column_stack([c["x"], c["y"], c["z"]])
         img = np.column_stack([c["ix"], c["iy"], c["iz"]])
         out.append((fr.step, x + img * L,
-                    np.column_stack([c["v_fn_vx"], c["v_fn_vy"], c["v_fn_vz"]]),
-                    np.column_stack([c["v_fn_fx"], c["v_fn_fy"], c["v_fn_fz"]])))
+                    np.column_stack([c["vx"], c["vy"], c["vz"]]),
+                    np.column_stack([c["fx"], c["fy"], c["fz"]])))
     return out
 
 

@@ -72,8 +72,8 @@ def _dump(job_folder):
         xs = np.column_stack([c["x"], c["y"], c["z"]])
         img = np.column_stack([c["ix"], c["iy"], c["iz"]])
         out.append((fr.step, xs + img * (fr.hi - fr.lo),
-                    np.column_stack([c["v_fn_vx"], c["v_fn_vy"], c["v_fn_vz"]]),
-                    np.column_stack([c["v_fn_fx"], c["v_fn_fy"], c["v_fn_fz"]])))
+                    np.column_stack([c["vx"], c["vy"], c["vz"]]),
+                    np.column_stack([c["fx"], c["fy"], c["fz"]])))
     return out
 
 

@@ -14,20 +14,11 @@ from pathlib import Path
 
 import numpy as np
 
-from fibrelmp.granmodel import GranularFrame, GranularModel
+from fibrelmp.granmodel import GranularFrame, GranularModel, quat_multiply
 from fibrelmp.pipeline.run import wrong_frame
 from fibrelmp.post.lammps_dump.reader import iter_frames
 from fibrelmp.translate.granular_job import GranularJob
 from fibrelmp.translate.granular.geometry import nearest_triangle
-
-
-def quat_multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Hamilton product a (x) b of (n,4) w,x,y,z quaternions."""
-    w1, v1 = a[:, :1], a[:, 1:]
-    w2, v2 = b[:, :1], b[:, 1:]
-    w = w1 * w2 - (v1 * v2).sum(1, keepdims=True)
-    v = w1 * v2 + w2 * v1 + np.cross(v1, v2)
-    return np.hstack([w, v])
 
 
 class _BreakLog:
@@ -138,7 +129,7 @@ class FrameBuilder:
         vel = np.column_stack([c["vx"], c["vy"], c["vz"]])
         omega = np.column_stack([c["omegax"], c["omegay"], c["omegaz"]])
         force = np.column_stack([c["fx"], c["fy"], c["fz"]])
-        ql = np.column_stack([c[f"c_fl_quat[{k}]"] for k in range(1, 5)])
+        ql = np.column_stack([c["quatw"], c["quati"], c["quatj"], c["quatk"]])
         quat = quat_multiply(ql, self.q0[rows])
 
         # spheres gone since the previous frame: activity end (exact) or domain exit (estimate)

@@ -50,6 +50,11 @@ class Rendered:
         return Path(self.job.data)
 
     @property
+    def inputs(self) -> list[Path]:
+        """The files the script reads (the data file, a state file): hashed by checkpoints."""
+        return [Path(p) for p in getattr(self.job, "inputs", [self.job.data])]
+
+    @property
     def total_steps(self) -> int:
         return int(self.job.total_steps)
 

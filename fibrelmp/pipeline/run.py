@@ -84,7 +84,7 @@ def simulate(request: RunRequest, options: RunOptions, rank: int = 0,
     # a cmusen script resumes the simulation that was interrupted; finished ones run again
     resume = options.resume and (rendered.folder / STATE).exists()
     checkpoints = prepare_checkpoints(rendered.folder, rendered.text, options.checkpoint_every,
-                                      resume, [p.name for p in rendered.dumps], rank, [rendered.data])
+                                      resume, [p.name for p in rendered.dumps], rank, rendered.inputs)
     if rank == 0 and not resume:
         for dump in rendered.dumps:
             dump.unlink(missing_ok=True)

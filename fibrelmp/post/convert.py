@@ -113,6 +113,13 @@ def _convert(reader, target: DumpTarget, dump: Path, data: Path | None, types: l
     if data is not None:
         from fibrelmp.post.lammps_data.reader import read_data
         context.datafile = read_data(data)
+    else:
+        from fibrelmp.translate.work_facts import facts_path
+
+        beside = dump.parent / "data.lammps"
+        if facts_path(beside).is_file():
+            context.warn("work folder", f"{dump} is a fibrelmp job's dump: give --data {beside} "
+                         "for the run's names, ids and exact times (docs/post.md)")
     known: dict[int, str] = dict(context.datafile.type_names) if context.datafile else {}
     context.type_names = TypeNames(known, reader.type_names)    # labels met later join ``known``
     complete = Completer(context.datafile, types, known, context.warnings, target.units)

@@ -66,6 +66,11 @@ class PostContext:
     warnings: list[tuple[str, str]] = field(default_factory=list)
     precision: int | None = None                   # --precision (targets that take it)
 
+    @property
+    def facts(self):
+        """The job facts of a fibrelmp work folder's data file (``translate.work_facts``), or None."""
+        return getattr(self.datafile, "facts", None)
+
     def warn(self, kind: str, text: str) -> None:
         """One warning per kind."""
         if kind not in {k for k, _ in self.warnings}:
@@ -150,7 +155,19 @@ class DumpTarget(Writer):
         self.end()
 
     def time_of(self, frame: Frame) -> float:
-        """The frame's time (ITEM: TIME), else its step, with a warning."""
+        """The frame's time: as the run computed it when ``--data`` has fibrelmp's job facts
+        (``ITEM: TIME`` is LAMMPS's running sum, printed with 16 digits), else ITEM: TIME,
+        else its step, with a warning."""
+        facts = self.context.facts
+        if facts is not None:
+            exact = facts.time(frame.step)
+            scale = max(abs(exact), abs(facts.time_step) * max(1, abs(frame.step)))
+            if frame.time is None or abs(frame.time - exact) <= 1e-9 * scale:
+                return exact
+            self.context.warn("data facts", f"{facts.path}: the job's times (start "
+                              f"{facts.time_start!r}, {facts.time_step!r} per step) do not match the "
+                              f"dump's ITEM: TIME ({frame.time!r} at step {frame.step}): is --data from "
+                              "another run? the dump's times are used")
         if frame.time is not None:
             return frame.time
         self.context.warn("no times", f"{frame.source}: no ITEM: TIME in the dump (dump_modify time "

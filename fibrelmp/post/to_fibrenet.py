@@ -156,14 +156,19 @@ def write_fibrenet(frames: Iterable[Frame], basename: str, folder: Path, fields:
 
 
 def dt_from(first: list[Frame], warn: Callable[[str, str], None]) -> float:
-    """The MD time step for FibreNet's FRAME lines: from ITEM: TIME values when present."""
+    """The MD time step for FibreNet's FRAME lines: from ITEM: TIME values when present
+    (rounded to 15 digits: LAMMPS's time is a running sum, printed with 16)."""
     for f in first:
         if f.time is not None and f.step:
-            return f.time / f.step
+            return _clean(f.time / f.step)
     if len(first) == 2 and all(f.time is not None for f in first) and first[1].step != first[0].step:
-        return (first[1].time - first[0].time) / (first[1].step - first[0].step)
+        return _clean((first[1].time - first[0].time) / (first[1].step - first[0].step))
     warn("no time step", "the dump does not give the time step (no ITEM: TIME); FRAME lines carry dt 0")
     return 0.0
+
+
+def _clean(dt: float) -> float:
+    return float(f"{dt:.15g}")
 
 
 class _FibreNetTarget(DumpTarget):
@@ -177,9 +182,19 @@ class _FibreNetTarget(DumpTarget):
         return ()
 
     def start(self, first: list[Frame]) -> None:
+        """With fibrelmp's job facts (``--data`` of a FibreNet work folder) the files are the
+        run's: its time step, box lengths, output_type and output_data."""
         ctx = self.context
+        facts = ctx.facts if ctx.facts is not None and ctx.facts.kind == "fibrenet" else None
         fields = self.fields(first[0])
-        self.convert = FibreNetFrames(fields, ctx.type_names, dt_from(first, ctx.warn), self.restart)
+        if facts is None:
+            self.convert = FibreNetFrames(fields, ctx.type_names, dt_from(first, ctx.warn), self.restart)
+        else:
+            if facts.output_fields is not None and not self.restart:
+                fields = tuple(f for f in fields if f in facts.output_fields)
+            only = None if facts.output_types is None else set(facts.output_types)
+            self.convert = FibreNetFrames(fields, ctx.type_names, facts.time_step, self.restart,
+                                          facts.box_lengths, only, ctx.warn)
         self.out = self.adopt(FibreNetWriter(self.target, fields, self.restart))
 
     def write_frame(self, frame: Frame) -> None:

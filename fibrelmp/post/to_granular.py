@@ -5,10 +5,18 @@ The model is built from the first frame (plus ``--data`` facts): one sphere per 
 one material per atom type.  A dump says nothing about materials or contact laws, so the
 MUSEN result carries materials with only a density (from mass and radius when both are
 known) and the DEMDF document only object types with radius and mass.
+
+The data file of a fibrelmp work folder has the job's facts beside it
+(``translate.work_facts``): with them the spheres are the run's -- MUSEN object ids, material
+keys and names, orientations (the dump's LAMMPS rotation times the initial orientation, as
+the run composes them), sphere radii, exact times -- and a DEMDF snapshot repeats the run's
+document.  What no dump holds (walls, bonds, material properties, interactions) is still
+missing from a MUSEN result (docs/post.md).
 """
 
 from __future__ import annotations
 
+import copy
 import math
 from pathlib import Path
 from typing import ClassVar, Mapping
@@ -17,9 +25,10 @@ import numpy as np
 
 from fibrelmp.errors import InputError
 from fibrelmp.formatbase import Writer
-from fibrelmp.granmodel import GranularFrame, GranularModel, GranularPlan, Material, Spheres
+from fibrelmp.granmodel import GranularFrame, GranularModel, GranularPlan, Material, Spheres, quat_multiply
 from fibrelmp.post.lammps_dump.reader import Frame
 from fibrelmp.post.target import DumpTarget, ReadBack
+from fibrelmp.translate.work_facts import WorkFacts
 from fibrelmp.units import SI
 
 
@@ -27,17 +36,39 @@ def _vector(frame: Frame, names: tuple[str, str, str], n: int) -> np.ndarray:
     return frame.vector(*names) if frame.has(*names) else np.zeros((n, 3))
 
 
+def _per_atom(facts: WorkFacts, name: str, ids: np.ndarray) -> np.ndarray | None:
+    """The facts' per-atom array ``name`` for the atom ids of a frame (None: not given)."""
+    values = getattr(facts, name)
+    if values is None:
+        return None
+    if len(ids) and (ids.min() < 1 or ids.max() > len(values)):
+        raise InputError(facts.path, None, f"atom id {int(ids.max())} of the dump is not in the "
+                         f"job's facts ({len(values)} atoms): is --data from another run?")
+    return values[ids - 1]
+
+
 def model_from_frame(first: Frame, source: Path, names: Mapping[int, str], kind: str,
-                     time: float, dt: float, keep_ids: bool = True) -> GranularModel:
+                     time: float, dt: float, keep_ids: bool = True,
+                     facts: WorkFacts | None = None) -> GranularModel:
     """The scene of the first frame; ``keep_ids``: the atoms' ids become the spheres' ids
-    (else 0..n-1, for formats whose particles have no ids)."""
+    (else 0..n-1, for formats whose particles have no ids); ``facts``: the job's facts (their
+    MUSEN ids, keys, sphere radii and initial orientations)."""
     n = first.count
     if not first.has("radius"):
         raise InputError(source, first.line, f"--to {kind} needs sphere radii: the dump has no "
                          "'radius' (or 'diameter') column; add it to the dump or give --data")
     ids = first.column("id").astype(np.int64)
     types = first.column("type").astype(np.int64)
-    radius = first.column("radius").astype(np.float64)
+    contact = first.column("radius").astype(np.float64)
+    radius = contact
+    keys: dict[int, str] = {}
+    object_ids = ids
+    if facts is not None:
+        radius = _per_atom(facts, "radius", ids)
+        radius = contact if radius is None else radius
+        keys = facts.material_keys or {}
+        given = _per_atom(facts, "object_ids", ids)
+        object_ids = ids if given is None else given
     mass = first.column("mass").astype(np.float64) if first.has("mass") else np.full(n, np.nan)
     tlist = sorted(set(types.tolist()))
     mat_of_type = {t: k for k, t in enumerate(tlist)}
@@ -47,17 +78,17 @@ def model_from_frame(first: Frame, source: Path, names: Mapping[int, str], kind:
         vol = 4.0 / 3.0 * math.pi * radius[rows] ** 3
         rho = float(np.mean(mass[rows] / vol)) if np.isfinite(mass[rows]).all() else float("nan")
         name = names.get(t, f"type{t}")
-        mat = Material(key=f"LAMMPS_TYPE_{t}", name=name.replace(" ", "_"), density=rho)
+        mat = Material(key=keys.get(t, f"LAMMPS_TYPE_{t}"), name=name.replace(" ", "_"), density=rho)
         if math.isfinite(rho):
             mat.props[0] = rho
         materials.append(mat)
     x = first.wrapped()
-    spheres = Spheres(ids=ids if keep_ids else np.arange(n), material=np.array([mat_of_type[t] for t in types]),
-                      radius=radius, contact_radius=radius.copy(), mass=mass, position=x,
+    spheres = Spheres(ids=object_ids if keep_ids else np.arange(n),
+                      material=np.array([mat_of_type[t] for t in types]),
+                      radius=radius, contact_radius=contact.copy(), mass=mass, position=x,
                       velocity=_vector(first, ("vx", "vy", "vz"), n),
                       omega=_vector(first, ("omegax", "omegay", "omegaz"), n),
-                      quaternion=first.vector("quatw", "quati", "quatj", "quatk") if first.has("quatw", "quati", "quatj", "quatk")
-                      else np.tile([1.0, 0.0, 0.0, 0.0], (n, 1)),
+                      quaternion=_orientation(first, facts),
                       active_start=np.full(n, time), active_end=np.full(n, np.inf))
     plan = GranularPlan(dt=dt, t_start=time, t_end=time,
                         domain=(first.lo.copy(), first.hi.copy()),
@@ -68,7 +99,18 @@ def model_from_frame(first: Frame, source: Path, names: Mapping[int, str], kind:
     return model
 
 
-def granular_frame(frame: Frame, time: float, model: GranularModel) -> GranularFrame:
+def _orientation(frame: Frame, facts: WorkFacts | None) -> np.ndarray:
+    """(n, 4) orientations: the dump's quatw..quatk (identity without them), times the
+    initial orientations of the job's facts (a LAMMPS sphere starts at the identity)."""
+    n = frame.count
+    q = (frame.vector("quatw", "quati", "quatj", "quatk") if frame.has("quatw", "quati", "quatj", "quatk")
+         else np.tile([1.0, 0.0, 0.0, 0.0], (n, 1)))
+    q0 = None if facts is None else _per_atom(facts, "orientation", frame.column("id").astype(np.int64))
+    return q if q0 is None else quat_multiply(q, q0)
+
+
+def granular_frame(frame: Frame, time: float, model: GranularModel,
+                   facts: WorkFacts | None = None) -> GranularFrame:
     """A dump frame as a GranularFrame; atoms missing from it count as removed, atoms the
     first frame did not have are an error (a model cannot grow)."""
     ids = model.passthrough["atom_ids"]
@@ -82,12 +124,11 @@ def granular_frame(frame: Frame, time: float, model: GranularModel) -> GranularF
         raise InputError(frame.source, frame.line, f"atom {new} appears after the first frame: "
                          "MUSEN/DEMDF results need every object present from the start")
     n = frame.count
-    quat = (frame.vector("quatw", "quati", "quatj", "quatk") if frame.has("quatw", "quati", "quatj", "quatk")
-            else np.tile([1.0, 0.0, 0.0, 0.0], (n, 1)))
     return GranularFrame(time=time, step=frame.step, sphere_rows=rows, position=frame.wrapped(),
                          velocity=_vector(frame, ("vx", "vy", "vz"), n),
                          omega=_vector(frame, ("omegax", "omegay", "omegaz"), n),
-                         force=_vector(frame, ("fx", "fy", "fz"), n), quaternion=quat)
+                         force=_vector(frame, ("fx", "fy", "fz"), n),
+                         quaternion=_orientation(frame, facts))
 
 
 def demdf_document(model: GranularModel, filename: str) -> dict:
@@ -124,15 +165,18 @@ class _GranularTarget(DumpTarget):
     def start(self, first: list[Frame]) -> None:
         times = [self.time_of(f) for f in first]
         dt = times[1] - times[0] if len(times) > 1 else 1.0
+        facts = self.context.facts
+        # a MUSEN result from a DEMDF job (or back) takes the names only
+        self.facts = facts if facts is not None and facts.kind == self.kind else None
         self.model = model_from_frame(first[0], Path(self.context.source), self.context.type_names,
-                                      self.kind, times[0], dt, self.keeps_ids)
+                                      self.kind, times[0], dt, self.keeps_ids, self.facts)
         self.out = self.adopt(self.result_writer(self.model, dt))
 
     def result_writer(self, model: GranularModel, dt: float) -> Writer:
         raise NotImplementedError
 
     def write_frame(self, frame: Frame) -> None:
-        self.out.add(granular_frame(frame, self.time_of(frame), self.model))
+        self.out.add(granular_frame(frame, self.time_of(frame), self.model, self.facts))
 
     def end(self) -> None:
         if self.count:
@@ -211,12 +255,22 @@ class DemdfTarget(_GranularTarget):
         from fibrelmp.translate.demdf.writer import DemdfSnapshotWriter
 
         name = self.target.name
-        model.passthrough["demdf"] = {
-            "document": demdf_document(model, name), "dimensionality": 3,
-            "particle_rows": [[0.0] * 6 + [int(t)] for t in model.spheres.material],
-            "particles_file": None, "output_location": ("output", "snapshot"),
-            "filename": name, "save_count": 0, "file_time_step": dt, "substeps": 1,
-            "time_step_count": 0}
+        demdf = self.facts.demdf if self.facts is not None else None
+        if demdf is not None and len(demdf["particle_rows"]) != model.spheres.count:
+            self.context.warn("data facts", f"{self.facts.path}: the job's document has "
+                              f"{len(demdf['particle_rows'])} particles, the dump's first frame "
+                              f"{model.spheres.count}; the snapshots describe the dump's particles only")
+            demdf = None
+        if demdf is not None:
+            # the run's document, counters and object types (the rows' last entry)
+            model.passthrough["demdf"] = {**copy.deepcopy(demdf), "filename": name}
+        else:
+            model.passthrough["demdf"] = {
+                "document": demdf_document(model, name), "dimensionality": 3,
+                "particle_rows": [[0.0] * 6 + [int(t)] for t in model.spheres.material],
+                "particles_file": None, "output_location": ("output", "snapshot"),
+                "filename": name, "save_count": 0, "file_time_step": dt, "substeps": 1,
+                "time_step_count": 0}
         return DemdfSnapshotWriter(model, self.target.parent)
 
     @classmethod

@@ -20,7 +20,7 @@ from fibrelmp.granmodel import GranularModel
 from fibrelmp import lammps_styles
 from fibrelmp.lammps_text import lammps_path, template_environment
 from fibrelmp.textio import atomic_write
-from fibrelmp.translate.granular.bonds import (GEOMETRY_FIX, GEOMETRY_SECTION, PARTNERS, VALUES,
+from fibrelmp.translate.granular.bonds import (GEOMETRY_FIX, GEOMETRY_NAME, PARTNERS, VALUES,
                                               bond_geometry, select_bonds)
 from fibrelmp.translate.granular.box import box_axes, box_commands, domain_bounds, fit_box, periodic_axes
 from fibrelmp.translate.granular.contacts import (STOCK_PAIR_WARNING, law_args, pair_coeff_lines,
@@ -35,6 +35,7 @@ from fibrelmp.translate.granular.walls import (WallPlan, describe_walls, plan_wa
                                                wall_warnings)
 from fibrelmp.translate.lammps_format import float_text
 from fibrelmp.translate.steps import SaveSteps
+from fibrelmp.translate.work_facts import WorkFacts, write_facts
 
 __all__ = ["BONDS_NAME", "BREAKS_NAME", "DATA_NAME", "FRAMES_NAME", "SCRIPT_NAME", "TILES_NAME",
            "GranularJob", "WallPlan", "build_granular_job", "describe_walls", "law_args", "plan_walls",
@@ -75,6 +76,12 @@ class GranularJob:
     warnings: list[tuple[str, str]] = field(default_factory=list)
     wall_forces: Path | None = None  # fix musen/wall/mesh: per-triangle forces per frame
     mesh_rows: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))   # model row of each
+    geometry: Path | None = None     # per-atom bond geometry (musen/elastic), beside the data file
+
+    @property
+    def inputs(self) -> list[Path]:
+        """The files the script reads (a checkpoint is refused when one changed)."""
+        return [self.data] + ([self.geometry] if self.geometry is not None else [])
 
 
 def write_granular_job(model: GranularModel, folder: str | Path) -> GranularJob:
@@ -91,6 +98,25 @@ def write_granular_job(model: GranularModel, folder: str | Path) -> GranularJob:
         if (kind, message) not in model.warnings:
             model.warn(kind, message)
     return job
+
+
+def job_facts(model: GranularModel, spheres, tiles, t_start: float, dt: float) -> WorkFacts:
+    """What ``fibrelmp post --data`` needs beyond the data file and dump to write the spheres
+    as the run does (translate.work_facts): names, MUSEN keys and ids, initial orientations,
+    the DEMDF document."""
+    sp = model.spheres
+    types = {**spheres.type_of_mat, **tiles.type_of_mat}          # material -> LAMMPS type
+    q = np.asarray(sp.quaternion, float)
+    identity = bool((q == np.array([1.0, 0.0, 0.0, 0.0])).all()) if len(q) else True
+    demdf = model.passthrough.get("demdf")
+    return WorkFacts(
+        kind=model.kind, source=model.source.name, time_start=t_start, time_step=dt,
+        type_names={t: model.materials[m].name for m, t in types.items()},
+        material_keys={t: model.materials[m].key for m, t in types.items()},
+        object_ids=np.asarray(sp.ids, np.int64) if model.kind == "musen" else None,
+        orientation=None if identity else q,
+        radius=None if np.array_equal(spheres.crad, sp.radius) else np.asarray(sp.radius, float),
+        demdf=demdf)
 
 
 def build_granular_job(model: GranularModel, folder: str | Path):
@@ -141,6 +167,7 @@ def build_granular_job(model: GranularModel, folder: str | Path):
                    bonds.rows, bonds.type, len(bonds.types), geometry)
         if len(mesh):
             write_mesh(model, wall_plans, spheres, folder / MESH_NAME)
+        write_facts(data_path, job_facts(model, spheres, tiles, t_start, dt))
 
     # ---- script
     saves = save_steps(model, total, dt)
@@ -165,7 +192,7 @@ def build_granular_job(model: GranularModel, folder: str | Path):
         comm_cut=comm_cut, skin=skin, musen_hm=musen_hm, pair_lines=pair_lines, has_bonds=has_bonds,
         overlay=bool(plan.contacts_between_bonded), breakage=breakage, bond_types=bonds.types,
         musen_bonds=geometry is not None, bond_geometry=geometry, bond_partners=PARTNERS,
-        bond_values=VALUES, geometry_fix=GEOMETRY_FIX, geometry_section=GEOMETRY_SECTION,
+        bond_values=VALUES, geometry_fix=GEOMETRY_FIX, geometry_name=GEOMETRY_NAME,
         bond_criterion=int(plan.bond_breakage), bond_model=plan.bond_model,
         bond_max_damp_ratio=plan.bond_max_damp_ratio,
         sphere_types=[spheres.type_of_mat[m] for m in mats],
@@ -190,5 +217,6 @@ def build_granular_job(model: GranularModel, folder: str | Path):
         sphere_rows=rows, outside_rows=spheres.outside_rows, late_rows=spheres.late_rows,
         bond_rows=bonds.rows, deletions=spheres.deletions, wall_plans=wall_plans, domain_lo=dom_lo,
         domain_hi=dom_hi, removal_axes=axes.removal_axes, frame_columns=frame_columns, warnings=warnings,
-        wall_forces=folder / MESH_FORCES_NAME if len(mesh) else None, mesh_rows=mesh)
+        wall_forces=folder / MESH_FORCES_NAME if len(mesh) else None, mesh_rows=mesh,
+        geometry=folder / GEOMETRY_NAME if geometry is not None else None)
     return job, script, write_data_file

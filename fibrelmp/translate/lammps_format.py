@@ -1,7 +1,8 @@
 """Numbers and data-file rows as the LAMMPS jobs write them (bead-spring and granular).
 
 ``float_text`` is how every float enters an input script (shortest text that reads back to the
-same double); ``data_rows`` formats the columns of a data-file section.
+same double); ``data_rows`` formats the columns of a data-file section; ``atomfile_blocks``
+writes per-atom values for ``fix property/atom`` that the data file does not hold.
 """
 
 from __future__ import annotations
@@ -29,3 +30,24 @@ def data_rows(fmt_row: str, columns: list[np.ndarray]) -> str:
         if text is not None:
             return text.decode("ascii")
     return format_rows(fmt_row, columns)
+
+
+def atomfile_blocks(ids: np.ndarray, columns: list[tuple[str, np.ndarray]], title: str) -> str:
+    """Per-atom values as consecutive LAMMPS atomfile blocks, one per column (``variable V
+    atomfile FILE``, then ``set group all NAME v_V`` and ``next V`` for each): a comment naming
+    the column, a count and "atom-id value" lines.  A value not listed is 0 to LAMMPS, so only
+    values other than +0.0 are listed, and at least one line, as LAMMPS takes an empty block
+    for the end of the file.  Kept out of the data file, whose custom sections other readers
+    (MDAnalysis, OVITO) cannot skip."""
+    ids = np.asarray(ids, np.int64)
+    parts = ["".join(f"# {line}\n" for line in title.splitlines())]
+    for name, values in columns:
+        values = np.asarray(values)
+        keep = (values != 0) | (np.signbit(values) if values.dtype.kind == "f" else False)
+        if not keep.any():
+            keep = np.zeros(len(values), bool)
+            keep[0] = True
+        parts.append(f"# {name}\n{int(keep.sum())}\n")
+        fmt = "%d %d\n" if values.dtype.kind in "iu" else "%d %.17g\n"
+        parts.append(data_rows(fmt, [ids[keep], values[keep]]))
+    return "".join(parts)

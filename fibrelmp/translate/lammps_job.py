@@ -20,13 +20,20 @@ from fibrelmp.errors import InputError, RunError
 from fibrelmp.lammps_text import comment_text, lammps_path, lammps_token, template_environment
 from fibrelmp.model import Model
 from fibrelmp.textio import atomic_write
-from fibrelmp.translate.lammps_format import data_rows, float_text
+from fibrelmp.translate.lammps_format import atomfile_blocks, data_rows, float_text
 from fibrelmp.translate.steps import SaveSteps
+from fibrelmp.translate.work_facts import WorkFacts, write_facts
 
 SCRIPT_NAME = "in.lammps"
 DATA_NAME = "data.lammps"
 FRAMES_NAME = "frames.dump"
-STATE_SECTION = "FibreNetState"
+# FibreNet's per-bead state (fix fn_state), read by LAMMPS as an atomfile variable: kept out of
+# the data file, whose custom section other readers (MDAnalysis, OVITO) cannot skip
+STATE_NAME = "fibrenet_state.txt"
+STATE_COLUMNS = ("d_fox", "d_foy", "d_foz", "d_vtx", "d_vty", "d_vtz")
+# the work dump's columns named as LAMMPS names them (velocity and force are FibreNet's)
+DUMP_NAMES = {"v_fn_vx": "vx", "v_fn_vy": "vy", "v_fn_vz": "vz", "v_fn_fx": "fx", "v_fn_fy": "fy",
+              "v_fn_fz": "fz", "v_fn_radius": "radius", "v_fn_mass": "mass"}
 OUTPUT_FIX = "fn_out"                  # fix fibrenet/output (fibrelmp's plugin)
 NATIVE_KIND = "FibreNet files after the run"
 
@@ -49,6 +56,12 @@ class Job:
     output_steps: SaveSteps | tuple = ()   # the steps of the frames (lazy)
     text: str = ""                        # the script, also when only rank 0 wrote files
     native: NativeFiles | None = None     # FibreNet's files written by LAMMPS (the plugin)
+    state: Path | None = None             # the per-bead state file (STATE_NAME)
+
+    @property
+    def inputs(self) -> list[Path]:
+        """The files the script reads (a checkpoint is refused when one changed)."""
+        return [self.data] + ([self.state] if self.state is not None else [])
 
 
 def _factorize(col: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -287,16 +300,21 @@ def write_job(model: Model, folder: str | Path, write_files: bool = True) -> Job
         model.warn(STOCK_ANGLES, stock_angle_warning(styles.how))
 
     data_path = folder / DATA_NAME
+    state_path = folder / STATE_NAME if p.count else None
     if write_files:
         _write_data(model, bonds, data_path, ltypes, atype, btypes, btype, atypes, antype, use_mvv)
+        if state_path is not None:
+            _write_state(model, state_path)
+        write_facts(data_path, _facts(model, type_names))
     script = template_environment().get_template("bead_spring.lammps.j2").render(
         model=model, dyn=dyn, box=box, fmt=float_text, use_mvv=use_mvv,
         frozen_types=frozen_types, mobile_types=mobile_types,
         bond_types=btypes, angle_types=atypes, pair_lines=pair_lines, pair_styles=pair_styles,
         max_cut=max(max_cut, 1e-6), skin=skin, comm_cut=comm_cut, acts=acts,
         general_lambda=general_lambda, data_name=DATA_NAME, frames_name=FRAMES_NAME,
-        state_section=STATE_SECTION, wall_pad=float(box.lengths.max()),
-        type_names=type_names,
+        state_name=STATE_NAME if state_path is not None else None, state_columns=STATE_COLUMNS,
+        wall_pad=float(box.lengths.max()), type_names=type_names,
+        radius_expression=_per_type_expression(ltypes[:, 2]), dump_names=DUMP_NAMES,
         rad2deg=180.0 / math.pi, inf=float("inf"), angle_expression=angle_expression,
         extra_packages=_extra_packages(pair_styles, btypes, use_mvv),
         plugin=lammps_path(styles.path, "plugin") if styles.path else None, native=native,
@@ -306,7 +324,39 @@ def write_job(model: Model, folder: str | Path, write_files: bool = True) -> Job
         atomic_write(script_path, script)
     type_of_ltype = np.r_[-1, ltypes[:, 0].astype(np.int64)]
     return Job(folder, script_path, data_path, folder / FRAMES_NAME, total, type_of_ltype, out_steps,
-               text=script, native=native_files)
+               text=script, native=native_files, state=state_path)
+
+
+def _per_type_expression(values: np.ndarray) -> str:
+    """An atom-style variable formula giving each LAMMPS type its value (1-based types)."""
+    return "+".join(f"{float_text(v)}*(type=={t})" for t, v in enumerate(values, 1)) or "0.0"
+
+
+def _facts(model: Model, type_names: list[str]) -> WorkFacts:
+    """What ``fibrelmp post --data`` needs beyond the data file to write FibreNet's files
+    exactly as the run does (translate.work_facts)."""
+    spec = model.plan.output
+    only = None if spec.types is None else sorted({model.particles.type_names[t] for t in spec.types})
+    return WorkFacts(kind="fibrenet", source=model.source.name, time_start=0.0,
+                     time_step=model.dynamics.dt,
+                     type_names={k: name for k, name in enumerate(type_names, 1)},
+                     box_lengths=np.asarray(model.box.lengths, float), output_types=only,
+                     output_fields=list(spec.fields))
+
+
+def _write_state(model: Model, path: Path) -> None:
+    """FibreNet's state of each bead (the force of the last step, the lambda-predicted
+    velocity): the values of fix fn_state's columns, as atomfile blocks."""
+    p = model.particles
+    n = p.count
+    f0 = p.initial_forces if p.initial_forces is not None else np.zeros((n, 3))
+    vt = p.display_velocities if p.display_velocities is not None else p.velocities
+    values = [f0[:, 0], f0[:, 1], f0[:, 2], vt[:, 0], vt[:, 1], vt[:, 2]]
+    title = ("fibrelmp: FibreNet's per-bead state (fix fn_state), read by in.lammps as 'variable\n"
+             "fn_state atomfile': a block per column (a count, then 'atom-id value' lines); beads\n"
+             "not listed are 0")
+    atomic_write(path, atomfile_blocks(np.arange(1, n + 1), [
+        (name, np.asarray(v, np.float64)) for name, v in zip(STATE_COLUMNS, values)], title))
 
 
 def _native_output(model: Model, folder: Path, type_names: list[str],
@@ -416,7 +466,7 @@ def _write_data(model: Model, bonds, path: Path, ltypes, atype, btypes, btype, a
     # unwrapped coordinates: read_data wraps them into periodic boxes and sets image flags
     cols = [ids, p.molecules, atype + 1, x[:, 0], x[:, 1], x[:, 2]]
     if use_mvv:
-        parts.append("\nAtoms # hybrid\n\n")
+        parts.append("\nAtoms # hybrid angle mdpd\n\n")
         parts.append(data_rows("%d %d %.17g %.17g %.17g %d 0\n", [ids, atype + 1, x[:, 0], x[:, 1], x[:, 2], p.molecules]))
     else:
         parts.append("\nAtoms # angle\n\n")
@@ -432,9 +482,4 @@ def _write_data(model: Model, bonds, path: Path, ltypes, atype, btypes, btype, a
         a = model.angles.atoms + 1
         parts.append("\nAngles\n\n")
         parts.append(data_rows("%d %d %d %d %d\n", [np.arange(1, len(a) + 1), antype + 1, a[:, 0], a[:, 1], a[:, 2]]))
-    f0 = p.initial_forces if p.initial_forces is not None else np.zeros((n, 3))
-    vt = p.display_velocities if p.display_velocities is not None else p.velocities
-    parts.append(f"\n{STATE_SECTION}\n\n")
-    parts.append(data_rows("%d %.17g %.17g %.17g %.17g %.17g %.17g\n",
-                        [ids, f0[:, 0], f0[:, 1], f0[:, 2], vt[:, 0], vt[:, 1], vt[:, 2]]))
     atomic_write(path, "".join(parts))

@@ -3,7 +3,10 @@
 Gives, by atom id: type, radius, mass and molecule; per type: name and mass; the bond
 list.  Type names come from an ``Atom Type Labels`` section, else from the first word of
 the comment on each ``Masses`` line (fibrelmp writes ``1 1.0  # F1 m=1 R=0.42``; VMD and
-moltemplate write similar comments), else the type number.
+moltemplate write similar comments), else the type number.  A data file fibrelmp wrote for a
+job has its ``data.fibrelmp.json`` beside it (``translate.work_facts``): the source's exact
+names, MUSEN object ids and initial orientations, the run's exact times; ``facts`` holds them,
+and its names win.
 """
 
 from __future__ import annotations
@@ -16,6 +19,7 @@ import numpy as np
 
 from fibrelmp.errors import InputError
 from fibrelmp.textio import integer_column, parse_table, read_text
+from fibrelmp.translate.work_facts import WorkFacts, read_facts
 
 SECTIONS = {
     "Atoms", "Velocities", "Masses", "Ellipsoids", "Lines", "Triangles", "Bodies", "Bonds",
@@ -42,7 +46,7 @@ STYLE_COLUMNS = {
 HYBRID_FIELDS = {
     "atomic": [], "charge": ["q"], "bond": ["mol"], "angle": ["mol"], "molecular": ["mol"],
     "full": ["mol", "q"], "sphere": ["diameter", "density"], "bpm/sphere": ["mol", "diameter", "density"],
-    "ellipsoid": ["ellipsoidflag", "density"],
+    "ellipsoid": ["ellipsoidflag", "density"], "mdpd": ["rho"],
 }
 
 
@@ -62,6 +66,7 @@ class DataFile:
     tilt: np.ndarray | None = None
     atom_style: str = ""
     notes: list[str] = field(default_factory=list)
+    facts: WorkFacts | None = None        # fibrelmp's job facts (data.fibrelmp.json), if any
 
     def rows(self, ids: np.ndarray, what: str) -> np.ndarray:
         """Row of each id in this file's arrays; an InputError names an id it lacks."""
@@ -198,8 +203,11 @@ def read_data(path: str | Path) -> DataFile:
         btab, bval = parse_table([r.partition("#")[0] for r in brows], bnum, 4, path, "Bonds")
         bonds = np.column_stack([integer_column(bval, btab, 2, path, bnum, "Bonds"),
                                  integer_column(bval, btab, 3, path, bnum, "Bonds")])
+    facts = read_facts(path)
+    if facts is not None:
+        type_names.update(facts.type_names)
     return DataFile(path, ids, types, mol, radius, mass, type_names, type_masses, bonds, lo, hi,
-                    tilt, style)
+                    tilt, style, facts=facts)
 
 
 def _style_columns(path: Path, line: int, comment: str, rows: list[str]) -> tuple[str, list[str]]:

@@ -4,8 +4,8 @@ their LAMMPS bond types.
 With fibrelmp's LAMMPS styles (``exact``): ``bond_style musen/elastic``, MUSEN's elastic or
 Kelvin bond and its breakage criteria; one bond type per bond material (E, G, strengths,
 viscosity) and each bond's own diameter, initial length and initial tangential overlap in
-per-atom arrays (``fix property/atom``, a ``BondGeometry`` section of the data file) on the
-atom that stores it, the bond's first (MUSEN "left") sphere.
+per-atom arrays (``fix property/atom``, set from the atomfile ``bond_geometry.txt`` beside the
+data file) on the atom that stores it, the bond's first (MUSEN "left") sphere.
 
 Without them: stock ``bond_style bpm/rotational`` coefficients, one type per material and
 binned diameter and initial length, an approximation of MUSEN's law that says so.
@@ -25,7 +25,7 @@ from fibrelmp.translate.granular.schedule import RunTime
 
 BOND_BIN_RTOL = 1e-3        # stock bond types: diameter and L0 binned to 0.1 % (log bins)
 BIG = 1e300                 # "never breaks"
-GEOMETRY_SECTION = "BondGeometry"    # data-file sections BondGeometry1..K: per-atom bond geometry
+GEOMETRY_NAME = "bond_geometry.txt"  # per-atom bond geometry (LAMMPS atomfile blocks)
 GEOMETRY_FIX = "fl_bgeom"           # their fix property/atom IDs fl_bgeom1..K
 PARTNERS, VALUES = "fl_bp", "fl_bv"  # their per-atom values i_fl_bpk, d2_fl_bvk
 
@@ -34,9 +34,8 @@ PARTNERS, VALUES = "fl_bp", "fl_bv"  # their per-atom values i_fl_bpk, d2_fl_bvk
 class BondGeometry:
     """Per-atom slots for ``musen/elastic geometry``: for each LAMMPS atom (row of the data
     file's atoms, in order) the partner ids of up to K bonds it stores (0: none) and, for
-    each, d, L0 [and the initial tangential overlap, 3].  One ``fix property/atom`` and one
-    data-file section per slot: read_data cuts lines at 256 characters, so a whole atom's
-    bonds cannot be one line."""
+    each, d, L0 [and the initial tangential overlap, 3].  One ``fix property/atom`` per slot
+    (the slots were data-file sections once, whose lines read_data cuts at 256 characters)."""
     partners: np.ndarray             # (natoms, K) int
     values: np.ndarray               # (natoms, K, width)
     width: int                       # 2 (d L0) or 5 (d L0 overlap)

@@ -1,5 +1,7 @@
 """The data file of a granular job: spheres and wall particles (atom style bpm/sphere), their
-velocities, and the solid bonds."""
+velocities, and the solid bonds; the per-atom bond geometry of fibrelmp's bond style goes
+beside it (``bond_geometry.txt``, LAMMPS atomfile blocks), so the data file stays one every
+reader of data files reads."""
 
 from __future__ import annotations
 
@@ -10,16 +12,16 @@ import numpy as np
 
 from fibrelmp.lammps_text import comment_text
 from fibrelmp.textio import atomic_write
-from fibrelmp.translate.granular.bonds import GEOMETRY_SECTION
-from fibrelmp.translate.lammps_format import data_rows, float_text
+from fibrelmp.translate.granular.bonds import GEOMETRY_NAME, PARTNERS, VALUES
+from fibrelmp.translate.lammps_format import atomfile_blocks, data_rows, float_text
 
 
 def write_data(model, path: Path, rows, type_of_mat, smat, crad, lo, hi, ntypes,
                tx, ttype, tv, tids, tile_radius, tile_mass, bond_rows, btype, nbtypes,
                geometry=None) -> None:
-    """``geometry`` (bonds.BondGeometry, or None): the per-atom bond geometry sections
-    BondGeometry1..K that ``read_data … fix fl_bgeomk NULL BondGeometryk`` hands to fix
-    property/atom (one line per atom, in the Atoms section's order)."""
+    """``geometry`` (bonds.BondGeometry, or None): the per-atom bond geometry, written to
+    ``GEOMETRY_NAME`` beside the data file as atomfile blocks: per slot k the partner ids
+    (i_fl_bpk), then each column c of d2_fl_bvk[c], in the order the script sets them."""
     sp = model.spheres
     n = len(rows) + len(tx)
     parts = [f"LAMMPS data file written by fibrelmp from {comment_text(model.source.name)}\n\n",
@@ -61,9 +63,15 @@ def write_data(model, path: Path, rows, type_of_mat, smat, crad, lo, hi, ntypes,
         b = model.bonds.pair[bond_rows].astype(np.int64) + 1
         parts.append("\nBonds\n\n")
         parts.append(data_rows("%d %d %d %d\n", [np.arange(1, len(b) + 1), btype + 1, b[:, 0], b[:, 1]]))
-        if geometry is not None:
-            for k in range(geometry.slots):
-                cols = [ids, geometry.partners[:, k]] + [geometry.values[:, k, c] for c in range(geometry.width)]
-                parts.append(f"\n{GEOMETRY_SECTION}{k + 1}\n\n")
-                parts.append(data_rows("%d %d" + " %.17g" * geometry.width + "\n", cols))
     atomic_write(path, "".join(parts))
+    if len(bond_rows) and geometry is not None:
+        columns = []
+        for k in range(geometry.slots):
+            columns.append((f"i_{PARTNERS}{k + 1}", geometry.partners[:, k].astype(np.int64)))
+            columns += [(f"d2_{VALUES}{k + 1}[{c + 1}]", geometry.values[:, k, c].astype(np.float64))
+                        for c in range(geometry.width)]
+        title = ("fibrelmp: each bond's partner id, diameter, initial length [, initial tangential\n"
+                 "overlap] on its first sphere, read by in.lammps as 'variable fl_bgeom atomfile':\n"
+                 "a block per per-atom array column (a count, then 'atom-id value' lines); atoms not\n"
+                 "listed are 0")
+        atomic_write(path.with_name(GEOMETRY_NAME), atomfile_blocks(ids, columns, title))

@@ -5,7 +5,7 @@ is built on; the ``vtk`` wheel of the ``test`` extra) and OVITO's Python module 
 optional: skipped when absent).  Expected numbers come from the inputs (times, radii,
 masses), the work dumps LAMMPS wrote, the runs' own result files, and geometry computed
 here, never from the writer.  (meshio reads VTK XML only as UnstructuredGrid, which OVITO
-does not read as particles, so it cannot open these files.)
+does not read as particles, so it opens the wall series (``_walls.vtu``), not the particles.)
 """
 
 from __future__ import annotations
@@ -434,3 +434,32 @@ def test_a_frame_without_bonds_has_an_empty_bonds_block(tmp_path):
     if have("ovito"):
         pipeline = ovito_import(tmp_path / "b.pvd")
         assert [pipeline.compute(k).particles.count for k in range(2)] == [2, 2]
+
+
+def test_musen_walls_are_a_series_meshio_and_vtk_open(tmp_path):
+    """A MUSEN run with walls: ``<stem>_walls.pvd`` lists an UnstructuredGrid of the wall
+    triangles per frame, read with meshio (and VTK's reader when installed); its points are
+    the result's wall vertices at the same time, read from the run's own .mdem result."""
+    meshio = pytest.importorskip("meshio")
+    from fibrelmp import python_api
+    from fibrelmp.translate.musen.mdem.model import MdemReader
+
+    scene = tmp_path / "SingelParticle.mdem"
+    shutil.copy(REPO / "examples" / "musen" / "SingelParticle.mdem", scene)
+    python_api.run(scene, end_time=2e-3, step=1e-7, save_step=1e-3, viewer_files=True)
+    series = read_pvd(tmp_path / "SingelParticle_result_walls.pvd")
+    frames = list(MdemReader(tmp_path / "SingelParticle_result.mdem"))
+    assert [t for t, _ in series] == [f.time for f in frames]
+    for (time, path), frame in zip(series, frames):
+        mesh = meshio.read(path)
+        assert [b.type for b in mesh.cells] == ["triangle"] and len(mesh.cells[0].data) == 12
+        np.testing.assert_array_equal(mesh.points.reshape(12, 3, 3), frame.triangle_vertices)
+        assert mesh.cell_data["Velocity"][0].shape == (12, 3)
+        try:
+            xml = __import__("vtkmodules.vtkIOXML", fromlist=["vtkXMLUnstructuredGridReader"])
+        except ImportError:
+            continue
+        reader = xml.vtkXMLUnstructuredGridReader()
+        reader.SetFileName(str(path))
+        reader.Update()
+        assert reader.GetOutput().GetNumberOfCells() == 12

@@ -8,6 +8,9 @@ They are outputs of the run like its results: checked and locked before LAMMPS s
 staged and renamed into place when the run succeeds, replaced (all frames) only with
 ``--force``.
 
+With MUSEN walls also ``<base>_walls.pvd`` and ``<base>_NNNNNN_walls.vtu`` (the triangles
+where they are at each frame, with their velocity and force).
+
 What: every saved frame; ids, types, ``Radius``, ``Mass``, ``Velocity``, ``Force``,
 ``Angular Velocity`` and ``Orientation`` where the run has them (post/vtk/frame.py); the
 time is the simulation time.
@@ -46,6 +49,7 @@ def declare(outputs: "Outputs", base: Path) -> None:
     """Add the viewer files of ``base`` to a run's outputs (its ``.pvd``, and its frame files
     as a family: earlier frames need ``--force`` and go when the run succeeds)."""
     outputs.files.append(base.with_name(base.name + ".pvd"))
+    outputs.files.append(base.with_name(base.name + "_walls.pvd"))
     outputs.patterns.append((base.parent, frame_pattern(base)))
 
 
@@ -88,9 +92,16 @@ def granular_frame(model: "GranularModel", frame: "GranularFrame") -> ViewerFram
         bonds = np.asarray(s.ids, np.int64)[model.bonds.pair[alive]]
         if frame.bond_force is not None:
             bond_data["Force"] = frame.bond_force[alive]
+    walls, wall_data = None, {}
+    if model.triangles is not None and model.triangles.count:
+        tri = model.triangles
+        walls = tri.vertices if frame.triangle_vertices is None else frame.triangle_vertices
+        wall_data["Velocity"] = tri.velocity if frame.triangle_velocity is None else frame.triangle_velocity
+        if frame.triangle_force is not None:
+            wall_data["Force"] = frame.triangle_force
     return ViewerFrame(frame.step, frame.time, np.asarray(s.ids, np.int64)[rows],
                        wrap(frame.position, origin, cell, periodic), origin, cell, periodic,
-                       data, bonds, bond_data)
+                       data, bonds, bond_data, walls, wall_data)
 
 
 def viewer_writers(model: "GranularModel", outputs: "Outputs", base: Path,

@@ -40,6 +40,8 @@ class ViewerFrame:
     point_data: dict[str, np.ndarray] = field(default_factory=dict)   # (n,) or (n,k)
     bonds: np.ndarray | None = None    # (m,2) atom ids
     bond_data: dict[str, np.ndarray] = field(default_factory=dict)    # (m,) or (m,k)
+    walls: np.ndarray | None = None    # (k,3,3) wall triangles' vertices (MUSEN geometries)
+    wall_data: dict[str, np.ndarray] = field(default_factory=dict)    # (k,) or (k,j)
 
 
 def box_of(lo, hi, periodic, tilt=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

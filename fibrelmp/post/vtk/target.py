@@ -14,7 +14,7 @@ from fibrelmp.post.vtk.writer import VtkWriter
 
 def frame_pattern(base: Path) -> re.Pattern:
     """The names of a base's frame files (``.vtu``: what earlier fibrelmp versions wrote)."""
-    return re.compile(re.escape(base.name) + r"_\d{6}(\.vtp|_bonds\.vtp|\.vtm|\.vtu)")
+    return re.compile(re.escape(base.name) + r"_\d{6}(\.vtp|_bonds\.vtp|\.vtm|\.vtu|_walls\.vtu)")
 
 
 class VtkTarget(DumpTarget):

@@ -6,6 +6,8 @@ Layout (``<base>`` = the output name without suffix)::
     <base>_NNNNNN.vtp           the particles of frame NNNNNN: points with one vertex each
     <base>_NNNNNN_bonds.vtp     its bonds as lines (output with bonds; none in a frame without)
     <base>_NNNNNN.vtm           the two above as one multiblock frame (output with bonds)
+    <base>_walls.pvd            wall triangles over time (runs with MUSEN walls; open it too)
+    <base>_NNNNNN_walls.vtu     the walls of frame NNNNNN: an UnstructuredGrid of triangles
 
 Why PolyData and not an UnstructuredGrid (``.vtu``): OVITO (3.17) reads particles only from
 PolyData made of vertices (its ``.vtu`` reader takes a simulation cell: 8 points, 1 cell),
@@ -13,6 +15,9 @@ and bonds from a PolyData file of lines with the cell arrays ``id1``/``id2``, jo
 frame by a ``.vtm`` (the layout of Aspherix's output).  ParaView reads all of them.  Arrays
 are inline base64 (``format="binary"``) or ascii, never compressed (OVITO reads no
 compressed arrays), with UInt64 headers (VTK XML version 1.0).
+
+Walls are a separate series of UnstructuredGrid files (which ParaView, meshio and VTK read;
+OVITO would take a ``.vtu`` for a simulation cell, so they stay out of the particles' ``.vtm``).
 
 Bonds that cross a periodic face are drawn cut at the face (``frame.bond_segments``): each
 piece is its own line with the bond's ``id1``/``id2``, so a bond is one or more lines.
@@ -108,6 +113,22 @@ def bonds_vtp(frame: ViewerFrame, ascii_: bool = False) -> bytes | None:
                   _cells("Lines", 2, len(bond), ascii_), ascii_)
 
 
+def walls_vtu(frame: ViewerFrame, ascii_: bool = False) -> bytes:
+    """The wall triangles: three points and one VTK_TRIANGLE (5) cell each; cell data the
+    frame's wall arrays (``Velocity``, ``Force``)."""
+    tri = np.asarray(frame.walls, np.float64).reshape(-1, 3, 3)
+    k = len(tri)
+    arrays = "".join(data_array(name, values, ascii_) for name, values in frame.wall_data.items())
+    cells = ("<Cells>\n" + data_array("connectivity", np.arange(3 * k, dtype=np.int64), ascii_)
+             + data_array("offsets", 3 * np.arange(1, k + 1, dtype=np.int64), ascii_)
+             + data_array("types", np.full(k, 5, np.uint8), ascii_) + "</Cells>\n")
+    return (HEAD.format(kind="UnstructuredGrid") + "<UnstructuredGrid>\n" +
+            f'<Piece NumberOfPoints="{3 * k}" NumberOfCells="{k}">\n' +
+            "<CellData>\n" + arrays + "</CellData>\n" +
+            "<Points>\n" + data_array("Points", tri.reshape(-1, 3), ascii_) + "</Points>\n" +
+            cells + "</Piece>\n" + _field_data(frame) + "</UnstructuredGrid>\n</VTKFile>\n").encode()
+
+
 def vtm_text(blocks: list[tuple[str, str | None]]) -> bytes:
     """A multiblock file naming each block's file (relative to the ``.vtm``); a block
     without a file is an empty block."""
@@ -139,6 +160,7 @@ class VtkWriter(Writer):
         self.bonded = bonded if bonded is not None else bonds is not None and len(bonds) > 0
         self.ascii = ascii_
         self.entries: list[tuple[float, Path]] = []
+        self.wall_entries: list[tuple[float, Path]] = []
         self.stage(self.pvd_path)             # listed first, written at close
 
     @property
@@ -149,8 +171,12 @@ class VtkWriter(Writer):
     def pvd_path(self) -> Path:
         return self.target.with_name(self.target.name + ".pvd")
 
+    @property
+    def walls_pvd_path(self) -> Path:
+        return self.target.with_name(self.target.name + "_walls.pvd")
+
     def outputs(self) -> list[Path]:
-        return [self.pvd_path]
+        return [self.pvd_path, self.walls_pvd_path]
 
     def frame_path(self, index: int, suffix: str) -> Path:
         return self.target.with_name(f"{self.target.name}_{index:06d}{suffix}")
@@ -173,6 +199,12 @@ class VtkWriter(Writer):
             self.write_file(listed, vtm_text([("Particles", particles.name),
                                               ("Bonds", bonds.name if bonds else None)]))
         self.entries.append((frame.time, listed))
+        if frame.walls is not None and len(frame.walls):
+            walls = self.frame_path(k, "_walls.vtu")
+            self.write_file(walls, walls_vtu(frame, self.ascii))
+            self.wall_entries.append((frame.time, walls))
 
     def finish(self) -> None:
         self.write_file(self.pvd_path, pvd_text(self.entries))
+        if self.wall_entries:
+            self.write_file(self.walls_pvd_path, pvd_text(self.wall_entries))

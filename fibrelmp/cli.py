@@ -278,6 +278,9 @@ def run(input: Path = typer.Argument(..., help=f"{_TITLES[0].upper()}{_TITLES[1:
                                     "checkpoint in its work folder."),
         force: bool = typer.Option(False, "--force", help="Replace the results of an earlier run "
                                    "(all of them: stale files are removed)."),
+        log_every: Optional[str] = typer.Option(None, "--log-every", metavar="WHEN", help="Without a "
+                                                "terminal (batch jobs): a progress line on stderr every "
+                                                "10% of the steps, 60s/5m/1h, or both (default 10%,5m)."),
         stock_styles: bool = _STOCK, quiet: bool = _QUIET, verbose: bool = _VERBOSE,
         ) -> None:
     import time
@@ -289,11 +292,15 @@ def run(input: Path = typer.Argument(..., help=f"{_TITLES[0].upper()}{_TITLES[1:
     result = run_any(input, out, work=work, force=force, checkpoint_every=checkpoint_every,
                      resume=resume, end_time=end_time, step=step, save_step=save_step, steps=steps,
                      precision=precision, progress=not _state["quiet"], stock_styles=stock_styles, say=_say,
-                     warn=_report_warnings)
+                     warn=_report_warnings, log_every=log_every)
     for note in result.notes:
         _say(note)
     for path in result.outputs:
         _say(f"wrote {path}")
+    from fibrelmp.record import summary_lines
+
+    for summary in result.summaries:
+        _say("\n".join(summary_lines(summary)))
     script = result.scripts[-1] if result.scripts else None
     _say(f"done in {time.monotonic() - start:.1f} s (LAMMPS job: {script})")
 

@@ -49,6 +49,7 @@ class Job:
     output_steps: SaveSteps | tuple = ()   # the steps of the frames (lazy)
     text: str = ""                        # the script, also when only rank 0 wrote files
     native: NativeFiles | None = None     # FibreNet's files written by LAMMPS (the plugin)
+    bond_lengths: np.ndarray | None = None   # rest length of each LAMMPS bond type (1-based: [type - 1])
 
 
 def _factorize(col: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -300,13 +301,15 @@ def write_job(model: Model, folder: str | Path, write_files: bool = True) -> Job
         rad2deg=180.0 / math.pi, inf=float("inf"), angle_expression=angle_expression,
         extra_packages=_extra_packages(pair_styles, btypes, use_mvv),
         plugin=lammps_path(styles.path, "plugin") if styles.path else None, native=native,
+        thermo_every=min(out_steps.period or 0, 2 ** 31 - 1),     # thermo N is a C int
     )
     script_path = folder / SCRIPT_NAME
     if write_files:
         atomic_write(script_path, script)
     type_of_ltype = np.r_[-1, ltypes[:, 0].astype(np.int64)]
     return Job(folder, script_path, data_path, folder / FRAMES_NAME, total, type_of_ltype, out_steps,
-               text=script, native=native_files)
+               text=script, native=native_files,
+               bond_lengths=btypes[:, 1].astype(float) if bonds.count else np.zeros(0))
 
 
 def _native_output(model: Model, folder: Path, type_names: list[str],

@@ -86,14 +86,14 @@ class Progress:
 
     def __init__(self, total: int, enabled: bool, done: int = 0, every: LogEvery | None = None,
                  label: str = "", stream=None):
-        self.total, self.done, self.initial = max(total, 1), done, done
+        self.total, self.done, self.initial = total, done, done
         self.stream = stream if stream is not None else sys.stderr
-        self.enabled = enabled
+        self.enabled = enabled and total > 0          # a job of no steps: nothing to show
         self.every = every or DEFAULT_LOG_EVERY
         self.label = label
         self.bar = None
         self.start = time.monotonic()
-        if not enabled:
+        if not self.enabled:
             return
         from tqdm import tqdm
 

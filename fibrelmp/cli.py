@@ -299,6 +299,9 @@ def run(input: Path = typer.Argument(..., help=f"{_TITLES[0].upper()}{_TITLES[1:
         viewer_files: bool = typer.Option(False, "--vtk", help="Also write every saved frame "
                                           "as files 3D viewers open (OVITO and others; "
                                           "docs/post.md), next to the results."),
+        log_every: Optional[str] = typer.Option(None, "--log-every", metavar="WHEN", help="Without a "
+                                                "terminal (batch jobs): a progress line on stderr every "
+                                                "10% of the steps, 60s/5m/1h, or both (default 10%,5m)."),
         stock_styles: bool = _STOCK, quiet: bool = _QUIET, verbose: bool = _VERBOSE,
         ) -> None:
     import time
@@ -311,11 +314,15 @@ def run(input: Path = typer.Argument(..., help=f"{_TITLES[0].upper()}{_TITLES[1:
                      resume=resume, end_time=end_time, step=step, save_step=save_step, steps=steps,
                      precision=precision, progress=not _state["quiet"], stock_styles=stock_styles,
                      viewer_files=viewer_files, say=_say,
-                     warn=_report_warnings)
+                     warn=_report_warnings, log_every=log_every)
     for note in result.notes:
         _say(note)
     for line in _written(result.outputs):
         _say(line)
+    from fibrelmp.record import summary_lines
+
+    for summary in result.summaries:
+        _say("\n".join(summary_lines(summary)))
     script = result.scripts[-1] if result.scripts else None
     _say(f"done in {time.monotonic() - start:.1f} s (LAMMPS job: {script})")
 

@@ -29,7 +29,7 @@ from fibrelmp.errors import InputError
 # what a run writes into its work folder (translate.lammps_job / granular_job, checkpoint)
 WORK_FILES = frozenset({"in.lammps", "data.lammps", "frames.dump", "bonds.dump", "walls.dump",
                         "breaks.dump", "checkpoint.json", "log.lammps", "data.fibrelmp.json",
-                        "fibrenet_state.txt", "bond_geometry.txt"})
+                        "fibrenet_state.txt", "bond_geometry.txt", "summary.json"})
 
 
 @dataclass

@@ -74,6 +74,7 @@ class RunResult:
     dumps: list[Path] = field(default_factory=list)
     warnings: list[tuple[str, str]] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
+    summaries: list[dict] = field(default_factory=list)   # per simulation (docs/record.md)
 
     def frames(self, simulation: int = -1) -> Iterator:
         """The saved frames of one simulation (default: the last), one at a time, as
@@ -94,7 +95,7 @@ def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | N
         end_time: float | None = None, step: float | None = None, save_step: float | None = None,
         steps: int | None = None, precision: int | None = None, progress: bool = False,
         stock_styles: bool = False, viewer_files: bool = False, say: Say = _quiet,
-        warn: Warn | None = None) -> RunResult:
+        warn: Warn | None = None, log_every: str | None = None) -> RunResult:
     """Run any supported input on LAMMPS and write its results in the input's own format.
 
     ``out``: the results' folder, or the result file of an input with a single result;
@@ -105,7 +106,10 @@ def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | N
     styles instead of fibrelmp's own (see ``translate_job``).  ``viewer_files`` (``run --vtk``):
     also write every saved frame as files 3D viewers open, beside the results
     (``fibrelmp.pipeline.viewer``; they are in ``outputs``).  ``say`` receives progress notes, ``warn`` lists of
-    ``(kind, text)`` warnings as they are found (they are also in the result)."""
+    ``(kind, text)`` warnings as they are found (they are also in the result).  ``progress``:
+    a bar on a terminal, else a line on stderr every ``log_every`` (``"10%"``, ``"60s"``,
+    ``"10%,5m"``: the default).  Each simulation's summary (``summary.json``) is in
+    ``summaries``."""
     from fibrelmp.checkpoint import check_every
     from fibrelmp.pipeline import RunOptions, run as run_plan
     from fibrelmp.pipeline.inputs import RunSettings
@@ -118,6 +122,9 @@ def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | N
         unused = hook.precision_unused(path, None if out is None else Path(out))
         if unused is not None:
             raise InputError(path, None, f"--precision has no meaning here: {unused}")
+    from fibrelmp.runner import parse_log_every
+
+    every = None if log_every is None else parse_log_every(log_every)
     result = RunResult()
 
     def warned(items: list[tuple[str, str]]) -> None:
@@ -135,11 +142,12 @@ def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | N
     from fibrelmp import lammps_styles
 
     with lammps_styles.stock(stock_styles):
-        plan = hook.plan(path, settings, RunOptions(progress, force, checkpoint_every, resume), say, warned)
+        plan = hook.plan(path, settings, RunOptions(progress, force, checkpoint_every, resume, every), say, warned)
         outcome = run_plan(plan, warn=warned)
     result.outputs, result.notes = outcome.outputs, list(plan.notes)
     result.scripts = [job.script for job in outcome.jobs]
     result.dumps = [job.job.frames for job in outcome.jobs]
+    result.summaries = outcome.summaries
     return result
 
 

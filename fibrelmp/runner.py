@@ -25,6 +25,9 @@ from fibrelmp.lammps_text import input_lines, read_script
 
 if TYPE_CHECKING:
     from fibrelmp.checkpoint import Checkpointing  # noqa: F401
+    from fibrelmp.record import Recorder  # noqa: F401
+
+LOG_NAME = "log.lammps"          # LAMMPS's own log with the thermo output (fibrelmp.record)
 
 
 def mpi_rank_size() -> tuple[int, int]:
@@ -34,33 +37,116 @@ def mpi_rank_size() -> tuple[int, int]:
     return 0, 1
 
 
-class Progress:
-    """A one-line progress bar with ETA on a TTY (rank 0 only); silent otherwise."""
+@dataclass(frozen=True)
+class LogEvery:
+    """When a run without a terminal writes a progress line (``--log-every``): at every
+    ``percent`` of the steps and/or after ``seconds`` since the last line (None: not by that)."""
+    percent: float | None = 10.0
+    seconds: float | None = 300.0
 
-    def __init__(self, total: int, enabled: bool):
-        self.total, self.done = max(total, 1), 0
-        self.enabled = enabled and sys.stderr.isatty()
+    def __str__(self) -> str:
+        parts = ([f"{self.percent:g}%"] if self.percent else []) + ([f"{self.seconds:g}s"] if self.seconds else [])
+        return ",".join(parts)
+
+
+DEFAULT_LOG_EVERY = LogEvery()
+_UNITS = {"s": 1.0, "m": 60.0, "h": 3600.0}
+
+
+def parse_log_every(text: str) -> LogEvery:
+    """``10%`` (every 10 % of the steps), ``60``/``60s``/``5m``/``1h`` (every so long), or
+    both, comma-separated (``10%,5m``: whichever comes first)."""
+    from fibrelmp.errors import InputError
+
+    percent = seconds = None
+    for part in str(text).replace(" ", "").split(","):
+        try:
+            if part.endswith("%"):
+                value = float(part[:-1])
+                ok = percent is None and 0 < value <= 100
+                percent = value
+            else:
+                scale = _UNITS.get(part[-1:], None)
+                value = float(part[:-1] if scale else part) * (scale or 1.0)
+                ok = seconds is None and 0 < value < float("inf")
+                seconds = value
+        except ValueError:
+            ok = False
+        if not ok:
+            raise InputError(None, None, f"--log-every {text!r}: give a percentage of the steps "
+                             "(10%), a time (60, 60s, 5m, 1h) or both (10%,5m)")
+    return LogEvery(percent, seconds)
+
+
+class Progress:
+    """The steps done, drawn by tqdm on rank 0: a bar with ETA on a terminal; without one
+    (batch jobs), a line on stderr at the start, every ``every`` and at the end.  After a
+    resume the count starts at the steps done before and the rate (so the ETA) counts only
+    the steps of this session (tqdm's ``initial``)."""
+
+    def __init__(self, total: int, enabled: bool, done: int = 0, every: LogEvery | None = None,
+                 label: str = "", stream=None):
+        self.total, self.done, self.initial = total, done, done
+        self.stream = stream if stream is not None else sys.stderr
+        self.enabled = enabled and total > 0          # a job of no steps: nothing to show
+        self.every = every or DEFAULT_LOG_EVERY
+        self.label = label
+        self.bar = None
         self.start = time.monotonic()
-        self.shown = -1.0
+        if not self.enabled:
+            return
+        from tqdm import tqdm
+
+        self.tqdm = tqdm
+        if self.stream.isatty():
+            try:                    # a terminal without a size (script, some CI): 80 x 24
+                size = os.get_terminal_size(self.stream.fileno())
+                sized = size.columns > 0 and size.lines > 0
+            except (OSError, ValueError, AttributeError):
+                sized = False
+            fixed = {} if sized else {"ncols": 80, "nrows": 24}
+            self.bar = tqdm(total=self.total, initial=done, file=self.stream, unit="step",
+                            desc=label or None, dynamic_ncols=sized, mininterval=0.2, leave=True,
+                            **fixed)
+        else:
+            self.line_at, self.line_done = self.start, None
+            self._line()
 
     def advance(self, steps: int) -> None:
         self.done += steps
-        if not self.enabled:
+        if not self.enabled or steps <= 0:
             return
-        frac = min(self.done / self.total, 1.0)
+        if self.bar is not None:
+            self.bar.update(steps)
+            return
         now = time.monotonic()
-        if now - self.shown < 0.1 and frac < 1.0:      # loops of tiny runs: redraw 10x a second
-            return
-        self.shown = now
-        elapsed = now - self.start
-        eta = elapsed * (1 - frac) / frac if frac > 0 else 0.0
-        bar = "#" * int(30 * frac)
-        sys.stderr.write(f"\r[{bar:<30}] {100 * frac:5.1f}%  step {self.done}/{self.total}  ETA {eta:6.1f}s")
-        sys.stderr.flush()
+        every = self.every
+        due = every.seconds is not None and now - self.line_at >= every.seconds
+        if every.percent is not None:
+            size = every.percent / 100 * self.total
+            due = due or int((self.done - steps) // size) != int(self.done // size)
+        if due:
+            self._line(now)
+
+    def _line(self, now: float | None = None) -> None:
+        now = time.monotonic() if now is None else now
+        meter = self.tqdm.format_meter(
+            min(self.done, self.total), self.total, now - self.start, initial=self.initial,
+            unit=" step", bar_format="{percentage:5.1f}% step {n}/{total}, elapsed {elapsed}, "
+                                    "ETA {remaining}, {rate_fmt}")
+        label = f" {self.label}" if self.label else ""
+        stamp = time.strftime("%Y-%m-%d %H:%M:%S")
+        self.stream.write(f"[{stamp}] progress{label}: {meter}\n")
+        self.stream.flush()
+        self.line_at, self.line_done = now, self.done
 
     def close(self) -> None:
-        if self.enabled:
-            sys.stderr.write("\n")
+        if not self.enabled:
+            return
+        if self.bar is not None:
+            self.bar.close()
+        elif self.line_done != self.done:
+            self._line()
 
 
 @dataclass
@@ -128,10 +214,12 @@ def execute(commands: list[Command], labels: dict[str, int], where: str = "in.la
         yield cmd
 
 
-def run_script(script: Path, total_steps: int, progress: bool = True, log: bool = False,
+def run_script(script: Path, total_steps: int, progress: bool = True, log: bool = True,
                on_command: Callable[[list[str]], None] | None = None, text: str | None = None,
                checkpoints: "Checkpointing | None" = None,
-               finished: Callable[[object], None] | None = None) -> None:
+               finished: Callable[[object], None] | None = None,
+               record: "Recorder | None" = None, log_every: LogEvery | None = None,
+               label: str = "") -> None:
     """Execute ``script`` inside its folder with the lammps module.
 
     ``text`` is the script's content when this rank did not write the file (MPI ranks > 0:
@@ -140,19 +228,25 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
     a resumed run skips: their frames are in the dump already).  ``checkpoints`` enables
     checkpoints and resuming (see fibrelmp.checkpoint).  ``finished(lmp)`` is called after
     the last command (before LAMMPS closes), e.g. to read a fix's global values.
+
+    ``log``: LAMMPS writes ``log.lammps`` in the job folder (rank 0; a resumed run appends).
+    ``record`` (a ``fibrelmp.record.Recorder``) takes the final state, on every rank.  Progress (rank 0): ``Progress`` with ``log_every``.
     """
     from fibrelmp.checkpoint import ACTIONS, CheckpointStop
 
     script = Path(script)
     rank, size = mpi_rank_size()
-    args = ["-nocite", "-log", "log.lammps" if log and rank == 0 else "none", "-screen", "none"]
+    resume = checkpoints.resume if checkpoints is not None else None
+    fresh_log = log and rank == 0 and not resume
+    args = ["-nocite", "-log", str(script.parent.resolve() / LOG_NAME) if fresh_log else "none",
+            "-screen", "none"]
     script_text = text if text is not None else read_script(script)
     commands, labels = parse_commands(script_text, str(script))
     cwd = os.getcwd()
-    bar = Progress(total_steps, progress and rank == 0)
-    resume = checkpoints.resume if checkpoints is not None else None
     skip_to = resume["commands"] if resume else 0     # commands done before the checkpoint
     steps = resume["steps"] if resume else 0
+    resumed_steps = steps
+    bar = Progress(total_steps, progress and rank == 0, done=steps, every=log_every, label=label)
     frames = 0
     since = 0
     done = 0                         # commands executed (the position in the command stream)
@@ -161,8 +255,6 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
     resumed_state = checkpoints.load_step_state() if resume else None
     deferred: list[str] = []         # per-atom fixes: defined after read_restart to get their data
     lmp = None
-    if resume:
-        bar.advance(steps)
     try:
         lmp = new_lammps(args)
         if size > 1:
@@ -175,6 +267,8 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
         except OSError as exc:
             raise RunError(f"{script.parent}: job folder not visible on MPI rank {rank} ({exc.strerror}): "
                            "the work folder must be on a file system shared by all ranks") from None
+        if log and resume:
+            lmp.command(f"log {LOG_NAME} append")      # LAMMPS opens it on rank 0
         if checkpoints is not None:
             checkpoints.install()
         for cmd in execute(commands, labels, str(script)):
@@ -208,7 +302,10 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
                     # pre no" would use a stale neighbour list
                     restore_step_state(lmp, saved_state)
                     rebuild = False
-                before = _timestep(lmp) if words[0] == "run" else 0
+                # FibreNet's first step after a (re)start is made by commands: its
+                # "reset_timestep $(step+1)" counts it; a reset to 0 (a new stage) none
+                counts = words[0] in ("run", "reset_timestep")
+                before = _timestep(lmp) if counts else 0
                 lmp.command(text)
                 if replaying and words[0] == "read_data":
                     for fix in deferred:
@@ -221,8 +318,8 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
                 raise RunError(f"{script}:{cmd.number}: LAMMPS error: {str(exc).strip()}") from None
             if words[0] == "write_dump":
                 frames += 1
-            if words[0] == "run":
-                n = _timestep(lmp) - before
+            if counts:
+                n = max(_timestep(lmp) - before, 0)
                 bar.advance(n)
                 steps += n
                 since += n
@@ -238,6 +335,8 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
                     since = 0
                     if signum:
                         raise CheckpointStop(script.parent, signum)
+        if record is not None:
+            record.end(lmp, steps, resumed_steps)
         if finished is not None:
             finished(lmp)
         if checkpoints is not None:
@@ -274,13 +373,20 @@ def restore_step_state(lmp, state: dict) -> None:
     forces of ``step_state`` put back, so the next step is the one an uninterrupted run takes."""
     import ctypes
 
+    import numpy as np
+
     lmp.command("run 0 post no")
-    ids = state["id"]
+    # atoms beyond an 'f' face that LAMMPS had not yet dropped at the checkpoint are dropped
+    # by read_restart: scattering to an id LAMMPS no longer has reads past its atom map
+    now = int(lmp.get_natoms())
+    present = np.array(lmp.gather_atoms_concat("id", 0, 1)[:now], dtype=np.int64)
+    keep = np.isin(state["id"], present)
+    ids = state["id"][keep]
     n = len(ids)
     c_ids = (ctypes.c_int * n)(*ids.tolist()) if n else (ctypes.c_int * 1)()
     for name in ("f", "torque"):
         if name in state:
-            values = state[name]
+            values = state[name].reshape(-1, 3)[keep].reshape(-1)
             data = (ctypes.c_double * len(values))(*values.tolist()) if n else (ctypes.c_double * 1)()
             lmp.scatter_atoms_subset(name, 1, 3, n, c_ids, data)
 
@@ -291,7 +397,8 @@ class RunAborted(Exception):
 
 
 def run_overlapped(script: Path, total_steps: int, frame_token: Callable[[list[str]], object],
-                   consume: Callable, progress: bool = True, checkpoints=None, finished=None):
+                   consume: Callable, progress: bool = True, checkpoints=None, finished=None,
+                   **options):
     """Run ``script`` while ``consume(tokens)`` converts frames on a second thread (the lammps
     module releases the GIL inside the library, so conversion overlaps the next steps).
 
@@ -341,7 +448,7 @@ def run_overlapped(script: Path, total_steps: int, frame_token: Callable[[list[s
     try:
         with cores_taken(1):        # LAMMPS's core: the converter then uses one thread only
             run_script(script, total_steps, progress=progress, on_command=hook, checkpoints=checkpoints,
-                       finished=finished)
+                       finished=finished, **options)
     except BaseException:
         ready.put(abort)
         worker.join()

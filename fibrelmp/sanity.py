@@ -12,6 +12,7 @@ spanning fewer than about three is unstable.
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 
@@ -155,3 +156,51 @@ def contact_check(model: GranularModel) -> list[str]:
             model.warn("time step", f"the time step {plan.dt:g} exceeds 1/10 of the Hertz "
                        f"contact time {tc[0]:.3g}: contacts will be poorly resolved")
     return lines
+
+
+def time_step_check(model: Model | GranularModel) -> list[str]:
+    """``spring_check`` or ``contact_check``, by the kind of model (``run`` warns before it
+    starts, as ``check`` does)."""
+    if isinstance(model, GranularModel):
+        return contact_check(model)
+    return spring_check(model)
+
+
+def time_step_scale(model: Model | GranularModel) -> dict | None:
+    """The time the step has to resolve, for the run summary: ``{"name": "spring period" |
+    "contact time", "value", "where"}`` (None: no spring / no sphere with a contact law)."""
+    if isinstance(model, GranularModel):
+        with np.errstate(all="ignore"):
+            found = granular_contact_time(model)
+        if found is None or not math.isfinite(found[0]):
+            return None
+        return {"name": "contact time", "value": found[0],
+                "where": f"Hertz, {found[1]}, fastest approach in the input"}
+    found = spring_period(model)
+    if found is None:
+        return None
+    period, row = found
+    i, j = (int(x) for x in model.bonds.atoms[row])
+    return {"name": "spring period", "value": period, "where": f"spring {row}: beads {i}-{j}"}
+
+
+# LAMMPS errors of atoms that moved too far in one step (a blown-up run)
+_BLOW_UP = re.compile(r"(Bond|Angle|Dihedral|Improper) atoms? .*missing|Lost atoms|Non-numeric atom coords|"
+                      r"Out of range atoms|extent > half of periodic box|atom missing in box size check|"
+                      r"Neighbor list overflow|Too many neighbor bins|domain too large for neighbor bins",
+                      re.IGNORECASE)
+
+
+def blow_up_hint(model: Model | GranularModel, message: str) -> str | None:
+    """The hint a LAMMPS error gets when atoms flew apart: the time step warning ``run``
+    printed before it started, or the figures to check; None for other errors."""
+    if not _BLOW_UP.search(message):
+        return None
+    warned = [text for kind, text in model.warnings if kind == "time step"]
+    if warned:
+        return (f"hint: atoms moved too far in one step, as the 'time step' warning above "
+                f"foresaw ({warned[0].split(':')[0]}): run again with a smaller time step")
+    what = "Hertz contact time" if isinstance(model, GranularModel) else "shortest spring period"
+    return (f"hint: atoms moved too far in one step: the run became unstable. `fibrelmp check` "
+            f"shows the time step against the {what}; a smaller step, stiffer walls or less "
+            "overlap at the start usually help")

@@ -96,6 +96,16 @@ class FrameBuilder:
         tri = model.triangles
         self.v0 = np.asarray(tri.vertices, float) if tri is not None and tri.count else None
 
+    def tally(self) -> dict:
+        """Spheres and bonds as of the last frame read, for the run summary (fibrelmp.record):
+        spheres present, removed at their activity end or by leaving the domain, bonds alive."""
+        removed = np.flatnonzero(self.removed)
+        at_end = sum(1 for r in removed.tolist()
+                     if self.deletion_time.get(r) == self.sphere_end[r])
+        return {"spheres": int(self.present.sum()), "activity_end": at_end,
+                "left_domain": len(removed) - at_end,
+                "bonds": int(self.bond_alive.sum()) if self.nb else 0}
+
     def _bond_lookup(self, id1: np.ndarray, id2: np.ndarray) -> np.ndarray:
         """Bond rows (or -1) for atom-id pairs."""
         key = np.minimum(id1, id2) * self.id_base + np.maximum(id1, id2)

@@ -17,6 +17,7 @@ if TYPE_CHECKING:
     from fibrelmp.granmodel import GranularModel
     from fibrelmp.model import Model
     from fibrelmp.outputs import Outputs
+    from fibrelmp.runner import LogEvery
 
 
 @dataclass(frozen=True)
@@ -26,6 +27,7 @@ class RunOptions:
     force: bool = False                # replace the results of an earlier run
     checkpoint_every: int | None = None   # steps between checkpoints (None: on signals only)
     resume: bool = False               # continue from the checkpoint in the work folder
+    log_every: "LogEvery | None" = None   # progress lines without a terminal (None: the default)
 
 
 @dataclass
@@ -114,3 +116,4 @@ class Outcome:
     """What a plan wrote, and the jobs it ran (their scripts and dumps stay in the work folder)."""
     outputs: list[Path] = field(default_factory=list)
     jobs: list[Rendered] = field(default_factory=list)
+    summaries: list[dict] = field(default_factory=list)   # fibrelmp.record, one per simulation

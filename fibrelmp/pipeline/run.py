@@ -13,6 +13,7 @@ MPI: LAMMPS runs on every rank; files, frames and writers are rank 0's.
 from __future__ import annotations
 
 import os
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, Callable, Iterator
 
@@ -29,6 +30,7 @@ def run(plan: RunPlan, warn: Warn | None = None) -> Outcome:
     its model while it is translated and run."""
     from fibrelmp.outputs import finish, locked
     from fibrelmp.runner import mpi_rank_size
+    from fibrelmp.sanity import time_step_check
 
     rank, size = mpi_rank_size()
     options = plan.options
@@ -37,6 +39,7 @@ def run(plan: RunPlan, warn: Warn | None = None) -> Outcome:
 
         raise InputError(plan.outputs.source, None, NO_CHECKPOINT)
     outcome = Outcome()
+    several = sum(isinstance(step, RunRequest) for step in plan.steps) > 1
     # resuming continues this run's own (locked) work: its partial results are not "earlier" ones
     with locked(plan.outputs, options.force or options.resume, rank):
         try:
@@ -49,9 +52,16 @@ def run(plan: RunPlan, warn: Warn | None = None) -> Outcome:
                     outcome.outputs += step.run(rank == 0)
                     continue
                 said = len(step.model.warnings)
-                rendered, written = simulate(step, options, rank, size)
+                time_step_check(step.model)     # check's warning, said before the run starts
+                if warn is not None and step.model.warnings[said:]:
+                    warn(step.model.warnings[said:])
+                said = len(step.model.warnings)
+                rendered, written, summary = simulate(step, options, rank, size,
+                                                      Path(step.work).name if several else "")
                 outcome.jobs.append(rendered)
                 outcome.outputs += written
+                if summary is not None:
+                    outcome.summaries.append(summary)
                 if warn is not None and step.model.warnings[said:]:
                     warn(step.model.warnings[said:])    # found while translating or running
             if rank == 0:
@@ -70,11 +80,16 @@ def has_checkpoint(work: Path) -> bool:
     return work.is_dir() and next(work.rglob(STATE), None) is not None
 
 
-def simulate(request: RunRequest, options: RunOptions, rank: int = 0,
-             size: int = 1) -> tuple[Rendered, list[Path]]:
-    """Render, run and convert one simulation; (the rendered job, the result files)."""
+def simulate(request: RunRequest, options: RunOptions, rank: int = 0, size: int = 1,
+             label: str = "") -> tuple[Rendered, list[Path], dict | None]:
+    """Render, run and convert one simulation; (the rendered job, the result files, its
+    summary: rank 0, also written as ``summary.json`` beside ``log.lammps``).  ``label``
+    names the simulation in progress lines."""
+    import time
+
     from fibrelmp._lammps import mpi_barrier
     from fibrelmp.checkpoint import STATE
+    from fibrelmp.record import SUMMARY_NAME, Recorder, write_summary
     from fibrelmp.runner import run_script
 
     # every rank renders identically; only rank 0 writes the job files
@@ -88,11 +103,17 @@ def simulate(request: RunRequest, options: RunOptions, rank: int = 0,
     if rank == 0 and not resume:
         for dump in rendered.dumps:
             dump.unlink(missing_ok=True)
+    if rank == 0:            # an earlier run's summary must not pass for this run's
+        (rendered.folder / SUMMARY_NAME).unlink(missing_ok=True)
+    record = Recorder(request.model, rendered.job, rendered.text)
+    started = time.monotonic()
     if rank != 0:            # the same script text; LAMMPS reads the data file on rank 0 only
-        run_script(rendered.script, rendered.total_steps, progress=False, text=rendered.text,
-                   checkpoints=checkpoints)
+        with _hint(request.model):
+            run_script(rendered.script, rendered.total_steps, progress=False, text=rendered.text,
+                       checkpoints=checkpoints, record=record)
         mpi_barrier()
-        return rendered, []
+        return rendered, [], None
+    more = dict(record=record, log_every=options.log_every, label=label)
 
     source = request.frames(rendered)
     try:
@@ -110,20 +131,41 @@ def simulate(request: RunRequest, options: RunOptions, rank: int = 0,
 
             # convert each frame on a second core while LAMMPS computes the next ones (the
             # lammps module releases the GIL inside the library)
-            written = run_overlapped(rendered.script, rendered.total_steps, token, convert,
-                                     progress=options.progress, checkpoints=checkpoints,
-                                     finished=rendered.finished)
+            with _hint(request.model):
+                written = run_overlapped(rendered.script, rendered.total_steps, token, convert,
+                                         progress=options.progress, checkpoints=checkpoints,
+                                         finished=rendered.finished, **more)
         else:
-            written = _run_serial(rendered, token, convert, options.progress, checkpoints)
+            with _hint(request.model):
+                written = _run_serial(rendered, token, convert, options.progress, checkpoints, more)
     finally:
         source.close()
+    tally = getattr(source, "tally", None)
+    summary = record.summary(rendered, time.monotonic() - started, request.model.warnings,
+                             tally() if tally is not None else None)
+    write_summary(rendered.folder, summary)
     if size > 1:
         mpi_barrier()
-    return rendered, list(written)
+    return rendered, list(written), summary
+
+
+@contextmanager
+def _hint(model) -> Iterator[None]:
+    """A LAMMPS error that follows from too large a time step gets a hint
+    (``sanity.blow_up_hint``)."""
+    from fibrelmp.sanity import blow_up_hint
+
+    try:
+        yield
+    except RunError as exc:
+        hint = blow_up_hint(model, str(exc))
+        if hint is None:
+            raise
+        raise RunError(f"{exc}\n{hint}") from None
 
 
 def _run_serial(rendered: Rendered, token: Callable, convert: Consumer, progress: bool,
-                checkpoints) -> list[Path]:
+                checkpoints, more: dict) -> list[Path]:
     """Run LAMMPS to the end, then convert the frames it saved (MPI, or a single core)."""
     from fibrelmp.runner import RunAborted, run_script
 
@@ -140,7 +182,7 @@ def _run_serial(rendered: Rendered, token: Callable, convert: Consumer, progress
 
     try:
         run_script(rendered.script, rendered.total_steps, progress=progress, on_command=hook,
-                   text=rendered.text, checkpoints=checkpoints, finished=rendered.finished)
+                   text=rendered.text, checkpoints=checkpoints, finished=rendered.finished, **more)
     except BaseException:
         try:
             convert(aborted())      # the writers discard what they staged

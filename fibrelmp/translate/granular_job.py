@@ -205,6 +205,7 @@ def build_granular_job(model: GranularModel, folder: str | Path):
         frame_columns=frame_columns, acts=acts, compress_ids=compress_ids,
         lost=bool(axes.removal_axes.any()), walls=[(wp.name, wp.description) for wp in wall_plans],
         mesh_fix=MESH_FIX if len(mesh) else None, mesh_forces_name=MESH_FORCES_NAME,
+        thermo_every=min(saves.period or 0, 2 ** 31 - 1),      # thermo N is a C int
     )
     job = GranularJob(
         folder=folder, script=folder / SCRIPT_NAME, data=data_path, total_steps=total,

@@ -57,6 +57,7 @@ class Job:
     text: str = ""                        # the script, also when only rank 0 wrote files
     native: NativeFiles | None = None     # FibreNet's files written by LAMMPS (the plugin)
     state: Path | None = None             # the per-bead state file (STATE_NAME)
+    bond_lengths: np.ndarray | None = None   # rest length of each LAMMPS bond type (1-based: [type - 1])
 
     @property
     def inputs(self) -> list[Path]:
@@ -318,13 +319,15 @@ def write_job(model: Model, folder: str | Path, write_files: bool = True) -> Job
         rad2deg=180.0 / math.pi, inf=float("inf"), angle_expression=angle_expression,
         extra_packages=_extra_packages(pair_styles, btypes, use_mvv),
         plugin=lammps_path(styles.path, "plugin") if styles.path else None, native=native,
+        thermo_every=min(out_steps.period or 0, 2 ** 31 - 1),     # thermo N is a C int
     )
     script_path = folder / SCRIPT_NAME
     if write_files:
         atomic_write(script_path, script)
     type_of_ltype = np.r_[-1, ltypes[:, 0].astype(np.int64)]
     return Job(folder, script_path, data_path, folder / FRAMES_NAME, total, type_of_ltype, out_steps,
-               text=script, native=native_files, state=state_path)
+               text=script, native=native_files, state=state_path,
+               bond_lengths=btypes[:, 1].astype(float) if bonds.count else np.zeros(0))
 
 
 def _per_type_expression(values: np.ndarray) -> str:

@@ -271,17 +271,23 @@ def largest_overlap(ids: np.ndarray, x: np.ndarray, radius: np.ndarray, lo: np.n
     if len(x) < 2:
         return None
     reach = 2.0 * float(radius.max())
-    y = np.array(x, float)
-    box = np.empty(3)
-    for k in range(3):
-        if periodic[k]:
-            box[k] = hi[k] - lo[k]
-            y[:, k] = np.mod(y[:, k] - lo[k], box[k])
-            y[y[:, k] >= box[k], k] = 0.0
-        else:         # wide enough that no pair meets across the (unused) wrap
-            y[:, k] -= y[:, k].min()
-            box[k] = 2.0 * (float(y[:, k].max()) + reach) or 1.0
-    pairs = cKDTree(y, boxsize=box).query_pairs(reach, output_type="ndarray")
+    if not periodic.any():
+        from fibrelmp.sanity import close_pairs
+
+        pairs = close_pairs(x, reach)        # robust for any finite coordinates
+    else:
+        y = np.array(x, float)
+        box = np.empty(3)
+        for k in range(3):
+            if periodic[k]:
+                box[k] = hi[k] - lo[k]
+                y[:, k] = np.mod(y[:, k] - lo[k], box[k])
+                y[y[:, k] >= box[k], k] = 0.0
+            else:     # wide enough that no pair meets across the (unused) wrap
+                y[:, k] -= y[:, k].min()
+                box[k] = 2.0 * (float(y[:, k].max()) + reach) or 1.0
+        # Chebyshev candidates (no squared differences to overflow), confirmed below
+        pairs = cKDTree(y, boxsize=box).query_pairs(reach, p=np.inf, output_type="ndarray")
     if not len(pairs):
         return None
     d = _min_image_diff(x, lo, hi, periodic)(pairs[:, 0], pairs[:, 1])

@@ -254,6 +254,7 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
     saved_state: dict = {}           # the step state at the last checkpoint
     resumed_state = checkpoints.load_step_state() if resume else None
     deferred: list[str] = []         # per-atom fixes: defined after read_restart to get their data
+    atomfiles: set[str] = set()      # atomfile variables skipped while replaying
     lmp = None
     try:
         lmp = new_lammps(args)
@@ -287,6 +288,13 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
                     continue
                 if words[0] == "fix" and len(words) > 3 and words[3] == "property/atom":
                     deferred.append(text)
+                    continue
+                # per-atom values set from atomfiles (bond geometry, FibreNet's state) come
+                # back with read_restart; the files may name atoms lost before the checkpoint
+                if words[0] == "variable" and len(words) > 2 and words[2] == "atomfile":
+                    atomfiles.add(words[1])
+                    continue
+                if atomfiles and _uses_atomfile(words, atomfiles):
                     continue
                 if words[0] == "read_data":
                     text = f"read_restart {resume['restart']}"
@@ -366,6 +374,16 @@ def step_state(lmp) -> dict:
         if lmp.extract_atom(name) is not None:
             state[name] = np.array(lmp.gather_atoms_concat(name, 1, 3)[:3 * n], dtype=np.float64)
     return state
+
+
+def _uses_atomfile(words: list[str], names: set[str]) -> bool:
+    """Does a command only load or apply one of the atomfile variables ``names``
+    (``next V``, ``set ... v_V``, ``variable V delete``)?"""
+    if words[0] == "next":
+        return any(w in names for w in words[1:])
+    if words[0] == "set":
+        return any(w.startswith("v_") and w[2:] in names for w in words)
+    return words[0] == "variable" and len(words) > 2 and words[1] in names and words[2] == "delete"
 
 
 def restore_step_state(lmp, state: dict) -> None:

@@ -267,6 +267,7 @@ def _spoil(tmp_path: Path, edit) -> Path:
     (lambda s: setattr(s.data_blocks[0], "format", 9), "storage format 9"),
     (lambda s: s.info.particles.add(type=77), "unsupported MUSEN object type(s) [77]"),
     (lambda s: s.ClearField("data_blocks"), "lists no time-point blocks"),
+    (lambda s: setattr(s.data_blocks[0], "uncompressed_size", -5), "uncompressed size -5"),
 ])
 def test_hostile_descriptors_are_input_errors(tmp_path, edit, message):
     path = _spoil(tmp_path, edit)
@@ -327,3 +328,49 @@ def test_script_on_musens_compression_example_keeps_what_the_run_changed(tmp_pat
     ours, text = read_time_points(tmp_path / "export.txt"), read_time_points(tmp_path / "result.txt")
     for tag in text.fields:
         assert np.array_equal(ours.fields[tag], text.fields[tag], equal_nan=True), tag
+
+
+@pytest.mark.parametrize("line, message", [
+    ("39 vol", "`39` line cannot be imported: too few values"),
+    ("34 MIX", "`34` line cannot be imported: too few values"),
+    ("29 abc", "`29` line cannot be imported"),
+])
+def test_text_import_of_bad_scene_lines_is_an_input_error(tmp_path, line, message):
+    text = (REPO / "examples" / "musen" / "SingelParticle_text.txt").read_text() + line + "\n"
+    (tmp_path / "s.txt").write_text(text)
+    with pytest.raises(InputError) as err:
+        python_api.convert_file(tmp_path / "s.txt", tmp_path / "s.mdem")
+    assert message in err.value.message and err.value.line == text.count("\n")
+    assert not (tmp_path / "s.mdem").exists()
+
+
+def test_text_import_refuses_ids_far_beyond_the_object_count(tmp_path):
+    """.mdem files index objects by id: id 2e7 for one object would be 2e7 empty entries."""
+    (tmp_path / "s.txt").write_text("0 20000000 1 1 5 0.001 0.001 23 X 24 0 1e300 2 0 12 0 0 0\n"
+                                    "32 X glass 0 1000\n")
+    with pytest.raises(InputError, match="far beyond the 1 objects"):
+        python_api.convert_file(tmp_path / "s.txt", tmp_path / "s.mdem")
+
+
+def test_copy_keeps_blocks_another_zlib_compressed(tmp_path):
+    """A block compressed by another zlib or level (here 9) is kept as stored: the copy is
+    the same file and reads the same, never a block that no longer fits its descriptor."""
+    from fibrelmp.translate.musen.mdem.container import ContainerWriter
+
+    with MdemFile(BOUNCE / "bounce_result.mdem") as mdem:
+        storage = mdem.storage
+        blocks = [zlib.compress(mdem.block_bytes(i), 9) for i in range(len(storage.data_blocks))]
+    at = 0
+    for d, b in zip(storage.data_blocks, blocks):
+        d.offset_in_file, d.size = at, len(b)
+        at += len(b)
+    with open(tmp_path / "l9.mdem", "w+b") as fh:
+        w = ContainerWriter(fh)
+        w._block(0, 0)
+        w.write(1, 0, b"".join(blocks))
+        w.write(0, 0, zlib.compress(storage.SerializeToString(), 9))
+        w.finish()
+    python_api.convert_file(tmp_path / "l9.mdem", tmp_path / "copy.mdem")
+    assert (tmp_path / "copy.mdem").read_bytes() == (tmp_path / "l9.mdem").read_bytes()
+    python_api.convert_file(tmp_path / "copy.mdem", tmp_path / "copy.txt", precision=17)
+    assert (tmp_path / "copy.txt").read_bytes() == (BOUNCE / "bounce_result_prec17.txt").read_bytes()

@@ -430,7 +430,7 @@ def format_xyz(codes: np.ndarray, table: list[str], values: np.ndarray, decimals
 MDEM_COLUMNS = 34       # the columns of fp_mdem_decode (see _fastparse.c)
 
 
-def mdem_decode(raw: bytes) -> tuple[float, np.ndarray, np.ndarray] | None:
+def mdem_decode(raw: bytes, most: int | None = None) -> tuple[float, np.ndarray, np.ndarray] | None:
     """A serialized ``ProtoTimePoint``: (time, values (n, 34), field masks (n,) uint32);
     None without the C library; ValueError if malformed."""
     lib = library()
@@ -442,6 +442,8 @@ def mdem_decode(raw: bytes) -> tuple[float, np.ndarray, np.ndarray] | None:
     n = lib.fp_mdem_count(buf.ctypes.data, len(raw))
     if n < 0:
         raise ValueError("malformed time point")
+    if most is not None and n > most:
+        raise ValueError(f"{n} objects in a time point of a scene of {most}")
     values = np.zeros((n, MDEM_COLUMNS))
     masks = np.zeros(n, np.uint32)
     time = ctypes.c_double(0.0)

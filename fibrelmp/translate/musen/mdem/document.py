@@ -33,7 +33,7 @@ def _inflate(data: bytes, limit: int | None, what: str, path: Path) -> bytes:
     """zlib data, decompressed (at most ``limit`` bytes if given)."""
     d = zlib.decompressobj()
     try:
-        out = d.decompress(data, limit or 0)
+        out = d.decompress(data, limit if limit else 0)
         if limit is not None and (d.unconsumed_tail or len(out) > limit):
             raise InputError(path, None, f"corrupt .mdem file: {what} is larger than its "
                              f"descriptor says ({limit} bytes)")
@@ -53,8 +53,10 @@ class MdemFile:
         self.path = Path(path)
         self.container = Container(self.path)
         try:
-            raw = _inflate(self.container.read(0, 0, self.container.sizes[0]), None,
-                           "the scene (file thread 0)", self.path)
+            packed = self.container.read(0, 0, self.container.sizes[0])
+            # a scene compresses a few times (MUSEN's examples: 2.6x-6.5x); far more is a bomb
+            raw = _inflate(packed, 200 * len(packed) + (16 << 20), "the scene (file thread 0)",
+                           self.path)
             try:
                 self.storage: Any = new("ProtoSimulationStorage", raw)
             except DecodeError:
@@ -75,6 +77,9 @@ class MdemFile:
                 raise InputError(self.path, None, f"truncated .mdem file: time-point block {i} "
                                  f"(bytes {d.offset_in_file}..{d.offset_in_file + d.size} of the "
                                  f"time-dependent data) lies beyond its end ({size} bytes)")
+            if d.uncompressed_size < 0 or (d.format == ZIPPED and d.size and not d.uncompressed_size):
+                raise InputError(self.path, None, f"corrupt .mdem file: time-point block {i} has "
+                                 f"uncompressed size {d.uncompressed_size}")
             if d.format not in (PLAIN, ZIPPED) and d.size:
                 raise InputError(self.path, None, f"unsupported .mdem file: time-point block {i} "
                                  f"has storage format {d.format}")
@@ -141,7 +146,10 @@ class MdemFile:
         for index in range(len(self.storage.data_blocks)):
             try:
                 for payload in _messages(self.block_bytes(index), 2):
-                    point = timepoints.decode(payload) if decode else (timepoints.time_of(payload),)
+                    # entries of removed trailing objects may outlast the object list a little;
+                    # far more is a hostile file (each empty entry costs 2 bytes, 272 decoded)
+                    point = (timepoints.decode(payload, 2 * len(self.info.particles) + 1024) if decode
+                             else (timepoints.time_of(payload),))
                     yield point
             except ValueError as exc:
                 raise InputError(self.path, None, f"corrupt .mdem file: time-point block "
@@ -155,9 +163,15 @@ class MdemFile:
         layout: Layout = self.container.layout()
         out = ContainerWriter(fh, layout)
         for index, d in enumerate(self.storage.data_blocks):
+            stored = self.block_raw(index)
             block = self.block(index).SerializeToString()
-            out.write(1, d.offset_in_file, zlib.compress(block, _LEVEL) if d.format == ZIPPED else block)
-        out.write(0, 0, zlib.compress(self.storage.SerializeToString(), _LEVEL))
+            again = zlib.compress(block, _LEVEL) if d.format == ZIPPED else block
+            # another zlib (or level) than MUSEN's gives other bytes for the same message:
+            # then the stored bytes, which hold the same message, are written
+            out.write(1, d.offset_in_file, again if again == stored else stored)
+        stored = self.container.read(0, 0, self.container.sizes[0])
+        again = zlib.compress(self.storage.SerializeToString(), _LEVEL)
+        out.write(0, 0, again if again == stored else stored)
         out.finish()
 
     def close(self) -> None:

@@ -113,7 +113,9 @@ class MdemReader(Reader):
                     frame.bond_tangential_overlap = b[:, columns("angle_vel")]
                     frame.bond_torque = b[:, columns("total_torque").start]
                 if len(walls):
-                    w = values[walls]
+                    w = np.zeros((len(walls), values.shape[1]))      # absent entries: zeros
+                    inside = walls < n
+                    w[inside] = values[walls[inside]]
                     frame.triangle_vertices = np.stack(
                         [w[:, columns("coord")], w[:, q:q + 3], w[:, columns("angle_vel")]], axis=1)
                     frame.triangle_velocity = w[:, columns("vel")]

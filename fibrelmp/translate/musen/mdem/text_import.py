@@ -61,6 +61,12 @@ def import_text(path: str | Path) -> tuple[Any, Iterator[tuple[float, np.ndarray
 
 def _objects(info: Any, scan, ids: np.ndarray) -> None:
     n = int(ids.max()) + 1 if len(ids) else 0
+    if n > 2 ** 31 - 1 or n > 16 * len(ids) + (1 << 20):
+        # MUSEN's objects are particles[id]: ids far beyond the object count mean an array
+        # of mostly empty entries (MUSEN itself stores ids as int32)
+        raise InputError(scan.path, scan.lines[int(np.argmax(ids))], f"object id {n - 1} is far "
+                         f"beyond the {len(ids)} objects of the file (.mdem files index objects "
+                         "by id); renumber the objects")
     for _ in range(n):
         info.particles.add()
     for r, oid in enumerate(ids.tolist()):
@@ -168,46 +174,56 @@ def _scene(storage: Any, scan, path: Path) -> None:
     mods.package_generator.verlet_coeff = 2.0
     geometry = None
     for ln, tag, tok in scan.scene:
-        if tag == 22:
-            v = _floats(tok, path, ln, "22")
-            _vector(info.simulation_volume_min, v[:3])
-            _vector(info.simulation_volume_max, v[3:6])
-        elif tag == 28:
-            v = _floats(tok, path, ln, "28")
-            info.periodic_conditions_enabled, info.periodic_conditions_x, \
-                info.periodic_conditions_y, info.periodic_conditions_z = (bool(x) for x in v[:4])
-            _vector(info.periodic_conditions_min, v[4:7])
-            _vector(info.periodic_conditions_max, v[7:10])
-        elif tag == 29:
-            info.anisotripy = bool(float(tok[0]))
-        elif tag == 30:
-            info.contact_radius = bool(float(tok[0]))
-        elif tag == 25:
-            geometry = _geometry(info.real_geometry.add(), tok, path, ln)
-        elif tag == 26:
-            if geometry is None:
-                raise InputError(path, ln, "`26` (geometry motion) before any `25` geometry")
-            _motion(geometry.base_geometry.motion, tok, path, ln)
-        elif tag == 27:
-            if geometry is None:
-                raise InputError(path, ln, "`27` (geometry walls) before any `25` geometry")
-            geometry.planes.extend(int(float(t)) for t in tok[1:])
-        elif tag == 38:
-            _volume(info.analysis_volume.add(), tok, path, ln)
-        elif tag == 32:
-            _compound(db, tok, path, ln)
-        elif tag == 33:
-            _interaction(db, tok, path, ln)
-        elif tag == 34:
-            _mixture(db, tok, path, ln)
-        elif tag == 39:
-            _package(mods.package_generator.generators.add(), tok, path, ln)
-        elif tag == 40:
-            v = _floats(tok[:2], path, ln, "40")
-            mods.package_generator.simulator_type = int(v[0])
-            mods.package_generator.verlet_coeff = v[1]
-        elif tag == 41:
-            _bonds_generator(mods.bonds_generator.generators.add(), tok, path, ln)
+        try:
+            geometry = _scene_line(info, mods, db, geometry, ln, tag, tok, path)
+        except (IndexError, ValueError, OverflowError, TypeError) as exc:
+            raise InputError(path, ln, f"`{tag}` line cannot be imported: "
+                             f"{'too few values' if isinstance(exc, IndexError) else exc}") from None
+
+
+def _scene_line(info, mods, db, geometry, ln: int, tag: int, tok: list[str], path: Path):
+    """One scene line into the scene message; the geometry lines 26/27 belong to."""
+    if tag == 22:
+        v = _floats(tok, path, ln, "22")
+        _vector(info.simulation_volume_min, v[:3])
+        _vector(info.simulation_volume_max, v[3:6])
+    elif tag == 28:
+        v = _floats(tok, path, ln, "28")
+        info.periodic_conditions_enabled, info.periodic_conditions_x, \
+            info.periodic_conditions_y, info.periodic_conditions_z = (bool(x) for x in v[:4])
+        _vector(info.periodic_conditions_min, v[4:7])
+        _vector(info.periodic_conditions_max, v[7:10])
+    elif tag == 29:
+        info.anisotripy = bool(float(tok[0]))
+    elif tag == 30:
+        info.contact_radius = bool(float(tok[0]))
+    elif tag == 25:
+        geometry = _geometry(info.real_geometry.add(), tok, path, ln)
+    elif tag == 26:
+        if geometry is None:
+            raise InputError(path, ln, "`26` (geometry motion) before any `25` geometry")
+        _motion(geometry.base_geometry.motion, tok, path, ln)
+    elif tag == 27:
+        if geometry is None:
+            raise InputError(path, ln, "`27` (geometry walls) before any `25` geometry")
+        geometry.planes.extend(int(float(t)) for t in tok[1:])
+    elif tag == 38:
+        _volume(info.analysis_volume.add(), tok, path, ln)
+    elif tag == 32:
+        _compound(db, tok, path, ln)
+    elif tag == 33:
+        _interaction(db, tok, path, ln)
+    elif tag == 34:
+        _mixture(db, tok, path, ln)
+    elif tag == 39:
+        _package(mods.package_generator.generators.add(), tok, path, ln)
+    elif tag == 40:
+        v = _floats(tok[:2], path, ln, "40")
+        mods.package_generator.simulator_type = int(v[0])
+        mods.package_generator.verlet_coeff = v[1]
+    elif tag == 41:
+        _bonds_generator(mods.bonds_generator.generators.add(), tok, path, ln)
+    return geometry
 
 
 def _base(base: Any, name: str, key: str) -> None:

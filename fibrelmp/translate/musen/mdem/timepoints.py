@@ -36,17 +36,28 @@ def bit(*names: str) -> int:
 
 
 def time_of(raw: bytes) -> float:
-    """The time of a serialized ``ProtoTimePoint`` (field 1; 0 when absent)."""
+    """The time of a serialized ``ProtoTimePoint`` (field 1; 0 when absent); ValueError if
+    it is malformed."""
+    from google.protobuf.message import DecodeError
+
     tp = new("ProtoTimePoint")
-    tp.MergeFromString(bytes(raw))
+    try:
+        tp.MergeFromString(bytes(raw))
+    except DecodeError as exc:
+        raise ValueError(f"malformed time point ({exc})") from None
     return tp.time
 
 
-def decode(raw: bytes) -> tuple[float, np.ndarray, np.ndarray]:
+def decode(raw: bytes, most: int | None = None) -> tuple[float, np.ndarray, np.ndarray]:
     """(time, values (n, 34), masks (n,)) of a serialized ``ProtoTimePoint``; ValueError if
-    it is malformed."""
-    done = fast.mdem_decode(raw)
-    return done if done is not None else decode_py(raw)
+    it is malformed or holds more than ``most`` objects (checked before allocating)."""
+    done = fast.mdem_decode(raw, most)
+    if done is not None:
+        return done
+    point = decode_py(raw)
+    if most is not None and len(point[2]) > most:
+        raise ValueError(f"{len(point[2])} objects in a time point of a scene of {most}")
+    return point
 
 
 def decode_py(raw: bytes) -> tuple[float, np.ndarray, np.ndarray]:

@@ -18,7 +18,6 @@ import numpy as np
 from fibrelmp.formatbase import Reader, Writer
 
 HEADER = 1024
-MICROMETRE = 1e-6
 _TYPES = {"vec3f": "f4", "vec3d": "f8"}
 _ORDER = {"little_endian": "<", "big_endian": ">"}
 

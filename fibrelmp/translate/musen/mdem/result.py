@@ -153,7 +153,7 @@ class MdemResultWriter(MusenResultWriter):
         as MUSEN saves them (the old list stays, unread)."""
         from fibrelmp.translate.musen.mdem.text_export import (ACTIVE_INTERACTIONS, ACTIVE_PROPERTIES,
                                                                property_value)
-        from fibrelmp.translate.musen.mdem.text_import import set_constant
+        from fibrelmp.translate.musen.mdem.text_import import set_constant, set_motion, set_vector
         from fibrelmp.translate.musen.writer import _property
 
         m, info = self.model, storage.info
@@ -181,27 +181,22 @@ class MdemResultWriter(MusenResultWriter):
                     _replace_property(i.property, pid, values[pid], set_constant)
         plan = m.plan
         if plan.domain is not None:
-            _vector(info.simulation_volume_min, plan.domain[0])
-            _vector(info.simulation_volume_max, plan.domain[1])
+            set_vector(info.simulation_volume_min, plan.domain[0])
+            set_vector(info.simulation_volume_max, plan.domain[1])
         periodic = tuple(bool(p) for p in plan.periodic)
         info.periodic_conditions_enabled = any(periodic)
         info.periodic_conditions_x, info.periodic_conditions_y, info.periodic_conditions_z = periodic
         if plan.periodic_box is not None:
-            _vector(info.periodic_conditions_min, plan.periodic_box[0])
-            _vector(info.periodic_conditions_max, plan.periodic_box[1])
+            set_vector(info.periodic_conditions_min, plan.periodic_box[0])
+            set_vector(info.periodic_conditions_max, plan.periodic_box[1])
         if info.version == 0:
             _geometries_v1(info)
         for geo, g in zip(info.real_geometry, m.geometries):
             if g.motion_type == 1:
                 motion = geo.base_geometry.motion
-                motion.type = 1
-                del motion.intervals[:]
-                for iv in g.motion:
-                    new = motion.intervals.add()
-                    _vector(new.velocity, iv.velocity)
-                    _vector(new.rot_velocity, iv.angular_velocity)
-                    _vector(new.rot_center, iv.centre)
-                    new.limit1, new.limit2 = iv.t_begin, iv.t_end
+                motion.Clear()
+                set_motion(motion, 1, [(iv.t_begin, iv.t_end, iv.velocity, iv.centre,
+                                        iv.angular_velocity) for iv in g.motion])
 
     def _set_settings(self, storage: Any) -> None:
         m, plan = self.model, self.model.plan
@@ -233,11 +228,6 @@ class MdemResultWriter(MusenResultWriter):
 
 
 
-def _vector(msg: Any, values) -> None:
-    msg.SetInParent()
-    msg.x, msg.y, msg.z = (float(v) for v in values)
-
-
 def _replace_property(props: Any, pid: int, value: float, set_constant) -> None:
     """A TP property's value as one constant correlation (``SetPropertyValue``)."""
     for prop in props:
@@ -250,13 +240,14 @@ def _replace_property(props: Any, pid: int, value: float, set_constant) -> None:
 def _geometries_v1(info: Any) -> None:
     """Version-0 geometries and analysis volumes in the current lists (``FlushToStorage``)."""
     from fibrelmp.translate.musen.mdem.text_export import geometries, volumes
+    from fibrelmp.translate.musen.mdem.text_import import relevant_sizes, set_motion, set_vector
 
     del info.real_geometry[:]
     for old, geo in zip(info.real_geometry_v0, geometries(info)):
         new = info.real_geometry.add()
         base = new.base_geometry
         base.name, base.key, base.shape = geo["name"], geo["key"], old.type
-        _motion(base.motion, geo["motion_type"], geo["intervals"])
+        set_motion(base.motion, geo["motion_type"], geo["intervals"])
         if old.HasField("color"):
             base.color.CopyFrom(old.color)
         if old.HasField("rotation"):
@@ -264,7 +255,7 @@ def _geometries_v1(info: Any) -> None:
         base.sizes.extend(old.props)
         base.scaling = 1.0
         new.planes.extend(geo["planes"])
-        _vector(new.free_motion, geo["free"])
+        set_vector(new.free_motion, geo["free"])
         new.mass = geo["mass"]
         new.rotate_around_center = bool(geo["rotate"])
     del info.analysis_volume[:]
@@ -273,31 +264,15 @@ def _geometries_v1(info: Any) -> None:
         base = new.base_geometry
         base.name, base.key, base.shape = vol["name"], vol["key"], vol["shape"]
         base.color.r, base.color.g, base.color.b, base.color.a = vol["colour"]
-        w, d, h, r, ri = vol["sizes"]
-        base.sizes.extend({0: [r], 1: [w, d, h], 2: [r, h], 3: [r, ri]}.get(vol["shape"], []))
+        base.sizes.extend(relevant_sizes(vol["shape"], vol["sizes"]))
         base.scaling = vol["scaling"]
         rot = vol["rotation"]
         for row, msg in enumerate((base.rotation.v1, base.rotation.v2, base.rotation.v3)):
-            _vector(msg, rot[3 * row:3 * row + 3])
-        _motion(base.motion, vol["motion_type"], vol["intervals"])
+            set_vector(msg, rot[3 * row:3 * row + 3])
+        set_motion(base.motion, vol["motion_type"], vol["intervals"])
         for tri in vol["triangles"]:
             t = new.triangles.add()
-            _vector(t.vert1, tri[0:3])
-            _vector(t.vert2, tri[3:6])
-            _vector(t.vert3, tri[6:9])
+            set_vector(t.vert1, tri[0:3])
+            set_vector(t.vert2, tri[3:6])
+            set_vector(t.vert3, tri[6:9])
     info.version = 1
-
-
-def _motion(motion: Any, kind: int, intervals: list[tuple]) -> None:
-    motion.SetInParent()
-    motion.type = kind
-    for a, b, vel, centre, rot in intervals:
-        iv = motion.intervals.add()
-        _vector(iv.velocity, vel)
-        _vector(iv.rot_velocity, rot)
-        _vector(iv.rot_center, centre)
-        iv.limit1 = a
-        if kind == 1:
-            iv.limit2 = b
-        else:
-            iv.limit_type = int(b)

@@ -148,7 +148,8 @@ def _column_mask(mask: int) -> np.ndarray:
 
 
 # ------------------------------------------------------------------------ scene
-def _vector(msg: Any, values) -> None:
+def set_vector(msg: Any, values) -> None:
+    """A ``ProtoVector`` set (present even if all zero, as after MUSEN's ``mutable_...``)."""
     msg.SetInParent()
     msg.x, msg.y, msg.z = (float(v) for v in values)
 
@@ -162,11 +163,11 @@ def _floats(tok: list[str], path: Path, ln: int, what: str) -> list[float]:
 
 def _scene(storage: Any, scan, path: Path) -> None:
     info, mods = storage.info, storage.modules_data
-    _vector(info.simulation_volume_min, (-5e-3,) * 3)            # ClearAllData's domain
-    _vector(info.simulation_volume_max, (5e-3,) * 3)
-    _vector(info.periodic_conditions_min, (-5e-3,) * 3)
-    _vector(info.periodic_conditions_max, (5e-3,) * 3)
-    _vector(info.periodic_conditions_vel, (0.0,) * 3)
+    set_vector(info.simulation_volume_min, (-5e-3,) * 3)            # ClearAllData's domain
+    set_vector(info.simulation_volume_max, (5e-3,) * 3)
+    set_vector(info.periodic_conditions_min, (-5e-3,) * 3)
+    set_vector(info.periodic_conditions_max, (5e-3,) * 3)
+    set_vector(info.periodic_conditions_vel, (0.0,) * 3)
     db = mods.materials_database
     db.SetInParent()
     mods.bonds_generator.SetInParent()              # the generators' SaveConfiguration after import
@@ -185,14 +186,14 @@ def _scene_line(info, mods, db, geometry, ln: int, tag: int, tok: list[str], pat
     """One scene line into the scene message; the geometry lines 26/27 belong to."""
     if tag == 22:
         v = _floats(tok, path, ln, "22")
-        _vector(info.simulation_volume_min, v[:3])
-        _vector(info.simulation_volume_max, v[3:6])
+        set_vector(info.simulation_volume_min, v[:3])
+        set_vector(info.simulation_volume_max, v[3:6])
     elif tag == 28:
         v = _floats(tok, path, ln, "28")
         info.periodic_conditions_enabled, info.periodic_conditions_x, \
             info.periodic_conditions_y, info.periodic_conditions_z = (bool(x) for x in v[:4])
-        _vector(info.periodic_conditions_min, v[4:7])
-        _vector(info.periodic_conditions_max, v[7:10])
+        set_vector(info.periodic_conditions_min, v[4:7])
+        set_vector(info.periodic_conditions_max, v[7:10])
     elif tag == 29:
         info.anisotripy = bool(float(tok[0]))
     elif tag == 30:
@@ -233,9 +234,9 @@ def _base(base: Any, name: str, key: str) -> None:
     base.color.SetInParent()
     base.color.r, base.color.g, base.color.b, base.color.a = 0.5, 0.5, 1.0, 1.0
     base.rotation.SetInParent()
-    _vector(base.rotation.v1, (1, 0, 0))
-    _vector(base.rotation.v2, (0, 1, 0))
-    _vector(base.rotation.v3, (0, 0, 1))
+    set_vector(base.rotation.v1, (1, 0, 0))
+    set_vector(base.rotation.v2, (0, 1, 0))
+    set_vector(base.rotation.v3, (0, 0, 1))
     base.motion.SetInParent()
     base.scaling = 1.0
 
@@ -244,26 +245,45 @@ def _geometry(geo: Any, tok: list[str], path: Path, ln: int) -> Any:
     _base(geo.base_geometry, tok[0], tok[1])
     v = _floats(tok[2:], path, ln, "25")
     geo.mass = v[0]
-    _vector(geo.free_motion, [1.0 if x else 0.0 for x in v[1:4]])
+    set_vector(geo.free_motion, [1.0 if x else 0.0 for x in v[1:4]])
     geo.rotate_around_center = bool(v[4]) if len(v) > 4 else False
     return geo
 
 
 def _motion(motion: Any, tok: list[str], path: Path, ln: int) -> None:
+    """A geometry motion from text: type, count, then per interval two limits and velocity,
+    rotation centre, rotation velocity (``operator<<(CGeometryMotion)``)."""
     v = _floats(tok, path, ln, "26")
     kind, count = int(v[0]), int(v[1]) if len(v) > 1 else 0
-    motion.type = kind
+    intervals = []
     for i in range(count if kind else 0):
         a, b, *rest = v[2 + 11 * i: 13 + 11 * i]
+        intervals.append((a, b, rest[0:3], rest[3:6], rest[6:9]))
+    set_motion(motion, kind, intervals)
+
+
+def set_motion(motion: Any, kind: int, intervals: list[tuple]) -> None:
+    """``ProtoGeometryMotion`` of a type and its intervals (limit1, limit2 or limit type,
+    velocity, rotation centre, rotation velocity), as ``CGeometryMotion::SaveToProto``."""
+    motion.SetInParent()
+    motion.type = kind
+    for a, b, vel, centre, rot in intervals:
         iv = motion.intervals.add()
-        _vector(iv.velocity, rest[0:3])
-        _vector(iv.rot_center, rest[3:6])
-        _vector(iv.rot_velocity, rest[6:9])
+        set_vector(iv.velocity, vel)
+        set_vector(iv.rot_center, centre)
+        set_vector(iv.rot_velocity, rot)
         iv.limit1 = a
         if kind == 1:
             iv.limit2 = b
         else:
             iv.limit_type = int(b)
+
+
+def relevant_sizes(shape: int, sizes: list[float]) -> list[float]:
+    """``CGeometrySizes::RelevantSizes``: of width, depth, height, radius, inner radius,
+    those a shape stores."""
+    w, d, h, r, ri = sizes
+    return {0: [r], 1: [w, d, h], 2: [r, h], 3: [r, ri]}.get(shape, [])
 
 
 def _volume(vol: Any, tok: list[str], path: Path, ln: int) -> None:
@@ -272,12 +292,11 @@ def _volume(vol: Any, tok: list[str], path: Path, ln: int) -> None:
     v = _floats(tok[2:23], path, ln, "38")
     base.shape = int(v[0])
     base.color.r, base.color.g, base.color.b, base.color.a = v[1:5]
-    w, d, h, r, ri = v[5:10]
     del base.sizes[:]
-    base.sizes.extend({0: [r], 1: [w, d, h], 2: [r, h], 3: [r, ri]}.get(base.shape, []))
+    base.sizes.extend(relevant_sizes(base.shape, v[5:10]))
     base.scaling = v[10]
     for row, msg in zip(range(3), (base.rotation.v1, base.rotation.v2, base.rotation.v3)):
-        _vector(msg, v[11 + 3 * row: 14 + 3 * row])
+        set_vector(msg, v[11 + 3 * row: 14 + 3 * row])
     rest = tok[23:]
     kind = int(float(rest[0]))
     count = int(float(rest[1])) if kind else 0
@@ -287,9 +306,9 @@ def _volume(vol: Any, tok: list[str], path: Path, ln: int) -> None:
     values = _floats(mesh[2:2 + 9 * ntri], path, ln, "38")
     for i in range(ntri):
         t = vol.triangles.add()
-        _vector(t.vert1, values[9 * i:9 * i + 3])
-        _vector(t.vert2, values[9 * i + 3:9 * i + 6])
-        _vector(t.vert3, values[9 * i + 6:9 * i + 9])
+        set_vector(t.vert1, values[9 * i:9 * i + 3])
+        set_vector(t.vert2, values[9 * i + 3:9 * i + 6])
+        set_vector(t.vert3, values[9 * i + 6:9 * i + 9])
 
 
 def set_constant(prop: Any, pid: int, value: float) -> None:
@@ -360,7 +379,7 @@ def _package(gen: Any, tok: list[str], path: Path, ln: int) -> None:
     gen.volume_key, gen.mixture_key = tok[2], tok[3]
     v = _floats(tok[4:11], path, ln, "39")
     gen.porosity, gen.max_overlap, gen.max_iterations = v[0], v[1], int(v[2])
-    _vector(gen.init_velocity, v[3:6])
+    set_vector(gen.init_velocity, v[3:6])
     gen.inside_geometry = bool(v[6])
 
 

@@ -93,6 +93,7 @@ class Writer(ABC):
         self._staged: dict[Path, Path] = {}        # final path -> temp path
         self._handles: dict[Path, IO] = {}         # final path -> open temp file
         self._parts: list[Writer] = []             # writers whose files belong to this output
+        self._settled = False                      # prepare() wrote everything already
         existing = [p for p in self.outputs() if p.exists()]
         if existing and not force:
             raise InputError(existing[0], None, "output exists; use --force to overwrite")
@@ -174,12 +175,29 @@ class Writer(ABC):
             raise
         self.count += 1
 
+    def prepare(self) -> None:
+        """Write everything still to come (``finish``) and close the temp files, renaming
+        nothing yet: ``close`` then only renames.  A run prepares all its writers before
+        closing any, so that a failure in one leaves no output of the others in place."""
+        if self.closed or self._settled:
+            return
+        try:
+            self._settle()
+        except OSError as exc:
+            self.abort()
+            raise write_failure(getattr(exc, "output", None) or self.target, exc) from None
+        except BaseException:
+            self.abort()
+            raise
+        self._settled = True
+
     def close(self) -> list[Path]:
         """Finish, then rename every staged file into place; returns the final paths."""
         if self.closed:
             return []
         try:
-            self._settle()
+            if not self._settled:
+                self._settle()
             done = self._commit()
         except OSError as exc:            # from finish(): it names no file
             self.abort()

@@ -231,7 +231,7 @@ def check(path: str | Path, *, stock_styles: bool = False) -> CheckReport:
     hook = fmt.load(INPUT)()
     model = _read_for_check(lambda: hook.model(path), lambda: hook.check_patch(path))
     with lammps_styles.stock(stock_styles):     # the wall lines depend on the styles too
-        styles = lammps_styles.plugin().describe()
+        styles = lammps_styles.plugin().describe() if hook.styles is None else hook.styles
         lines = hook.check_lines(path, model)
         lines[-1:-1] = [f"{'styles':<12} {styles}"]      # before the last line: where results go
     return CheckReport(fmt.name, lines, list(model.warnings))

@@ -371,7 +371,7 @@ def summary_lines(s: dict) -> list[str]:
                  f"{g(s['time']['end'])}, dt {g(s['time_step'])}; {s['frames']} frames")
     rate = f" ({s['steps_per_second']:.4g} steps/s)" if s.get("steps_per_second") else ""
     lines.append(f"  wall time  {s['wall_time']:.3g} s{rate}")
-    e0, e1 = s["energy"]["start"], s["energy"]["end"]
+    e0, e1 = s.get("energy", {}).get("start"), s.get("energy", {}).get("end")
     if e0 or e1:
         parts = []
         for name in ENERGY_COLUMNS.values():
@@ -389,6 +389,11 @@ def summary_lines(s: dict) -> list[str]:
         most = ("largest overlap " + (f"{ov['value']:.3g} ({100 * ov['relative']:.3g} % of the "
                 f"smaller radius, spheres {ov['ids'][0]}-{ov['ids'][1]})" if ov else "none"))
         lines.append(f"  contacts   {g(s.get('contacts'), 'd')} overlapping sphere pairs; {most}")
+    elif p["kind"] == "sph":
+        lines.append(f"  fluid      {p['fluid_start']} -> {p['fluid_end']} particles; {p['wall']} wall particles")
+        for name, o in s.get("openings", {}).items():
+            lines.append(f"  opening    {name}: {o['crossed_particles']} particles crossed "
+                         f"({o['crossed_volume']:.4g} m^3)")
     else:
         lines.append(f"  beads      {p['start']}")
     if "bonds" in s:

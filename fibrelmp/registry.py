@@ -183,6 +183,12 @@ register_format(Format(
     magic=re.compile(rb"\A\s*(0\s+\d+\s+1\s+\d+\s+5\b|(22|32)\s+\S)"),
     example="examples/musen/SingelParticle_text.txt", home="fibrelmp.translate.musen"))
 register_format(Format(
+    # JSON whose first key is "cardioproof" (before DEMDF, whose magic is any JSON object)
+    "cardioproof", "a CardioProof case (JSON: moving FE wall, SPH water, outflow openings)", "si",
+    {INPUT: "fibrelmp.pipeline.inputs.cardioproof:CaseInput"},
+    magic=re.compile(rb'\A\s*\{\s*"cardioproof"\s*:'),
+    example="examples/cardioproof/piston_tube.json", home="fibrelmp.cardioproof"))
+register_format(Format(
     "demdf", "a DEMDF JSON file (input or snapshot)", "dimensionless",
     {INPUT: "fibrelmp.pipeline.inputs.demdf:DemdfInput",
      RESULT: "fibrelmp.translate.demdf.writer:DemdfSnapshotWriter",

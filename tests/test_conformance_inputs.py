@@ -12,6 +12,7 @@ from pathlib import Path
 import pytest
 
 from fibrelmp import python_api
+from fibrelmp.cardioproof.case import SphCase
 from fibrelmp.errors import InputError
 from fibrelmp.granmodel import GranularModel
 from fibrelmp.model import Model
@@ -37,7 +38,7 @@ def _files(folder: Path) -> set[Path]:
 
 
 def test_every_input_format_has_a_hook_and_an_example():
-    assert [f.name for f in FORMATS] == ["fibrenet", "musen-script", "mdem", "musen", "demdf"]
+    assert [f.name for f in FORMATS] == ["fibrenet", "musen-script", "mdem", "musen", "cardioproof", "demdf"]
     for fmt in FORMATS:
         assert (REPO / fmt.example).is_file(), fmt.name
         hook = fmt.load(INPUT)
@@ -50,7 +51,7 @@ def test_detect_read_check_translate(example, tmp_path):
     hook = fmt.load(INPUT)()
     assert python_api.read(path) is not None
     model = hook.model(path)
-    assert isinstance(model, (Model, GranularModel))
+    assert isinstance(model, (Model, GranularModel, SphCase))
 
     report = python_api.check(path)
     assert report.format == fmt.name

@@ -26,7 +26,7 @@ def test_total_force_is_minus_p_a_n_every_cycle():
     for cycle in range(20):
         rot = _rotation(rng)
         opening = _square(size=1.5 + cycle * 0.1, tilt=rot)
-        x = (rng.random((4000, 3)) * [2.0, 2.0, 0.6] - [0.2, 0.2, 0.3]) @ rot.T
+        x = (rng.random((4000, 3)) * [2.0, 2.0, 0.6] - [0.2, 0.2, 0.4]) @ rot.T
         p = 1000.0 + 50.0 * np.sin(cycle)
         s = share(opening, x, 0.2, p)
         expected = -p * opening.area * opening.normal
@@ -38,10 +38,11 @@ def test_total_force_is_minus_p_a_n_every_cycle():
 def test_half_the_search_distance_gets_half_the_weight():
     opening = _square()
     d = 0.4
-    x = np.array([[1.0, 1.0, 0.0], [0.5, 0.5, -0.2], [1.5, 1.2, 0.2], [1.0, 1.0, 0.41]])
+    # on the plane, at d/2 behind it (the fluid's side), in front of it (has left), beyond d
+    x = np.array([[1.0, 1.0, 0.0], [0.5, 0.5, -0.2], [1.5, 1.2, 0.2], [1.0, 1.0, -0.41], [1.2, 0.7, -0.4]])
     s = share(opening, x, d, 100.0)
-    assert s.rows.tolist() == [0, 1, 2]                    # the last is beyond d
-    np.testing.assert_allclose(s.weight, [1.0, 0.5, 0.5], rtol=1e-15)
+    assert s.rows.tolist() == [0, 1, 4]
+    np.testing.assert_allclose(s.weight, [1.0, 0.5, 0.0], rtol=1e-15, atol=1e-15)
     norms = np.linalg.norm(s.force, axis=1)
     np.testing.assert_allclose(norms[1] / norms[0], 0.5, rtol=1e-15)
 
@@ -51,9 +52,9 @@ def test_projection_margin_and_bounding_box():
     d = 0.5
     # projections just inside the 3 % margin beyond an edge (of a triangle 2 long: 0.06) and
     # just outside it; one particle inside the box but beside the opening
-    inside = [2.0 + 0.9 * MARGIN * 2.0, 1.0, 0.1]
-    outside = [2.0 + 1.1 * MARGIN * 2.0, 1.0, 0.1]
-    far = [2.4, 1.0, 0.1]
+    inside = [2.0 + 0.9 * MARGIN * 2.0, 1.0, -0.1]
+    outside = [2.0 + 1.1 * MARGIN * 2.0, 1.0, -0.1]
+    far = [2.4, 1.0, -0.1]
     rows, _ = near(opening, np.array([inside, outside, far]), d)
     assert rows.tolist() == [0]
 
@@ -70,6 +71,10 @@ def test_flux_estimates():
     v = np.tile([0.0, 0.0, u], (len(x), 1))
     crossing, velocity = flux(opening, x, x + v * dt, v, 0.1, h ** 3)
     assert abs(velocity - opening.area * u) < 1e-12
+    # the particles that cross in one cycle are those within u dt behind the plane
+    rows, _ = near(opening, x, 0.1)
+    behind = -((x[rows] - [0, 0, 0]) @ opening.normal)
+    assert abs(crossing - np.count_nonzero(behind < u * dt) * h ** 3) < 1e-15
     # lattice planes 0.02 apart move 0.002 per cycle: 1 in 10 cycles crosses; over 10 cycles
     # the crossing estimate averages A u dt
     total = 0.0

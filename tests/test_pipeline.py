@@ -80,3 +80,26 @@ def test_python_api_has_no_format_branches():
             assert not any(isinstance(c, ast.Constant) and c.value in names for c in node.comparators)
         if isinstance(node, ast.Constant) and isinstance(node.value, str):
             assert node.value not in names, node.value
+
+
+def test_a_writer_failing_at_the_end_leaves_no_output_of_the_others(tmp_path):
+    """``feed`` prepares every writer (their last files written) before renaming any file into
+    place: the last writer failing in ``finish`` leaves nothing of the first one."""
+    from fibrelmp.formatbase import Writer
+    from fibrelmp.pipeline.run import feed
+
+    class Lines(Writer):
+        def write(self, frame) -> None:
+            self.put(self.target, f"{frame}\n".encode())
+
+    class FailsAtTheEnd(Lines):
+        def finish(self) -> None:
+            raise ValueError("cannot finish")
+
+    first, second = Lines(tmp_path / "a.txt"), FailsAtTheEnd(tmp_path / "b.txt")
+    with pytest.raises(ValueError, match="cannot finish"):
+        feed([first, second])(iter([1, 2, 3]))
+    assert sorted(p.name for p in tmp_path.iterdir()) == []
+    ok = Lines(tmp_path / "c.txt")
+    assert feed([ok])(iter([1, 2])) == [tmp_path / "c.txt"]
+    assert (tmp_path / "c.txt").read_text() == "1\n2\n"

@@ -6,8 +6,10 @@ Each cycle, with the mesh where it is now:
 1. candidates are the particles inside the opening's bounding box enlarged by the search
    distance ``d`` on every side;
 2. a candidate is *near* the opening if its projection on some element's plane falls inside
-   that element (barycentric coordinates >= -3 %, the projection margin) and its distance to
-   that plane is at most ``d`` (the closest such element counts);
+   that element (barycentric coordinates >= -3 %, the projection margin) and it is on the
+   fluid's side of that plane (behind it: the outward normal points away) at a distance of at
+   most ``d`` (the closest such element counts); particles in front of the plane have left
+   (the LAMMPS run removes them and counts them as crossed);
 3. near particles share the force ``-p(t) A n`` (A the opening's area, n its area-weighted unit
    outward normal), weighted linearly by normal distance: ``w = 1 - delta/d`` (1 on the plane,
    1/2 at half the search distance);
@@ -70,7 +72,7 @@ class Share:
 
 
 def near(opening: Opening, x: np.ndarray, d: float) -> tuple[np.ndarray, np.ndarray]:
-    """(rows, normal distance) of the particles near the opening (steps 1-2)."""
+    """(rows, normal distance >= 0) of the particles near the opening (steps 1-2)."""
     t = opening.triangles
     lo, hi = t.reshape(-1, 3).min(axis=0) - d, t.reshape(-1, 3).max(axis=0) + d
     rows = np.flatnonzero(np.all((x >= lo) & (x <= hi), axis=1))
@@ -89,8 +91,8 @@ def near(opening: Opening, x: np.ndarray, d: float) -> tuple[np.ndarray, np.ndar
     beta = (d11 * d20 - d01 * d21) / den
     gamma = (d00 * d21 - d01 * d20) / den
     alpha = 1.0 - beta - gamma
-    inside = (alpha >= -MARGIN) & (beta >= -MARGIN) & (gamma >= -MARGIN) & (np.abs(delta) <= d)
-    dist = np.where(inside, np.abs(delta), np.inf)
+    inside = (alpha >= -MARGIN) & (beta >= -MARGIN) & (gamma >= -MARGIN) & (delta <= 0) & (delta >= -d)
+    dist = np.where(inside, -delta, np.inf)
     best = dist.min(axis=1)
     keep = np.isfinite(best)
     return rows[keep], best[keep]
@@ -110,12 +112,12 @@ def share(opening: Opening, x: np.ndarray, d: float, pressure: float) -> Share:
 def flux(opening: Opening, x_before: np.ndarray, x_now: np.ndarray, v_now: np.ndarray,
          d: float, particle_volume: float) -> tuple[float, float]:
     """(crossing estimate, velocity estimate) of the outward volume flux over one cycle:
-    the volume of particles near the opening that went from behind its plane to in front of
-    it (per cycle), and A x the mean outward normal velocity of the near particles."""
+    the volume of the particles that were near the opening (behind its plane) at the last
+    cycle and are in front of it now, and A x the mean outward normal velocity of the
+    particles near it now."""
     n, origin = opening.normal, opening.triangles[:, 0].mean(axis=0)
+    was, _ = near(opening, x_before, d)
+    crossed = int(np.count_nonzero((x_now[was] - origin) @ n > 0))
     rows, _ = near(opening, x_now, d)
-    before = (x_before[rows] - origin) @ n
-    after = (x_now[rows] - origin) @ n
-    crossed = int(np.count_nonzero((before < 0) & (after >= 0)))
     mean_vn = float((v_now[rows] @ n).mean()) if len(rows) else 0.0
     return crossed * particle_volume, opening.area * mean_vn

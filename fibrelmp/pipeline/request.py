@@ -88,6 +88,8 @@ class RunRequest:
     frames: Callable[[Rendered], FrameSource]          # reads the frames the job saves
     results: Callable[[Rendered], Consumer]            # the native writers (rank 0 only)
     work: Path                                         # the job folder
+    # what the run summary records (None: fibrelmp.record.Recorder, FibreNet and granular runs)
+    recorder: Callable[[Any, Any, str], Any] | None = None
 
 
 @dataclass

@@ -105,7 +105,7 @@ def simulate(request: RunRequest, options: RunOptions, rank: int = 0, size: int 
             dump.unlink(missing_ok=True)
     if rank == 0:            # an earlier run's summary must not pass for this run's
         (rendered.folder / SUMMARY_NAME).unlink(missing_ok=True)
-    record = Recorder(request.model, rendered.job, rendered.text)
+    record = (request.recorder or Recorder)(request.model, rendered.job, rendered.text)
     started = time.monotonic()
     if rank != 0:            # the same script text; LAMMPS reads the data file on rank 0 only
         with _hint(request.model):
@@ -259,6 +259,19 @@ def feed(writers: list) -> Consumer:
             for writer in writers:
                 writer.abort()
             raise
+        # every writer writes its last files before any file is renamed into place: a
+        # writer failing at the end leaves no output of the others behind
+        for k, writer in enumerate(writers):
+            prepare = getattr(writer, "prepare", None)
+            if prepare is None:
+                continue
+            try:
+                prepare()
+            except BaseException:
+                for other in writers:
+                    if other is not writer:
+                        other.abort()
+                raise
         written: list[Path] = []
         for k, writer in enumerate(writers):
             try:

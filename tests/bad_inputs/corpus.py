@@ -304,6 +304,26 @@ def _set(offset: int, value: bytes) -> Callable[[bytearray], None]:
     return edit
 
 
+def _case(edit: Callable[[str], str], spoil: Callable[[Path], None] | None = None,
+          command: str = "check") -> Callable[[Path], list[str]]:
+    """A copy of the CardioProof piston-tube example with its case file (and files) spoilt."""
+    def make(tmp: Path) -> list[str]:
+        example = CORPUS.parents[1] / "examples" / "cardioproof"
+        for f in example.glob("piston_tube.*"):
+            (tmp / f.name).write_bytes(f.read_bytes())
+        case = tmp / "piston_tube.json"
+        case.write_text(edit(case.read_text()))
+        if spoil is not None:
+            spoil(tmp)
+        return [command, str(case)]
+    return make
+
+
+def _truncate_dynpt(tmp: Path) -> None:
+    path = tmp / "piston_tube.dynpt"
+    path.write_bytes(path.read_bytes()[:-100])
+
+
 def _device(tmp: Path) -> list[str]:
     return ["check", "/dev/zero"]
 
@@ -345,6 +365,21 @@ GENERATED = [
          make=_mdem(_set(2200, b"@" * 100))),
     Case("generated/mdem_run_truncated", "MUSEN .mdem", "", "run of a .mdem cut in its time "
          "points", make=_mdem(lambda d: d.__delitem__(slice(6300, None)), "run")),
+    Case("generated/case_syntax", "CardioProof case", "", "a case file that is not valid JSON",
+         make=_case(lambda t: t.replace('"run":', '"run"'))),
+    Case("generated/case_version", "CardioProof case", "", "case file version 2",
+         make=_case(lambda t: t.replace('"cardioproof": 1', '"cardioproof": 2'))),
+    Case("generated/case_no_opening_elements", "CardioProof case", "", "an opening whose tags "
+         "select no element", make=_case(lambda t: t.replace('"tags": [3]', '"tags": [7]'))),
+    Case("generated/case_moving_opening", "CardioProof case", "", "the moving piston named as "
+         "the opening", command="run",
+         make=_case(lambda t: t.replace('"tags": [3]', '"tags": [2]'), command="run")),
+    Case("generated/case_end_time", "CardioProof case", "", "end time beyond the last motion frame",
+         make=_case(lambda t: t.replace('"end_time": 0.01', '"end_time": 0.5'))),
+    Case("generated/case_dynpt_truncated", "CardioProof case", "", "a .dynpt shorter than its "
+         "header says", make=_case(lambda t: t, _truncate_dynpt)),
+    Case("generated/case_mesh_missing", "CardioProof case", "", "the mesh file named is missing",
+         make=_case(lambda t: t.replace('"file": "piston_tube.pts"', '"file": "none.pts"'))),
 ]
 
 CASES: list[Case] = (FIBRENET + FIBRENET_MODEL + MUSEN + MUSEN_SCRIPT + DEMDF + DUMP + GENERIC

@@ -43,6 +43,8 @@ class InputFormat(ABC):
     """The hook of one input format."""
 
     name: ClassVar[str] = ""            # the registry name
+    # what ``check`` says about the LAMMPS styles a job uses (None: fibrelmp's plugin or stock)
+    styles: ClassVar[str | None] = None
 
     @abstractmethod
     def read(self, path: Path) -> Any:

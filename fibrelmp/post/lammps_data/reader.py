@@ -41,12 +41,13 @@ STYLE_COLUMNS = {
     "sphere": ["id", "type", "diameter", "density", "x"],
     "bpm/sphere": ["id", "mol", "type", "diameter", "density", "x"],
     "ellipsoid": ["id", "type", "ellipsoidflag", "density", "x"],
+    "sph": ["id", "type", "rho", "esph", "cv", "x"],
 }
 # extra per-atom fields each sub-style adds after "id type x y z" in atom_style hybrid
 HYBRID_FIELDS = {
     "atomic": [], "charge": ["q"], "bond": ["mol"], "angle": ["mol"], "molecular": ["mol"],
     "full": ["mol", "q"], "sphere": ["diameter", "density"], "bpm/sphere": ["mol", "diameter", "density"],
-    "ellipsoid": ["ellipsoidflag", "density"], "mdpd": ["rho"],
+    "ellipsoid": ["ellipsoidflag", "density"], "mdpd": ["rho"], "sph": ["rho", "esph", "cv"],
 }
 
 

@@ -1,0 +1,246 @@
+"""The CardioProof case file: a JSON document whose first key is ``"cardioproof"``.
+
+::
+
+    {"cardioproof": 1,
+     "mesh":    {"file": "tube.pts", "unit": 1e-6},          # openCARP (µm) or VTK (m); a string works
+     "motion":  {"file": "tube.dynpt", "frame_interval": 1e-3},   # or {"meshes": [...]}; optional
+     "fluid":   {"spacing": 1e-4, "density": 1000, "artificial_viscosity": 0.1, "sound_speed": 5.0},
+     "wall":    {"layers": 3},
+     "openings": [{"name": "outlet", "tags": [3], "pressure": [[0, 0], [0.01, 50]],
+                   "search_distance": 2e-4}],
+     "run":     {"end_time": 0.01},
+     "output":  {"interval": 1e-3, "series_interval": 1e-4}}
+
+Everything in SI units except the mesh coordinates, which keep their file's unit (``unit``:
+metres per coordinate unit; openCARP files default to µm, VTK files to m).  Paths are relative
+to the case file.  docs/cardioproof.md describes every key and its default.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from fibrelmp.errors import InputError
+from fibrelmp.lammps_text import lammps_word
+from fibrelmp.mesh.model import Mesh
+from fibrelmp.translate.demdf.json_doc import JsonDoc, load_json
+
+VERSION = 1
+ARTIFICIAL_VISCOSITY = 0.1   # Monaghan's alpha when the case gives no viscosity
+SMOOTHING_RATIO = 2.6          # kernel cutoff h / particle spacing (LAMMPS's SPH examples)
+CFL = 0.1                      # dt <= CFL h / c0 (LAMMPS's SPH examples)
+KEYS = {"cardioproof", "mesh", "motion", "fluid", "wall", "openings", "run", "output", "comment"}
+
+
+@dataclass
+class Opening:
+    name: str                      # a LAMMPS word (IDs of its regions, fixes, variables)
+    elements: np.ndarray           # indices into the mesh's shell elements (file order)
+    pressure: np.ndarray           # (k, 2) time [s], pressure [Pa]; linear, held beyond the ends
+    search_distance: float         # m
+
+
+@dataclass
+class Motion:
+    kind: str                      # "dynpt" | "meshes"
+    files: list[Path]
+    frame_interval: float          # s between frames
+    count: int                     # frames
+
+
+@dataclass
+class SphCase:
+    source: Path
+    mesh: Mesh
+    mesh_file: Path
+    motion: Motion | None
+    spacing: float                 # m, particle spacing dx
+    density: float                 # kg/m^3
+    viscosity: float | None        # Pa s (dynamic; Morris's laminar viscosity) or None
+    artificial_viscosity: float | None   # Monaghan's alpha (sph/taitwater) or None
+    sound_speed: float | None      # m/s (None: from the motion, see job.sound_speed)
+    smoothing_ratio: float
+    layers: int
+    openings: list[Opening]
+    end_time: float
+    time_step: float | None
+    cfl: float
+    save_interval: float
+    series_interval: float | None
+    name: str
+    kind: str = "cardioproof"
+    units: str = "si"
+    warnings: list[tuple[str, str]] = field(default_factory=list)
+    plan: dict | None = field(default=None, repr=False)       # cardioproof.job.plan_job's, once
+
+    @property
+    def smoothing(self) -> float:
+        """h: the kernel's cutoff (m)."""
+        return self.smoothing_ratio * self.spacing
+
+
+def read_case(path: str | Path) -> SphCase:
+    """The case file at ``path`` and the mesh (and motion header) it names."""
+    path = Path(path)
+    doc = load_json(path, "CardioProof case file")
+    j = JsonDoc(path)
+    doc = j.obj(doc, "")
+    unknown = sorted(set(doc) - KEYS)
+    if unknown:
+        j.fail(unknown[0], f"unknown key (known: {', '.join(sorted(KEYS))})")
+    version = j.integer(doc.get("cardioproof"), "cardioproof")
+    if version != VERSION:
+        j.fail("cardioproof", f"case file version {version}: this fibrelmp reads version {VERSION}")
+    folder = path.parent
+
+    mesh_spec = doc.get("mesh")
+    if isinstance(mesh_spec, str):
+        mesh_spec = {"file": mesh_spec}
+    mesh_spec = j.obj(mesh_spec, "mesh")
+    mesh_file = folder / j.string(mesh_spec.get("file"), "mesh.file")
+    unit = mesh_spec.get("unit")
+    mesh = read_mesh(mesh_file, None if unit is None else j.number(unit, "mesh.unit", positive=True))
+
+    fluid = j.obj(doc.get("fluid"), "fluid")
+    dx = j.number(fluid.get("spacing"), "fluid.spacing", positive=True)
+    density = j.number(fluid.get("density", 1000.0), "fluid.density", positive=True)
+    if "viscosity" in fluid and "artificial_viscosity" in fluid:
+        j.fail("fluid", "give either viscosity (laminar, Morris) or artificial_viscosity (Monaghan's "
+               "alpha): LAMMPS's Tait-water styles take one of them")
+    viscosity = None
+    alpha = ARTIFICIAL_VISCOSITY
+    if "viscosity" in fluid:
+        viscosity = j.number(fluid["viscosity"], "fluid.viscosity", positive=True)
+        alpha = None
+    elif "artificial_viscosity" in fluid:
+        alpha = j.number(fluid["artificial_viscosity"], "fluid.artificial_viscosity", minimum=0.0)
+    c0 = fluid.get("sound_speed")
+    c0 = None if c0 is None else j.number(c0, "fluid.sound_speed", positive=True)
+    ratio = j.number(fluid.get("smoothing_ratio", SMOOTHING_RATIO), "fluid.smoothing_ratio", positive=True)
+    if not 1.5 <= ratio <= 4.0:
+        j.fail("fluid.smoothing_ratio", f"{ratio:g}: the kernel cutoff must be 1.5 to 4 spacings")
+    wall = j.obj(doc.get("wall", {}), "wall")
+    layers = j.integer(wall.get("layers", math.ceil(ratio)), "wall.layers", minimum=1)
+    if layers > 8:
+        j.fail("wall.layers", f"{layers}: at most 8 layers")
+
+    motion = _motion(j, doc.get("motion"), folder, mesh)
+    run = j.obj(doc.get("run"), "run")
+    end_time = j.number(run.get("end_time"), "run.end_time", positive=True)
+    dt = run.get("time_step")
+    dt = None if dt is None else j.number(dt, "run.time_step", positive=True)
+    cfl = j.number(run.get("cfl", CFL), "run.cfl", positive=True)
+    if motion is not None and end_time > (motion.count - 1) * motion.frame_interval * (1 + 1e-12):
+        j.fail("run.end_time", f"{end_time:g} s is beyond the last motion frame "
+               f"({(motion.count - 1) * motion.frame_interval:g} s)")
+    output = j.obj(doc.get("output", {}), "output")
+    save = j.number(output.get("interval", end_time / 10), "output.interval", positive=True)
+    series = output.get("series_interval")
+    series = None if series is None else j.number(series, "output.series_interval", positive=True)
+    name = lammps_word(j.string(output.get("name", path.stem), "output.name"), path, None, "output.name")
+
+    openings = _openings(j, doc.get("openings", []), mesh, dx)
+    return SphCase(path, mesh, mesh_file, motion, dx, density, viscosity, alpha, c0, ratio, layers,
+                   openings, end_time, dt, cfl, save, series, str(name))
+
+
+def read_mesh(path: Path, unit: float | None) -> Mesh:
+    """A mesh file of any registered mesh format (by extension); ``unit``: metres per
+    coordinate unit (None: the format's own)."""
+    from fibrelmp import registry
+
+    suffix = path.suffix.lower()
+    for fmt in registry.formats(registry.MESH):
+        if suffix in fmt.extensions:
+            hook = fmt.load(registry.MESH)
+            if fmt.name == "opencarp":
+                mesh = hook.reader(path).read()
+                if unit is not None:
+                    mesh.unit = unit
+            else:
+                mesh = hook.reader(path, unit=1.0 if unit is None else unit).read()
+            return mesh
+    exts = ", ".join(e for f in registry.formats(registry.MESH) for e in f.extensions)
+    raise InputError(path, None, f"not a mesh file fibrelmp reads (extensions: {exts})")
+
+
+def _motion(j: JsonDoc, spec: Any, folder: Path, mesh: Mesh) -> Motion | None:
+    if spec is None:
+        return None
+    spec = j.obj(spec, "motion")
+    interval = spec.get("frame_interval")
+    if "file" in spec:
+        from fibrelmp.mesh.opencarp.dynpt import DynptReader
+
+        file = folder / j.string(spec["file"], "motion.file")
+        reader = DynptReader(file)
+        if reader.nodes != len(mesh.points):
+            raise InputError(file, None, f"{reader.nodes} nodes per frame, the mesh has {len(mesh.points)}")
+        if interval is None:
+            # openCARP's time unit is the millisecond (unites_t says otherwise)
+            scale = 1.0 if reader.header.get("unites_t", "ms") == "s" else 1e-3
+            interval = reader.inc_t * scale
+        count, files, kind = reader.count, [file], "dynpt"
+    elif "meshes" in spec:
+        items = j.array(spec["meshes"], "motion.meshes")
+        files = [folder / j.string(f, f"motion.meshes[{k}]") for k, f in enumerate(items)]
+        count, kind = len(files), "meshes"
+        if interval is None:
+            j.fail("motion.frame_interval", "needed with a mesh series")
+    else:
+        j.fail("motion", "give 'file' (a .dynpt) or 'meshes' (one mesh file per frame)")
+    interval = j.number(interval, "motion.frame_interval", positive=True)
+    if count < 2:
+        j.fail("motion", f"{count} frame(s): a motion needs at least two")
+    return Motion(kind, files, interval, count)
+
+
+def _openings(j: JsonDoc, spec: Any, mesh: Mesh, dx: float) -> list[Opening]:
+    from fibrelmp.cardioproof.geometry import shell_elements
+
+    items = j.array(spec, "openings")
+    _, tags = shell_elements(mesh)
+    out, taken, names = [], np.zeros(len(tags), bool), set()
+    for k, item in enumerate(items):
+        where = f"openings[{k}]"
+        item = j.obj(item, where)
+        name = str(lammps_word(j.string(item.get("name", f"opening{k + 1}"), f"{where}.name"),
+                               j.path, None, f"{where}.name"))
+        if name in names:
+            j.fail(f"{where}.name", f"{name!r} is used twice")
+        names.add(name)
+        chosen = np.zeros(len(tags), bool)
+        for t in j.array(item.get("tags", []), f"{where}.tags"):
+            chosen |= tags == j.integer(t, f"{where}.tags")
+        for e in j.array(item.get("elements", []), f"{where}.elements"):
+            e = j.integer(e, f"{where}.elements", minimum=0)
+            if e >= len(tags):
+                j.fail(f"{where}.elements", f"element {e}: the mesh has {len(tags)} shell elements")
+            chosen[e] = True
+        if not chosen.any():
+            j.fail(where, "selects no shell element (give 'tags' or 'elements')")
+        if (chosen & taken).any():
+            j.fail(where, "shares elements with an earlier opening")
+        taken |= chosen
+        pressure = item.get("pressure", 0.0)
+        if isinstance(pressure, list):
+            rows = [j.vector(r, 2, f"{where}.pressure[{i}]", "[time, pressure]")
+                    for i, r in enumerate(pressure)]
+            table = np.array(rows, float).reshape(-1, 2)
+            if not len(table):
+                j.fail(f"{where}.pressure", "an empty table")
+            if np.any(np.diff(table[:, 0]) <= 0):
+                j.fail(f"{where}.pressure", "times must increase")
+        else:
+            table = np.array([[0.0, j.number(pressure, f"{where}.pressure")]])
+        d = j.number(item.get("search_distance", 2.0 * dx), f"{where}.search_distance", positive=True)
+        out.append(Opening(name, np.flatnonzero(chosen), table, d))
+    if taken.all():
+        j.fail("openings", "every shell element is an opening: there is no wall")
+    return out

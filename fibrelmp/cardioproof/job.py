@@ -50,6 +50,7 @@ class OpeningGeometry:
     distance: float            # search distance d
     pressure: np.ndarray       # (k, 2)
     nonplanar: float           # largest distance of its nodes from its plane
+    velocity: np.ndarray = field(default_factory=lambda: np.zeros(3))   # of a moving opening, m/s
 
     def series_name(self) -> str:
         return f"opening_{self.name}.txt"
@@ -72,7 +73,7 @@ class SphJob:
     particle_volume: float     # m^3 per fluid particle (cavity volume / fluid count)
     wall_count: int
     moving_count: int
-    openings: list[OpeningGeometry]
+    openings: list[OpeningGeometry]       # where they start (moving ones: the first interval's)
     wall_tri: np.ndarray       # (t, 3) node indices of the wall triangles (outward)
     box: tuple[np.ndarray, np.ndarray]
     inputs: list[Path] = field(default_factory=list)
@@ -114,11 +115,17 @@ def plan_job(case: SphCase) -> dict:
 
 def _plan(case: SphCase) -> dict:
     tri4, _ = geometry.shell_elements(case.mesh, case.mesh_file)
+    opening_of = np.full(len(tri4), -1)
+    for k, o in enumerate(case.openings):
+        opening_of[np.isin(tri4[:, 3], o.elements)] = k
+    opening_nodes = np.unique(tri4[opening_of >= 0, :3])
     first = None
     moved = np.zeros(len(case.mesh.points), bool)
     lo = hi = None
     wall_speed = 0.0
     prev = None
+    at_frames = []                 # the openings' nodes at every frame (for moving openings)
+    longest = None                 # each triangle's longest edge over the frames
     for x in geometry.motion_frames(case):
         if first is None:
             first = x
@@ -127,27 +134,32 @@ def _plan(case: SphCase) -> dict:
         moved |= np.any(x != first, axis=1)
         if prev is not None:
             wall_speed = max(wall_speed, float(np.linalg.norm(x - prev, axis=1).max()) / case.motion.frame_interval)
+        at_frames.append(x[opening_nodes])
+        edges = geometry.edge_lengths(x, tri4[:, :3])
+        longest = edges if longest is None else np.maximum(longest, edges)
         prev = x
     x0 = first
-    opening_of = np.full(len(tri4), -1)
-    for k, o in enumerate(case.openings):
-        opening_of[np.isin(tri4[:, 3], o.elements)] = k
     tri, unclear = geometry.orient_outward(x0, tri4[:, :3], case.spacing)
     if unclear:
         case.warnings.append(("mesh", f"{unclear} of {len(tri)} shell triangles have the fluid on "
                               "neither or both sides (their winding is kept)"))
-    openings = []
+    openings, moving_openings = [], {}
     for k, o in enumerate(case.openings):
         rows = opening_of == k
-        nodes = np.unique(tri[rows])
-        if moved[nodes].any():
-            raise InputError(case.source, None, f"opening {o.name!r} moves with the mesh: this "
-                             "version applies the outflow at openings that stay in place")
         openings.append(_opening(o, x0[tri[rows]]))
-        if openings[-1].nonplanar > 1e-3 * o.search_distance:
+        shapes = [openings[-1]]
+        if moved[np.unique(tri[rows])].any():
+            # the opening where the mesh is halfway through each motion interval
+            local = np.searchsorted(opening_nodes, tri[rows])
+            shapes = [_opening(o, (0.5 * (a + b))[local], _opening(o, a[local]), _opening(o, b[local]),
+                               case.motion.frame_interval)
+                      for a, b in zip(at_frames[:-1], at_frames[1:])]
+            moving_openings[o.name] = shapes
+        worst = max(g.nonplanar for g in shapes)
+        if worst > 1e-3 * o.search_distance:
             case.warnings.append(("opening", f"opening {o.name!r} is not planar (nodes up to "
-                                  f"{openings[-1].nonplanar:.3g} m from its plane): LAMMPS measures "
-                                  "the normal distance to that plane"))
+                                  f"{worst:.3g} m from its plane): LAMMPS measures the normal "
+                                  "distance to that plane"))
     wall_tri = tri[opening_of < 0]
     dx = case.spacing
     margin = (case.layers + 2) * dx + max((3 * o.search_distance for o in case.openings), default=0.0)
@@ -157,6 +169,11 @@ def _plan(case: SphCase) -> dict:
         raise InputError(case.source, None, "the walls and openings enclose no fluid: they must close "
                          f"the cavity, and the cavity must be wider than fluid.spacing {dx:g} m")
     walls = geometry.wall_particles(x0, wall_tri, dx, case.layers, box_lo)
+    stretch = float((longest[opening_of < 0] / geometry.edge_lengths(x0, wall_tri)).max())
+    if stretch > geometry.STRETCHED:
+        case.warnings.append(("wall stretch", f"wall triangles stretch up to {stretch:.2f}x over the motion: "
+                              "their particles, placed at the start, are then that much farther apart "
+                              "than fluid.spacing and fluid may get through (a finer spacing helps)"))
     # the fluid carries the cavity's mass: each particle stands for volume / count
     volume = geometry.enclosed_volume(x0, tri)
     if not volume > 0:
@@ -175,19 +192,24 @@ def _plan(case: SphCase) -> dict:
     every = max(1, round(case.save_interval / dt))
     saves = list(range(0, total, every)) + [total]
     series = max(1, round(case.series_interval / dt)) if case.series_interval else max(1, every // 10)
-    return dict(particle_volume=particle_volume, volume=volume, x0=x0, tri=tri, wall_tri=wall_tri, walls=walls, wall_moving=wall_moving, fluid=fluid,
+    return dict(moving_openings=moving_openings, particle_volume=particle_volume, volume=volume, x0=x0, tri=tri, wall_tri=wall_tri, walls=walls, wall_moving=wall_moving, fluid=fluid,
                 openings=openings, c0=c0, dt=dt, frame_steps=frame_steps, total=total, saves=saves,
                 series=series, box=(box_lo, box_hi), moved=moved)
 
 
-def _opening(o, t: np.ndarray) -> OpeningGeometry:
+def _opening(o, t: np.ndarray, start: OpeningGeometry | None = None, end: OpeningGeometry | None = None,
+             interval: float = 1.0) -> OpeningGeometry:
+    """The opening with triangles ``t``; between ``start`` and ``end`` (an interval later) it
+    moves with the velocity of its area-weighted centre."""
     area_vectors = 0.5 * np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
     areas = np.linalg.norm(area_vectors, axis=1)
     n = area_vectors.sum(axis=0)
     n = n / np.linalg.norm(n)
     centre = (t.mean(axis=1) * areas[:, None]).sum(axis=0) / areas.sum()
     off = float(np.abs((t.reshape(-1, 3) - centre) @ n).max())
-    return OpeningGeometry(o.name, t, centre, n, float(areas.sum()), o.search_distance, o.pressure, off)
+    velocity = (end.centre - start.centre) / interval if start is not None else np.zeros(3)
+    return OpeningGeometry(o.name, t, centre, n, float(areas.sum()), o.search_distance, o.pressure, off,
+                           velocity)
 
 
 def edge_planes(t: np.ndarray, n: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -221,22 +243,47 @@ def pressure_expression(table: np.ndarray) -> str:
 
 
 def opening_context(o: OpeningGeometry) -> dict:
+    """What the script says about an opening: its region, deletion and variable commands
+    (rendered again, after the deletions, when a moving opening is put in its next place)."""
     f = float_text
-    n, c, d = o.normal, o.centre, o.distance
+    n, c, d, name = o.normal, o.centre, o.distance, o.name
+    nx, ny, nz, area = f(n[0]), f(n[1]), f(n[2]), f(o.area)
 
-    def plane(point, normal) -> str:
-        return " ".join(f(v) for v in (*point, *normal))
+    def plane(rid: str, point, normal) -> str:
+        return f"region          {rid} plane " + " ".join(f(v) for v in (*point, *normal)) + " units box"
+
+    def block(rid: str, lo, hi) -> str:
+        return f"region          {rid} block " + " ".join(f(v) for v in np.column_stack([lo, hi]).ravel()) + " units box"
 
     lo, hi = o.triangles.reshape(-1, 3).min(axis=0), o.triangles.reshape(-1, 3).max(axis=0)
-    prisms = [[plane(p, m) for p, m in edge_planes(t, n)] for t in o.triangles]
-    return dict(
-        name=o.name, nx=f(n[0]), ny=f(n[1]), nz=f(n[2]), area=f(o.area), d=f(d),
-        pressure=pressure_expression(o.pressure), prisms=prisms,
-        near_box=" ".join(f(v) for v in np.column_stack([lo - d, hi + d]).ravel()),
-        wide_box=" ".join(f(v) for v in np.column_stack([lo - 3 * d, hi + 3 * d]).ravel()),
-        slab_lo=plane(c - d * n, n), behind=plane(c, -n), front=plane(c, n),
-        delta=f"({f(n[0])})*(x-({f(c[0])}))+({f(n[1])})*(y-({f(c[1])}))+({f(n[2])})*(z-({f(c[2])}))",
-        series=o.series_name())
+    regions, parts = [], []
+    for k, t in enumerate(o.triangles, 1):
+        edges = [f"e{k}{s}_{name}" for s in "abc"]
+        regions += [plane(e, p, m) for e, (p, m) in zip(edges, edge_planes(t, n))]
+        regions.append(f"region          t{k}_{name} intersect 3 {' '.join(edges)}")
+        parts.append(f"t{k}_{name}")
+    regions += [f"region          prism_{name} union {len(parts)} {' '.join(parts)}",
+                block(f"box_{name}", lo - d, hi + d),
+                plane(f"deep_{name}", c - d * n, n), plane(f"behind_{name}", c, -n),
+                f"region          near_{name} intersect 4 box_{name} deep_{name} behind_{name} prism_{name}",
+                block(f"wide_{name}", lo - 3 * d, hi + 3 * d), plane(f"front_{name}", c, n),
+                f"region          beyond_{name} intersect 2 wide_{name} front_{name}"]
+    # composite regions first, then their parts
+    ids = [f"near_{name}", f"beyond_{name}", f"prism_{name}"]
+    for k in range(1, len(o.triangles) + 1):
+        ids += [f"t{k}_{name}", *(f"e{k}{s}_{name}" for s in "abc")]
+    ids += [f"{r}_{name}" for r in ("box", "deep", "behind", "wide", "front")]
+    deletes = [f"region          {r} delete" for r in ids]
+    delta = f"({nx})*(x-({f(c[0])}))+({ny})*(y-({f(c[1])}))+({nz})*(z-({f(c[2])}))"
+    variables = [f"variable        w_{name} atom 1.0+({delta})/{f(d)}",
+                 f"variable        F_{name} equal -v_p_{name}*{area}",
+                 *(f"variable        f{a}_{name} atom v_F_{name}*({na})*v_w_{name}/v_wsum_{name}"
+                   for a, na in zip("xyz", (nx, ny, nz))),
+                 # the fluid's normal velocity relative to the opening's
+                 f"variable        vn_{name} atom vx*({nx})+vy*({ny})+vz*({nz})-({f(float(o.velocity @ n))})",
+                 f"variable        flux_{name} equal {area}*c_vn_{name}"]
+    return dict(name=name, nx=nx, ny=ny, nz=nz, area=area, d=f(d), pressure=pressure_expression(o.pressure),
+                regions=regions, deletes=deletes, variables=variables, series=o.series_name())
 
 
 def write_job(case: SphCase, folder: str | Path, write_files: bool = True) -> tuple[SphJob, str]:
@@ -250,24 +297,27 @@ def write_job(case: SphCase, folder: str | Path, write_files: bool = True) -> tu
     static_rows, moving_rows = np.flatnonzero(~moving), np.flatnonzero(moving)
     nfluid, nstatic, nmoving = len(p["fluid"]), len(static_rows), len(moving_rows)
     frame_steps = p["frame_steps"]
-    motion_intervals = 0
-    if case.motion is not None and nmoving:
-        motion_intervals = math.ceil(p["total"] / frame_steps)
-    events = sorted(set(p["saves"]) | ({k * frame_steps for k in range(motion_intervals)}
-                                        if motion_intervals else set()))
+    moving_openings = p["moving_openings"]
+    intervals = math.ceil(p["total"] / frame_steps) if case.motion is not None else 0
+    walls_move = nmoving > 0 and intervals > 0
+    frames_matter = walls_move or bool(moving_openings)
+    events = sorted(set(p["saves"]) | ({k * frame_steps for k in range(intervals)} if frames_matter else set()))
     chunks = []
     for k, step in enumerate(events):
-        chunks.append(dict(step=step, frame=(step // frame_steps if motion_intervals and step % frame_steps == 0
-                                             and step // frame_steps < motion_intervals else None),
-                           save=step in p["saves"],
+        frame = step // frame_steps if frames_matter and step % frame_steps == 0 and step // frame_steps < intervals \
+            else None
+        # a moving opening is put where the mesh is halfway through each motion interval
+        redefine = [opening_context(shapes[frame]) for shapes in moving_openings.values()] if frame else []
+        chunks.append(dict(step=step, frame=frame, save=step in p["saves"], redefine=redefine,
                            run=(events[k + 1] - step) if k + 1 < len(events) else 0))
-    openings = [opening_context(o) for o in p["openings"]]
+    openings = [opening_context(moving_openings[o.name][0] if o.name in moving_openings else o)
+                for o in p["openings"]]
     script = template_environment().get_template("sph.lammps.j2").render(
         case=case, fmt=float_text, data_name=DATA_NAME, frames_name=FRAMES_NAME, walls_name=WALLS_NAME,
         rho0=case.density, c0=p["c0"], h=case.smoothing, dt=p["dt"],
         morris=case.viscosity is not None,
         viscosity=case.viscosity if case.viscosity is not None else case.artificial_viscosity,
-        skin=0.3 * case.smoothing, openings=openings, chunks=chunks, moving=nmoving > 0 and motion_intervals > 0,
+        skin=0.3 * case.smoothing, openings=openings, chunks=chunks, moving=walls_move,
         has_moving=nmoving > 0, velocity_names=VELOCITY_NAMES,
         series_every=p["series"], evaporate_every=EVAPORATE_EVERY, thermo_every=max(1, p["saves"][1] - p["saves"][0]),
         fluid_count=nfluid, wall_count=len(walls.rows), moving_count=nmoving, layers=case.layers,
@@ -275,8 +325,9 @@ def write_job(case: SphCase, folder: str | Path, write_files: bool = True) -> tu
     job = SphJob(folder, folder / SCRIPT_NAME, folder / DATA_NAME, folder / FRAMES_NAME,
                  folder / WALLS_NAME if nmoving else None, p["dt"], p["total"],
                  p["saves"], p["series"], frame_steps, p["c0"], nfluid, p["particle_volume"], len(walls.rows), nmoving,
-                 p["openings"], p["wall_tri"], p["box"])
-    job.inputs = [job.data] + ([folder / n for n in VELOCITY_NAMES] if nmoving and motion_intervals else [])
+                 [moving_openings[o.name][0] if o.name in moving_openings else o for o in p["openings"]],
+                 p["wall_tri"], p["box"])
+    job.inputs = [job.data] + ([folder / n for n in VELOCITY_NAMES] if walls_move else [])
     if write_files:
         folder.mkdir(parents=True, exist_ok=True)
         x0 = p["x0"]
@@ -284,8 +335,8 @@ def write_job(case: SphCase, folder: str | Path, write_files: bool = True) -> tu
         positions = np.concatenate([p["fluid"], wall_x[static_rows], wall_x[moving_rows]])
         types = np.concatenate([np.full(nfluid, FLUID), np.full(nstatic, WALL), np.full(nmoving, MOVING)])
         atomic_write(job.data, _data_text(case, positions, types, p["box"], p["particle_volume"]))
-        if nmoving and motion_intervals:
-            _write_velocities(case, job, walls, moving_rows, p["wall_tri"], nfluid + nstatic, motion_intervals)
+        if walls_move:
+            _write_velocities(case, job, walls, moving_rows, p["wall_tri"], nfluid + nstatic, intervals)
         atomic_write(job.script, script)
     return job, script
 

@@ -371,9 +371,9 @@ GENERATED = [
          make=_case(lambda t: t.replace('"cardioproof": 1', '"cardioproof": 2'))),
     Case("generated/case_no_opening_elements", "CardioProof case", "", "an opening whose tags "
          "select no element", make=_case(lambda t: t.replace('"tags": [3]', '"tags": [7]'))),
-    Case("generated/case_moving_opening", "CardioProof case", "", "the moving piston named as "
-         "the opening", command="run",
-         make=_case(lambda t: t.replace('"tags": [3]', '"tags": [2]'), command="run")),
+    Case("generated/case_shared_elements", "CardioProof case", "", "two openings naming the "
+         "same elements", make=_case(lambda t: t.replace(
+             '"openings": [', '"openings": [{"name": "first", "tags": [3]}, '))),
     Case("generated/case_end_time", "CardioProof case", "", "end time beyond the last motion frame",
          make=_case(lambda t: t.replace('"end_time": 0.01', '"end_time": 0.5'))),
     Case("generated/case_dynpt_truncated", "CardioProof case", "", "a .dynpt shorter than its "

@@ -127,8 +127,11 @@ class SphRecorder:
         # at the last step (the series' rows come every series_interval)
         self.final["crossed"] = {o.name: int(round(lmp.extract_variable(f"crossed_{o.name}")))
                                  for o in self.job.openings}
+        # in the cavity: not yet removed from in front of an opening is out already
+        self.final["fluid"] = self.final["atoms"] - self.job.wall_count - sum(
+            int(round(lmp.extract_variable(f"out_{o.name}"))) for o in self.job.openings)
         # fluid neither in the cavity nor out by an opening went through a wall and off the box
-        lost = self.job.fluid_count - (self.final["atoms"] - self.job.wall_count) - sum(self.final["crossed"].values())
+        lost = self.job.fluid_count - self.final["fluid"] - sum(self.final["crossed"].values())
         if lost > 0 and self.model.warnings is not None:
             from fibrelmp.runner import mpi_rank_size
 
@@ -163,6 +166,6 @@ class SphRecorder:
             "steps_per_second": self.steps / wall_time if wall_time > 0 else None,
             "frames": len(job.save_steps),
             "particles": {"kind": "sph", "fluid_start": job.fluid_count, "wall": walls,
-                          "fluid_end": self.final.get("atoms", 0) - walls},
+                          "fluid_end": self.final.get("fluid")},
             "openings": openings, "final_step": self.final.get("step"), "warnings": kinds,
         }

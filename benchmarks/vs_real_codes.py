@@ -53,6 +53,9 @@ from _common import load_generator  # noqa: E402
 
 AGGLOMERATE = ROOT / "examples" / "musen" / "SphericalAgglomerate_text.txt"
 SIDES = ("real", "fibrelmp-1", "fibrelmp-2")
+# real code / best of fibrelmp's 1 and 2 ranks (issue 17: >= 1.5 on FibreNet; faster than cmusen
+# -t=2 on the agglomerate, i.e. above 1; 1.01 so that a tie does not count)
+GOALS = {"fibrenet-5k": 1.5, "fibrenet-50k": 1.5, "fibrenet-260k": 1.5, "musen-agglomerate": 1.01}
 
 
 @dataclass
@@ -73,7 +76,7 @@ def fibrenet_case(name: str, beads: int, steps: int) -> Case:
     def make(folder: Path) -> tuple[str, int]:
         gen = load_generator()
         net = gen.generate(gen.parse_args(["--beads", str(beads), "--seed", "1", "--out", str(folder),
-                                           "--run", str(steps), "--output-freq", "400"]))
+                                           "--run", str(steps), "--output-freq", str(min(400, steps))]))
         return "input.txt", int(net["n"])
     return Case(name, "fibrenet", beads, steps, make)
 
@@ -109,8 +112,9 @@ def agglomerate_case(steps: int) -> Case:
             scene=AGGLOMERATE.name, dt=dt, save=steps * dt / 10, end=steps * dt,
             models="MODEL_SB             ModelSBElastic\nMODEL_SB_PARAMS      CONSIDER_BREAKAGE 1\n",
             domain="-0.02 -0.02 -0.02 0.02 0.02 0.02"))
+        # object lines "0 ID 1 SHAPE ...": shape 1 is a sphere (9 a solid bond, 14 a triangle)
         spheres = sum(1 for line in AGGLOMERATE.read_text().splitlines()
-                      if line.startswith("0 ") and " 5 " in line[:16] and " 1 1 5 " in line[:24])
+                      if line.split()[:1] == ["0"] and line.split()[3:4] == ["1"])
         return "job.txt", spheres
     return Case("musen-agglomerate", "musen", 5696, steps, make)
 
@@ -134,9 +138,9 @@ def packing_scene(n: int, seed: int = 1) -> str:
     for i in range(n):
         ix, iy, iz = i % side, (i // side) % side, i // (side * side)
         p = np.array([0.0016 + ix * spacing, 0.0016 + iy * spacing, 0.002 + iz * spacing])
-        p += rng.uniform(-1e-4, 1e-4, 3)
-        r = rng.uniform(0.0009, 0.0011)
-        v = rng.uniform(-0.05, 0.05, 3)
+        p = (p + rng.uniform(-1e-4, 1e-4, 3)).tolist()
+        r = float(rng.uniform(0.0009, 0.0011))
+        v = rng.uniform(-0.05, 0.05, 3).tolist()
         lines.append(f"0 {len(tris) + i} 1 1 5 {r!r} {r!r} 23 MBEAD 24 0 1e+300 2 0 16 0.0 0.0 0.0 "
                      f"12 {p[0]!r} {p[1]!r} {p[2]!r} 20 0 0 0 18 0 31 1 0 0 0 37 0 15 "
                      f"{v[0]!r} {v[1]!r} {v[2]!r}")
@@ -335,16 +339,16 @@ def print_table(chosen: list[Case], args, load0, load1, peak_load: float) -> Non
         per = [f"{1e6 * med[s] / (case.particles * case.steps):.3f}" if med[s] else "-" for s in SIDES]
         best = min((med[s] for s in ("fibrelmp-1", "fibrelmp-2") if med[s]), default=None)
         ratio = med["real"] / best if med["real"] and best else None
-        goal = {"fibrenet": 1.5, "musen-agglomerate": 1.0}.get(case.kind if case.kind == "fibrenet" else case.name)
+        goal = GOALS.get(case.name)
         verdict = "-" if ratio is None or goal is None else ("OK" if ratio >= goal else "MISSED")
-        if case.kind == "musen" and goal is not None and ratio is not None and ratio <= goal:
-            verdict = "MISSED"
 
         def cell(s: str) -> str:
             return f"{med[s]:.2f}" if med[s] else ("not given" if s == "real" else "-")
         print(f"| {case.name:<18}| {case.particles:>9} | {case.steps:>7} | {cell('real'):>7} | {cell('fibrelmp-1'):>8} "
               f"| {cell('fibrelmp-2'):>9} | {' / '.join(per):<30}| {(f'{ratio:.2f}' if ratio else '-'):>11} "
               f"| {(f'>={goal:g}' if goal else '-'):<6}| {verdict:<8}|")
+        if ratio is not None and best is not None:
+            print(f"  {case.name}: real / best fibrelmp ratio: {ratio:.3f}")
         if case.note:
             print(f"  note: {case.note}")
 

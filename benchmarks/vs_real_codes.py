@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import argparse
 import datetime
+import math
 import os
 import shutil
 import signal
@@ -120,11 +121,14 @@ def agglomerate_case(steps: int) -> Case:
 
 
 def packing_scene(n: int, seed: int = 1) -> str:
-    """MUSEN text scene: ``n`` soft glass beads (R 0.9-1.1 mm) on a jittered lattice above the
-    floor of an open steel box (20 x 20 mm, 40 mm high; 10 triangles, normals inward),
-    in MUSEN 1.74's text format (the layout of tests/data/.../rotating_drum/drum_scene.txt)."""
+    """MUSEN text scene: ``n`` soft glass beads (R 0.9-1.1 mm) on a jittered lattice of up to 7
+    layers above the floor of an open steel box (20 x 20 mm for n <= 448, wider for more; 40 mm
+    high; 10 triangles, normals inward), in MUSEN 1.74's text format (the layout of
+    tests/data/real-outputs/musen/scenarios/rotating_drum/drum_scene.txt)."""
     rng = np.random.default_rng(seed)
-    w, h = 0.02, 0.04
+    spacing = 0.0024
+    side = max(8, math.ceil(math.sqrt(n / 7)))        # beads per lattice row
+    w, h = 0.0032 + (side - 1) * spacing, 0.04
     corners = {"a": (0, 0, 0), "b": (w, 0, 0), "c": (w, w, 0), "d": (0, w, 0),
                "A": (0, 0, h), "B": (w, 0, h), "C": (w, w, h), "D": (0, w, h)}
     # each triangle (p, q, r) with (q - p) x (r - p) pointing into the box
@@ -133,8 +137,6 @@ def packing_scene(n: int, seed: int = 1) -> str:
     for k, t in enumerate(tris):
         xyz = " ".join(repr(float(v)) for p in t for v in corners[p])
         lines.append(f"0 {k} 1 14 5  23 MSTEEL 24 0 1e+300 2 0 44 {xyz} 20 0 0 0 18 0 15 0 0 0")
-    side = 8
-    spacing = 0.0024
     for i in range(n):
         ix, iy, iz = i % side, (i // side) % side, i // (side * side)
         p = np.array([0.0016 + ix * spacing, 0.0016 + iy * spacing, 0.002 + iz * spacing])
@@ -146,7 +148,7 @@ def packing_scene(n: int, seed: int = 1) -> str:
                      f"{v[0]!r} {v[1]!r} {v[2]!r}")
     ids = " ".join(str(k) for k in range(len(tris)))
     lines += [
-        "22 -0.005 -0.005 -0.005 0.025 0.025 0.045",
+        f"22 -0.005 -0.005 -0.005 {w + 0.005!r} {w + 0.005!r} 0.045",
         "28 0 0 0 0 0 0 0 0 0 0", "29 0", "30 0",
         "25 Box GBOX 0 0 0 0 0", "26 0", f"27 {len(tris)} {ids}",
         "32 MBEAD SoftGlassBead 0 2500.0 1 1000 2 0.1 3 0.5 7 100000000.0 8 10000000.0 9 10000000.0 "
@@ -159,6 +161,11 @@ def packing_scene(n: int, seed: int = 1) -> str:
     return "\n".join(lines) + "\n"
 
 
+def packing_domain(n: int) -> str:
+    w = 0.0032 + (max(8, math.ceil(math.sqrt(n / 7))) - 1) * 0.0024
+    return f"-0.005 -0.005 -0.005 {w + 0.005!r} {w + 0.005!r} 0.045"
+
+
 def packing_case(spheres: int, steps: int) -> Case:
     def make(folder: Path) -> tuple[str, int]:
         (folder / "packing_scene.txt").write_text(packing_scene(spheres))
@@ -166,7 +173,7 @@ def packing_case(spheres: int, steps: int) -> Case:
         (folder / "job.txt").write_text(MUSEN_JOB.format(
             scene="packing_scene.txt", dt=dt, save=steps * dt / 10, end=steps * dt,
             models="MODEL_PW             ModelPWHertzMindlin\n",
-            domain="-0.005 -0.005 -0.005 0.025 0.025 0.045"))
+            domain=packing_domain(spheres)))
         return "job.txt", spheres
     return Case("musen-packing", "musen", spheres, steps, make)
 

@@ -169,9 +169,9 @@ def time_step_check(model: Model | GranularModel) -> list[str]:
 
 
 # Particles per MPI rank below which a run is faster on fewer ranks (measured on 2 cores,
-# docs/performance.md#ranks-and-threads): a rank's per-step cost (communication, ghosts,
-# every rank parsing the input) outweighs its share of the work on smaller systems
-MIN_PER_RANK = {"beads": 10_000, "spheres": 3_000}
+# docs/performance.md#ranks-and-threads): a rank's fixed costs (ghost exchange every step,
+# every rank reading the input) outweigh its share of the work on smaller systems
+MIN_PER_RANK = {"beads": 2_000, "spheres": 1_000}
 
 
 def rank_check(model: Model | GranularModel, ranks: int) -> None:

@@ -36,6 +36,7 @@ class Bench:
     pattern: str              # regex for the ratio on the script's output
     goal: str                 # e.g. "<= 1.0"
     quick: list[str]          # arguments for --quick
+    needs: str = ""           # an environment variable it needs (skipped without it)
 
     def ok(self, ratio: float) -> bool:
         op, value = self.goal.split()
@@ -65,6 +66,9 @@ BENCHES = [
     Bench("mdem_io", "reading 100k spheres x 50 saves: MUSEN .mdem / MUSEN text (fibrelmp's readers)",
           r"mdem/text read time ratio: ([0-9.]+)", "<= 1.0",
           ["--spheres", "20000", "--saves", "10", "--few", "5"]),
+    Bench("vs_real_codes", "real FibreNet, 2 PoCL threads / best fibrelmp 1|2 ranks (worst of 5k/50k/260k)",
+          r"worst FibreNet ratio, real / best fibrelmp: ([0-9.]+)", ">= 1.5", ["--quick", "--repeat", "1"],
+          needs="FIBRELMP_FIBRENET"),
 ]
 
 
@@ -82,6 +86,10 @@ def main() -> int:
     started = datetime.datetime.now().astimezone()
     rows, logs = [], []
     for b in chosen:
+        if b.needs and not os.environ.get(b.needs):
+            print(f"== {b.name}: skipped ({b.needs} not set)", flush=True)
+            rows.append((b, "skipped", 0.0))
+            continue
         cmd = [sys.executable, str(HERE / f"{b.name}.py")] + (b.quick if args.quick else []) + args.pass_args.split()
         print(f"== {b.name}: {' '.join(cmd[1:])}", flush=True)
         t0 = time.perf_counter()
@@ -106,7 +114,9 @@ def main() -> int:
     print("|" + "|".join("-" * (len(c)) for c in head.split("|")[1:-1]) + "|")
     failed = 0
     for b, ratio, wall in rows:
-        if ratio is None:
+        if ratio == "skipped":
+            value, verdict = "-", "SKIPPED"
+        elif ratio is None:
             value, verdict = "error", "ERROR"
             failed += 1
         else:

@@ -2,7 +2,9 @@
 step, and the warnings they trigger.  Plain physics on the neutral models, no LAMMPS.
 
 * granular inputs (MUSEN, DEMDF): the Hertz contact duration against the time step;
-* FibreNet: the shortest spring oscillation period against the time step.
+* FibreNet: the shortest spring oscillation period against the time step;
+* any run under MPI: particles per rank against the size below which more ranks are slower
+  (``rank_check``).
 
 Either warns when the step exceeds ``STEP_FRACTION`` of the time it has to resolve: a
 contact or an oscillation spanning fewer than ten steps is integrated poorly, and one
@@ -166,6 +168,26 @@ def time_step_check(model: Model | GranularModel) -> list[str]:
     if isinstance(model, Model):
         return spring_check(model)
     return []                  # a CardioProof case checks its own step (cardioproof.job)
+
+
+# Particles per MPI rank below which a run is faster on fewer ranks (measured on 2 cores,
+# docs/performance.md#ranks-and-threads): a rank's fixed costs (ghost exchange every step,
+# every rank reading the input) outweigh its share of the work on smaller systems
+MIN_PER_RANK = {"beads": 2_000, "spheres": 1_000}
+
+
+def rank_check(model: Model | GranularModel, ranks: int) -> None:
+    """Warns (kind "ranks"; said once, on rank 0, like every warning) when ``ranks`` MPI
+    ranks leave fewer particles per rank than ``MIN_PER_RANK``."""
+    granular = isinstance(model, GranularModel)
+    what = "spheres" if granular else "beads"
+    count = model.spheres.count if granular else model.particles.count
+    limit = MIN_PER_RANK[what]
+    if ranks > 1 and count < limit * ranks:
+        best = max(1, count // limit)
+        model.warn("ranks", f"{ranks} MPI ranks for {count} {what} ({count // ranks} per rank): below "
+                   f"~{limit} {what} per rank more ranks make the run slower; use "
+                   f"{'1 (no mpiexec)' if best == 1 else f'mpiexec -n {best}'} (docs/performance.md)")
 
 
 def time_step_scale(model: Model | GranularModel) -> dict | None:

@@ -123,7 +123,7 @@ def test_lines_without_a_terminal(tmp_path):
 def test_resumed_run_without_a_terminal(tmp_path):
     inp = _example(tmp_path)
     out = tmp_path / "out"
-    done = _stop(tmp_path, inp, out, 20)
+    done = _stop(tmp_path, inp, out, 4)
     assert 0 < done < 2000
     proc = subprocess.run(CLI + ["run", str(inp), "-o", str(out), "--resume", "--log-every", "10%"],
                           cwd=tmp_path, capture_output=True, text=True, timeout=120)
@@ -139,7 +139,7 @@ def test_resumed_run_without_a_terminal(tmp_path):
 def test_resumed_run_on_a_terminal(tmp_path):
     inp = _example(tmp_path)
     out = tmp_path / "out"
-    done = _stop(tmp_path, inp, out, 30)
+    done = _stop(tmp_path, inp, out, 6)
     rc, shown = _in_pty(CLI + ["run", str(inp), "-o", str(out), "--resume"], tmp_path)
     assert rc == 0, shown
     bars = [s.strip() for s in shown.split("\r") if "step/s" in s]

@@ -30,7 +30,7 @@ def run(plan: RunPlan, warn: Warn | None = None) -> Outcome:
     its model while it is translated and run."""
     from fibrelmp.outputs import finish, locked
     from fibrelmp.runner import mpi_rank_size
-    from fibrelmp.sanity import time_step_check
+    from fibrelmp.sanity import rank_check, time_step_check
 
     rank, size = mpi_rank_size()
     options = plan.options
@@ -53,6 +53,7 @@ def run(plan: RunPlan, warn: Warn | None = None) -> Outcome:
                     continue
                 said = len(step.model.warnings)
                 time_step_check(step.model)     # check's warning, said before the run starts
+                rank_check(step.model, size)    # too many MPI ranks for this system
                 if warn is not None and step.model.warnings[said:]:
                     warn(step.model.warnings[said:])
                 said = len(step.model.warnings)

@@ -21,7 +21,7 @@ from fibrelmp.lammps_text import comment_text, lammps_path, lammps_token, templa
 from fibrelmp.model import Model
 from fibrelmp.textio import atomic_write
 from fibrelmp.translate.lammps_format import atomfile_blocks, data_rows, float_text
-from fibrelmp.translate.steps import SaveSteps
+from fibrelmp.translate.steps import MIN_PIECE_STEPS, SaveSteps, run_piece
 from fibrelmp.translate.work_facts import WorkFacts, write_facts
 
 SCRIPT_NAME = "in.lammps"
@@ -185,7 +185,7 @@ def _schedule(model: Model, general_lambda: bool) -> tuple[list[tuple], SaveStep
     """
     acts: list[tuple] = []
     total = sum(st.steps for st in model.plan.stages)
-    piece = max(1, min(math.ceil(total / 50), 2 ** 31 - 1))    # progress; LAMMPS: run N <= 2^31-1
+    piece = run_piece(total, MIN_PIECE_STEPS)     # progress pieces (translate.steps)
     fresh = True                                   # next step starts from the stored state
 
     def advance(n: int, store_before_last: bool) -> None:

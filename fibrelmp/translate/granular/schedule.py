@@ -10,7 +10,7 @@ import numpy as np
 
 from fibrelmp.errors import InputError
 from fibrelmp.granmodel import GranularModel
-from fibrelmp.translate.steps import SaveSteps
+from fibrelmp.translate.steps import SaveSteps, run_piece
 
 MAX_STEPS = 2.0 ** 63 - 1   # LAMMPS counts time steps in a 64-bit integer
 # explicit (irregular) save schedules longer than this are refused: regular ones are loops
@@ -49,10 +49,10 @@ def run_time(model: GranularModel) -> RunTime:
 
 
 def schedule(total: int, saves: SaveSteps, deletions: list[tuple[int, np.ndarray]]):
-    """Actions of the script: runs (in pieces of at most 1/50 of the run, for progress),
+    """Actions of the script: runs (in pieces of 1/50 of the run: ``steps.run_piece``),
     activity-end deletions and frames.  A stretch of regular saves with no deletion in it is
     one LAMMPS loop ("loop" ... "end"), so the script does not grow with the number of frames."""
-    piece = max(1, min(math.ceil(total / 50), 2 ** 31 - 1))     # LAMMPS: run N <= 2^31-1
+    piece = run_piece(total)                  # progress pieces (translate.steps)
     acts: list[tuple] = [("run0",), ("frame", 0)]
     dels = {s: rows for s, rows in deletions}
     step, pre = 0, False

@@ -178,7 +178,9 @@ MIN_PER_RANK = {"beads": 2_000, "spheres": 1_000}
 
 def rank_check(model: Model | GranularModel, ranks: int) -> None:
     """Warns (kind "ranks"; said once, on rank 0, like every warning) when ``ranks`` MPI
-    ranks leave fewer particles per rank than ``MIN_PER_RANK``."""
+    ranks leave fewer particles per rank than ``MIN_PER_RANK`` (not measured for SPH cases)."""
+    if not isinstance(model, (Model, GranularModel)):
+        return
     granular = isinstance(model, GranularModel)
     what = "spheres" if granular else "beads"
     count = model.spheres.count if granular else model.particles.count

@@ -271,3 +271,27 @@ def test_error_seen_by_rank_0_only_exits_fast(tmp_path):
     _assert_fast_exit(proc, 2)
     # found before LAMMPS starts now (every rank checks the locations; rank 0 says it)
     assert "cannot be created below it" in proc.err, proc.describe()
+
+
+def test_cardioproof_case_under_mpi(tmp_path):
+    """The piston-tube case on 2 ranks: the same files as a serial run, every fluid particle
+    accounted for, the outflow force still -p(t) A n (the physics: tests/test_cardioproof.py)."""
+    import json
+
+    import numpy as np
+
+    def populate(folder: Path) -> None:
+        for f in (REPO / "examples" / "cardioproof").glob("piston_tube.*"):
+            shutil.copy(f, folder)
+
+    runs = serial_and_mpi(tmp_path, populate, ["run", "piston_tube.json"])
+    assert_ran(runs)
+    assert_same_files(runs)
+    case = runs["mpi"][0]
+    summary = json.loads((case / "piston_tube_work" / "summary.json").read_text())
+    particles = summary["particles"]
+    assert particles["fluid_start"] == particles["fluid_end"] + summary["openings"]["outlet"]["crossed_particles"]
+    rows = np.genfromtxt(case / "piston_tube_outlet.csv", delimiter=",", names=True)
+    p = np.interp(rows["time_s"], [0.0, 0.01], [0.0, 10.0])
+    np.testing.assert_allclose(rows["force_normal_N"], -p * summary["openings"]["outlet"]["area"],
+                               rtol=1e-12, atol=1e-18)

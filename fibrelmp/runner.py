@@ -250,7 +250,6 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
     frames = 0
     since = 0
     done = 0                         # commands executed (the position in the command stream)
-    rebuild = False                  # a checkpoint re-exchanged the atoms: rebuild neighbours
     saved_state: dict = {}           # the step state at the last checkpoint
     resumed_state = checkpoints.load_step_state() if resume else None
     deferred: list[str] = []         # per-atom fixes: defined after read_restart to get their data
@@ -304,12 +303,6 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
                     # forces back (a write_dump or set may come before any run)
                     restore_step_state(lmp, resumed_state)
                     resumed_state = None
-                    rebuild = False
-                if rebuild and words[0] == "run":
-                    # write_restart re-exchanged the atoms and rebuilt the ghosts: a "run …
-                    # pre no" would use a stale neighbour list
-                    restore_step_state(lmp, saved_state)
-                    rebuild = False
                 # FibreNet's first step after a (re)start is made by commands: its
                 # "reset_timestep $(step+1)" counts it; a reset to 0 (a new stage) none
                 counts = words[0] in ("run", "reset_timestep")
@@ -339,10 +332,18 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
                     saved_state = step_state(lmp)
                     checkpoints.write(lmp, rank, done, cmd.number, steps, frames, script_text,
                                       saved_state)
-                    rebuild = True
                     since = 0
                     if signum:
                         raise CheckpointStop(script.parent, signum)
+                    # write_restart re-exchanged the atoms (on several ranks their forces
+                    # did not travel) and rebuilt the ghosts: put the step's state back before
+                    # any command reads it (a frame written right after the checkpoint; a
+                    # "run ... pre no" would use a stale neighbour list)
+                    try:
+                        restore_step_state(lmp, saved_state)
+                    except Exception as exc:
+                        raise RunError(f"{script}:{cmd.number}: LAMMPS error after a checkpoint: "
+                                       f"{str(exc).strip()}") from None
         if record is not None:
             record.end(lmp, steps, resumed_steps)
         if finished is not None:

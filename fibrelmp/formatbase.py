@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import os
 from abc import ABC, abstractmethod
+from contextlib import contextmanager
 from pathlib import Path
 from typing import IO, Any, ClassVar, Iterator
 
@@ -162,17 +163,24 @@ class Writer(ABC):
         self._parts.append(part)
         return part
 
-    def add(self, frame: Any) -> None:
-        if self.closed:
-            raise ValueError(f"{type(self).__name__} for {self.target} is closed")
+    @contextmanager
+    def _aborting(self) -> Iterator[None]:
+        """Abort on any failure; an OSError becomes an error naming the output (the file it
+        names, else the target: ``finish`` names no file)."""
         try:
-            self.write(frame)
+            yield
         except OSError as exc:
             self.abort()
             raise write_failure(getattr(exc, "output", None) or self.target, exc) from None
         except BaseException:
             self.abort()
             raise
+
+    def add(self, frame: Any) -> None:
+        if self.closed:
+            raise ValueError(f"{type(self).__name__} for {self.target} is closed")
+        with self._aborting():
+            self.write(frame)
         self.count += 1
 
     def prepare(self) -> None:
@@ -181,30 +189,18 @@ class Writer(ABC):
         closing any, so that a failure in one leaves no output of the others in place."""
         if self.closed or self._settled:
             return
-        try:
+        with self._aborting():
             self._settle()
-        except OSError as exc:
-            self.abort()
-            raise write_failure(getattr(exc, "output", None) or self.target, exc) from None
-        except BaseException:
-            self.abort()
-            raise
         self._settled = True
 
     def close(self) -> list[Path]:
         """Finish, then rename every staged file into place; returns the final paths."""
         if self.closed:
             return []
-        try:
+        with self._aborting():
             if not self._settled:
                 self._settle()
             done = self._commit()
-        except OSError as exc:            # from finish(): it names no file
-            self.abort()
-            raise write_failure(getattr(exc, "output", None) or self.target, exc) from None
-        except BaseException:
-            self.abort()
-            raise
         self._closed()
         for old in self._earlier:          # only now: a failed close keeps the earlier output
             if old not in done:

@@ -36,6 +36,23 @@ ARTIFICIAL_VISCOSITY = 0.1   # Monaghan's alpha when the case gives no viscosity
 SMOOTHING_RATIO = 2.6          # kernel cutoff h / particle spacing (LAMMPS's SPH examples)
 CFL = 0.1                      # dt <= CFL h / c0 (LAMMPS's SPH examples)
 KEYS = {"cardioproof", "mesh", "motion", "fluid", "wall", "openings", "run", "output", "comment"}
+# the keys of each object (a misspelt key must not silently give a default)
+OBJECT_KEYS = {
+    "mesh": {"file", "unit"},
+    "motion": {"file", "meshes", "frame_interval"},
+    "fluid": {"spacing", "density", "viscosity", "artificial_viscosity", "sound_speed", "smoothing_ratio"},
+    "wall": {"layers"},
+    "openings": {"name", "tags", "elements", "pressure", "search_distance"},
+    "run": {"end_time", "time_step", "cfl"},
+    "output": {"interval", "series_interval", "name"},
+}
+
+
+def _known(j: JsonDoc, obj: dict, kind: str, where: str) -> dict:
+    unknown = sorted(set(obj) - OBJECT_KEYS[kind])
+    if unknown:
+        j.fail(f"{where}.{unknown[0]}", f"unknown key (known: {', '.join(sorted(OBJECT_KEYS[kind]))})")
+    return obj
 
 
 @dataclass
@@ -102,12 +119,12 @@ def read_case(path: str | Path) -> SphCase:
     mesh_spec = doc.get("mesh")
     if isinstance(mesh_spec, str):
         mesh_spec = {"file": mesh_spec}
-    mesh_spec = j.obj(mesh_spec, "mesh")
+    mesh_spec = _known(j, j.obj(mesh_spec, "mesh"), "mesh", "mesh")
     mesh_file = folder / j.string(mesh_spec.get("file"), "mesh.file")
     unit = mesh_spec.get("unit")
     mesh = read_mesh(mesh_file, None if unit is None else j.number(unit, "mesh.unit", positive=True))
 
-    fluid = j.obj(doc.get("fluid"), "fluid")
+    fluid = _known(j, j.obj(doc.get("fluid"), "fluid"), "fluid", "fluid")
     dx = j.number(fluid.get("spacing"), "fluid.spacing", positive=True)
     density = j.number(fluid.get("density", 1000.0), "fluid.density", positive=True)
     if "viscosity" in fluid and "artificial_viscosity" in fluid:
@@ -125,13 +142,13 @@ def read_case(path: str | Path) -> SphCase:
     ratio = j.number(fluid.get("smoothing_ratio", SMOOTHING_RATIO), "fluid.smoothing_ratio", positive=True)
     if not 1.5 <= ratio <= 4.0:
         j.fail("fluid.smoothing_ratio", f"{ratio:g}: the kernel cutoff must be 1.5 to 4 spacings")
-    wall = j.obj(doc.get("wall", {}), "wall")
+    wall = _known(j, j.obj(doc.get("wall", {}), "wall"), "wall", "wall")
     layers = j.integer(wall.get("layers", math.ceil(ratio)), "wall.layers", minimum=1)
     if layers > 8:
         j.fail("wall.layers", f"{layers}: at most 8 layers")
 
     motion = _motion(j, doc.get("motion"), folder, mesh)
-    run = j.obj(doc.get("run"), "run")
+    run = _known(j, j.obj(doc.get("run"), "run"), "run", "run")
     end_time = j.number(run.get("end_time"), "run.end_time", positive=True)
     dt = run.get("time_step")
     dt = None if dt is None else j.number(dt, "run.time_step", positive=True)
@@ -139,13 +156,13 @@ def read_case(path: str | Path) -> SphCase:
     if motion is not None and end_time > (motion.count - 1) * motion.frame_interval * (1 + 1e-12):
         j.fail("run.end_time", f"{end_time:g} s is beyond the last motion frame "
                f"({(motion.count - 1) * motion.frame_interval:g} s)")
-    output = j.obj(doc.get("output", {}), "output")
+    output = _known(j, j.obj(doc.get("output", {}), "output"), "output", "output")
     save = j.number(output.get("interval", end_time / 10), "output.interval", positive=True)
     series = output.get("series_interval")
     series = None if series is None else j.number(series, "output.series_interval", positive=True)
     name = lammps_word(j.string(output.get("name", path.stem), "output.name"), path, None, "output.name")
 
-    openings = _openings(j, doc.get("openings", []), mesh, dx)
+    openings = _openings(j, doc.get("openings", []), mesh, dx, mesh_file)
     return SphCase(path, mesh, mesh_file, motion, dx, density, viscosity, alpha, c0, ratio, layers,
                    openings, end_time, dt, cfl, save, series, str(name))
 
@@ -173,7 +190,9 @@ def read_mesh(path: Path, unit: float | None) -> Mesh:
 def _motion(j: JsonDoc, spec: Any, folder: Path, mesh: Mesh) -> Motion | None:
     if spec is None:
         return None
-    spec = j.obj(spec, "motion")
+    spec = _known(j, j.obj(spec, "motion"), "motion", "motion")
+    if "file" in spec and "meshes" in spec:
+        j.fail("motion", "give either 'file' (a .dynpt) or 'meshes', not both")
     interval = spec.get("frame_interval")
     if "file" in spec:
         from fibrelmp.mesh.opencarp.dynpt import DynptReader
@@ -201,15 +220,15 @@ def _motion(j: JsonDoc, spec: Any, folder: Path, mesh: Mesh) -> Motion | None:
     return Motion(kind, files, interval, count)
 
 
-def _openings(j: JsonDoc, spec: Any, mesh: Mesh, dx: float) -> list[Opening]:
+def _openings(j: JsonDoc, spec: Any, mesh: Mesh, dx: float, mesh_file: Path) -> list[Opening]:
     from fibrelmp.cardioproof.geometry import shell_elements
 
     items = j.array(spec, "openings")
-    _, tags = shell_elements(mesh)
+    _, tags = shell_elements(mesh, mesh_file)
     out, taken, names = [], np.zeros(len(tags), bool), set()
     for k, item in enumerate(items):
         where = f"openings[{k}]"
-        item = j.obj(item, where)
+        item = _known(j, j.obj(item, where), "openings", where)
         name = str(lammps_word(j.string(item.get("name", f"opening{k + 1}"), f"{where}.name"),
                                j.path, None, f"{where}.name"))
         if name in names:

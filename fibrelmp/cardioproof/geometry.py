@@ -25,12 +25,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Iterator
+from typing import TYPE_CHECKING, Iterator
 
 import numpy as np
 
 from fibrelmp.errors import InputError
 from fibrelmp.mesh.model import Mesh
+
+if TYPE_CHECKING:
+    from fibrelmp.cardioproof.case import SphCase
 
 SHELL = ("triangle", "quad")
 
@@ -57,6 +60,21 @@ def shell_elements(mesh: Mesh, source: Path | None = None) -> tuple[np.ndarray, 
         raise InputError(source, None, "the mesh has no shell elements")
     tri = np.concatenate(tris).astype(np.int64)
     return tri[np.argsort(tri[:, 3], kind="stable")], np.concatenate(tags)
+
+
+def open_edge(x: np.ndarray, tri: np.ndarray) -> tuple[int, int] | None:
+    """(triangle row, its edge's first corner) of an edge that not exactly two triangles
+    share, nodes merged by position (separate parts may touch: a piston disc in a tube);
+    None when the surface is closed."""
+    scale = float(np.ptp(x, axis=0).max()) or 1.0
+    _, merged = np.unique(np.round(x / (scale * 1e-9)).astype(np.int64), axis=0, return_inverse=True)
+    t = merged.reshape(-1)[tri]
+    edges = np.concatenate([np.sort(t[:, [i, (i + 1) % 3]], axis=1) for i in range(3)])
+    _, inverse, counts = np.unique(edges, axis=0, return_inverse=True, return_counts=True)
+    bad = np.flatnonzero(counts[inverse.reshape(-1)] != 2)
+    if not len(bad):
+        return None
+    return int(bad[0] % len(tri)), int(bad[0] // len(tri))
 
 
 def unit_normals(x: np.ndarray, tri: np.ndarray) -> np.ndarray:
@@ -105,9 +123,9 @@ def is_inside(x: np.ndarray, tri: np.ndarray, q: np.ndarray) -> np.ndarray:
     return crossings_below(x, tri, q) % 2 == 1
 
 
-def orient_outward(x: np.ndarray, tri: np.ndarray, spacing: float) -> tuple[np.ndarray, int]:
-    """``tri`` with each triangle turned so its normal points away from the inside; the
-    number of triangles whose sides could not be told apart (kept as given)."""
+def orient_outward(x: np.ndarray, tri: np.ndarray, spacing: float) -> tuple[np.ndarray, np.ndarray]:
+    """``tri`` with each triangle turned so its normal points away from the inside; which
+    triangles' sides could not be told apart (kept as given)."""
     n = unit_normals(x, tri)
     centre = x[tri[:, :3]].mean(axis=1)
     area = 0.5 * np.linalg.norm(np.cross(x[tri[:, 1]] - x[tri[:, 0]], x[tri[:, 2]] - x[tri[:, 0]]), axis=1)
@@ -117,7 +135,7 @@ def orient_outward(x: np.ndarray, tri: np.ndarray, spacing: float) -> tuple[np.n
     flip = front & ~back
     out = tri.copy()
     out[flip, 1], out[flip, 2] = tri[flip, 2], tri[flip, 1]
-    return out, int(np.count_nonzero(front == back))
+    return out, front == back
 
 
 def enclosed_volume(x: np.ndarray, tri: np.ndarray) -> float:
@@ -202,7 +220,7 @@ def fluid_points(x: np.ndarray, tri: np.ndarray, spacing: float) -> np.ndarray:
     return grid[is_inside(x, tri, grid)]
 
 
-def motion_frames(case) -> Iterator[np.ndarray]:
+def motion_frames(case: "SphCase") -> Iterator[np.ndarray]:
     """The mesh's node positions (m) at each motion frame (the mesh itself when static)."""
     if case.motion is None:
         yield case.mesh.points_m

@@ -109,7 +109,12 @@ def plan_job(case: SphCase) -> dict:
     """Everything the script and data file need (numpy arrays included); worked out once per
     case (its input errors come before a run locks or writes anything)."""
     if case.plan is None:
-        case.plan = _plan(case)
+        try:
+            case.plan = _plan(case)
+        except InputError as exc:
+            if exc.path is None:           # a geometry check that knows no file: the case's
+                raise InputError(case.source, None, exc.message) from None
+            raise
     return case.plan
 
 
@@ -139,10 +144,15 @@ def _plan(case: SphCase) -> dict:
         longest = edges if longest is None else np.maximum(longest, edges)
         prev = x
     x0 = first
+    _check_surface(case, x0, tri4)
     tri, unclear = geometry.orient_outward(x0, tri4[:, :3], case.spacing)
-    if unclear:
-        case.warnings.append(("mesh", f"{unclear} of {len(tri)} shell triangles have the fluid on "
-                              "neither or both sides (their winding is kept)"))
+    if (unclear & (opening_of >= 0)).any():
+        element = int(tri4[np.flatnonzero(unclear & (opening_of >= 0))[0], 3])
+        raise InputError(case.mesh_file, None, f"shell element {element} of an opening has the fluid on "
+                         "neither or both sides: an opening must separate the cavity from the outside")
+    if unclear.any():
+        case.warnings.append(("mesh", f"{int(unclear.sum())} of {len(tri)} shell triangles have the fluid "
+                              "on neither or both sides (their winding is kept)"))
     openings, moving_openings = [], {}
     for k, o in enumerate(case.openings):
         rows = opening_of == k
@@ -155,6 +165,9 @@ def _plan(case: SphCase) -> dict:
                                case.motion.frame_interval)
                       for a, b in zip(at_frames[:-1], at_frames[1:])]
             moving_openings[o.name] = shapes
+        for shape in shapes:               # each place must give LAMMPS regions
+            for t in shape.triangles:
+                edge_planes(t, shape.normal)
         worst = max(g.nonplanar for g in shapes)
         if worst > 1e-3 * o.search_distance:
             case.warnings.append(("opening", f"opening {o.name!r} is not planar (nodes up to "
@@ -168,6 +181,12 @@ def _plan(case: SphCase) -> dict:
     if not len(fluid):
         raise InputError(case.source, None, "the walls and openings enclose no fluid: they must close "
                          f"the cavity, and the cavity must be wider than fluid.spacing {dx:g} m")
+    for o in openings:
+        ahead = in_front(moving_openings.get(o.name, [o])[0], fluid)
+        if ahead.any():
+            raise InputError(case.source, None, f"opening {o.name!r}: {int(ahead.sum())} fluid particles start "
+                             "in front of it (within 2 search distances, over the opening): the cavity must "
+                             "not continue beyond an opening")
     walls = geometry.wall_particles(x0, wall_tri, dx, case.layers, box_lo)
     stretch = float((longest[opening_of < 0] / geometry.edge_lengths(x0, wall_tri)).max())
     if stretch > geometry.STRETCHED:
@@ -197,6 +216,35 @@ def _plan(case: SphCase) -> dict:
                 series=series, box=(box_lo, box_hi), moved=moved)
 
 
+def _check_surface(case: SphCase, x: np.ndarray, tri4: np.ndarray) -> None:
+    """Shell elements with an area, and a closed surface (walls and openings together)."""
+    t = tri4[:, :3]
+    area = 0.5 * np.linalg.norm(np.cross(x[t[:, 1]] - x[t[:, 0]], x[t[:, 2]] - x[t[:, 0]]), axis=1)
+    scale = float(np.ptp(x, axis=0).max()) or 1.0
+    flat = np.flatnonzero(~(area > 1e-12 * scale * scale))
+    if len(flat):
+        raise InputError(case.mesh_file, None, f"shell element {int(tri4[flat[0], 3])} has no area at the start "
+                         "(coinciding or collinear nodes)")
+    edge = geometry.open_edge(x, t)
+    if edge is not None:
+        raise InputError(case.mesh_file, None, f"shell element {int(tri4[edge[0], 3])}: its edge from node "
+                         f"{int(t[edge[0], edge[1]])} is not shared by exactly two elements: walls and "
+                         "openings must close the cavity (no hole, no T-junction)")
+
+
+def in_front(o: OpeningGeometry, x: np.ndarray) -> np.ndarray:
+    """Which points are where LAMMPS removes fluid: over the opening (its widened triangles)
+    and in front of its plane by at most twice the search distance (``beyond_<name>``)."""
+    delta = (x - o.centre) @ o.normal
+    inside = np.zeros(len(x), bool)
+    for t in o.triangles:
+        ok = np.ones(len(x), bool)
+        for p, m in edge_planes(t, o.normal):
+            ok &= (x - p) @ m >= 0
+        inside |= ok
+    return inside & (delta >= 0) & (delta <= 2 * o.distance)
+
+
 def _opening(o, t: np.ndarray, start: OpeningGeometry | None = None, end: OpeningGeometry | None = None,
              interval: float = 1.0) -> OpeningGeometry:
     """The opening with triangles ``t``; between ``start`` and ``end`` (an interval later) it
@@ -204,6 +252,9 @@ def _opening(o, t: np.ndarray, start: OpeningGeometry | None = None, end: Openin
     area_vectors = 0.5 * np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
     areas = np.linalg.norm(area_vectors, axis=1)
     n = area_vectors.sum(axis=0)
+    if not np.linalg.norm(n) > 1e-9 * areas.sum():
+        raise InputError(None, None, f"opening {o.name!r} has no area facing any direction (its elements "
+                         "cancel out or have no area)")
     n = n / np.linalg.norm(n)
     centre = (t.mean(axis=1) * areas[:, None]).sum(axis=0) / areas.sum()
     off = float(np.abs((t.reshape(-1, 3) - centre) @ n).max())
@@ -222,6 +273,9 @@ def edge_planes(t: np.ndarray, n: np.ndarray) -> list[tuple[np.ndarray, np.ndarr
         m = np.cross(n, q - p)
         m = m / np.linalg.norm(m)
         height = float(m @ (v - p))
+        if not abs(height) > 1e-9 * float(np.linalg.norm(q - p)):
+            raise InputError(None, None, "an opening's element stands (nearly) perpendicular to the "
+                             "opening's plane: its projection has no area")
         if height < 0:
             m, height = -m, -height
         planes.append((p - MARGIN * height * m, m))
@@ -266,13 +320,13 @@ def opening_context(o: OpeningGeometry) -> dict:
                 block(f"box_{name}", lo - d, hi + d),
                 plane(f"deep_{name}", c - d * n, n), plane(f"behind_{name}", c, -n),
                 f"region          near_{name} intersect 4 box_{name} deep_{name} behind_{name} prism_{name}",
-                block(f"wide_{name}", lo - 3 * d, hi + 3 * d), plane(f"front_{name}", c, n),
-                f"region          beyond_{name} intersect 2 wide_{name} front_{name}"]
+                plane(f"front_{name}", c, n), plane(f"ahead_{name}", c + 2 * d * n, -n),
+                f"region          beyond_{name} intersect 3 front_{name} ahead_{name} prism_{name}"]
     # composite regions first, then their parts
     ids = [f"near_{name}", f"beyond_{name}", f"prism_{name}"]
     for k in range(1, len(o.triangles) + 1):
         ids += [f"t{k}_{name}", *(f"e{k}{s}_{name}" for s in "abc")]
-    ids += [f"{r}_{name}" for r in ("box", "deep", "behind", "wide", "front")]
+    ids += [f"{r}_{name}" for r in ("box", "deep", "behind", "front", "ahead")]
     deletes = [f"region          {r} delete" for r in ids]
     delta = f"({nx})*(x-({f(c[0])}))+({ny})*(y-({f(c[1])}))+({nz})*(z-({f(c[2])}))"
     variables = [f"variable        w_{name} atom 1.0+({delta})/{f(d)}",

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterator
 
 import numpy as np
 
@@ -157,30 +157,32 @@ class OpeningSeriesWriter(Writer):
         pass                       # the series is LAMMPS's; frames carry nothing for it
 
     def finish(self) -> None:
-        rows = read_series(self.source)
-        lines = [",".join(SERIES_COLUMNS)]
+        fh = self.open(self.target)
+        fh.write((",".join(SERIES_COLUMNS) + "\n").encode())
         prev = None
-        for row in rows:
-            _, t, p, fx, fy, fz, near, flux, crossed = row.tolist()
+        for _, t, p, fx, fy, fz, near, flux, crossed in iter_series(self.source):
             crossing = "" if prev is None or t <= prev[0] else \
                 repr((crossed - prev[1]) * self.volume / (t - prev[0]))
             normal = fx * self.normal[0] + fy * self.normal[1] + fz * self.normal[2]
-            lines.append(",".join([*(repr(v) for v in (t, p, fx, fy, fz, float(normal))), str(int(near)),
-                                   repr(flux), str(int(crossed)), crossing]))
+            fh.write((",".join([*(repr(v) for v in (t, p, fx, fy, fz, float(normal))), str(int(near)),
+                                repr(flux), str(int(crossed)), crossing]) + "\n").encode())
             prev = (t, crossed)
-        self.write_file(self.target, ("\n".join(lines) + "\n").encode())
 
 
-def read_series(path: Path) -> np.ndarray:
-    """The rows of a ``fix ave/time`` file: step, t, p, fx, fy, fz, near, flux, crossed."""
+def iter_series(path: Path) -> Iterator[tuple[float, ...]]:
+    """The rows of a ``fix ave/time`` file, one at a time: step, t, p, fx, fy, fz, near,
+    flux, crossed."""
     try:
-        text = Path(path).read_text()
+        with open(path) as fh:
+            for number, line in enumerate(fh, 1):
+                if not line.strip() or line.startswith("#"):
+                    continue
+                words = line.split()
+                if len(words) != 9:
+                    raise RunError(f"{path}:{number}: unexpected row in the opening's series")
+                yield tuple(float(w) for w in words)
     except OSError as exc:
         raise RunError(f"{path}: cannot read the opening's series ({exc.strerror})") from None
-    rows = [line.split() for line in text.splitlines() if line.strip() and not line.startswith("#")]
-    if any(len(r) != 9 for r in rows):
-        raise RunError(f"{path}: unexpected rows in the opening's series")
-    return np.array(rows, float).reshape(-1, 9)
 
 
 def result_writers(case: SphCase, job: SphJob, folder: Path, force: bool = True) -> list[Writer]:

@@ -56,6 +56,13 @@ class VtkMeshReader(Reader):
         points = np.asarray(m.points, np.float64)
         if points.shape[1] == 2:
             points = np.hstack([points, np.zeros((len(points), 1))])
+        if not np.isfinite(points).all():
+            raise self.error(None, f"point {int(np.flatnonzero(~np.isfinite(points).all(axis=1))[0])}: "
+                             "coordinates must be finite")
+        for block in blocks:
+            if len(block.nodes) and (block.nodes.min() < 0 or block.nodes.max() >= len(points)):
+                bad = int(np.flatnonzero((block.nodes < 0).any(axis=1) | (block.nodes >= len(points)).any(axis=1))[0])
+                raise self.error(None, f"{block.kind} cell {bad} names a point outside 0..{len(points) - 1}")
         return Mesh(points, blocks, unit=self.unit, name=self.path.stem)
 
 

@@ -14,7 +14,7 @@ if TYPE_CHECKING:
     from fibrelmp.cardioproof.case import SphCase
     from fibrelmp.cardioproof.job import SphJob
     from fibrelmp.outputs import Outputs
-    from fibrelmp.pipeline.request import RunOptions, RunPlan
+    from fibrelmp.pipeline.request import Rendered, RunOptions, RunPlan
 
 
 class CaseInput(InputFormat):
@@ -120,7 +120,7 @@ class SphRecorder:
         self.steps = self.resumed = 0
         self.final: dict[str, Any] = {}
 
-    def end(self, lmp, steps: int, resumed: int) -> None:
+    def end(self, lmp: Any, steps: int, resumed: int) -> None:
         self.steps, self.resumed = steps, resumed
         self.final["step"] = int(lmp.extract_global("ntimestep"))
         self.final["atoms"] = int(lmp.get_natoms())
@@ -140,7 +140,7 @@ class SphRecorder:
                                             "left the box: a finer spacing, more wall.layers or a higher "
                                             "fluid.sound_speed keep the fluid in"))
 
-    def summary(self, rendered, wall_time: float, warnings: list[tuple[str, str]],
+    def summary(self, rendered: "Rendered", wall_time: float, warnings: list[tuple[str, str]],
                 tally: dict | None = None) -> dict:
         from fibrelmp.record import LOG_NAME, SUMMARY_VERSION
 

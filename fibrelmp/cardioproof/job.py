@@ -66,7 +66,6 @@ class SphJob:
     dt: float
     total_steps: int
     save_steps: list[int]
-    series_steps: int
     frame_steps: int | None    # steps per motion frame interval
     sound_speed: float
     fluid_count: int
@@ -74,7 +73,8 @@ class SphJob:
     wall_count: int
     moving_count: int
     openings: list[OpeningGeometry]       # where they start (moving ones: the first interval's)
-    wall_tri: np.ndarray       # (t, 3) node indices of the wall triangles (outward)
+    surface: np.ndarray        # (t, 3) node indices of the mesh's triangles, as the file winds them
+    opening_of: np.ndarray     # (t,) each triangle's opening (index into openings), -1: wall
     box: tuple[np.ndarray, np.ndarray]
     inputs: list[Path] = field(default_factory=list)
 
@@ -130,7 +130,7 @@ def _plan(case: SphCase) -> dict:
     wall_speed = 0.0
     prev = None
     at_frames = []                 # the openings' nodes at every frame (for moving openings)
-    longest = None                 # each triangle's longest edge over the frames
+    longest = first_edges = None   # each triangle's longest edge: over the frames, at the start
     for x in geometry.motion_frames(case):
         if first is None:
             first = x
@@ -141,7 +141,9 @@ def _plan(case: SphCase) -> dict:
             wall_speed = max(wall_speed, float(np.linalg.norm(x - prev, axis=1).max()) / case.motion.frame_interval)
         at_frames.append(x[opening_nodes])
         edges = geometry.edge_lengths(x, tri4[:, :3])
-        longest = edges if longest is None else np.maximum(longest, edges)
+        if longest is None:
+            longest = first_edges = edges
+        longest = np.maximum(longest, edges)
         prev = x
     x0 = first
     _check_surface(case, x0, tri4)
@@ -159,11 +161,12 @@ def _plan(case: SphCase) -> dict:
         openings.append(_opening(o, x0[tri[rows]]))
         shapes = [openings[-1]]
         if moved[np.unique(tri[rows])].any():
-            # the opening where the mesh is halfway through each motion interval
+            # the opening where the mesh is halfway through each motion interval, moving with
+            # its centre's velocity over the interval
             local = np.searchsorted(opening_nodes, tri[rows])
-            shapes = [_opening(o, (0.5 * (a + b))[local], _opening(o, a[local]), _opening(o, b[local]),
-                               case.motion.frame_interval)
-                      for a, b in zip(at_frames[:-1], at_frames[1:])]
+            centres = [_opening(o, a[local]).centre for a in at_frames]
+            shapes = [_opening(o, (0.5 * (a + b))[local], (cb - ca) / case.motion.frame_interval)
+                      for a, b, ca, cb in zip(at_frames[:-1], at_frames[1:], centres[:-1], centres[1:])]
             moving_openings[o.name] = shapes
         for shape in shapes:               # each place must give LAMMPS regions
             for t in shape.triangles:
@@ -188,7 +191,7 @@ def _plan(case: SphCase) -> dict:
                              "in front of it (within 2 search distances, over the opening): the cavity must "
                              "not continue beyond an opening")
     walls = geometry.wall_particles(x0, wall_tri, dx, case.layers, box_lo)
-    stretch = float((longest[opening_of < 0] / geometry.edge_lengths(x0, wall_tri)).max())
+    stretch = float((longest / first_edges)[opening_of < 0].max())
     if stretch > geometry.STRETCHED:
         case.warnings.append(("wall stretch", f"wall triangles stretch up to {stretch:.2f}x over the motion: "
                               "their particles, placed at the start, are then that much farther apart "
@@ -211,9 +214,10 @@ def _plan(case: SphCase) -> dict:
     every = max(1, round(case.save_interval / dt))
     saves = list(range(0, total, every)) + [total]
     series = max(1, round(case.series_interval / dt)) if case.series_interval else max(1, every // 10)
-    return dict(moving_openings=moving_openings, particle_volume=particle_volume, volume=volume, x0=x0, tri=tri, wall_tri=wall_tri, walls=walls, wall_moving=wall_moving, fluid=fluid,
+    return dict(moving_openings=moving_openings, particle_volume=particle_volume, x0=x0, wall_tri=wall_tri,
+                surface=tri4[:, :3], opening_of=opening_of, walls=walls, wall_moving=wall_moving, fluid=fluid,
                 openings=openings, c0=c0, dt=dt, frame_steps=frame_steps, total=total, saves=saves,
-                series=series, box=(box_lo, box_hi), moved=moved)
+                series=series, box=(box_lo, box_hi))
 
 
 def _check_surface(case: SphCase, x: np.ndarray, tri4: np.ndarray) -> None:
@@ -245,10 +249,8 @@ def in_front(o: OpeningGeometry, x: np.ndarray) -> np.ndarray:
     return inside & (delta >= 0) & (delta <= 2 * o.distance)
 
 
-def _opening(o, t: np.ndarray, start: OpeningGeometry | None = None, end: OpeningGeometry | None = None,
-             interval: float = 1.0) -> OpeningGeometry:
-    """The opening with triangles ``t``; between ``start`` and ``end`` (an interval later) it
-    moves with the velocity of its area-weighted centre."""
+def _opening(o, t: np.ndarray, velocity: np.ndarray | None = None) -> OpeningGeometry:
+    """The opening with triangles ``t`` (moving with ``velocity``: none, static)."""
     area_vectors = 0.5 * np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
     areas = np.linalg.norm(area_vectors, axis=1)
     n = area_vectors.sum(axis=0)
@@ -258,9 +260,8 @@ def _opening(o, t: np.ndarray, start: OpeningGeometry | None = None, end: Openin
     n = n / np.linalg.norm(n)
     centre = (t.mean(axis=1) * areas[:, None]).sum(axis=0) / areas.sum()
     off = float(np.abs((t.reshape(-1, 3) - centre) @ n).max())
-    velocity = (end.centre - start.centre) / interval if start is not None else np.zeros(3)
     return OpeningGeometry(o.name, t, centre, n, float(areas.sum()), o.search_distance, o.pressure, off,
-                           velocity)
+                           np.zeros(3) if velocity is None else velocity)
 
 
 def edge_planes(t: np.ndarray, n: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -378,9 +379,9 @@ def write_job(case: SphCase, folder: str | Path, write_files: bool = True) -> tu
         spacing=case.spacing, frame_steps=frame_steps)
     job = SphJob(folder, folder / SCRIPT_NAME, folder / DATA_NAME, folder / FRAMES_NAME,
                  folder / WALLS_NAME if nmoving else None, p["dt"], p["total"],
-                 p["saves"], p["series"], frame_steps, p["c0"], nfluid, p["particle_volume"], len(walls.rows), nmoving,
+                 p["saves"], frame_steps, p["c0"], nfluid, p["particle_volume"], len(walls.rows), nmoving,
                  [moving_openings[o.name][0] if o.name in moving_openings else o for o in p["openings"]],
-                 p["wall_tri"], p["box"])
+                 p["surface"], p["opening_of"], p["box"])
     job.inputs = [job.data] + ([folder / n for n in VELOCITY_NAMES] if walls_move else [])
     if write_files:
         folder.mkdir(parents=True, exist_ok=True)
@@ -418,6 +419,7 @@ def _write_velocities(case: SphCase, job: SphJob, walls, moving_rows: np.ndarray
     """One atomfile per velocity component: a set per motion frame interval (``next`` loads the
     following one), the moving wall particles' straight-line velocity from frame to frame."""
     from fibrelmp.textio import discard, temp_name
+    from fibrelmp.translate.lammps_format import atomfile_blocks
 
     moving = geometry.WallParticles(walls.rows[moving_rows], walls.bary[moving_rows], walls.layer[moving_rows])
     ids = np.arange(first_id + 1, first_id + 1 + len(moving_rows))
@@ -434,8 +436,7 @@ def _write_velocities(case: SphCase, job: SphJob, walls, moving_rows: np.ndarray
             if prev is not None:
                 v = (now - prev) / dt_frame
                 for a, fh in enumerate(handles):
-                    fh.write(f"# interval {k - 1}: frames {k - 1} -> {k}\n{len(ids)}\n")
-                    fh.write("".join(f"{i} {float_text(val)}\n" for i, val in zip(ids.tolist(), v[:, a].tolist())))
+                    fh.write(atomfile_blocks(ids, [(f"interval {k - 1}: frames {k - 1} -> {k}", v[:, a])], ""))
             prev = now
         for fh in handles:
             fh.close()

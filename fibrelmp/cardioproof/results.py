@@ -115,18 +115,13 @@ class SphVtkWriter(Writer):
 
     format = "vtk"
 
-    def __init__(self, base: Path, case: SphCase, job: SphJob, *, force: bool = True):
+    def __init__(self, base: Path, job: SphJob, *, force: bool = True):
         from fibrelmp.post.vtk.writer import VtkWriter
 
         self.vtk = VtkWriter(base, force=force)
         super().__init__(base, force=force)
         self.adopt(self.vtk)
-        tri4, _ = geometry.shell_elements(case.mesh, case.mesh_file)
-        self.tri = tri4[:, :3]
-        opening = np.full(len(tri4), -1)
-        for k, o in enumerate(case.openings):
-            opening[np.isin(tri4[:, 3], o.elements)] = k
-        self.opening = opening
+        self.tri, self.opening = job.surface, job.opening_of
         self.lo, self.hi = job.box
 
     def outputs(self) -> list[Path]:
@@ -186,7 +181,7 @@ def iter_series(path: Path) -> Iterator[tuple[float, ...]]:
 
 
 def result_writers(case: SphCase, job: SphJob, folder: Path, force: bool = True) -> list[Writer]:
-    writers: list[Writer] = [SphVtkWriter(folder / case.name, case, job, force=force)]
+    writers: list[Writer] = [SphVtkWriter(folder / case.name, job, force=force)]
     for o in job.openings:
         writers.append(OpeningSeriesWriter(folder / f"{case.name}_{o.name}.csv", job.folder / o.series_name(),
                                            o.normal, job.particle_volume, force=force))

@@ -262,17 +262,15 @@ def feed(writers: list) -> Consumer:
             raise
         # every writer writes its last files before any file is renamed into place: a
         # writer failing at the end leaves no output of the others behind
-        for k, writer in enumerate(writers):
-            prepare = getattr(writer, "prepare", None)
-            if prepare is None:
-                continue
-            try:
-                prepare()
-            except BaseException:
-                for other in writers:
-                    if other is not writer:
-                        other.abort()
-                raise
+        try:
+            for writer in writers:
+                prepare = getattr(writer, "prepare", None)
+                if prepare is not None:
+                    prepare()
+        except BaseException:
+            for writer in writers:      # abort never raises, and a closed writer ignores it
+                writer.abort()
+            raise
         written: list[Path] = []
         for k, writer in enumerate(writers):
             try:

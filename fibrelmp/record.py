@@ -210,11 +210,16 @@ class Recorder:
             scale["limit"] = 1 / STEP_FRACTION
             scale["ok"] = dt <= STEP_FRACTION * scale["value"]
         out["time_step_check"] = scale
-        kinds: dict[str, int] = {}
-        for kind, _ in warnings:
-            kinds[kind] = kinds.get(kind, 0) + 1
-        out["warnings"] = kinds
+        out["warnings"] = warning_counts(warnings)
         return out
+
+
+def warning_counts(warnings: list[tuple[str, str]]) -> dict[str, int]:
+    """``{kind: count}`` of a run's warnings, in the order they came (every summary's field)."""
+    kinds: dict[str, int] = {}
+    for kind, _ in warnings:
+        kinds[kind] = kinds.get(kind, 0) + 1
+    return kinds
 
 
 def write_summary(folder: Path, summary: dict) -> Path:

@@ -142,7 +142,7 @@ class SphRecorder:
 
     def summary(self, rendered: "Rendered", wall_time: float, warnings: list[tuple[str, str]],
                 tally: dict | None = None) -> dict:
-        from fibrelmp.record import LOG_NAME, SUMMARY_VERSION
+        from fibrelmp.record import LOG_NAME, SUMMARY_VERSION, warning_counts
 
         job, case = self.job, self.model
         folder = Path(rendered.folder)
@@ -152,9 +152,6 @@ class SphRecorder:
             crossed = self.final.get("crossed", {}).get(o.name, 0)
             openings[o.name] = {"area": o.area, "crossed_particles": crossed,
                                 "crossed_volume": crossed * job.particle_volume}
-        kinds: dict[str, int] = {}
-        for kind, _ in warnings:
-            kinds[kind] = kinds.get(kind, 0) + 1
         return {
             "summary_version": SUMMARY_VERSION, "input": str(case.source), "kind": "cardioproof",
             "units": "si", "folder": str(folder),
@@ -167,5 +164,6 @@ class SphRecorder:
             "frames": len(job.save_steps),
             "particles": {"kind": "sph", "fluid_start": job.fluid_count, "wall": walls,
                           "fluid_end": self.final.get("fluid")},
-            "openings": openings, "final_step": self.final.get("step"), "warnings": kinds,
+            "openings": openings, "final_step": self.final.get("step"),
+            "warnings": warning_counts(warnings),
         }

@@ -3,6 +3,8 @@ labels numbered, ``--types`` applied, positions checked."""
 
 from __future__ import annotations
 
+from typing import Callable
+
 import numpy as np
 
 from fibrelmp.errors import InputError
@@ -13,11 +15,12 @@ class Completer:
     """Fill what writers need and the dump lacks; sort atoms by id; apply ``--types``."""
 
     def __init__(self, data, types: list[str] | None, names: dict[int, str], warnings: list,
-                 target_units=None):
+                 target_units=None, check: Callable[[Frame], None] | None = None):
         self.data = data
         self.names = names
         self.warnings = warnings
         self.target_units = target_units     # (format name, units.UnitSystem) of the output, if any
+        self.check = check                   # the target's check of a frame as read (inf/nan)
         self.warned: set[str] = set()
         self.labels = {v: k for k, v in names.items()}
         self.keep = self._types(types) if types else None
@@ -50,10 +53,12 @@ class Completer:
             note = mismatch_note(frame.units, self.target_units[1], self.target_units[0])
             if note is not None:
                 self._warn("units", f"{frame.source}: {note}")
+        if self.check is not None:
+            self.check(frame)
         cols = self._by_id(frame)
         self._facts(frame, cols)
         out = Frame(frame.step, frame.lo, frame.hi, frame.boundary, cols, frame.tilt, frame.time,
-                    frame.line, frame.units, frame.source)
+                    frame.line, frame.units, frame.source, frame.index)
         self._positions(out)
         if self.keep is not None:
             codes = cols["type"].astype(np.int64)

@@ -50,6 +50,8 @@ class Frame:
     line: int | None = None             # line of the frame's first ITEM in the file
     units: str | None = None            # ITEM: UNITS (dump_modify units yes)
     source: str | None = None           # file the frame came from (error messages)
+    index: int | None = None            # frame index in the file, from 0 (as --frames counts)
+    atom_line: int | None = None        # line of the first atom line (atom rows in file order)
 
     @property
     def count(self) -> int:
@@ -134,7 +136,7 @@ class Frame:
         """A frame with only the given atom rows (a mask, index array or slice)."""
         cols = {k: v[rows] for k, v in self.columns.items()}
         return Frame(self.step, self.lo, self.hi, self.boundary, cols, self.tilt, self.time,
-                     self.line, self.units, self.source)
+                     self.line, self.units, self.source, self.index)
 
 
 @dataclass
@@ -521,7 +523,8 @@ def iter_headers(path: str | Path, warnings: list[tuple[str, str]] | None = None
 def frame_from(head: Header, block: bytes, path: Path | str | None) -> Frame:
     cols = parse_block(block, head, path)
     return Frame(head.step, head.lo, head.hi, head.boundary, cols, head.tilt, head.time,
-                 head.line, head.units, None if path is None else str(path))
+                 head.line, head.units, None if path is None else str(path), head.extra.get("index"),
+                 head.line + head.extra["header_lines"] if "header_lines" in head.extra else None)
 
 
 def iter_frames(path: str | Path, warnings: list[tuple[str, str]] | None = None,

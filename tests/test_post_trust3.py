@@ -165,6 +165,13 @@ def test_inf_in_a_column_the_target_does_not_write_is_no_error(tmp_path):
     assert [f.step for f in read_xyz(tmp_path / "o_coord.xyz")] == [0]
 
 
+def test_inf_in_atoms_that_types_leaves_out_is_no_error(tmp_path):
+    """Only the atoms written are checked: ``--types 2`` leaves out the blown-up atom 3."""
+    p, _ = blown_up(tmp_path, "vx", "inf")
+    written = post(p, "xyz", tmp_path / "o", types=["2"])
+    assert [len(f.values) for f in read_xyz(written[0])] == [1, 1]
+
+
 def test_vtk_writes_inf_as_is_with_a_warning_and_vtk_reads_it(tmp_path):
     """VTK's Float64 arrays hold inf/nan (a viewer of a blown-up run shows them): written,
     never silently (a warning names the first)."""

@@ -100,13 +100,22 @@ POSITION_COLUMNS = frozenset({"x", "y", "z", "xs", "ys", "zs", "xu", "yu", "zu",
 
 
 def first_nonfinite(frame: Frame, names: frozenset[str] | None) -> tuple[str, int] | None:
-    """(column, row in file order) of the first inf/nan among the frame's numeric columns
-    ``names`` (None: all of them), or None."""
-    for name, col in frame.columns.items():
-        if (names is None or name in names) and col.dtype.kind == "f":
-            finite = np.isfinite(col)
-            if not finite.all():
-                return name, int(np.argmin(finite))
+    """(column, row) of the first inf/nan among the frame's numeric columns ``names`` (None:
+    all of them), or None."""
+    cols = [(name, col) for name, col in frame.columns.items()
+            if (names is None or name in names) and col.dtype.kind == "f"]
+    # A parsed block is one (n, k) array and its columns are strided views: one pass over
+    # the whole array (a finite sum means no inf/nan: they propagate) costs what one column
+    # costs, and only an array that fails is looked at column by column.
+    bases = {id(col.base): col.base for _, col in cols
+             if isinstance(col.base, np.ndarray) and col.base.dtype.kind == "f"}
+    clean = {key for key, base in bases.items() if np.isfinite(base.sum())}
+    for name, col in cols:
+        if id(col.base) in clean or np.isfinite(col.sum()):
+            continue
+        finite = np.isfinite(col)
+        if not finite.all():
+            return name, int(np.argmin(finite))
     return None
 
 
@@ -156,19 +165,25 @@ class DumpTarget(Writer):
         raise NotImplementedError
 
     # -- shared ------------------------------------------------------------------------------
-    def check_finite(self, frame: Frame) -> None:
+    def check_finite(self, frame: Frame, file_rows: np.ndarray | None = None,
+                     first_line: int | None = None, only: frozenset[str] | None = None) -> None:
         """Refuse an inf or nan (a dump's ``inf``/``nan``, or ``1e400``) this target cannot
-        write: ``path:line`` of the atom, the frame, the atom id and the column.  Called on
-        the frame as read (rows in file order, so the line is the atom's)."""
+        write: ``path:line`` of the atom, the frame, the atom id and the column.  ``file_rows``:
+        each row's row in the file (None: as in the file), ``first_line`` the line of the
+        file's first atom row; ``only``: check just these columns (and warn of nothing)."""
         must = INTEGER_COLUMNS | POSITION_COLUMNS | (self.finite_columns or frozenset())
-        hit = first_nonfinite(frame, must if self.writes_nonfinite or self.finite_columns else None)
+        names = must if self.writes_nonfinite or self.finite_columns else None
+        if only is not None:
+            names = only if names is None else names & only
+        hit = first_nonfinite(frame, names)
         if hit is not None:
             name, row = hit
-            raise InputError(frame.source, None if frame.atom_line is None else frame.atom_line + row,
+            in_file = row if file_rows is None else int(file_rows[row])
+            raise InputError(frame.source, None if first_line is None else first_line + in_file,
                              f"{self._where(frame, row)}: {name} is {frame.columns[name][row]}: "
                              f"--to {self.context.target_name or self.format or type(self).__name__} cannot write inf or "
                              "nan (did the simulation blow up?); nothing written")
-        if self.writes_nonfinite:
+        if self.writes_nonfinite and only is None:
             hit = first_nonfinite(frame, None)
             if hit is not None:
                 name, row = hit

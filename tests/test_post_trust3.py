@@ -291,20 +291,25 @@ def test_vtk_output_and_column_names_that_need_escaping_survive(tmp_path, bonds)
         assert vtk_array(lines, "id1").tolist() == [1, 1] and vtk_array(lines, "id2").tolist() == [2, 2]
 
 
+def fibrenet_case(folder: Path, output_file: str) -> None:
+    """The example network, 100 steps, a frame every 50, written as ``output_file``."""
+    from .conftest import REPO
+
+    src = REPO / "examples" / "fibre_network"
+    (folder / "model.txt").write_bytes((src / "model.txt").read_bytes())
+    text = (src / "input.txt").read_text()
+    for old, new in (("output_file\tfibre_network", f"output_file\t{output_file}"),
+                     ("run\t2000", "run\t100"), ("output_freq\t400", "output_freq\t50")):
+        assert old in text
+        text = text.replace(old, new)
+    (folder / "input.txt").write_text(text)
+
+
 def test_fibrenet_output_file_that_needs_escaping_with_vtk(tmp_path):
     """Was: FibreNet ``output_file net&a"b<c`` with ``--vtk`` wrote a .pvd/.vtm VTK cannot
     parse.  A short run of the example network (3 frames, bonds: .vtm frames)."""
-    from .conftest import REPO
-
     name = 'net&a"b<c'
-    src = REPO / "examples" / "fibre_network"
-    (tmp_path / "model.txt").write_bytes((src / "model.txt").read_bytes())
-    text = (src / "input.txt").read_text()
-    for old, new in (("output_file\tfibre_network", f"output_file\t{name}"), ("run\t2000", "run\t100"),
-                     ("output_freq\t400", "output_freq\t50")):
-        assert old in text
-        text = text.replace(old, new)
-    (tmp_path / "input.txt").write_text(text)
+    fibrenet_case(tmp_path, name)
     proc = cli(["-q", "run", "input.txt", "--vtk"], tmp_path, timeout=120)
     assert proc.returncode == 0, proc.stderr
     pvd = tmp_path / f"{name}.pvd"
@@ -324,6 +329,15 @@ def test_names_xml_cannot_hold_are_refused_before_writing(tmp_path, where):
     what = "output name 'r\\x02un'" if where == "output" else "array name 'c_a\\x01b'"
     assert f"{what} has a character a VTK XML file cannot hold" in proc.stderr
     assert listing(tmp_path) == ["d.dump"]
+
+
+def test_run_vtk_output_name_xml_cannot_hold_is_refused_before_the_run(tmp_path):
+    """Was refused only when the writer was made, after the work folder was written."""
+    fibrenet_case(tmp_path, "net\x01x")
+    proc = cli(["-q", "run", "input.txt", "--vtk"], tmp_path)
+    assert proc.returncode == 2, proc.stderr
+    assert "output name 'net\\x01x' has a character a VTK XML file cannot hold" in proc.stderr
+    assert listing(tmp_path) == ["input.txt", "model.txt"]
 
 
 # ------------------------------------------------------------- 7. .pvd times

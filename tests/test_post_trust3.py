@@ -426,3 +426,20 @@ def test_post_error_under_mpi_ends_every_rank_with_its_message(tmp_path):
     assert again.returncode == 2, again.stderr
     assert again.stderr.count("error: out/net_coord.xyz: output exists; use --force to overwrite") == 1
     assert {f: f.stat().st_mtime_ns for f in written} == before
+
+
+def test_the_mdanalysis_view_of_a_dump_bounds_its_lines_too(tmp_path):
+    """``RunResult.universe()`` indexes a dump with its own line reader: same bound."""
+    pytest.importorskip("MDAnalysis")
+    from fibrelmp.errors import InputError
+    from fibrelmp.post.lammps_dump.universe import dump_universe
+
+    good = frame(0, ROWS, time=0.0) + frame(10, ROWS, time=0.5)
+    universe = dump_universe(write(tmp_path, good, "good.dump"))
+    assert [ts.time for ts in universe.trajectory] == [0.0, 0.5]
+    long_line = "1 1 0.5 0.5 " + "5" * (MAX_LINE + 10) + "\n"
+    third = frame(20, ROWS[:2]).replace("ITEM: NUMBER OF ATOMS\n2", "ITEM: NUMBER OF ATOMS\n3")
+    p = write(tmp_path, good + third + long_line, "long.dump")
+    line = len((good + third).splitlines()) + 1
+    with pytest.raises(InputError, match=rf"long\.dump:{line}: line longer than 1 MiB"):
+        dump_universe(p).trajectory.n_frames

@@ -109,6 +109,24 @@ def mpi_barrier() -> None:
         lib.MPI_Barrier(ctypes.c_int(_COMM_WORLD))
 
 
+def mpi_wait_for_all(poll: float = 0.05) -> None:
+    """A barrier that sleeps between tests (MPI_Ibarrier + MPI_Test): MPICH's blocking
+    barrier spins, which would keep a core busy on every waiting rank for as long as rank 0
+    works alone (``fibrelmp post``).  Every rank must call it; a no-op without MPI."""
+    import time
+
+    lib = _libmpi()
+    if not _mpi_initialized(lib):
+        return
+    request, flag = ctypes.c_int(0), ctypes.c_int(0)      # MPI_Request is an int (MPICH ABI)
+    lib.MPI_Ibarrier(ctypes.c_int(_COMM_WORLD), ctypes.byref(request))
+    while True:
+        lib.MPI_Test(ctypes.byref(request), ctypes.byref(flag), ctypes.c_void_p(1))  # MPI_STATUS_IGNORE
+        if flag.value:
+            return
+        time.sleep(poll)
+
+
 def mpi_finalize() -> None:
     """Wait for every rank, then finalize.  A rank that simply exits makes mpiexec kill the
     others -- rank 0 may still be writing the results (and mpiexec still returns 0)."""

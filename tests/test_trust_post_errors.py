@@ -261,7 +261,7 @@ def test_xyz_writer_on_a_full_disk(tmp_path, monkeypatch, full_disk):
 
 
 @pytest.mark.parametrize("to,output", [("xyz", "o_coord.xyz"), ("res", "o_restart.res"),
-                                       ("vtk", "o_000000.vtp"), ("musen", "o"),
+                                       ("vtk", "o_000000.vtp"), ("musen", "o.txt"),
                                        ("demdf", "o_0.json"), ("mercury", "o")])
 def test_post_on_a_full_disk_names_the_output_and_leaves_nothing(tmp_path, full_disk, to, output):
     rows = [r + (0.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.1, 1.0) for r in ROWS]
@@ -293,7 +293,7 @@ def test_musen_result_writer_on_a_full_disk(tmp_path, monkeypatch):
             OSError(errno.ENOSPC, ENOSPC)))
         return real_finish(self)
     monkeypatch.setattr(musen_out.MusenResultWriter, "finish", finish)
-    with pytest.raises(RunError, match=f"/o: cannot write output: {ENOSPC}$"):
+    with pytest.raises(RunError, match=f"/o.txt: cannot write output: {ENOSPC}$"):
         post(p, "musen", tmp_path / "o")
     assert made and not made[0].tmp.exists() and not made[0].spool.exists()
     assert files(tmp_path) == ["d.dump"]

@@ -26,7 +26,7 @@ import numpy as np
 
 from fibrelmp.post.vtk.frame import ViewerFrame, box_of, from_dump, wrap
 from fibrelmp.post.vtk.target import frame_pattern
-from fibrelmp.post.vtk.writer import VtkWriter
+from fibrelmp.post.vtk.writer import VtkWriter, check_output_name
 
 if TYPE_CHECKING:
     from fibrelmp.granmodel import GranularFrame, GranularModel
@@ -47,7 +47,9 @@ def viewer_base(result: str | Path) -> Path:
 
 def declare(outputs: "Outputs", base: Path) -> None:
     """Add the viewer files of ``base`` to a run's outputs (its ``.pvd``, and its frame files
-    as a family: earlier frames need ``--force`` and go when the run succeeds)."""
+    as a family: earlier frames need ``--force`` and go when the run succeeds).  A name the
+    XML files cannot hold is an input error here, before anything is written."""
+    check_output_name(base)
     outputs.files.append(base.with_name(base.name + ".pvd"))
     outputs.files.append(base.with_name(base.name + "_walls.pvd"))
     outputs.patterns.append((base.parent, frame_pattern(base)))

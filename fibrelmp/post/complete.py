@@ -3,21 +3,25 @@ labels numbered, ``--types`` applied, positions checked."""
 
 from __future__ import annotations
 
+from typing import Callable
+
 import numpy as np
 
 from fibrelmp.errors import InputError
 from fibrelmp.post.lammps_dump.reader import Frame
+from fibrelmp.post.target import INTEGER_COLUMNS
 
 
 class Completer:
     """Fill what writers need and the dump lacks; sort atoms by id; apply ``--types``."""
 
     def __init__(self, data, types: list[str] | None, names: dict[int, str], warnings: list,
-                 target_units=None):
+                 target_units=None, check: Callable[..., None] | None = None):
         self.data = data
         self.names = names
         self.warnings = warnings
         self.target_units = target_units     # (format name, units.UnitSystem) of the output, if any
+        self.check = check                   # DumpTarget.check_finite (inf/nan)
         self.warned: set[str] = set()
         self.labels = {v: k for k, v in names.items()}
         self.keep = self._types(types) if types else None
@@ -50,11 +54,14 @@ class Completer:
             note = mismatch_note(frame.units, self.target_units[1], self.target_units[0])
             if note is not None:
                 self._warn("units", f"{frame.source}: {note}")
-        cols = self._by_id(frame)
+        if self.check is not None:
+            # the frame as read: its rows are the file's (without --types all atoms are
+            # written; with it, ids and types first, as sorting and selecting use them)
+            self.check(frame, None, frame.atom_line, None if self.keep is None else INTEGER_COLUMNS)
+        cols, rows = self._by_id(frame)
         self._facts(frame, cols)
         out = Frame(frame.step, frame.lo, frame.hi, frame.boundary, cols, frame.tilt, frame.time,
-                    frame.line, frame.units, frame.source)
-        self._positions(out)
+                    frame.line, frame.units, frame.source, frame.index)
         if self.keep is not None:
             codes = cols["type"].astype(np.int64)
             mask = np.isin(codes, list(self.keep))
@@ -62,11 +69,15 @@ class Completer:
                 self.kept_any = bool(mask.any())
                 if not self.kept_any:
                     self.present.update(np.unique(codes).tolist())
-            out = out.select(mask)
+            out, rows = out.select(mask), rows[mask]
+            if self.check is not None:   # the atoms written, named by their lines in the file
+                self.check(out, rows, frame.atom_line)
+        self._positions(out)
         return out
 
-    def _by_id(self, frame: Frame) -> dict[str, np.ndarray]:
-        """The frame's columns with atoms in id order (numbered 1..N without ids)."""
+    def _by_id(self, frame: Frame) -> tuple[dict[str, np.ndarray], np.ndarray]:
+        """The frame's columns with atoms in id order (numbered 1..N without ids), and the
+        row in the file of each."""
         cols = dict(frame.columns)
         n = frame.count
         if "id" not in cols:
@@ -74,6 +85,7 @@ class Completer:
             self._warn("no ids", f"{frame.source}: the dump has no 'id' column; atoms are numbered "
                        "1..N in file order")
         ids = cols["id"]
+        order = np.arange(n)
         if n > 1 and not bool(np.all(ids[1:] > ids[:-1])):
             order = np.argsort(ids, kind="stable")
             cols = {k: v[order] for k, v in cols.items()}
@@ -82,7 +94,7 @@ class Completer:
             if len(twice):        # every writer keys atoms by id: two would be merged or doubled
                 raise InputError(frame.source, frame.line, f"atom id {ids[twice[0]]:.0f} appears "
                                  f"twice in the frame of step {frame.step}")
-        return cols
+        return cols, order
 
     def _facts(self, frame: Frame, cols: dict[str, np.ndarray]) -> None:
         """Types (numbered labels), radii and masses the dump lacks, from --data."""

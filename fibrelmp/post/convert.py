@@ -27,17 +27,33 @@ def post_command(dump: Path, to: str | None, out: Path | None, info: bool, frame
                  report: Callable[[list[tuple[str, str]]], None] | None = None,
                  precision: int | None = None) -> list[Path]:
     """Convert ``dump`` (see docs/post.md); returns the files written.  Warnings go to
-    ``report`` (the CLI's grouped, coloured report) or, without one, to ``say``."""
+    ``report`` (the CLI's grouped, coloured report) or, without one, to ``say``.
+
+    Under MPI (``mpiexec -n N``) rank 0 does the conversion and writes; the other ranks
+    touch no file, return ``[]`` and wait for rank 0 (an error on rank 0 aborts them all)."""
+    from fibrelmp._lammps import mpi_wait_for_all
+    from fibrelmp.runner import mpi_rank_size
+
     dump = Path(dump)
+    if mpi_rank_size()[0] != 0:
+        mpi_wait_for_all()
+        return []
     warnings: list[tuple[str, str]] = []
     try:
-        return _post(dump, to, out, info, frames, types, data, local, gravity, force, topology, say,
-                     warnings, precision)
+        written = _post(dump, to, out, info, frames, types, data, local, gravity, force, topology,
+                        say, warnings, precision)
+    except InputError as exc:
+        if exc.path is not None:
+            raise
+        # an option's error (--to pdb, --precision 0, ...): name the trajectory, not "<input>"
+        raise InputError(dump, exc.line, exc.message) from None
     finally:
         if report is not None:
             report(warnings)
         else:
             _report(warnings, say)
+    mpi_wait_for_all()                  # the other ranks wait here for the files to be written
+    return written
 
 
 def _report(warnings: list[tuple[str, str]], say) -> None:
@@ -86,7 +102,8 @@ def _post(dump, to, out, info, frames, types, data, local, gravity, force, topol
                              f"--to {users} writes numbers with a chosen number of digits")
     out = Path(out)
     base = out / dump.name.split(".")[0] if out.is_dir() else out
-    context = PostContext(dump, local=local, gravity=gravity, warnings=warnings, precision=precision)
+    context = PostContext(dump, local=local, gravity=gravity, warnings=warnings, precision=precision,
+                          target_name=to.lower())
     target = kind(base, context, force=force)        # refuses existing outputs without force
     created = [p for p in (base.parent, *base.parent.parents) if not p.exists()]
     if created:
@@ -122,7 +139,8 @@ def _convert(reader, target: DumpTarget, dump: Path, data: Path | None, types: l
                          "for the run's names, ids and exact times (docs/post.md)")
     known: dict[int, str] = dict(context.datafile.type_names) if context.datafile else {}
     context.type_names = TypeNames(known, reader.type_names)    # labels met later join ``known``
-    complete = Completer(context.datafile, types, known, context.warnings, target.units)
+    complete = Completer(context.datafile, types, known, context.warnings, target.units,
+                         target.check_finite)
     for frame in _selected(reader, Selection(frames, default_last=target.last_frame_by_default),
                            last_only=target.last_frame_by_default and frames is None):
         target.add(complete(frame))

@@ -18,6 +18,7 @@ from typing import Any, ClassVar, Iterator, Mapping
 
 import numpy as np
 
+from fibrelmp.errors import InputError
 from fibrelmp.formatbase import Writer
 from fibrelmp.post.lammps_dump.reader import Frame
 
@@ -65,6 +66,7 @@ class PostContext:
     gravity: tuple[float, float, float] | None = None
     warnings: list[tuple[str, str]] = field(default_factory=list)
     precision: int | None = None                   # --precision (targets that take it)
+    target_name: str | None = None                 # the --to name (messages)
 
     @property
     def facts(self):
@@ -91,6 +93,32 @@ class ReadBack:
     value_tol: tuple[float, float] | None = None
 
 
+# integer fields: no target can hold an inf or nan in them (an id of inf is no atom)
+INTEGER_COLUMNS = frozenset({"id", "type", "ix", "iy", "iz"})
+# every spelling of a position a target may take its positions from
+POSITION_COLUMNS = frozenset({"x", "y", "z", "xs", "ys", "zs", "xu", "yu", "zu", "xsu", "ysu", "zsu"})
+
+
+def first_nonfinite(frame: Frame, names: frozenset[str] | None) -> tuple[str, int] | None:
+    """(column, row) of the first inf/nan among the frame's numeric columns ``names`` (None:
+    all of them), or None."""
+    cols = [(name, col) for name, col in frame.columns.items()
+            if (names is None or name in names) and col.dtype.kind == "f"]
+    # A parsed block is one (n, k) array and its columns are strided views: one pass over
+    # the whole array (a finite sum means no inf/nan: they propagate) costs what one column
+    # costs, and only an array that fails is looked at column by column.
+    bases = {id(col.base): col.base for _, col in cols
+             if isinstance(col.base, np.ndarray) and col.base.dtype.kind == "f"}
+    clean = {key for key, base in bases.items() if np.isfinite(base.sum())}
+    for name, col in cols:
+        if id(col.base) in clean or np.isfinite(col.sum()):
+            continue
+        finite = np.isfinite(col)
+        if not finite.all():
+            return name, int(np.argmin(finite))
+    return None
+
+
 class DumpTarget(Writer):
     """A ``post --to`` output, written from completed dump frames (``add(frame)``)."""
 
@@ -100,6 +128,11 @@ class DumpTarget(Writer):
     takes_precision: ClassVar[bool] = False           # writes text with --precision digits
     lookahead: ClassVar[int] = 1                      # frames ``start`` sees
     replaces_earlier: ClassVar[bool] = True           # --force: old frame files go too
+    # the dump columns the target writes, none of which may be inf or nan (None: every
+    # numeric column); an inf/nan there is an input error naming frame, atom and column
+    finite_columns: ClassVar[frozenset[str] | None] = None
+    # a target that can hold inf/nan in its other columns writes them with a warning
+    writes_nonfinite: ClassVar[bool] = False
 
     def __init__(self, base: str | Path, context: PostContext | None = None, *,
                  force: bool = True):
@@ -132,6 +165,39 @@ class DumpTarget(Writer):
         raise NotImplementedError
 
     # -- shared ------------------------------------------------------------------------------
+    def check_finite(self, frame: Frame, file_rows: np.ndarray | None = None,
+                     first_line: int | None = None, only: frozenset[str] | None = None) -> None:
+        """Refuse an inf or nan (a dump's ``inf``/``nan``, or ``1e400``) this target cannot
+        write: ``path:line`` of the atom, the frame, the atom id and the column.  ``file_rows``:
+        each row's row in the file (None: as in the file), ``first_line`` the line of the
+        file's first atom row; ``only``: check just these columns (and warn of nothing)."""
+        must = INTEGER_COLUMNS | POSITION_COLUMNS | (self.finite_columns or frozenset())
+        names = must if self.writes_nonfinite or self.finite_columns else None
+        if only is not None:
+            names = only if names is None else names & only
+        hit = first_nonfinite(frame, names)
+        if hit is not None:
+            name, row = hit
+            in_file = row if file_rows is None else int(file_rows[row])
+            raise InputError(frame.source, None if first_line is None else first_line + in_file,
+                             f"{self._where(frame, row)}: {name} is {frame.columns[name][row]}: "
+                             f"--to {self.context.target_name or self.format or type(self).__name__} cannot write inf or "
+                             "nan (did the simulation blow up?); nothing written")
+        if self.writes_nonfinite and only is None:
+            hit = first_nonfinite(frame, None)
+            if hit is not None:
+                name, row = hit
+                self.context.warn("inf/nan", f"{frame.source}: {self._where(frame, row)}: {name} is "
+                                  f"{frame.columns[name][row]}; written as is (the first of such "
+                                  "values; did the simulation blow up?)")
+
+    @staticmethod
+    def _where(frame: Frame, row: int) -> str:
+        ids = frame.columns.get("id")
+        atom = f"atom id {ids[row]:.0f}" if ids is not None and np.isfinite(ids[row]) else f"atom {row + 1}"
+        index = "" if frame.index is None else f"frame {frame.index} "
+        return f"{index}(step {frame.step}), {atom}"
+
     def outputs(self) -> list[Path]:
         return self.files(self.target)
 

@@ -176,6 +176,7 @@ class _FibreNetTarget(DumpTarget):
 
     units = ("FibreNet", LJ)
     lookahead = 2                  # the time step comes from the first two frames
+    finite_columns = frozenset({"vx", "vy", "vz", "fx", "fy", "fz", *VEL_COLUMNS, *FORCE_COLUMNS})
     restart: ClassVar[bool]
 
     def fields(self, first: Frame) -> tuple[str, ...]:

@@ -159,6 +159,9 @@ class _GranularTarget(DumpTarget):
     writers ``fibrelmp run`` uses (``result_writer``)."""
 
     lookahead = 2                 # the save interval comes from the first two frames
+    # what model_from_frame and granular_frame take from a dump
+    finite_columns = frozenset({"vx", "vy", "vz", "omegax", "omegay", "omegaz", "fx", "fy", "fz",
+                                "quatw", "quati", "quatj", "quatk", "radius", "diameter", "mass"})
     kind: ClassVar[str]
     keeps_ids: ClassVar[bool]
 
@@ -184,13 +187,32 @@ class _GranularTarget(DumpTarget):
                 self.context.warn(kind, text)
 
 
-class MusenTarget(_GranularTarget):
-    """``<base>``: a MUSEN text result (SI units)."""
+class _SingleFileTarget(_GranularTarget):
+    """One result file: ``<base>`` as given when it has a suffix, else ``<base>`` plus the
+    format's usual one (``-o out/run`` writes ``out/run.txt`` / ``out/run.mdem``)."""
+
+    suffix: ClassVar[str]
+
+    def __init__(self, base: str | Path, context=None, *, force: bool = True):
+        super().__init__(self.named(Path(base)), context, force=force)
+
+    @classmethod
+    def named(cls, base: Path) -> Path:
+        return base if base.suffix else base.with_name(base.name + cls.suffix)
+
+    @classmethod
+    def files(cls, base: Path) -> list[Path]:
+        return [cls.named(base)]
+
+
+class MusenTarget(_SingleFileTarget):
+    """``<base>`` (``.txt`` added to a name without a suffix): a MUSEN text result (SI units)."""
 
     kind = "musen"
     keeps_ids = True                 # MUSEN objects keep their ids
     units = ("MUSEN", SI)
     takes_precision = True
+    suffix = ".txt"                  # MUSEN's text results (and scenes) are .txt files
 
     def result_writer(self, model: GranularModel, dt: float) -> Writer:
         from fibrelmp.translate.musen.writer import MusenResultWriter
@@ -208,12 +230,14 @@ class MusenTarget(_GranularTarget):
                 for k in range(len(tp.times))]
 
 
-class MdemTarget(_GranularTarget):
-    """``<base>``: a MUSEN ``.mdem`` result (SI units), as ``fibrelmp run`` writes one."""
+class MdemTarget(_SingleFileTarget):
+    """``<base>`` (``.mdem`` added to a name without a suffix): a MUSEN ``.mdem`` result (SI
+    units), as ``fibrelmp run`` writes one."""
 
     kind = "musen"
     keeps_ids = True
     units = ("MUSEN", SI)
+    suffix = ".mdem"                 # MUSEN opens results by this extension
 
     def result_writer(self, model: GranularModel, dt: float) -> Writer:
         from fibrelmp.translate.musen.mdem.result import MdemResultWriter

@@ -229,6 +229,16 @@ def _post_new_folder(tmp: Path) -> list[str]:
             str(tmp / "new" / "sub" / "out")]
 
 
+def _dump_long_line(tmp: Path) -> list[str]:
+    """A small .gz whose first atom line runs 2 MiB without a newline (docs/post.md: 1 MiB)."""
+    import gzip
+
+    text = (CORPUS / "dump" / "good.dump").read_bytes()
+    head = text[:text.index(b"\n", text.index(b"ITEM: ATOMS")) + 1]
+    (tmp / "long.dump.gz").write_bytes(gzip.compress(head + b"1" * (2 << 20) + b"\n"))
+    return ["post", str(tmp / "long.dump.gz"), "--to", "xyz", "-o", str(tmp / "out")]
+
+
 def _run_unwritable(tmp: Path) -> list[str]:
     (tmp / "file").write_text("a file, not a folder\n")
     return ["run", str(CORPUS / "demdf" / "good.json"), "--out", str(tmp / "file" / "sub")]
@@ -342,6 +352,8 @@ GENERATED = [
          command="post", make=_post_existing),
     Case("generated/post_new_folder", "LAMMPS dump", "", "bad frame 2 with -o in new folders "
          "(none is left behind)", command="post", make=_post_new_folder),
+    Case("generated/dump_long_line", "LAMMPS dump", "", "a .gz whose atom line runs 2 MiB "
+         "without a newline", command="post", make=_dump_long_line),
     Case("generated/run_unwritable", "DEMDF", "", "run --out below a regular file",
          command="run", make=_run_unwritable),
     Case("generated/run_existing", "FibreNet", "", "an earlier run's result in -o, no --force",

@@ -3,8 +3,8 @@ registry's ``lammps-dump`` format; ``fibrelmp post`` reads through it)."""
 
 from __future__ import annotations
 
-import gzip
 import os
+import zlib
 from pathlib import Path
 from typing import Callable, Iterator
 
@@ -16,11 +16,12 @@ def is_text_dump(path: Path) -> bool:
     """Does the file (plain or gzip) begin like a LAMMPS text dump (or hold nothing)?"""
     try:
         with open(path, "rb") as fh:
-            head = fh.read(4096)
+            head = fh.read(1 << 16)
         if head[:2] == b"\x1f\x8b":
-            with gzip.open(path, "rb") as fh:
-                head = fh.read(4096)
-    except (OSError, EOFError):
+            # the start of the stream only: a gzip dump cut short (LAMMPS still writing) is
+            # still a dump, and a hostile stream is not expanded beyond these 4 kB
+            head = zlib.decompressobj(31).decompress(head, 4096)
+    except (OSError, zlib.error):
         return False
     text = head.lstrip()
     return not text or text.startswith(b"ITEM:")

@@ -4,9 +4,13 @@ A frame is the items from ``ITEM: UNITS`` / ``ITEM: TIME`` / ``ITEM: TIMESTEP`` 
 of its ``ITEM: ATOMS`` (or ``ITEM: ENTRIES``) block; the block's length is the frame's own
 ``NUMBER OF ATOMS`` (so the atom count may change between frames).  Each block is parsed
 by one C-level call (the optional C parser of ``fastparse``, else ``np.loadtxt``); memory holds one frame at a time, read in chunks, so
-a 10 GB dump converts frame by frame.  ``.gz`` dumps are read through gzip.
+a 10 GB dump converts frame by frame.  ``.gz`` dumps are read through gzip.  No line may be
+longer than ``MAX_LINE`` (1 MiB, plain or gzip): a hostile line (a few MB of gzip can expand
+to gigabytes without a newline) is an error after at most that much, so memory stays within
+one frame plus a read chunk plus ``MAX_LINE``.
 
-Only the real end of the file truncates: a last frame cut there is dropped with a warning.
+Only the real end of the file truncates: a last frame cut there is dropped with a warning;
+a gzip stream cut short (LAMMPS still writing) ends the file there too, with a warning.
 Every other defect -- among them a ``NUMBER OF ATOMS`` that does not match the atom lines of
 its frame, wherever the frame is -- is an InputError ``path:line: message`` naming the frame.
 """
@@ -29,6 +33,9 @@ from fibrelmp.numtext.fast import nth_newline, parse_numbers
 # columns that may hold text (type labels with ``dump_modify types labels``, element names)
 TEXT_COLUMNS = {"type", "element"}
 CHUNK = 1 << 24
+# the longest line accepted (header or atom line; a dump custom line of 1000 columns is
+# about 25 kB): memory for a line without a newline stops here, not at the end of the file
+MAX_LINE = 1 << 20
 
 
 @dataclass
@@ -43,6 +50,8 @@ class Frame:
     line: int | None = None             # line of the frame's first ITEM in the file
     units: str | None = None            # ITEM: UNITS (dump_modify units yes)
     source: str | None = None           # file the frame came from (error messages)
+    index: int | None = None            # frame index in the file, from 0 (as --frames counts)
+    atom_line: int | None = None        # line of the first atom line (atom rows in file order)
 
     @property
     def count(self) -> int:
@@ -127,7 +136,7 @@ class Frame:
         """A frame with only the given atom rows (a mask, index array or slice)."""
         cols = {k: v[rows] for k, v in self.columns.items()}
         return Frame(self.step, self.lo, self.hi, self.boundary, cols, self.tilt, self.time,
-                     self.line, self.units, self.source)
+                     self.line, self.units, self.source, self.index)
 
 
 @dataclass
@@ -159,19 +168,33 @@ def _open(path: Path):
 class _Stream:
     """Line and block access over a file read in large chunks (no per-line objects)."""
 
-    def __init__(self, fh, path: Path):
+    def __init__(self, fh, path: Path, warnings: list | None = None):
         self.fh = fh
         self.path = path
+        self.warnings = warnings
         self.buf = bytearray()
         self.pos = 0
         self.line = 0              # lines consumed so far
         self.line_bytes = 100.0    # mean atom-line length of the last block
+        # read1: a gzip stream cut short raises EOFError on the read after the last data,
+        # whereas read(CHUNK) would drop everything it had decompressed in that call
+        self.gzip = isinstance(fh, gzip.GzipFile)
+        self.cut_warned = False
 
     def _more(self) -> bool:
         # no latch on EOF: a dump LAMMPS is still writing may grow (fibrelmp run)
         try:
-            data = self.fh.read(CHUNK)
-        except (OSError, EOFError, zlib.error) as exc:     # gzip.BadGzipFile is an OSError
+            data = self.fh.read1(CHUNK) if self.gzip else self.fh.read(CHUNK)
+        except EOFError:
+            # a gzip stream without its end (LAMMPS still writing, a copy cut short): the end
+            # of the file, as for a plain dump; the frame it cuts is dropped by the caller
+            if not self.cut_warned and self.warnings is not None:
+                self.cut_warned = True
+                self.warnings.append(("truncated dump", f"{self.path}: the gzip stream ends "
+                                      "early (cut short, or LAMMPS still writing it); the "
+                                      "frames before the cut are kept"))
+            return False
+        except (OSError, zlib.error) as exc:     # gzip.BadGzipFile (a CRC error) is an OSError
             raise InputError(self.path, self.line + 1,
                              f"cannot read the dump: {exc}") from None
         if not data:
@@ -179,22 +202,24 @@ class _Stream:
         self.buf += data
         return True
 
+    def _too_long(self, line: int) -> InputError:
+        return InputError(self.path, line, f"line longer than {MAX_LINE >> 20} MiB, the longest a "
+                          "dump line may be (docs/post.md; not a LAMMPS text dump?)")
+
     def _compact(self) -> None:
         # drop consumed bytes (only between lines, so no caller holds an offset)
         if self.pos > CHUNK:
             del self.buf[:self.pos]
             self.pos = 0
 
-    def readline(self, limit: int = 1 << 20) -> bytes | None:
+    def readline(self) -> bytes | None:
         """Next line without its newline; None at the end of the file."""
         self._compact()
         scan = self.pos
         while True:
             k = self.buf.find(b"\n", scan)
-            if k < 0 and len(self.buf) - self.pos > limit:
-                # header lines are short: do not pull a whole binary file into memory
-                raise InputError(self.path, self.line + 1, "line longer than 1 MB where a dump "
-                                 "header line was expected (not a LAMMPS text dump?)")
+            if (k if k >= 0 else len(self.buf)) - self.pos > MAX_LINE:
+                raise self._too_long(self.line + 1)
             if k < 0:
                 scan = len(self.buf)
             if k >= 0:
@@ -215,7 +240,7 @@ class _Stream:
         if n <= 0:
             return b"", 0
         self._compact()
-        start = scan = self.pos
+        start = scan = line_start = self.pos
         need = n
         while True:
             end = len(self.buf)
@@ -241,8 +266,12 @@ class _Stream:
                 self.line += n
                 self.line_bytes = max(1.0, len(out) / n)
                 return out, n
+            if c:
+                line_start = self.buf.rfind(b"\n", scan, stop) + 1
             need -= c
             scan = stop
+            if stop - line_start > MAX_LINE:
+                raise self._too_long(self.line + n - need + 1)
             if stop < end:
                 continue
             if not self._more():
@@ -442,7 +471,7 @@ def iter_headers(path: str | Path, warnings: list[tuple[str, str]] | None = None
     except OSError as exc:
         raise InputError(path, None, f"cannot read the dump: {exc.strerror or exc}") from None
     with fh:
-        st = _Stream(fh, path)
+        st = _Stream(fh, path, warnings)
         index = 0
         seen_any = False
         prev = None
@@ -494,7 +523,8 @@ def iter_headers(path: str | Path, warnings: list[tuple[str, str]] | None = None
 def frame_from(head: Header, block: bytes, path: Path | str | None) -> Frame:
     cols = parse_block(block, head, path)
     return Frame(head.step, head.lo, head.hi, head.boundary, cols, head.tilt, head.time,
-                 head.line, head.units, None if path is None else str(path))
+                 head.line, head.units, None if path is None else str(path), head.extra.get("index"),
+                 head.line + head.extra["header_lines"] if "header_lines" in head.extra else None)
 
 
 def iter_frames(path: str | Path, warnings: list[tuple[str, str]] | None = None,

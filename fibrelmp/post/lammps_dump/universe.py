@@ -26,7 +26,8 @@ class TimedDumpReader(DumpReader):
         """Byte offset of every frame's ITEM: TIMESTEP line, its time, and the atom count."""
         offsets, times, count = [], [], None
         time = None
-        with util.anyopen(self.filename, "rb") as fh:
+        with util.anyopen(self.filename, "rb") as raw:
+            fh = _BoundedLines(raw, self.filename)
             pos = fh.tell()
             line = fh.readline()
             while line:
@@ -72,6 +73,28 @@ class TimedDumpReader(DumpReader):
         if self._times[ts.frame] is not None:
             ts.data["time"] = self._times[ts.frame]
         return ts
+
+
+class _BoundedLines:
+    """``readline`` of at most ``MAX_LINE`` bytes (the dump reader's bound): a line without
+    its end within that is an InputError, not a read of the whole rest of the file."""
+
+    def __init__(self, fh, path):
+        self.fh, self.path, self.lines = fh, path, 0
+
+    def tell(self) -> int:
+        return self.fh.tell()
+
+    def readline(self) -> bytes:
+        from fibrelmp.errors import InputError
+        from fibrelmp.post.lammps_dump.reader import MAX_LINE
+
+        line = self.fh.readline(MAX_LINE + 1)
+        self.lines += 1
+        if len(line) > MAX_LINE:
+            raise InputError(self.path, self.lines, f"line longer than {MAX_LINE >> 20} MiB, the "
+                             "longest a dump line may be")
+        return line
 
 
 def dump_universe(path: str | Path):

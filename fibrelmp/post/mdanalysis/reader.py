@@ -100,7 +100,7 @@ def iter_mda_frames(trajectory: Path, topology: Path | None, type_names: dict[in
                 lo, hi, tilt = (x.min(axis=0), x.max(axis=0), None) if len(x) else (np.zeros(3), np.zeros(3), None)
                 bnd = ("ff", "ff", "ff")
             step = int(ts.data.get("step", ts.frame)) if hasattr(ts, "data") else int(ts.frame)
-            yield Frame(step, lo, hi, bnd, cols, tilt, float(ts.time), None, None, str(trajectory))
+            yield Frame(step, lo, hi, bnd, cols, tilt, float(ts.time), None, None, str(trajectory), index)
     except InputError:
         raise
     except Exception as exc:

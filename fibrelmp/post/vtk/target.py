@@ -9,7 +9,7 @@ from fibrelmp.post.lammps_dump.reader import Frame
 from fibrelmp.post.target import DumpTarget, ReadBack
 from fibrelmp.post.vtk.frame import VECTORS, from_dump
 from fibrelmp.post.vtk.reader import read_frame, read_pvd
-from fibrelmp.post.vtk.writer import VtkWriter
+from fibrelmp.post.vtk.writer import VtkWriter, check_output_name
 
 
 def frame_pattern(base: Path) -> re.Pattern:
@@ -20,6 +20,12 @@ def frame_pattern(base: Path) -> re.Pattern:
 class VtkTarget(DumpTarget):
     """``<base>.pvd`` and its frames (writer.py); bonds of ``--data`` as lines; frames of an
     earlier conversion to the same base are removed."""
+
+    writes_nonfinite = True        # Float64 arrays hold inf/nan as they are (with a warning)
+
+    def __init__(self, base: str | Path, context=None, *, force: bool = True):
+        check_output_name(Path(base))
+        super().__init__(base, context, force=force)
 
     @classmethod
     def files(cls, base: Path) -> list[Path]:

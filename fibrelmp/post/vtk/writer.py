@@ -26,10 +26,13 @@ piece is its own line with the bond's ``id1``/``id2``, so a bond is one or more 
 from __future__ import annotations
 
 import base64
+import re
 from pathlib import Path
+from xml.sax.saxutils import escape
 
 import numpy as np
 
+from fibrelmp.errors import InputError
 from fibrelmp.formatbase import Writer
 from fibrelmp.post.lammps_dump.reader import Frame
 from fibrelmp.post.vtk.frame import ViewerFrame, bond_rows, bond_segments, from_dump
@@ -41,13 +44,48 @@ HEAD = ('<?xml version="1.0"?>\n<VTKFile type="{kind}" version="1.0" byte_order=
         'header_type="UInt64">\n')
 
 
+# characters XML 1.0 cannot hold at all, escaped or not (C0 controls but tab/LF/CR, lone
+# surrogates of undecodable file-name bytes, U+FFFE/U+FFFF)
+_NOT_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ud800-\udfff\ufffe\uffff]")
+_ATTR_ENTITIES = {'"': "&quot;", "\n": "&#10;", "\r": "&#13;", "\t": "&#9;"}
+
+
+def xml_attr(value: str, what: str = "name") -> str:
+    """``value`` as a double-quoted XML attribute value: every name and file name the VTK
+    files carry goes through here (``&``, ``<``, ``>``, ``"`` and line breaks escaped, so
+    VTK's expat parser reads back exactly ``value``).  Characters XML cannot hold at all
+    are an InputError naming ``what``."""
+    value = str(value)
+    bad = _NOT_XML.search(value)
+    if bad:
+        raise InputError(None, None, f"{what} {value!r} has a character a VTK XML file cannot hold "
+                         f"({bad.group()!r}); rename it")
+    return '"' + escape(value, _ATTR_ENTITIES) + '"'
+
+
+def check_output_name(base: Path) -> None:
+    """An output base name the ``.pvd``/``.vtm`` files can name (an InputError before
+    anything is written, not an unreadable file afterwards)."""
+    try:
+        xml_attr(Path(base).name, "output name")
+    except InputError as exc:
+        raise InputError(base, None, exc.message) from None
+
+
+def time_text(time: float) -> str:
+    """A time as written in the ``.pvd`` and ``TimeValue``: rounded to 15 significant digits
+    (shortest form), so 8 x 0.1 reads ``0.8``, not ``0.7999999999999999``; a double holds
+    15 digits exactly, and the 16th-17th of a running sum are round-off."""
+    return repr(float(f"{float(time):.15g}"))
+
+
 def data_array(name: str, data: np.ndarray, ascii_: bool = False) -> str:
     """One ``<DataArray>``: (n,) or (n, k) numbers, k components named X Y Z (W)."""
     data = np.ascontiguousarray(data)
     if data.dtype not in _TYPES:
         data = data.astype(np.int64 if data.dtype.kind in "iub" else np.float64)
     ncomp = data.shape[1] if data.ndim == 2 else 1
-    attrs = f'type="{_TYPES[data.dtype]}" Name="{name}"'
+    attrs = f'type="{_TYPES[data.dtype]}" Name={xml_attr(name, "array name")}'
     if ncomp > 1:
         attrs += f' NumberOfComponents="{ncomp}"'
         attrs += "".join(f' ComponentName{k}="{c}"' for k, c in enumerate(COMPONENTS.get(ncomp, ())))
@@ -63,7 +101,7 @@ def data_array(name: str, data: np.ndarray, ascii_: bool = False) -> str:
 def _field_data(frame: ViewerFrame) -> str:
     # TimeValue: the name VTK readers take as the dataset's time
     return ("<FieldData>\n"
-            f'<DataArray type="Float64" Name="TimeValue" NumberOfTuples="1" format="ascii">{float(frame.time)!r}</DataArray>\n'
+            f'<DataArray type="Float64" Name="TimeValue" NumberOfTuples="1" format="ascii">{time_text(frame.time)}</DataArray>\n'
             f'<DataArray type="Int64" Name="TimeStep" NumberOfTuples="1" format="ascii">{int(frame.step)}</DataArray>\n'
             "</FieldData>\n")
 
@@ -132,15 +170,16 @@ def walls_vtu(frame: ViewerFrame, ascii_: bool = False) -> bytes:
 def vtm_text(blocks: list[tuple[str, str | None]]) -> bytes:
     """A multiblock file naming each block's file (relative to the ``.vtm``); a block
     without a file is an empty block."""
-    rows = "".join(f'<DataSet index="{k}" name="{name}"' + (f' file="{file}"' if file else "") + "/>\n"
+    rows = "".join(f'<DataSet index="{k}" name={xml_attr(name, "block name")}'
+                   + (f" file={xml_attr(file, 'file name')}" if file else "") + "/>\n"
                    for k, (name, file) in enumerate(blocks))
     return (HEAD.format(kind="vtkMultiBlockDataSet") + "<vtkMultiBlockDataSet>\n" + rows +
             "</vtkMultiBlockDataSet>\n</VTKFile>\n").encode()
 
 
 def pvd_text(entries: list[tuple[float, Path]]) -> bytes:
-    rows = "".join(f'<DataSet timestep="{float(t)!r}" group="" part="0" file="{p.name}"/>\n'
-                   for t, p in entries)
+    rows = "".join(f'<DataSet timestep="{time_text(t)}" group="" part="0" '
+                   f'file={xml_attr(p.name, "file name")}/>\n' for t, p in entries)
     return ('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">\n'
             "<Collection>\n" + rows + "</Collection>\n</VTKFile>\n").encode()
 
@@ -156,6 +195,7 @@ class VtkWriter(Writer):
     def __init__(self, base: Path, bonds: np.ndarray | None = None, ascii_: bool = False, *,
                  bonded: bool | None = None, force: bool = True):
         super().__init__(base, force=force)
+        check_output_name(self.target)
         self.bonds = bonds
         self.bonded = bonded if bonded is not None else bonds is not None and len(bonds) > 0
         self.ascii = ascii_

@@ -1,0 +1,194 @@
+"""``post --to mercury``: the ``.restart`` MercuryCG reads (species densities, domain, time)
+and particle-wall rows in ``.fstat`` from a dump's wall-contact columns.
+
+A small LAMMPS run of two sphere types with different densities settling on a flat floor
+(``fix wall/gran ... zplane 0 NULL contacts``: the force on each sphere and the contact
+point, dumped as ``wall1_fx .. wall1_cz``).  Expected values come from the LAMMPS input (the
+densities), the dump (positions, radii, forces) and the floor's geometry, never from the
+writer: for a sphere touching the plane z = 0 the overlap is r - z, the normal from the wall
+to the centre is +z (MercuryDPM writes a wall contact once with the normal negated, -z), the
+contact point is the middle of the overlap, z = -(r - z) / 2.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fibrelmp.post.convert import post_command
+from fibrelmp.post.lammps_dump import iter_frames
+from fibrelmp.post.mercury import read_fstat
+
+DENSITY = {1: 2500.0, 2: 1000.0}          # the LAMMPS types' densities
+
+SCRIPT = """
+units si
+atom_style sphere
+dimension 3
+boundary p p f
+region box block 0 0.04 0 0.04 0 0.05
+create_box 2 box
+comm_modify vel yes
+region ins block 0.004 0.036 0.004 0.036 0.006 0.03
+lattice sc 0.01
+create_atoms 1 region ins
+set group all type/fraction 2 0.5 4321
+set type 1 diameter 0.008
+set type 2 diameter 0.006
+set type 1 density 2500
+set type 2 density 1000
+pair_style granular
+pair_coeff * * hertz/material 1e6 0.3 0.3 tangential mindlin NULL 1.0 0.4 damping tsuji
+fix grav all gravity 9.81 vector 0 0 -1
+fix nve all nve/sphere
+fix floor all wall/gran granular hertz/material 1e6 0.3 0.3 tangential mindlin NULL 1.0 0.4 damping tsuji zplane 0 NULL contacts
+timestep 1e-5
+dump d all custom 2000 atoms.dump id type x y z vx vy vz fx fy fz radius mass omegax omegay omegaz f_floor[2] f_floor[3] f_floor[4] f_floor[5] f_floor[6] f_floor[7]
+dump_modify d time yes sort id format float %.17g colname f_floor[2] wall1_fx colname f_floor[3] wall1_fy colname f_floor[4] wall1_fz colname f_floor[5] wall1_cx colname f_floor[6] wall1_cy colname f_floor[7] wall1_cz
+run 8000
+"""
+
+
+@pytest.fixture(scope="module")
+def settled(tmp_path_factory) -> Path:
+    from fibrelmp._lammps import new_lammps
+
+    folder = tmp_path_factory.mktemp("floor")
+    cwd = os.getcwd()
+    lmp = new_lammps(["-log", "none", "-screen", "none", "-nocite"])
+    try:
+        os.chdir(folder)
+        for line in SCRIPT.strip().splitlines():
+            lmp.command(line)
+    finally:
+        os.chdir(cwd)
+        lmp.close()
+    return folder
+
+
+def post(dump: Path, out: Path, **kw) -> list[Path]:
+    args = dict(info=False, frames=None, types=None, data=None, local=None, gravity=(0.0, 0.0, -9.81),
+                force=False, topology=None, say=lambda s: None)
+    args.update(kw)
+    return post_command(dump, "mercury", out, **args)
+
+
+def read_restart_as_mercury_cg(path: Path) -> dict:
+    """The keys MercuryDPM's ``DPMBase::read`` takes from a restart file (version 1.0), in its
+    order, up to the particles (MercuryCG reads no interactions): the file lines, domain,
+    time step and time, dimensions and gravity, species (each followed by its mixed species
+    with the earlier ones), walls, boundaries, particles."""
+    lines = iter(path.read_text().splitlines())
+    head = next(lines).split()
+    assert head[:2] == ["MercuryDPM", "1.0"] and head[2] == "name"
+    out: dict = {"name": head[3]}
+    for label in ("dataFile", "fStatFile", "eneFile", "restartFile", "statFile", "interactionFile"):
+        words = next(lines).split()
+        assert words[0] == label and words[1] == "fileType"
+        out[label] = words[2]
+    words = next(lines).split()
+    assert words[0::2] == ["xMin", "xMax", "yMin", "yMax", "zMin", "zMax"]
+    v = [float(w) for w in words[1::2]]
+    out["min"], out["max"] = np.array(v[0::2]), np.array(v[1::2])
+    words = next(lines).split()
+    assert words[0::2] == ["timeStep", "time", "ntimeSteps", "timeMax"]
+    out["timeStep"], out["time"], out["ntimeSteps"] = float(words[1]), float(words[3]), int(words[5])
+    words = next(lines).split()
+    assert words[0] == "systemDimensions" and words[2] == "particleDimensions" and words[4] == "gravity"
+    out["systemDimensions"], out["particleDimensions"] = int(words[1]), int(words[3])
+    out["gravity"] = np.array([float(w) for w in words[5:8]])
+    words = next(lines).split()
+    assert words[0] == "Species"
+    out["density"] = {}
+    for k in range(int(words[1])):
+        words = next(lines).split()
+        assert words[0] == "LinearViscoelasticSpecies" and words[1:3] == ["id", str(k)]
+        fields = dict(zip(words[3::2], words[4::2]))
+        out["density"][k] = float(fields["density"])
+        for other in range(k):
+            mixed = next(lines).split()
+            assert mixed[0] == "LinearViscoelasticMixedSpecies" and mixed[1:5] == ["idA", str(k), "idB", str(other)]
+    for section in ("Walls", "Boundaries"):
+        assert next(lines).split() == [section, "0"]
+    words = next(lines).split()
+    assert words[0] == "Particles"
+    rows = []
+    for _ in range(int(words[1])):
+        words = next(lines).split()
+        assert words[0] == "BaseParticle"
+        names = ["id", "indSpecies", "position", "orientation", "velocity", "angularVelocity", "force",
+                 "torque", "radius", "invMass", "timeStamp"]
+        at = {name: words.index(name) for name in names}
+        sizes = {"position": 3, "orientation": 4, "velocity": 3, "angularVelocity": 3, "force": 3, "torque": 3}
+        rows.append({name: [float(w) for w in words[at[name] + 1: at[name] + 1 + sizes.get(name, 1)]]
+                     for name in names})
+    out["particles"] = rows
+    return out
+
+
+def test_restart_gives_mercury_cg_the_densities_domain_and_time(settled, tmp_path):
+    written = post(settled / "atoms.dump", tmp_path / "run")
+    assert sorted(p.name for p in written) == ["run.data", "run.ene", "run.fstat", "run.restart"]
+    frames = list(iter_frames(settled / "atoms.dump"))
+    last = frames[-1]
+    r = read_restart_as_mercury_cg(tmp_path / "run.restart")
+    assert r["density"] == pytest.approx({t - 1: rho for t, rho in DENSITY.items()}, rel=1e-12)
+    np.testing.assert_allclose(r["min"], last.lo, rtol=1e-14)
+    np.testing.assert_allclose(r["max"], last.hi, rtol=1e-14)
+    assert r["time"] == pytest.approx(last.time, rel=1e-14) and r["ntimeSteps"] == last.step == 8000
+    assert r["timeStep"] == pytest.approx(1e-5, rel=1e-9)
+    assert (r["systemDimensions"], r["particleDimensions"]) == (3, 3)
+    np.testing.assert_array_equal(r["gravity"], [0, 0, -9.81])
+    assert r["fStatFile"] == "ONE_FILE"
+    parts = r["particles"]
+    assert len(parts) == last.count
+    np.testing.assert_array_equal([p["indSpecies"][0] for p in parts], last.column("type") - 1)
+    np.testing.assert_allclose([p["position"] for p in parts], last.vector("x", "y", "z"), rtol=1e-14)
+    np.testing.assert_allclose([p["radius"][0] for p in parts], last.column("radius"), rtol=1e-14)
+    np.testing.assert_allclose([p["invMass"][0] for p in parts], 1 / last.column("mass"), rtol=1e-14)
+    # MercuryDPM's mass from the species: density * 4/3 pi r^3 (particleDimensions 3)
+    species = last.column("type").astype(int) - 1
+    mass = np.array([r["density"][s] for s in species]) * 4 / 3 * np.pi * last.column("radius") ** 3
+    np.testing.assert_allclose(mass, last.column("mass"), rtol=1e-12)
+
+
+def test_wall_contact_rows_from_the_dump_columns(settled, tmp_path):
+    post(settled / "atoms.dump", tmp_path / "run")
+    frames = list(iter_frames(settled / "atoms.dump"))
+    fstat = read_fstat(tmp_path / "run.fstat")
+    assert len(fstat) == len(frames)
+    touching_seen = 0
+    for fs, f in zip(fstat, frames):
+        F = f.vector("wall1_fx", "wall1_fy", "wall1_fz")
+        rows = np.flatnonzero(np.any(F != 0, axis=1))
+        walls = fs.rows[fs.rows[:, 2] < 0]
+        assert len(walls) == len(rows)
+        touching_seen += len(rows)
+        if not len(rows):
+            continue
+        z, r = f.column("z")[rows], f.column("radius")[rows]
+        np.testing.assert_array_equal(walls[:, 1], rows)                 # particle index = row
+        np.testing.assert_array_equal(walls[:, 2], -1)                   # wall 0: -(0) - 1
+        np.testing.assert_allclose(walls[:, 6], r - z, rtol=1e-8)        # overlap
+        assert np.all(walls[:, 6] > 0)
+        np.testing.assert_allclose(walls[:, 10:13], np.tile([0, 0, -1], (len(rows), 1)), atol=1e-12)
+        np.testing.assert_allclose(walls[:, 8], F[:, 2][rows], rtol=1e-8)  # F . (+z)
+        np.testing.assert_allclose(walls[:, 9], np.hypot(F[rows, 0], F[rows, 1]), rtol=1e-8, atol=1e-15)
+        np.testing.assert_allclose(walls[:, 3:5], f.vector("x", "y")[rows], rtol=1e-9)
+        np.testing.assert_allclose(walls[:, 5], -(r - z) / 2, rtol=1e-8)
+        np.testing.assert_allclose(walls[:, 0], f.time, rtol=1e-9)
+    assert touching_seen > 0                   # the spheres did reach the floor
+
+
+def test_incomplete_wall_columns_are_an_error(tmp_path):
+    dump = tmp_path / "d.dump"
+    dump.write_text("ITEM: TIMESTEP\n0\nITEM: NUMBER OF ATOMS\n1\nITEM: BOX BOUNDS pp pp ff\n0 1\n0 1\n0 1\n"
+                    "ITEM: ATOMS id type x y z radius mass wall1_fx wall1_fy wall1_fz\n1 1 0.5 0.5 0.1 0.2 1 0 0 1\n")
+    from fibrelmp.errors import InputError
+
+    with pytest.raises(InputError, match="wall 1's contact columns are incomplete"):
+        post(dump, tmp_path / "run")
+    assert not list(tmp_path.glob("run.*"))

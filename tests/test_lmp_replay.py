@@ -40,7 +40,7 @@ CASES = {
                                  "cardioproof/piston_tube.elem", "cardioproof/piston_tube.dynpt"],
                                 "piston_tube.json", "piston_tube_work",
                                 ["frames.dump", "moving_walls.dump", "opening_outlet.txt"]),
-    "demdf_head_on": (["demdf/head_on.json"], "head_on.json", "head_on_work", ["frames.dump"]),
+    "demdf_head_on": (["demdf/head_on.json"], "head_on.json", "head_on_work", ["frames.dump", "contacts.dump"]),
     "demdf_drop_on_wall": (["demdf/drop_on_wall.json"], "drop_on_wall.json", "drop_on_wall_work",
                            ["frames.dump"]),
 }

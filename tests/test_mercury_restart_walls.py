@@ -12,6 +12,7 @@ contact point is the middle of the overlap, z = -(r - z) / 2.
 
 from __future__ import annotations
 
+import json
 import os
 from pathlib import Path
 
@@ -21,6 +22,8 @@ import pytest
 from fibrelmp.post.convert import post_command
 from fibrelmp.post.lammps_dump import iter_frames
 from fibrelmp.post.mercury import read_fstat
+
+from .conftest import REPO
 
 DENSITY = {1: 2500.0, 2: 1000.0}          # the LAMMPS types' densities
 
@@ -192,3 +195,36 @@ def test_incomplete_wall_columns_are_an_error(tmp_path):
     with pytest.raises(InputError, match="wall 1's contact columns are incomplete"):
         post(dump, tmp_path / "run")
     assert not list(tmp_path.glob("run.*"))
+
+
+def test_run_keeps_contacts_so_post_to_mercury_gives_fstat(tmp_path):
+    """A DEMDF run (stock pair granular) keeps its sphere-sphere contacts in the work
+    folder's contacts.dump; ``post --to mercury --local`` of it gives .fstat rows whose
+    overlap and normal match the positions and radii of the run's frames.dump, and a
+    .restart whose density is the input's mass over the sphere volume."""
+    from fibrelmp import python_api
+
+    doc = json.loads((REPO / "examples" / "demdf" / "head_on.json").read_text())
+    doc["timeEnd"] = 1.0                      # the collision's first contact frame is t = 1
+    case = tmp_path / "head_on.json"
+    case.write_text(json.dumps(doc))
+    python_api.run(case)
+    work = tmp_path / "head_on_work"
+    post(work / "frames.dump", tmp_path / "run", data=work / "data.lammps", local=work / "contacts.dump",
+         gravity=None)
+    frames = list(iter_frames(work / "frames.dump"))
+    fstat = read_fstat(tmp_path / "run.fstat")
+    assert len(fstat) == len(frames)
+    pairs = 0
+    for fs, f in zip(fstat, frames):
+        x, r = f.vector("x", "y", "z"), f.column("radius")
+        for row in fs.rows:
+            i, j = int(row[1]), int(row[2])
+            d = x[i] - x[j]
+            np.testing.assert_allclose(row[6], r[i] + r[j] - np.linalg.norm(d), rtol=1e-6, atol=1e-12)
+            np.testing.assert_allclose(row[10:13], d / np.linalg.norm(d), atol=1e-12)
+            pairs += 1
+    assert pairs == 2                         # one contact frame: the pair written both ways
+    particle = next(t for t in doc["objectTypes"] if t["type"] == "particle")
+    density = read_restart_as_mercury_cg(tmp_path / "run.restart")["density"][0]
+    assert density == pytest.approx(particle["mass"] / (4 / 3 * np.pi * particle["radius"] ** 3), rel=1e-12)

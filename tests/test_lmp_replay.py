@@ -35,7 +35,7 @@ CASES = {
                               ["frames.dump"]),
     "musen_agglomerate": (["musen/SphericalAgglomerate_text.txt", "musen/agglomerate_short_job.txt"],
                           "agglomerate_short_job.txt", "agglomerate_short_job_work/job2",
-                          ["frames.dump", "bonds.dump", "breaks.dump"]),
+                          ["frames.dump", "bonds.dump", "breaks.dump", "contacts.dump"]),
     "cardioproof_piston_tube": (["cardioproof/piston_tube.json", "cardioproof/piston_tube.pts",
                                  "cardioproof/piston_tube.elem", "cardioproof/piston_tube.dynpt"],
                                 "piston_tube.json", "piston_tube_work",

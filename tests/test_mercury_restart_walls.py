@@ -228,3 +228,55 @@ def test_run_keeps_contacts_so_post_to_mercury_gives_fstat(tmp_path):
     particle = next(t for t in doc["objectTypes"] if t["type"] == "particle")
     density = read_restart_as_mercury_cg(tmp_path / "run.restart")["density"][0]
     assert density == pytest.approx(particle["mass"] / (4 / 3 * np.pi * particle["radius"] ** 3), rel=1e-12)
+
+
+def test_musen_pair_single_gives_the_contact_force_for_pair_local(tmp_path):
+    """pair musen/hm's single() (compute pair/local, which run's contacts.dump uses): for
+    an elastic frictionless pair (e = 1: no damping; G* = 0: no tangential force) the normal
+    force it reports equals the force LAMMPS applied to each sphere in that step (the pair is
+    alone) and Hertz's 4/3 E* sqrt(R*) overlap^1.5, computed here."""
+    from fibrelmp import lammps_styles
+    from fibrelmp._lammps import new_lammps
+
+    plugin = lammps_styles.plugin()
+    if not plugin.available:
+        pytest.skip(f"fibrelmp's LAMMPS styles are not available: {plugin.how}")
+    estar, r1, r2 = 5e7, 1e-3, 7e-4
+    lmp = new_lammps(["-log", "none", "-screen", "none", "-nocite"])
+    cwd = os.getcwd()
+    try:
+        os.chdir(tmp_path)
+        for c in [f"plugin load {plugin.path}", "units si", "atom_style sphere", "boundary f f f",
+                  "newton off", "comm_modify vel yes", "atom_modify map array",
+                  "region box block -0.01 0.01 -0.01 0.01 -0.01 0.01", "create_box 1 box",
+                  "create_atoms 1 single 0 0 0 units box", "create_atoms 1 single 0.0016 0.0003 0.0001 units box",
+                  f"set atom 1 diameter {2 * r1!r} density 2500", f"set atom 2 diameter {2 * r2!r} density 2500",
+                  "set atom 1 vx 0.02 vy 0.01", "set atom 2 vx -0.03 vz 0.01", "set atom 2 omega 0 0 50",
+                  "pair_style musen/hm", f"pair_coeff 1 1 {estar!r} 0 1.0 0.3 0.0",
+                  "neighbor 0.0005 bin", "neigh_modify every 1 delay 0 check yes", "timestep 1e-7",
+                  "fix integrate all nve/sphere",
+                  "compute pl all pair/local dist fx fy fz p1 p2 p3 p4 p5 p6 cutoff radius",
+                  "compute pp all property/local patom1 patom2 cutoff radius", "run 40",
+                  "write_dump all local contacts.dump c_pp[1] c_pp[2] c_pl[1] c_pl[2] c_pl[3] c_pl[4] c_pl[5] "
+                  "c_pl[6] c_pl[7] c_pl[8] c_pl[9] c_pl[10] modify format float %.17g",
+                  "write_dump all custom atoms.dump id x y z fx fy fz radius modify sort id format float %.17g"]:
+            lmp.command(c)
+    finally:
+        os.chdir(cwd)
+        lmp.close()
+    pair = next(iter_frames(tmp_path / "contacts.dump")).columns
+    atoms = next(iter_frames(tmp_path / "atoms.dump"))
+    assert len(pair["c_pp[1]"]) == 1
+    first = int(pair["c_pp[1]"][0]) - 1                  # row of the pair's atom 1
+    x = atoms.vector("x", "y", "z")
+    d = x[first] - x[1 - first]
+    dist = np.linalg.norm(d)
+    np.testing.assert_allclose([pair[f"c_pl[{k}]"][0] for k in (8, 9, 10)], d, rtol=1e-15)
+    np.testing.assert_allclose(pair["c_pl[1]"][0], dist, rtol=1e-15)
+    force = np.array([pair[f"c_pl[{k}]"][0] for k in (2, 3, 4)])
+    np.testing.assert_allclose(force, atoms.vector("fx", "fy", "fz")[first], rtol=1e-12)
+    overlap = r1 + r2 - dist
+    assert overlap > 0
+    hertz = 4 / 3 * estar * np.sqrt(r1 * r2 / (r1 + r2)) * overlap ** 1.5
+    np.testing.assert_allclose(force, hertz * d / dist, rtol=1e-12)
+    assert [pair[f"c_pl[{k}]"][0] for k in (5, 6, 7)] == [0, 0, 0]

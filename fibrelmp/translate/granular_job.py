@@ -78,7 +78,7 @@ class GranularJob:
     wall_forces: Path | None = None  # fix musen/wall/mesh: per-triangle forces per frame
     mesh_rows: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))   # model row of each
     geometry: Path | None = None     # per-atom bond geometry (musen/elastic), beside the data file
-    contacts: Path | None = None     # sphere-sphere contacts per frame (pair/local; stock pair granular)
+    contacts: Path | None = None     # sphere-sphere contacts per frame (compute pair/local)
 
     @property
     def inputs(self) -> list[Path]:
@@ -207,7 +207,7 @@ def build_granular_job(model: GranularModel, folder: str | Path):
         frame_columns=frame_columns, acts=acts, compress_ids=compress_ids,
         lost=bool(axes.removal_axes.any()), walls=[(wp.name, wp.description) for wp in wall_plans],
         mesh_fix=MESH_FIX if len(mesh) else None, mesh_forces_name=MESH_FORCES_NAME,
-        contacts_name=None if musen_hm else CONTACTS_NAME,
+        contacts_name=CONTACTS_NAME,
         thermo_every=min(saves.period or 0, 2 ** 31 - 1),      # thermo N is a C int
     )
     job = GranularJob(
@@ -223,6 +223,5 @@ def build_granular_job(model: GranularModel, folder: str | Path):
         domain_hi=dom_hi, removal_axes=axes.removal_axes, frame_columns=frame_columns, warnings=warnings,
         wall_forces=folder / MESH_FORCES_NAME if len(mesh) else None, mesh_rows=mesh,
         geometry=folder / GEOMETRY_NAME if geometry is not None else None,
-        # pair musen/hm has no single(), which compute pair/local needs
-        contacts=None if musen_hm else folder / CONTACTS_NAME)
+        contacts=folder / CONTACTS_NAME)
     return job, script, write_data_file

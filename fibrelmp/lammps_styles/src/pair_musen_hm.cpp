@@ -76,7 +76,10 @@ PairMusenHM::PairMusenHM(LAMMPS *lmp) :
     Pair(lmp), estar(nullptr), gstar(nullptr), restitution(nullptr), alpha(nullptr),
     mu(nullptr), mu_roll(nullptr), maxrad(nullptr), history(nullptr)
 {
-  single_enable = 0;
+  // single(): the contact force at the current state, for compute pair/local
+  single_enable = 1;
+  single_extra = 6;
+  svector = new double[single_extra];
   restartinfo = 1;
   finitecutflag = 1;
   // forces are only written to owned atoms (newton off list): f.r over ghosts would be wrong
@@ -88,6 +91,7 @@ PairMusenHM::~PairMusenHM()
   if (copymode) return;
   // the history belongs to this style; LAMMPS deletes pair styles before fixes
   if (history && modify && modify->get_fix_by_id(HISTORY_ID)) modify->delete_fix(HISTORY_ID);
+  delete[] svector;
   if (allocated) {
     memory->destroy(setflag);
     memory->destroy(cutsq);
@@ -394,6 +398,87 @@ double PairMusenHM::init_one(int i, int j)
   mu[j][i] = mu[i][j];
   mu_roll[j][i] = mu_roll[i][j];
   return maxrad[i] + maxrad[j];
+}
+
+/* ----------------------------------------------------------------------
+   The contact force on i at the current state (compute pair/local, between runs): the
+   formulas of compute() with the stored tangential overlap as it is (compute() already
+   advanced it by this step's vt dt) and the current velocities (after a step: the
+   end-of-step ones, where compute() saw the half-step ones; the damping terms differ by
+   that).  fforce: the normal force on i over the distance along x_i - x_j (pair/local's
+   fx fy fz); svector: the tangential force on i (3), x_i - x_j (3).  Returns 0 (no energy).
+------------------------------------------------------------------------- */
+
+double PairMusenHM::single(int i, int j, int itype, int jtype, double rsq, double /*factor_coul*/,
+                           double factor_lj, double &fforce)
+{
+  double **x = atom->x;
+  double **v = atom->v;
+  double **omega = atom->omega;
+  double *radius = atom->radius;
+  double *rmass = atom->rmass;
+  tagint *tag = atom->tag;
+
+  const double cv[3] = {x[j][0] - x[i][0], x[j][1] - x[i][1], x[j][2] - x[i][2]};
+  fforce = 0.0;
+  for (int k = 0; k < 3; k++) {
+    svector[k] = 0.0;
+    svector[3 + k] = -cv[k];
+  }
+  const double r1 = radius[i], r2 = radius[j];
+  if (factor_lj == 0.0 || !((r1 + r2) * (r1 + r2) > rsq)) return 0.0;
+  const double overlap = r1 + r2 - std::sqrt(rsq);
+  const double equiv_radius = r1 * r2 / (r1 + r2);
+  const double equiv_mass = rmass[i] * rmass[j] / (rmass[i] + rmass[j]);
+  double xi[3] = {0.0, 0.0, 0.0};
+  if (const double *found = history ? history->find(i, tag[j]) : nullptr) {
+    xi[0] = found[0];
+    xi[1] = found[1];
+    xi[2] = found[2];
+  }
+
+  const double *w1 = omega[i], *w2 = omega[j];
+  const double s1 = r1 / (r1 + r2);
+  const double s2 = -r2 / (r1 + r2);
+  const double rc1[3] = {cv[0] * s1, cv[1] * s1, cv[2] * s1};
+  const double rc2[3] = {cv[0] * s2, cv[1] * s2, cv[2] * s2};
+  double n[3] = {0.0, 0.0, 0.0};
+  const double cvlen = length(cv);
+  if (cvlen != 0) {
+    n[0] = cv[0] / cvlen;
+    n[1] = cv[1] / cvlen;
+    n[2] = cv[2] / cvlen;
+  }
+  double w2rc2[3], w1rc1[3];
+  cross(w2, rc2, w2rc2);
+  cross(w1, rc1, w1rc1);
+  double rel[3];
+  for (int k = 0; k < 3; k++) rel[k] = (v[j][k] + w2rc2[k]) - (v[i][k] + w1rc1[k]);
+  const double vn = n[0] * rel[0] + n[1] * rel[1] + n[2] * rel[2];
+  double vt[3];
+  for (int k = 0; k < 3; k++) vt[k] = rel[k] - vn * n[k];
+
+  const double contact_area_radius = std::sqrt(equiv_radius * overlap);
+  const double kn = 2 * estar[itype][jtype] * contact_area_radius;
+  const double fn_el = -overlap * kn * 2. / 3.;
+  const double fn_damp = -MUSEN_2_SQRT_5_6 * alpha[itype][jtype] * vn * std::sqrt(kn * equiv_mass);
+  const double kt = 8 * gstar[itype][jtype] * contact_area_radius;
+  double ft_spring[3];
+  for (int k = 0; k < 3; k++) ft_spring[k] = xi[k] * kt;
+  const double damp_t = -MUSEN_2_SQRT_5_6 * alpha[itype][jtype] * std::sqrt(kt * equiv_mass);
+  double ft[3];
+  const double ft_spring_len = length(ft_spring);
+  const double friction_len = mu[itype][jtype] * std::fabs(fn_el + fn_damp);
+  if (ft_spring_len > friction_len) {
+    for (int k = 0; k < 3; k++) ft[k] = ft_spring[k] * friction_len / ft_spring_len;
+  } else {
+    for (int k = 0; k < 3; k++) ft[k] = ft_spring[k] + vt[k] * damp_t;
+  }
+
+  // normal force on i: n (fn_el + fn_damp) = (x_i - x_j) fforce
+  if (cvlen != 0) fforce = -(fn_el + fn_damp) / cvlen;
+  for (int k = 0; k < 3; k++) svector[k] = ft[k];
+  return 0.0;
 }
 
 /* ---------------------------------------------------------------------- */

@@ -43,6 +43,7 @@ class PairMusenHM : public Pair {
   void coeff(int, char **) override;
   void init_style() override;
   double init_one(int, int) override;
+  double single(int, int, int, int, double, double, double, double &) override;
   void write_restart(FILE *) override;
   void read_restart(FILE *) override;
   void *extract(const char *, int &) override;

@@ -280,3 +280,34 @@ def test_musen_pair_single_gives_the_contact_force_for_pair_local(tmp_path):
     hertz = 4 / 3 * estar * np.sqrt(r1 * r2 / (r1 + r2)) * overlap ** 1.5
     np.testing.assert_allclose(force, hertz * d / dist, rtol=1e-12)
     assert [pair[f"c_pl[{k}]"][0] for k in (5, 6, 7)] == [0, 0, 0]
+
+
+def _warned(dump: Path, out: Path) -> dict[str, str]:
+    said: list[str] = []
+    post(dump, out, say=said.append)
+    return {line.split("]")[0].split("[")[1]: line for line in said if line.startswith("warning [")}
+
+
+def test_restart_needs_radii_and_says_so(tmp_path):
+    """Without radii no density is known: no .restart, and a warning (not density 1)."""
+    dump = tmp_path / "d.dump"
+    dump.write_text("ITEM: TIMESTEP\n0\nITEM: NUMBER OF ATOMS\n1\nITEM: BOX BOUNDS pp pp pp\n0 1\n0 1\n0 1\n"
+                    "ITEM: ATOMS id type x y z mass\n1 1 0.5 0.5 0.5 2\n")
+    warned = _warned(dump, tmp_path / "run")
+    assert "no .restart" in warned and not (tmp_path / "run.restart").exists()
+    assert (tmp_path / "run.data").exists()
+
+
+def test_restart_species_with_several_densities_warns_and_takes_the_mean(tmp_path):
+    """One LAMMPS type, two densities (1000 and 3000, from mass and radius): MercuryDPM has
+    one density per species, so the mean, 2000, with a warning giving the range."""
+    v = 4 / 3 * np.pi * 0.1 ** 3
+    dump = tmp_path / "d.dump"
+    dump.write_text("ITEM: TIMESTEP\n0\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS pp pp pp\n0 1\n0 1\n0 1\n"
+                    f"ITEM: ATOMS id type x y z radius mass\n1 1 0.2 0.5 0.5 0.1 {1000 * v!r}\n"
+                    f"2 1 0.7 0.5 0.5 0.1 {3000 * v!r}\n")
+    warned = _warned(dump, tmp_path / "run")
+    assert "species density" in warned and "1000" in warned["species density"]
+    r = read_restart_as_mercury_cg(tmp_path / "run.restart")
+    assert r["density"] == {0: pytest.approx(2000, rel=1e-12)}
+    assert r["timeStep"] == 0 and "no time step" in warned

@@ -311,3 +311,29 @@ def test_restart_species_with_several_densities_warns_and_takes_the_mean(tmp_pat
     r = read_restart_as_mercury_cg(tmp_path / "run.restart")
     assert r["density"] == {0: pytest.approx(2000, rel=1e-12)}
     assert r["timeStep"] == 0 and "no time step" in warned
+
+
+def test_demdf_run_plane_wall_contacts_reach_fstat(tmp_path):
+    """A DEMDF sphere (r 0.5) placed at z = 0.45 on the floor z = 0, no gravity: the run's
+    frames.dump carries the floor's contact columns, and post --to mercury writes the wall
+    row of frame 0: overlap 0.05 = r - z, normal -z (MercuryDPM negates a wall's), partner -1,
+    fn = the dumped wall force along +z."""
+    from fibrelmp import python_api
+
+    doc = json.loads((REPO / "examples" / "demdf" / "drop_on_wall.json").read_text())
+    doc["timeEnd"], doc["bodyForce"] = 0.25, [0.0, 0.0, 0.0]
+    doc["objects"]["particles"] = [[2.0, 2.0, 0.45, 0.0, 0.0, 0.0, 0]]
+    case = tmp_path / "drop_on_wall.json"
+    case.write_text(json.dumps(doc))
+    python_api.run(case)
+    work = tmp_path / "drop_on_wall_work"
+    post(work / "frames.dump", tmp_path / "run", data=work / "data.lammps", gravity=None)
+    first = next(iter_frames(work / "frames.dump"))
+    fz = float(first.column("v_w1_fz")[0])
+    assert fz > 0                                            # the floor pushes the sphere up
+    walls = read_fstat(tmp_path / "run.fstat")[0].rows
+    assert walls.shape == (1, 16)
+    np.testing.assert_array_equal(walls[0, 1:3], [0, -1])
+    np.testing.assert_allclose(walls[0, 6], 0.5 - 0.45, rtol=1e-9)
+    np.testing.assert_allclose(walls[0, 10:13], [0, 0, -1], atol=1e-15)
+    np.testing.assert_allclose(walls[0, 8], fz, rtol=1e-9)

@@ -1,4 +1,5 @@
-"""MercuryDPM output files from LAMMPS frames: ``.data`` (XBalls), ``.ene`` and ``.fstat``.
+"""MercuryDPM output files from LAMMPS frames: ``.data`` (XBalls), ``.ene``, ``.fstat`` and
+``.restart`` (``DPMBase::write``'s layout: what MercuryCG reads, docs/post.md).
 
 Layouts as MercuryDPM's own writers produce them (shared/research/demdf_mercury.md, B):
 
@@ -449,7 +450,9 @@ class MercuryFrame:
 
 
 class MercuryWriter(Writer):
-    """``<base>.data`` + ``<base>.ene`` (+ ``<base>.fstat`` when contacts are given)."""
+    """``<base>.data`` + ``<base>.ene`` + ``<base>.restart`` (the last frame; not without masses
+    and radii) (+ ``<base>.fstat`` when ``fstat``: contacts of the frames' local dump and their
+    wall-contact columns)."""
 
     format = "mercury"
 

@@ -230,17 +230,23 @@ def test_run_keeps_contacts_so_post_to_mercury_gives_fstat(tmp_path):
     assert density == pytest.approx(particle["mass"] / (4 / 3 * np.pi * particle["radius"] ** 3), rel=1e-12)
 
 
-def test_musen_pair_single_gives_the_contact_force_for_pair_local(tmp_path):
-    """pair musen/hm's single() (compute pair/local, which run's contacts.dump uses): for
-    an elastic frictionless pair (e = 1: no damping; G* = 0: no tangential force) the normal
-    force it reports equals the force LAMMPS applied to each sphere in that step (the pair is
-    alone) and Hertz's 4/3 E* sqrt(R*) overlap^1.5, computed here."""
+@pytest.mark.parametrize("law", [(1.0, 0.0, 0.0), (0.5, 2e7, 0.3), (0.5, 2e7, 0.002)],
+                         ids=["elastic-frictionless", "damped-sticking", "damped-slipping"])
+@pytest.mark.parametrize("steps", [0, 40])
+def test_musen_pair_single_gives_the_applied_contact_force(tmp_path, law, steps):
+    """pair musen/hm's single() (compute pair/local, which run's contacts.dump uses) reports
+    the force the pair applied in the step: for an isolated pair it is each sphere's force
+    in the atom dump (normal part along x1 - x2, the rest tangential), at step 0 (the setup
+    force) and after 40 steps (the stored force of the last step), damped, sticking or
+    slipping; for the elastic frictionless law also Hertz's 4/3 E* sqrt(R*) overlap^1.5,
+    computed here."""
     from fibrelmp import lammps_styles
     from fibrelmp._lammps import new_lammps
 
     plugin = lammps_styles.plugin()
     if not plugin.available:
         pytest.skip(f"fibrelmp's LAMMPS styles are not available: {plugin.how}")
+    rest, gstar, mu = law
     estar, r1, r2 = 5e7, 1e-3, 7e-4
     lmp = new_lammps(["-log", "none", "-screen", "none", "-nocite"])
     cwd = os.getcwd()
@@ -252,11 +258,12 @@ def test_musen_pair_single_gives_the_contact_force_for_pair_local(tmp_path):
                   "create_atoms 1 single 0 0 0 units box", "create_atoms 1 single 0.0016 0.0003 0.0001 units box",
                   f"set atom 1 diameter {2 * r1!r} density 2500", f"set atom 2 diameter {2 * r2!r} density 2500",
                   "set atom 1 vx 0.02 vy 0.01", "set atom 2 vx -0.03 vz 0.01", "set atom 2 omega 0 0 50",
-                  "pair_style musen/hm", f"pair_coeff 1 1 {estar!r} 0 1.0 0.3 0.0",
+                  "pair_style musen/hm", f"pair_coeff 1 1 {estar!r} {gstar!r} {rest!r} {mu!r} 0.0",
                   "neighbor 0.0005 bin", "neigh_modify every 1 delay 0 check yes", "timestep 1e-7",
                   "fix integrate all nve/sphere",
                   "compute pl all pair/local dist fx fy fz p1 p2 p3 p4 p5 p6 cutoff radius",
-                  "compute pp all property/local patom1 patom2 cutoff radius", "run 40",
+                  "compute pp all property/local patom1 patom2 cutoff radius",
+                  "run 0 post no" if steps == 0 else f"run {steps} post no",
                   "write_dump all local contacts.dump c_pp[1] c_pp[2] c_pl[1] c_pl[2] c_pl[3] c_pl[4] c_pl[5] "
                   "c_pl[6] c_pl[7] c_pl[8] c_pl[9] c_pl[10] modify format float %.17g",
                   "write_dump all custom atoms.dump id x y z fx fy fz radius modify sort id format float %.17g"]:
@@ -273,13 +280,24 @@ def test_musen_pair_single_gives_the_contact_force_for_pair_local(tmp_path):
     dist = np.linalg.norm(d)
     np.testing.assert_allclose([pair[f"c_pl[{k}]"][0] for k in (8, 9, 10)], d, rtol=1e-15)
     np.testing.assert_allclose(pair["c_pl[1]"][0], dist, rtol=1e-15)
-    force = np.array([pair[f"c_pl[{k}]"][0] for k in (2, 3, 4)])
-    np.testing.assert_allclose(force, atoms.vector("fx", "fy", "fz")[first], rtol=1e-12)
-    overlap = r1 + r2 - dist
-    assert overlap > 0
-    hertz = 4 / 3 * estar * np.sqrt(r1 * r2 / (r1 + r2)) * overlap ** 1.5
-    np.testing.assert_allclose(force, hertz * d / dist, rtol=1e-12)
-    assert [pair[f"c_pl[{k}]"][0] for k in (5, 6, 7)] == [0, 0, 0]
+    normal = np.array([pair[f"c_pl[{k}]"][0] for k in (2, 3, 4)])
+    tangential = np.array([pair[f"c_pl[{k}]"][0] for k in (5, 6, 7)])
+    applied = atoms.vector("fx", "fy", "fz")[first]
+    scale = np.abs(applied).max()
+    np.testing.assert_allclose(normal + tangential, applied, rtol=0, atol=1e-12 * scale)
+    np.testing.assert_allclose(normal, (applied @ d) / dist ** 2 * d, rtol=0, atol=1e-12 * scale)
+    assert abs(tangential @ d) <= 1e-12 * scale * dist
+    if gstar:
+        assert np.linalg.norm(tangential) > 1e-3 * scale        # the law has a tangential force here
+        slipping = np.isclose(np.linalg.norm(tangential), mu * np.linalg.norm(normal), rtol=1e-12)
+        # MUSEN slips when the spring force alone exceeds mu |Fn|: then |Ft| = mu |Fn| (40 steps
+        # with mu 0.002); at step 0 the spring is vt dt K_t, far below it
+        assert slipping == (mu == 0.002 and steps > 0)
+    else:
+        overlap = r1 + r2 - dist
+        hertz = 4 / 3 * estar * np.sqrt(r1 * r2 / (r1 + r2)) * overlap ** 1.5
+        np.testing.assert_allclose(normal, hertz * d / dist, rtol=1e-12)
+        assert list(tangential) == [0, 0, 0]
 
 
 def _warned(dump: Path, out: Path) -> dict[str, str]:

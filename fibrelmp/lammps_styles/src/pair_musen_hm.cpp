@@ -261,11 +261,20 @@ void PairMusenHM::compute(int eflag, int vflag)
         }
       }
 
+      // the entry keeps xi and, for single(), the normal and tangential force of this step
       if (advance) {
-        for (int k = 0; k < 3; k++) xi_i[k] = xi[k];
+        for (int k = 0; k < 3; k++) {
+          xi_i[k] = xi[k];
+          xi_i[3 + k] = n[k] * fn;
+          xi_i[6 + k] = ft[k];
+        }
         if (j < nlocal) {
           double *xi_j = history->get(j, tag[i]);
-          for (int k = 0; k < 3; k++) xi_j[k] = -xi[k];
+          for (int k = 0; k < 3; k++) {
+            xi_j[k] = -xi[k];
+            xi_j[3 + k] = -(n[k] * fn);
+            xi_j[6 + k] = -ft[k];
+          }
         }
       }
 
@@ -368,9 +377,11 @@ void PairMusenHM::init_style()
 
   if (!history) {
     Fix *found = modify->get_fix_by_id(HISTORY_ID);
-    if (!found) found = modify->add_fix(std::string(HISTORY_ID) + " all MUSEN/HISTORY 3");
+    if (!found)
+      found = modify->add_fix(std::string(HISTORY_ID) + " all MUSEN/HISTORY " +
+                              std::to_string(HISTORY_VALUES));
     history = dynamic_cast<FixMusenHistory *>(found);
-    if (!history || history->nvalues() != 3)
+    if (!history || history->nvalues() != HISTORY_VALUES)
       error->all(FLERR, "pair musen/hm: fix ID {} exists but is not its MUSEN/HISTORY fix",
                  HISTORY_ID);
   }
@@ -401,12 +412,13 @@ double PairMusenHM::init_one(int i, int j)
 }
 
 /* ----------------------------------------------------------------------
-   The contact force on i at the current state (compute pair/local, between runs): the
-   formulas of compute() with the stored tangential overlap as it is (compute() already
-   advanced it by this step's vt dt) and the current velocities (after a step: the
-   end-of-step ones, where compute() saw the half-step ones; the damping terms differ by
-   that).  fforce: the normal force on i over the distance along x_i - x_j (pair/local's
-   fx fy fz); svector: the tangential force on i (3), x_i - x_j (3).  Returns 0 (no energy).
+   The contact force on i (compute pair/local, between runs): the force compute() applied
+   in the last step, as its history entry keeps it (a contact is swept the step it ends, so
+   an entry is this step's).  Without an entry (a contact no step has advanced yet: the
+   force of the first run's setup, step 0, is not stored) the force compute() gives at the
+   current state without advancing: xi = 0 + vt dt.
+   fforce: the normal force on i over the distance along x_i - x_j (pair/local's fx fy fz);
+   svector: the tangential force on i (3), x_i - x_j (3).  Returns 0 (no energy).
 ------------------------------------------------------------------------- */
 
 double PairMusenHM::single(int i, int j, int itype, int jtype, double rsq, double /*factor_coul*/,
@@ -430,11 +442,11 @@ double PairMusenHM::single(int i, int j, int itype, int jtype, double rsq, doubl
   const double overlap = r1 + r2 - std::sqrt(rsq);
   const double equiv_radius = r1 * r2 / (r1 + r2);
   const double equiv_mass = rmass[i] * rmass[j] / (rmass[i] + rmass[j]);
-  double xi[3] = {0.0, 0.0, 0.0};
   if (const double *found = history ? history->find(i, tag[j]) : nullptr) {
-    xi[0] = found[0];
-    xi[1] = found[1];
-    xi[2] = found[2];
+    // normal force n fn along -(x_i - x_j): fforce = (n fn) . (x_i - x_j) / |x_i - x_j|^2
+    fforce = -(found[3] * cv[0] + found[4] * cv[1] + found[5] * cv[2]) / rsq;
+    for (int k = 0; k < 3; k++) svector[k] = found[6 + k];
+    return 0.0;
   }
 
   const double *w1 = omega[i], *w2 = omega[j];
@@ -457,6 +469,8 @@ double PairMusenHM::single(int i, int j, int itype, int jtype, double rsq, doubl
   const double vn = n[0] * rel[0] + n[1] * rel[1] + n[2] * rel[2];
   double vt[3];
   for (int k = 0; k < 3; k++) vt[k] = rel[k] - vn * n[k];
+  double xi[3];
+  for (int k = 0; k < 3; k++) xi[k] = 0.0 + vt[k] * update->dt;    // a new contact's first xi
 
   const double contact_area_radius = std::sqrt(equiv_radius * overlap);
   const double kn = 2 * estar[itype][jtype] * contact_area_radius;

@@ -50,6 +50,9 @@ class PairMusenHM : public Pair {
   double memory_usage() override;
 
   static constexpr const char *HISTORY_ID = "MUSEN_HM_HISTORY";
+  // per contact: tangential overlap xi (3), the last step's normal and tangential force on
+  // the atom (3 + 3, for single())
+  static constexpr int HISTORY_VALUES = 9;
 
  protected:
   double **estar, **gstar;    // effective moduli per type pair

@@ -206,9 +206,9 @@ register_format(Format(
      TARGET: "fibrelmp.post.to_fibrenet:RestartTarget"},
     extensions=(".res",), home="fibrelmp.translate.fibrenet"))
 register_format(Format(
-    "mercury", "MercuryDPM .data/.ene/.fstat", "any",
+    "mercury", "MercuryDPM .data/.ene/.fstat/.restart", "any",
     {TARGET: "fibrelmp.post.mercury:MercuryTarget"},
-    extensions=(".data", ".ene", ".fstat"), home="fibrelmp.post.mercury"))
+    extensions=(".data", ".ene", ".fstat", ".restart"), home="fibrelmp.post.mercury"))
 register_format(Format(
     # also written by ``run --vtk`` beside the results (fibrelmp.pipeline.viewer)
     "vtk", "VTK .vtp/.vtm frames with a .pvd index (ParaView, OVITO)", "any",

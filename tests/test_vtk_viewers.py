@@ -5,7 +5,7 @@ is built on; the ``vtk`` wheel of the ``test`` extra) and OVITO's Python module 
 optional: skipped when absent).  Expected numbers come from the inputs (times, radii,
 masses), the work dumps LAMMPS wrote, the runs' own result files, and geometry computed
 here, never from the writer.  (meshio reads VTK XML only as UnstructuredGrid, which OVITO
-does not read as particles, so it opens the wall series (``_walls.vtu``), not the particles.)
+does not read as particles or meshes, so meshio opens none of these files.)
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ import pytest
 
 from fibrelmp.post.lammps_data.reader import read_data
 from fibrelmp.post.lammps_dump import iter_frames
-from fibrelmp.post.vtk import ViewerFrame, VtkWriter, bond_segments, read_frame, read_pvd
+from fibrelmp.post.vtk import ViewerFrame, VtkWriter, bond_segments, read_frame, read_piece, read_pvd
 
 from .conftest import REPO
 
@@ -436,11 +436,11 @@ def test_a_frame_without_bonds_has_an_empty_bonds_block(tmp_path):
         assert [pipeline.compute(k).particles.count for k in range(2)] == [2, 2]
 
 
-def test_musen_walls_are_a_series_meshio_and_vtk_open(tmp_path):
-    """A MUSEN run with walls: ``<stem>_walls.pvd`` lists an UnstructuredGrid of the wall
-    triangles per frame, read with meshio (and VTK's reader when installed); its points are
-    the result's wall vertices at the same time, read from the run's own .mdem result."""
-    meshio = pytest.importorskip("meshio")
+def test_musen_walls_are_a_polydata_series_vtk_and_ovito_open(tmp_path):
+    """A MUSEN run with walls: ``<stem>_walls.pvd`` lists a PolyData file of the wall
+    triangles (polygons) per frame, as OVITO reads a surface mesh; read by fibrelmp's reader,
+    VTK's PolyData reader and OVITO (when installed); its points are the result's wall
+    vertices at the same time, read from the run's own .mdem result."""
     from fibrelmp import python_api
     from fibrelmp.translate.musen.mdem.model import MdemReader
 
@@ -451,15 +451,18 @@ def test_musen_walls_are_a_series_meshio_and_vtk_open(tmp_path):
     frames = list(MdemReader(tmp_path / "SingelParticle_result.mdem"))
     assert [t for t, _ in series] == [f.time for f in frames]
     for (time, path), frame in zip(series, frames):
-        mesh = meshio.read(path)
-        assert [b.type for b in mesh.cells] == ["triangle"] and len(mesh.cells[0].data) == 12
-        np.testing.assert_array_equal(mesh.points.reshape(12, 3, 3), frame.triangle_vertices)
-        assert mesh.cell_data["Velocity"][0].shape == (12, 3)
-        try:
-            xml = __import__("vtkmodules.vtkIOXML", fromlist=["vtkXMLUnstructuredGridReader"])
-        except ImportError:
-            continue
-        reader = xml.vtkXMLUnstructuredGridReader()
-        reader.SetFileName(str(path))
-        reader.Update()
-        assert reader.GetOutput().GetNumberOfCells() == 12
+        assert path.name.endswith("_walls.vtp")
+        piece = read_piece(path)
+        assert piece.kind == "PolyData" and piece.attributes["NumberOfPolys"] == "12"
+        np.testing.assert_array_equal(piece.cells["Polys"]["connectivity"], np.arange(36))
+        np.testing.assert_array_equal(piece.cells["Polys"]["offsets"], 3 * np.arange(1, 13))
+        np.testing.assert_array_equal(piece.points.reshape(12, 3, 3), frame.triangle_vertices)
+        assert piece.cell_data["Velocity"].shape == (12, 3)
+        if have("vtkmodules"):
+            mesh = vtk_read(path)
+            assert mesh.GetNumberOfPolys() == 12 and mesh.GetNumberOfCells() == 12
+            assert all(mesh.GetCellType(k) == 5 for k in range(12))       # VTK_TRIANGLE
+            np.testing.assert_array_equal(vtk_arrays(mesh.GetCellData())["Velocity"].shape, (12, 3))
+    if have("ovito"):
+        pipeline = ovito_import(tmp_path / "SingelParticle_result_walls.pvd")
+        assert sum(mesh.faces.count for mesh in pipeline.compute(0).surfaces.values()) == 12

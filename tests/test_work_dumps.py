@@ -198,12 +198,16 @@ def test_musen_post_of_work_dump_has_the_runs_spheres(musen_run, tmp_path):
     """The sphere's line (id, radii, material key, activity, every time point) is the run's
     byte for byte; what a dump cannot hold differs, and only that: the wall triangles
     (objects of type 14) and their geometry (25-27), the PBC box (28), material properties
-    (32: only the density, from mass and radius) and interactions (33)."""
+    (32: only the density, from mass and radius) and interactions (33); a warning says so,
+    naming the walls this run had."""
     folder, result = musen_run
     work = folder / "single_particle_job_work" / "job2"
     run_txt = folder / "single_particle_result.txt"
     post_txt = tmp_path / "result.txt"
-    fibrelmp.convert(work / "frames.dump", "musen", post_txt, data=work / "data.lammps")
+    said: list[tuple[str, str]] = []
+    fibrelmp.convert(work / "frames.dump", "musen", post_txt, data=work / "data.lammps", warn=said.extend)
+    only = [text for kind, text in said if kind == "spheres only"]
+    assert len(only) == 1 and "its walls" in only[0] and "bonds" not in only[0]
     run, post = _lines_by_tag(run_txt), _lines_by_tag(post_txt)
     assert post["object type 1"] == run["object type 1"] and len(run["object type 1"]) == 1
     assert post["object type 1"][0].startswith("0 12 1 1 5 0.0005 0.0005 23 KF6843H84OPHH3017U3D 24 0 1e+300 2 0 ")
@@ -345,7 +349,7 @@ def test_facts_from_another_run_warn_and_dump_times_win(musen_run, tmp_path):
     (work / "data.fibrelmp.json").write_text(json.dumps(facts))
     said: list = []
     fibrelmp.convert(work / "frames.dump", "musen", tmp_path / "r.txt", data=work / "data.lammps", warn=said.extend)
-    assert [k for k, _ in said] == ["data facts"]
+    assert [k for k, _ in said] == ["data facts", "spheres only"]     # the latter: no walls in a dump
     times = [float(t) for t in re.findall(r" 2 (\S+) 16 ", (tmp_path / "r.txt").read_text())]
     assert times[1] == pytest.approx(1e-4, rel=1e-12)
 

@@ -4,7 +4,7 @@ CSV time series per opening.
 * ``<name>.pvd`` + ``<name>_NNNNNN.vtp``: the fluid particles (``Velocity``, ``Density``,
   ``Pressure`` from the Tait equation, and ``outflow_weight_<opening>``: the particle's share
   weight ``1 - |delta|/d`` while near the opening, else 0);
-* ``<name>_walls.pvd`` + ``<name>_NNNNNN_walls.vtu``: the surface mesh at the frame's time
+* ``<name>_walls.pvd`` + ``<name>_NNNNNN_walls.vtp``: the surface mesh at the frame's time
   (nodes interpolated linearly between motion frames, as the wall particles move), cell data
   ``opening`` (-1 on walls, else the opening's index);
 * ``<name>_<opening>.csv``: ``time_s, pressure_Pa, force_x_N, force_y_N, force_z_N,

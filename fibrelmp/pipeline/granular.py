@@ -24,8 +24,8 @@ def render(model: "GranularModel"):
             text = job.script.read_text()
         else:
             job, text, _ = build_granular_job(model, folder)
-        dumps = [p for p in (job.frames, job.bond_dump, job.tile_dump, job.breaks, job.wall_forces)
-                 if p is not None]
+        dumps = [p for p in (job.frames, job.bond_dump, job.tile_dump, job.breaks, job.wall_forces,
+                             job.contacts) if p is not None]
         return Rendered(job, text, job.save_steps, dumps)
     return build
 

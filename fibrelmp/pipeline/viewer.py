@@ -8,7 +8,7 @@ They are outputs of the run like its results: checked and locked before LAMMPS s
 staged and renamed into place when the run succeeds, replaced (all frames) only with
 ``--force``.
 
-With MUSEN walls also ``<base>_walls.pvd`` and ``<base>_NNNNNN_walls.vtu`` (the triangles
+With MUSEN walls also ``<base>_walls.pvd`` and ``<base>_NNNNNN_walls.vtp`` (PolyData triangles
 where they are at each frame, with their velocity and force).
 
 What: every saved frame; ids, types, ``Radius``, ``Mass``, ``Velocity``, ``Force``,

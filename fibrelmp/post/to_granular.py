@@ -154,6 +154,21 @@ def demdf_document(model: GranularModel, filename: str) -> dict:
             "output": {"snapshot": {"filename": filename, "saveCount": 0}}}
 
 
+def spheres_only(work: Path, frame: Frame) -> str:
+    """What a MUSEN result from a work folder's dump lacks against the run's own result."""
+    from fibrelmp.translate.granular.mesh import MESH_NAME
+    from fibrelmp.translate.granular_job import BONDS_NAME, TILES_NAME
+
+    walls = (work / MESH_NAME).exists() or (work / TILES_NAME).exists() or \
+        any(name.startswith("v_w") for name in frame.columns)
+    missing = (["its walls (triangles, geometries)"] if walls else []) + \
+        (["its bonds"] if (work / BONDS_NAME).exists() else [])
+    return (f"the result has the run's spheres only: {', '.join(missing + [''])}material properties "
+            "other than the density and the interactions are not in a dump, and the PBC line comes from "
+            "the dump's box; `fibrelmp run` writes the complete result (docs/post.md, fibrelmp's own "
+            "work dumps)")
+
+
 class _GranularTarget(DumpTarget):
     """MUSEN result / DEMDF snapshots through the neutral granular model and the same
     writers ``fibrelmp run`` uses (``result_writer``)."""
@@ -173,6 +188,8 @@ class _GranularTarget(DumpTarget):
         self.facts = facts if facts is not None and facts.kind == self.kind else None
         self.model = model_from_frame(first[0], Path(self.context.source), self.context.type_names,
                                       self.kind, times[0], dt, self.keeps_ids, self.facts)
+        if self.facts is not None and self.facts.path is not None and self.kind == "musen":
+            self.context.warn("spheres only", spheres_only(self.facts.path.parent, first[0]))
         self.out = self.adopt(self.result_writer(self.model, dt))
 
     def result_writer(self, model: GranularModel, dt: float) -> Writer:

@@ -37,7 +37,7 @@ from fibrelmp.translate.lammps_format import float_text
 from fibrelmp.translate.steps import SaveSteps
 from fibrelmp.translate.work_facts import WorkFacts, write_facts
 
-__all__ = ["BONDS_NAME", "BREAKS_NAME", "DATA_NAME", "FRAMES_NAME", "SCRIPT_NAME", "TILES_NAME",
+__all__ = ["BONDS_NAME", "BREAKS_NAME", "CONTACTS_NAME", "DATA_NAME", "FRAMES_NAME", "SCRIPT_NAME", "TILES_NAME",
            "GranularJob", "WallPlan", "build_granular_job", "describe_walls", "law_args", "plan_walls",
            "rolling_spring", "speed_bound", "tile_estimate", "write_granular_job"]
 
@@ -47,6 +47,7 @@ FRAMES_NAME = "frames.dump"
 BONDS_NAME = "bonds.dump"
 TILES_NAME = "walls.dump"
 BREAKS_NAME = "breaks.dump"
+CONTACTS_NAME = "contacts.dump"
 
 
 @dataclass
@@ -77,6 +78,7 @@ class GranularJob:
     wall_forces: Path | None = None  # fix musen/wall/mesh: per-triangle forces per frame
     mesh_rows: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))   # model row of each
     geometry: Path | None = None     # per-atom bond geometry (musen/elastic), beside the data file
+    contacts: Path | None = None     # sphere-sphere contacts per frame (compute pair/local)
 
     @property
     def inputs(self) -> list[Path]:
@@ -205,6 +207,7 @@ def build_granular_job(model: GranularModel, folder: str | Path):
         frame_columns=frame_columns, acts=acts, compress_ids=compress_ids,
         lost=bool(axes.removal_axes.any()), walls=[(wp.name, wp.description) for wp in wall_plans],
         mesh_fix=MESH_FIX if len(mesh) else None, mesh_forces_name=MESH_FORCES_NAME,
+        contacts_name=CONTACTS_NAME,
         thermo_every=min(saves.period or 0, 2 ** 31 - 1),      # thermo N is a C int
     )
     job = GranularJob(
@@ -219,5 +222,6 @@ def build_granular_job(model: GranularModel, folder: str | Path):
         bond_rows=bonds.rows, deletions=spheres.deletions, wall_plans=wall_plans, domain_lo=dom_lo,
         domain_hi=dom_hi, removal_axes=axes.removal_axes, frame_columns=frame_columns, warnings=warnings,
         wall_forces=folder / MESH_FORCES_NAME if len(mesh) else None, mesh_rows=mesh,
-        geometry=folder / GEOMETRY_NAME if geometry is not None else None)
+        geometry=folder / GEOMETRY_NAME if geometry is not None else None,
+        contacts=folder / CONTACTS_NAME)
     return job, script, write_data_file

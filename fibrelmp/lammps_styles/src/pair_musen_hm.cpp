@@ -76,7 +76,10 @@ PairMusenHM::PairMusenHM(LAMMPS *lmp) :
     Pair(lmp), estar(nullptr), gstar(nullptr), restitution(nullptr), alpha(nullptr),
     mu(nullptr), mu_roll(nullptr), maxrad(nullptr), history(nullptr)
 {
-  single_enable = 0;
+  // single(): the contact force at the current state, for compute pair/local
+  single_enable = 1;
+  single_extra = 6;
+  svector = new double[single_extra];
   restartinfo = 1;
   finitecutflag = 1;
   // forces are only written to owned atoms (newton off list): f.r over ghosts would be wrong
@@ -88,6 +91,7 @@ PairMusenHM::~PairMusenHM()
   if (copymode) return;
   // the history belongs to this style; LAMMPS deletes pair styles before fixes
   if (history && modify && modify->get_fix_by_id(HISTORY_ID)) modify->delete_fix(HISTORY_ID);
+  delete[] svector;
   if (allocated) {
     memory->destroy(setflag);
     memory->destroy(cutsq);
@@ -257,11 +261,20 @@ void PairMusenHM::compute(int eflag, int vflag)
         }
       }
 
+      // the entry keeps xi and, for single(), the normal and tangential force of this step
       if (advance) {
-        for (int k = 0; k < 3; k++) xi_i[k] = xi[k];
+        for (int k = 0; k < 3; k++) {
+          xi_i[k] = xi[k];
+          xi_i[3 + k] = n[k] * fn;
+          xi_i[6 + k] = ft[k];
+        }
         if (j < nlocal) {
           double *xi_j = history->get(j, tag[i]);
-          for (int k = 0; k < 3; k++) xi_j[k] = -xi[k];
+          for (int k = 0; k < 3; k++) {
+            xi_j[k] = -xi[k];
+            xi_j[3 + k] = -(n[k] * fn);
+            xi_j[6 + k] = -ft[k];
+          }
         }
       }
 
@@ -364,9 +377,11 @@ void PairMusenHM::init_style()
 
   if (!history) {
     Fix *found = modify->get_fix_by_id(HISTORY_ID);
-    if (!found) found = modify->add_fix(std::string(HISTORY_ID) + " all MUSEN/HISTORY 3");
+    if (!found)
+      found = modify->add_fix(std::string(HISTORY_ID) + " all MUSEN/HISTORY " +
+                              std::to_string(HISTORY_VALUES));
     history = dynamic_cast<FixMusenHistory *>(found);
-    if (!history || history->nvalues() != 3)
+    if (!history || history->nvalues() != HISTORY_VALUES)
       error->all(FLERR, "pair musen/hm: fix ID {} exists but is not its MUSEN/HISTORY fix",
                  HISTORY_ID);
   }
@@ -394,6 +409,90 @@ double PairMusenHM::init_one(int i, int j)
   mu[j][i] = mu[i][j];
   mu_roll[j][i] = mu_roll[i][j];
   return maxrad[i] + maxrad[j];
+}
+
+/* ----------------------------------------------------------------------
+   The contact force on i (compute pair/local, between runs): the force compute() applied
+   in the last step, as its history entry keeps it (a contact is swept the step it ends, so
+   an entry is this step's).  Without an entry (a contact no step has advanced yet: the
+   force of the first run's setup, step 0, is not stored) the force compute() gives at the
+   current state without advancing: xi = 0 + vt dt.
+   fforce: the normal force on i over the distance along x_i - x_j (pair/local's fx fy fz);
+   svector: the tangential force on i (3), x_i - x_j (3).  Returns 0 (no energy).
+------------------------------------------------------------------------- */
+
+double PairMusenHM::single(int i, int j, int itype, int jtype, double rsq, double /*factor_coul*/,
+                           double factor_lj, double &fforce)
+{
+  double **x = atom->x;
+  double **v = atom->v;
+  double **omega = atom->omega;
+  double *radius = atom->radius;
+  double *rmass = atom->rmass;
+  tagint *tag = atom->tag;
+
+  const double cv[3] = {x[j][0] - x[i][0], x[j][1] - x[i][1], x[j][2] - x[i][2]};
+  fforce = 0.0;
+  for (int k = 0; k < 3; k++) {
+    svector[k] = 0.0;
+    svector[3 + k] = -cv[k];
+  }
+  const double r1 = radius[i], r2 = radius[j];
+  if (factor_lj == 0.0 || !((r1 + r2) * (r1 + r2) > rsq)) return 0.0;
+  const double overlap = r1 + r2 - std::sqrt(rsq);
+  const double equiv_radius = r1 * r2 / (r1 + r2);
+  const double equiv_mass = rmass[i] * rmass[j] / (rmass[i] + rmass[j]);
+  if (const double *found = history ? history->find(i, tag[j]) : nullptr) {
+    // normal force n fn along -(x_i - x_j): fforce = (n fn) . (x_i - x_j) / |x_i - x_j|^2
+    fforce = -(found[3] * cv[0] + found[4] * cv[1] + found[5] * cv[2]) / rsq;
+    for (int k = 0; k < 3; k++) svector[k] = found[6 + k];
+    return 0.0;
+  }
+
+  const double *w1 = omega[i], *w2 = omega[j];
+  const double s1 = r1 / (r1 + r2);
+  const double s2 = -r2 / (r1 + r2);
+  const double rc1[3] = {cv[0] * s1, cv[1] * s1, cv[2] * s1};
+  const double rc2[3] = {cv[0] * s2, cv[1] * s2, cv[2] * s2};
+  double n[3] = {0.0, 0.0, 0.0};
+  const double cvlen = length(cv);
+  if (cvlen != 0) {
+    n[0] = cv[0] / cvlen;
+    n[1] = cv[1] / cvlen;
+    n[2] = cv[2] / cvlen;
+  }
+  double w2rc2[3], w1rc1[3];
+  cross(w2, rc2, w2rc2);
+  cross(w1, rc1, w1rc1);
+  double rel[3];
+  for (int k = 0; k < 3; k++) rel[k] = (v[j][k] + w2rc2[k]) - (v[i][k] + w1rc1[k]);
+  const double vn = n[0] * rel[0] + n[1] * rel[1] + n[2] * rel[2];
+  double vt[3];
+  for (int k = 0; k < 3; k++) vt[k] = rel[k] - vn * n[k];
+  double xi[3];
+  for (int k = 0; k < 3; k++) xi[k] = 0.0 + vt[k] * update->dt;    // a new contact's first xi
+
+  const double contact_area_radius = std::sqrt(equiv_radius * overlap);
+  const double kn = 2 * estar[itype][jtype] * contact_area_radius;
+  const double fn_el = -overlap * kn * 2. / 3.;
+  const double fn_damp = -MUSEN_2_SQRT_5_6 * alpha[itype][jtype] * vn * std::sqrt(kn * equiv_mass);
+  const double kt = 8 * gstar[itype][jtype] * contact_area_radius;
+  double ft_spring[3];
+  for (int k = 0; k < 3; k++) ft_spring[k] = xi[k] * kt;
+  const double damp_t = -MUSEN_2_SQRT_5_6 * alpha[itype][jtype] * std::sqrt(kt * equiv_mass);
+  double ft[3];
+  const double ft_spring_len = length(ft_spring);
+  const double friction_len = mu[itype][jtype] * std::fabs(fn_el + fn_damp);
+  if (ft_spring_len > friction_len) {
+    for (int k = 0; k < 3; k++) ft[k] = ft_spring[k] * friction_len / ft_spring_len;
+  } else {
+    for (int k = 0; k < 3; k++) ft[k] = ft_spring[k] + vt[k] * damp_t;
+  }
+
+  // normal force on i: n (fn_el + fn_damp) = (x_i - x_j) fforce
+  if (cvlen != 0) fforce = -(fn_el + fn_damp) / cvlen;
+  for (int k = 0; k < 3; k++) svector[k] = ft[k];
+  return 0.0;
 }
 
 /* ---------------------------------------------------------------------- */

@@ -43,12 +43,16 @@ class PairMusenHM : public Pair {
   void coeff(int, char **) override;
   void init_style() override;
   double init_one(int, int) override;
+  double single(int, int, int, int, double, double, double, double &) override;
   void write_restart(FILE *) override;
   void read_restart(FILE *) override;
   void *extract(const char *, int &) override;
   double memory_usage() override;
 
   static constexpr const char *HISTORY_ID = "MUSEN_HM_HISTORY";
+  // per contact: tangential overlap xi (3), the last step's normal and tangential force on
+  // the atom (3 + 3, for single())
+  static constexpr int HISTORY_VALUES = 9;
 
  protected:
   double **estar, **gstar;    // effective moduli per type pair

@@ -107,7 +107,7 @@ def case_outputs(case: "SphCase", out: str | Path | None = None,
     files = [folder / f"{case.name}.pvd", folder / f"{case.name}_walls.pvd"]
     files += [folder / f"{case.name}_{o.name}.csv" for o in case.openings]
     inputs = [case.source, case.mesh_file] + (case.motion.files if case.motion else [])
-    patterns = [(folder, re.compile(name + r"_\d{6}(_walls\.vtu|\.vtp)"))]
+    patterns = [(folder, re.compile(name + r"_\d{6}(_walls\.vtp|_walls\.vtu|\.vtp)"))]
     return Outputs(case.source, work_folder(folder, case.source.stem, work), files=files,
                    patterns=patterns, inputs=inputs), folder
 

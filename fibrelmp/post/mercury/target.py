@@ -1,4 +1,5 @@
-"""``fibrelmp post --to mercury``: MercuryDPM ``.data``/``.ene`` (+ ``.fstat`` with ``--local``)."""
+"""``fibrelmp post --to mercury``: MercuryDPM ``.data``/``.ene``/``.restart`` (+ ``.fstat`` with
+``--local`` or wall-contact columns in the dump)."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ import numpy as np
 
 from fibrelmp.post.lammps_dump.reader import Frame, iter_frames
 from fibrelmp.post.mercury.reader import read_data_file
-from fibrelmp.post.mercury.writer import MercuryFrame, MercuryWriter
+from fibrelmp.post.mercury.writer import MercuryFrame, MercuryWriter, wall_columns
 from fibrelmp.post.target import DumpTarget, ReadBack
 
 
@@ -32,20 +33,24 @@ def iter_matching(frames: Iterator[Frame], step: int, pending: list) -> Frame | 
 
 
 class MercuryTarget(DumpTarget):
-    """Every frame into ``<base>.data`` and ``<base>.ene``; contacts of the ``--local`` dump
-    frame with the same step into ``<base>.fstat``."""
+    """Every frame into ``<base>.data`` and ``<base>.ene``, the last one's state into
+    ``<base>.restart``; contacts of the ``--local`` dump frame with the same step and the
+    frame's own wall-contact columns into ``<base>.fstat``."""
 
     uses_local = True
 
     @classmethod
     def files(cls, base: Path) -> list[Path]:
-        return [base.with_name(base.name + s) for s in (".data", ".ene", ".fstat")]
+        return [base.with_name(base.name + s) for s in (".data", ".ene", ".fstat", ".restart")]
 
     def start(self, first: list[Frame]) -> None:
         ctx = self.context
         g = np.zeros(3) if ctx.gravity is None else np.asarray(ctx.gravity, float)
         bonds = {tuple(map(int, b)) for b in ctx.datafile.bonds} if ctx.datafile is not None else None
-        self.out = self.adopt(MercuryWriter(self.target, g, fstat=ctx.local is not None, bonds=bonds))
+        walls = bool(first) and bool(wall_columns(first[0]))
+        self.out = self.adopt(MercuryWriter(self.target, g, fstat=ctx.local is not None or walls, bonds=bonds,
+                                            time_step=ctx.facts.time_step if ctx.facts is not None else None,
+                                            warn=ctx.warn))
         self.local = iter_frames(ctx.local, ctx.warnings) if ctx.local is not None else None
         self.pending: list[Frame] = []
 

@@ -1,4 +1,5 @@
-"""MercuryDPM output files from LAMMPS frames: ``.data`` (XBalls), ``.ene`` and ``.fstat``.
+"""MercuryDPM output files from LAMMPS frames: ``.data`` (XBalls), ``.ene``, ``.fstat`` and
+``.restart`` (``DPMBase::write``'s layout: what MercuryCG reads, docs/post.md).
 
 Layouts as MercuryDPM's own writers produce them (shared/research/demdf_mercury.md, B):
 
@@ -24,8 +25,10 @@ Numbers use C++ iostream default formatting at precision 10, which is printf ``%
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
@@ -81,6 +84,8 @@ class Particles:
     angles: np.ndarray       # (n, 3) Euler angles
     lo: np.ndarray
     hi: np.ndarray
+    quaternion: np.ndarray | None = None     # (n, 4) w i j k
+    force: np.ndarray | None = None          # (n, 3)
 
 
 def particles(frame: Frame, time: float) -> Particles:
@@ -93,7 +98,8 @@ def particles(frame: Frame, time: float) -> Particles:
     return Particles(time, frame.column("id").astype(np.int64), frame.wrapped(), v, om,
                      frame.columns.get("radius"), frame.columns.get("mass"),
                      frame.column("type").astype(np.int64) - 1,
-                     euler(q) if q is not None else zeros, frame.lo, frame.hi)
+                     euler(q) if q is not None else zeros, frame.lo, frame.hi, q,
+                     frame.vector("fx", "fy", "fz") if frame.has("fx", "fy", "fz") else None)
 
 
 def energies(p: Particles, gravity: np.ndarray, elastic: float) -> list[float]:
@@ -188,10 +194,8 @@ def contacts(local: Frame, p: Particles, bonds: set[tuple[int, int]] | None = No
             d = np.column_stack([c["dx"], c["dy"], c["dz"]])
         else:
             d = x1 - p.x[np.where(wall, 0, j)] if len(p.x) else np.zeros((m, 3))
-            if periodic is not None and cell is not None and np.any(periodic):
-                s = np.linalg.solve(cell, d.T).T          # minimum image
-                s[:, periodic] -= np.round(s[:, periodic])
-                d = s @ cell.T
+            if periodic is not None and cell is not None:
+                d = _minimum_image(d, periodic, cell)
         if np.any(wall):                      # no partner position: the normal is the force's
             d[wall] = F[wall]
         length = np.linalg.norm(d, axis=1)
@@ -222,6 +226,77 @@ def contacts(local: Frame, p: Particles, bonds: set[tuple[int, int]] | None = No
     deltat = c.get("deltat", np.zeros(m))
     energy = float(np.sum(c["eng"])) if "eng" in c else None
     return Contacts(i, j, point, delta, deltat, fn, ft, n, t, energy)
+
+
+# per-atom wall contacts in the atom dump: fibrelmp's work dumps name them v_w<k>_fx..v_w<k>_cz
+# (fix wall/gran/region's force on the sphere and its contact point on the wall), a user's
+# dump can name them wall<k>_fx..wall<k>_cz with dump_modify colname
+WALL_COLUMN = re.compile(r"(?:v_w|wall)([1-9][0-9]*)_([fc])([xyz])")
+
+
+def wall_columns(frame: Frame) -> dict[int, tuple[np.ndarray, np.ndarray]]:
+    """Wall number k (from 1) -> (force on each atom (n, 3), contact point on the wall (n, 3))
+    of an atom frame's wall-contact columns; a wall needs all six columns."""
+    found: dict[int, dict[str, np.ndarray]] = {}
+    for name, values in frame.columns.items():
+        m = WALL_COLUMN.fullmatch(name)
+        if m:
+            found.setdefault(int(m.group(1)), {})[m.group(2) + m.group(3)] = np.asarray(values, np.float64)
+    out = {}
+    for k, cols in sorted(found.items()):
+        if len(cols) != 6:
+            raise InputError(frame.source, frame.line, f"wall {k}'s contact columns are incomplete: "
+                             f"{', '.join(sorted(cols))} (a wall needs fx fy fz cx cy cz)")
+        out[k] = (np.column_stack([cols["fx"], cols["fy"], cols["fz"]]),
+                  np.column_stack([cols["cx"], cols["cy"], cols["cz"]]))
+    return out
+
+
+def wall_contacts(frame: Frame, p: Particles) -> Contacts | None:
+    """The particle-wall contacts of an atom frame's wall-contact columns (None without such
+    columns): an atom touches wall k where its force from the wall is not zero; the normal
+    points from the contact point on the wall to the centre (minimum image on periodic
+    axes), the overlap is radius - distance, the contact point (as for pairs) the middle of
+    the overlap, and the partner is -(k - 1) - 1 = -k, MercuryDPM's index of wall k - 1."""
+    walls = wall_columns(frame)
+    if not walls:
+        return None
+    if p.radius is None:
+        raise InputError(frame.source, frame.line, "wall contacts need radii: a 'radius' dump column or --data")
+    parts = []
+    for k, (force, point) in walls.items():
+        i = np.flatnonzero(np.any(force != 0.0, axis=1))
+        d = _minimum_image(p.x[i] - point[i], frame.periodic, frame.cell)
+        dist = np.linalg.norm(d, axis=1)
+        if np.any(dist == 0):
+            raise InputError(frame.source, frame.line, f"atom id {int(p.ids[i[dist == 0][0]])} has its centre "
+                             f"on wall {k}'s contact point: no contact normal")
+        n = d / dist[:, None]
+        F = force[i]
+        fn = np.einsum("ij,ij->i", F, n)
+        Ft = F - fn[:, None] * n
+        ft = np.linalg.norm(Ft, axis=1)
+        t = np.divide(Ft, ft[:, None], out=np.zeros_like(Ft), where=ft[:, None] > 0)
+        delta = p.radius[i] - dist
+        parts.append(Contacts(i, np.full(len(i), -k), p.x[i] - n * (p.radius[i] - delta / 2)[:, None],
+                              delta, np.zeros(len(i)), fn, ft, n, t, None))
+    return join_contacts(parts)
+
+
+def join_contacts(parts: list[Contacts]) -> Contacts:
+    """One ``Contacts`` of several, rows in order; the energy is the sum of the known ones."""
+    energies = [c.energy for c in parts if c.energy is not None]
+    return Contacts(*(np.concatenate([getattr(c, f) for c in parts])
+                      for f in ("i", "j", "point", "delta", "deltat", "fn", "ft", "n", "t")),
+                    energy=float(sum(energies)) if energies else None)
+
+
+def _minimum_image(d: np.ndarray, periodic: np.ndarray, cell: np.ndarray) -> np.ndarray:
+    if not np.any(periodic) or not len(d):
+        return d
+    s = np.linalg.solve(cell, d.T).T
+    s[:, periodic] -= np.round(s[:, periodic])
+    return s @ cell.T
 
 
 def _index(ids: np.ndarray, want: np.ndarray, src, line) -> np.ndarray:
@@ -283,6 +358,86 @@ def fstat_frame_text(time: float, p: Particles, c: Contacts | None) -> str:
     return head + format_rows("%.10g %d %d" + " %.10g" * 13 + "\n", cols)
 
 
+def g15(x: float) -> str:
+    return "%.15g" % x
+
+
+class SpeciesDensities:
+    """Each species' particle density m / (4/3 pi r^3) over all frames: its range and mean
+    (MercuryDPM gives a species one density; particleDimensions 3 makes MercuryDPM's masses
+    rho 4/3 pi r^3 again, in 2D too)."""
+
+    def __init__(self) -> None:
+        self.low: dict[int, float] = {}
+        self.high: dict[int, float] = {}
+        self.total: dict[int, float] = {}
+        self.count: dict[int, int] = {}
+
+    def add(self, p: Particles) -> None:
+        if p.mass is None or p.radius is None:
+            return
+        ok = (p.mass > 0) & (p.radius > 0)          # a fixed (massless) or point particle has none
+        rho = p.mass[ok] / (4.0 / 3.0 * math.pi * p.radius[ok] ** 3)
+        for s in np.unique(p.species[ok]):
+            r = rho[p.species[ok] == s]
+            s = int(s)
+            self.low[s] = min(self.low.get(s, math.inf), float(r.min()))
+            self.high[s] = max(self.high.get(s, -math.inf), float(r.max()))
+            self.total[s] = self.total.get(s, 0.0) + float(r.sum())
+            self.count[s] = self.count.get(s, 0) + len(r)
+
+    def density(self, s: int) -> float | None:
+        return self.total[s] / self.count[s] if s in self.count else None
+
+    def spread(self) -> list[tuple[int, float, float]]:
+        """Species whose particles' densities differ by more than round-off: (s, low, high)."""
+        return [(s, self.low[s], self.high[s]) for s in sorted(self.count)
+                if self.high[s] - self.low[s] > 1e-12 * self.high[s]]
+
+
+def restart_text(name: str, p: Particles, step: int, frames: int, dim: int, gravity: np.ndarray,
+                 time_step: float, densities: SpeciesDensities, fstat: bool) -> str:
+    """MercuryDPM's ``.restart`` of the last frame, as ``DPMBase::write`` lays it out and
+    ``DPMBase::read`` (restart version 1.0; MercuryCG: up to the particles) reads it: the
+    file lines, the domain, time step and time, dimensions and gravity, one
+    ``LinearViscoelasticSpecies`` per species (its density; stiffness and dissipation 0:
+    no MercuryDPM law is claimed) with its mixed species, no walls or boundaries, the
+    particles (force from the dump, torque 0: dumps carry none), no interactions."""
+    n_species = int(p.species.max()) + 1 if len(p.species) else 1
+    n_species = max(n_species, max(densities.count, default=-1) + 1)
+    saved = f"fileType ONE_FILE saveCount 1 counter {frames} lastSavedTimeStep {step}"
+    files = "".join(f"{label:<12}{saved if written else 'fileType NO_FILE saveCount 1 counter 0'}\n"
+                    for label, written in (("dataFile", True), ("fStatFile", fstat), ("eneFile", True),
+                                           ("restartFile", True)))
+    lines = [f"MercuryDPM 1.0 name {name} revision fibrelmp repository https://bitbucket.org/mercurydpm/mercurydpm.git\n",
+             files,
+             "statFile    fileType ONE_FILE saveCount 1 counter 0\n",
+             "interactionFile fileType NO_FILE saveCount 0 counter 0\n",
+             " ".join(f"{a}Min {g15(p.lo[k])} {a}Max {g15(p.hi[k])}" for k, a in enumerate("xyz")) + "\n",
+             f"timeStep {g15(time_step)} time {g15(p.time)} ntimeSteps {step} timeMax {g15(p.time)}\n",
+             f"systemDimensions {dim} particleDimensions 3 gravity {' '.join(g15(v) for v in gravity)} "
+             "backgroundDrag 0\n",
+             f"Species {n_species}\n"]
+    for s in range(n_species):
+        rho = densities.density(s)
+        lines.append(f"LinearViscoelasticSpecies id {s} density {g15(1.0 if rho is None else rho)} "
+                     "stiffness 0 dissipation 0\n")
+        lines += [f"LinearViscoelasticMixedSpecies idA {s} idB {other} stiffness 0 dissipation 0\n"
+                  for other in range(s)]
+    lines += ["Walls 0\n", "Boundaries 0\n", f"Particles {len(p.ids)}\n"]
+    n = len(p.ids)
+    radius = p.radius if p.radius is not None else np.zeros(n)
+    mass = p.mass if p.mass is not None else np.zeros(n)
+    inv_mass = np.divide(1.0, mass, out=np.zeros(n), where=mass > 0)     # MercuryDPM: 0 = fixed
+    q = p.quaternion if p.quaternion is not None else np.tile([1.0, 0.0, 0.0, 0.0], (n, 1))
+    force = p.force if p.force is not None else np.zeros((n, 3))
+    cols = [np.arange(n), p.species, *p.x.T, *q.T, *p.v.T, *p.omega.T, *force.T, radius, inv_mass]
+    fmt = ("BaseParticle id %d indSpecies %d position %.15g %.15g %.15g orientation %.15g %.15g %.15g %.15g "
+           "velocity %.15g %.15g %.15g angularVelocity %.15g %.15g %.15g force %.15g %.15g %.15g "
+           "torque 0 0 0 radius %.15g invMass %.15g timeStamp 0\n")
+    return "".join(lines) + format_rows(fmt, cols) + "Interactions 0\n"
+
+
 # -- writer --------------------------------------------------------------------------------
 @dataclass
 class MercuryFrame:
@@ -295,24 +450,32 @@ class MercuryFrame:
 
 
 class MercuryWriter(Writer):
-    """``<base>.data`` + ``<base>.ene`` (+ ``<base>.fstat`` when contacts are given)."""
+    """``<base>.data`` + ``<base>.ene`` + ``<base>.restart`` (the last frame; not without masses
+    and radii) (+ ``<base>.fstat`` when ``fstat``: contacts of the frames' local dump and their
+    wall-contact columns)."""
 
     format = "mercury"
 
     def __init__(self, base: Path, gravity: np.ndarray, fstat: bool, dim: int | None = None,
-                 bonds: set[tuple[int, int]] | None = None, *, force: bool = True):
+                 bonds: set[tuple[int, int]] | None = None, *, force: bool = True,
+                 time_step: float | None = None, warn: Callable[[str, str], None] | None = None):
         self.fstat = fstat
         super().__init__(base, force=force)
         self.gravity = np.asarray(gravity, float)
         self.dim = dim
         self.bonds = bonds
         self.no_elastic = False
+        self.time_step = time_step
+        self.warn = warn or (lambda kind, text: None)
+        self.densities = SpeciesDensities()
+        self.last: tuple[Particles, int] | None = None
+        self.first: tuple[float, int] | None = None
 
     def file(self, ext: str) -> Path:
         return self.target.with_name(self.target.name + ext)
 
     def outputs(self) -> list[Path]:
-        return [self.file(e) for e in (".data", ".ene", ".fstat")[:3 if self.fstat else 2]]
+        return [self.file(e) for e in (".data", ".ene", ".restart") + ((".fstat",) if self.fstat else ())]
 
     def write(self, item: MercuryFrame) -> None:
         frame, time = item.frame, item.time
@@ -326,6 +489,9 @@ class MercuryWriter(Writer):
         c = None
         if item.local is not None:
             c = contacts(item.local, p, self.bonds, frame.periodic, frame.cell)
+        walls = wall_contacts(frame, p)
+        if walls is not None:
+            c = walls if c is None else join_contacts([c, walls])
         elastic = c.energy if c is not None and c.energy is not None else 0.0
         if c is None or c.energy is None:
             self.no_elastic = True
@@ -336,3 +502,28 @@ class MercuryWriter(Writer):
         self.open(self.file(".ene"), "w").write(line)
         if self.fstat:
             self.open(self.file(".fstat"), "w").write(fstat_frame_text(time, p, c))
+        self.densities.add(p)
+        self.last = (p, frame.step)
+        if self.first is None:
+            self.first = (time, frame.step)
+        elif self.time_step is None and frame.step != self.first[1]:
+            self.time_step = (time - self.first[0]) / (frame.step - self.first[1])
+
+    def finish(self) -> None:
+        p, step = self.last if self.last is not None else (None, 0)
+        if p is None:
+            return
+        if p.radius is None or p.mass is None:
+            self.warn("no .restart", f"{self.file('.restart')} is not written: the species densities "
+                      "need masses and radii (dump columns 'mass' and 'radius', or --data)")
+            return
+        for s, low, high in self.densities.spread():
+            self.warn("species density", f"{self.file('.restart')}: the particles of species {s} (LAMMPS "
+                      f"type {s + 1}) have densities from {low!r} to {high!r}; MercuryDPM gives a species "
+                      "one density, the mean is written")
+        if self.time_step is None:
+            self.warn("no time step", f"{self.file('.restart')}: timeStep 0: one frame and no --data "
+                      "job facts give no time step")
+        self.open(self.file(".restart"), "w").write(
+            restart_text(self.target.name, p, step, self.count, self.dim or 3, self.gravity,
+                         self.time_step or 0.0, self.densities, self.fstat))

@@ -74,7 +74,8 @@ def read_piece(path: str | Path) -> Piece:
                 arrays(dataset.find("FieldData")), cells, dict(piece.attrib))
     if len(out.points) != int(piece.get("NumberOfPoints")):
         raise ValueError(f"{path}: {len(out.points)} points, NumberOfPoints says {piece.get('NumberOfPoints')}")
-    for tag, count in (("Verts", "NumberOfVerts"), ("Lines", "NumberOfLines"), ("Cells", "NumberOfCells")):
+    for tag, count in (("Verts", "NumberOfVerts"), ("Lines", "NumberOfLines"), ("Polys", "NumberOfPolys"),
+                       ("Cells", "NumberOfCells")):
         if tag in cells and len(cells[tag]["offsets"]) != int(piece.get(count, "0")):
             raise ValueError(f"{path}: {tag} sizes do not match {count}")
     return out

@@ -13,8 +13,9 @@ from fibrelmp.post.vtk.writer import VtkWriter, check_output_name
 
 
 def frame_pattern(base: Path) -> re.Pattern:
-    """The names of a base's frame files (``.vtu``: what earlier fibrelmp versions wrote)."""
-    return re.compile(re.escape(base.name) + r"_\d{6}(\.vtp|_bonds\.vtp|\.vtm|\.vtu|_walls\.vtu)")
+    """The names of a base's frame files (``.vtu``, ``_walls.vtu``: what earlier fibrelmp
+    versions wrote)."""
+    return re.compile(re.escape(base.name) + r"_\d{6}(\.vtp|_bonds\.vtp|_walls\.vtp|\.vtm|\.vtu|_walls\.vtu)")
 
 
 class VtkTarget(DumpTarget):

@@ -7,7 +7,7 @@ Layout (``<base>`` = the output name without suffix)::
     <base>_NNNNNN_bonds.vtp     its bonds as lines (output with bonds; none in a frame without)
     <base>_NNNNNN.vtm           the two above as one multiblock frame (output with bonds)
     <base>_walls.pvd            wall triangles over time (runs with MUSEN walls; open it too)
-    <base>_NNNNNN_walls.vtu     the walls of frame NNNNNN: an UnstructuredGrid of triangles
+    <base>_NNNNNN_walls.vtp     the walls of frame NNNNNN: PolyData of triangles (polygons)
 
 Why PolyData and not an UnstructuredGrid (``.vtu``): OVITO (3.17) reads particles only from
 PolyData made of vertices (its ``.vtu`` reader takes a simulation cell: 8 points, 1 cell),
@@ -16,8 +16,10 @@ frame by a ``.vtm`` (the layout of Aspherix's output).  ParaView reads all of th
 are inline base64 (``format="binary"``) or ascii, never compressed (OVITO reads no
 compressed arrays), with UInt64 headers (VTK XML version 1.0).
 
-Walls are a separate series of UnstructuredGrid files (which ParaView, meshio and VTK read;
-OVITO would take a ``.vtu`` for a simulation cell, so they stay out of the particles' ``.vtm``).
+Walls are a separate series of PolyData files of triangles: OVITO reads PolyData with
+polygons as a surface mesh (its ``.vtu`` reader takes only a simulation cell), ParaView and
+VTK as any PolyData; meshio reads no PolyData.  They are a series of their own, since only
+runs with walls have them.
 
 Bonds that cross a periodic face are drawn cut at the face (``frame.bond_segments``): each
 piece is its own line with the bond's ``id1``/``id2``, so a bond is one or more lines.
@@ -151,20 +153,21 @@ def bonds_vtp(frame: ViewerFrame, ascii_: bool = False) -> bytes | None:
                   _cells("Lines", 2, len(bond), ascii_), ascii_)
 
 
-def walls_vtu(frame: ViewerFrame, ascii_: bool = False) -> bytes:
-    """The wall triangles: three points and one VTK_TRIANGLE (5) cell each; cell data the
-    frame's wall arrays (``Velocity``, ``Force``)."""
+def walls_vtp(frame: ViewerFrame, ascii_: bool = False) -> bytes:
+    """The wall triangles as PolyData: three points and one polygon each (OVITO reads a
+    PolyData file with polygons as a surface mesh, VTK and ParaView as any PolyData); cell
+    data the frame's wall arrays (``Velocity``, ``Force``; CardioProof ``opening``)."""
     tri = np.asarray(frame.walls, np.float64).reshape(-1, 3, 3)
     k = len(tri)
     arrays = "".join(data_array(name, values, ascii_) for name, values in frame.wall_data.items())
-    cells = ("<Cells>\n" + data_array("connectivity", np.arange(3 * k, dtype=np.int64), ascii_)
-             + data_array("offsets", 3 * np.arange(1, k + 1, dtype=np.int64), ascii_)
-             + data_array("types", np.full(k, 5, np.uint8), ascii_) + "</Cells>\n")
-    return (HEAD.format(kind="UnstructuredGrid") + "<UnstructuredGrid>\n" +
-            f'<Piece NumberOfPoints="{3 * k}" NumberOfCells="{k}">\n' +
+    # Piece first inside <PolyData>, FieldData after it, as in _piece (OVITO's format check)
+    return (HEAD.format(kind="PolyData") + "<PolyData>\n" +
+            f'<Piece NumberOfPoints="{3 * k}" NumberOfVerts="0" NumberOfLines="0" '
+            f'NumberOfStrips="0" NumberOfPolys="{k}">\n' +
             "<CellData>\n" + arrays + "</CellData>\n" +
             "<Points>\n" + data_array("Points", tri.reshape(-1, 3), ascii_) + "</Points>\n" +
-            cells + "</Piece>\n" + _field_data(frame) + "</UnstructuredGrid>\n</VTKFile>\n").encode()
+            _cells("Polys", 3, k, ascii_) + "</Piece>\n" + _field_data(frame) +
+            "</PolyData>\n</VTKFile>\n").encode()
 
 
 def vtm_text(blocks: list[tuple[str, str | None]]) -> bytes:
@@ -240,8 +243,8 @@ class VtkWriter(Writer):
                                               ("Bonds", bonds.name if bonds else None)]))
         self.entries.append((frame.time, listed))
         if frame.walls is not None and len(frame.walls):
-            walls = self.frame_path(k, "_walls.vtu")
-            self.write_file(walls, walls_vtu(frame, self.ascii))
+            walls = self.frame_path(k, "_walls.vtp")
+            self.write_file(walls, walls_vtp(frame, self.ascii))
             self.wall_entries.append((frame.time, walls))
 
     def finish(self) -> None:

@@ -235,7 +235,7 @@ def wall_commands(model: GranularModel, wall_plans: list[WallPlan], spheres, dt:
                          var_cmds, frame_columns)
         elif wp.kind == "plane":
             _plane_wall(model, model.planes[wp.plane_index], wp, tag, mat_groups, spheres.m_min, dt,
-                        wall_cmds)
+                        wall_cmds, frame_columns)
         elif wp.kind == "tiles" and wp.kinematics.moving:
             _tile_motion(wp, tag, var_cmds, wall_cmds)
     return wall_cmds, var_cmds, frame_columns
@@ -351,7 +351,10 @@ def _angle_expression(kin: Kinematics, th0: float = 0.0) -> str:
     return piecewise_expression(kin, coeff)
 
 
-def _plane_wall(model, pl, wp: WallPlan, tag: str, mat_groups, m_min, dt, wall_cmds) -> None:
+def _plane_wall(model, pl, wp: WallPlan, tag: str, mat_groups, m_min, dt, wall_cmds, frame_columns) -> None:
+    """wall/gran fixes per sphere type (wall/gran/region for a plane not along an axis), with
+    ``contacts``: each sphere's force from the plane and contact point go to the frames
+    (``v_<tag>_fx`` .. ``v_<tag>_cz``, as for region walls; post --to mercury's wall rows)."""
     n = np.asarray(pl.normal, float)
     n = n / np.linalg.norm(n)
     axis = int(np.argmax(np.abs(n)))
@@ -369,11 +372,18 @@ def _plane_wall(model, pl, wp: WallPlan, tag: str, mat_groups, m_min, dt, wall_c
             lohi = f"{pos} NULL" if n[axis] > 0 else f"NULL {pos}"
             where = f"{'xyz'[axis]}plane {lohi}"
             wall_cmds.append(f"fix             {fid} m{t} wall/gran granular "
-                             f"{law_args(law, law.rolling_friction, k, g)} {where}")
+                             f"{law_args(law, law.rolling_friction, k, g)} {where} contacts")
         else:
             wall_cmds.append(f"fix             {fid} m{t} wall/gran/region granular "
-                             f"{law_args(law, law.rolling_friction, k, g)} region {tag}")
+                             f"{law_args(law, law.rolling_friction, k, g)} region {tag} contacts")
         wp.fixes.append(fid)
+    if wp.fixes:
+        for name, first in (("f", 2), ("c", 5)):
+            for i, ax in enumerate("xyz"):
+                wall_cmds.append(f"variable        {tag}_{name}{ax} atom \""
+                                 + "+".join(f"f_{fid}[{first + i}]" for fid in wp.fixes) + "\"")
+        wp.contact_vars = [f"v_{tag}_f{a}" for a in "xyz"] + [f"v_{tag}_c{a}" for a in "xyz"]
+        frame_columns.extend(wp.contact_vars)
 
 
 def _tile_motion(wp: WallPlan, tag: str, var_cmds, wall_cmds) -> None:

@@ -608,3 +608,29 @@ else:
         assert (x[1] == y[1]).all() and (x[3] == y[3]).all()
         np.testing.assert_allclose(x[2], y[2], rtol=0, atol=1e-12)
         np.testing.assert_allclose(x[4], y[4], rtol=1e-9, atol=1e-15)
+
+
+@pytest.mark.parametrize("where,normals", [
+    ("face", [[0, 0, 1]]),                               # on the top face
+    ("vertex", [[1, 0, 0], [0, 1, 0], [0, 0, 1]]),       # on the corner: three faces touch it
+])
+def test_sphere_centre_on_a_wall_gives_the_face_normal_force(tmp_path, where, normals):
+    """Was: a sphere centre exactly on a triangle gave nan nan nan (exit 0): the contact
+    direction divides by the zero centre-to-contact distance, as MUSEN does (the real cmusen
+    1.74.2 gives nan for this scene too).  fibrelmp takes the face normal instead and warns:
+    each touched face (one per normal) pushes with Hertz's 4/3 E* sqrt(R) R^1.5 at overlap R."""
+    mesh_styles()
+    mats, contacts = gm.two_materials()
+    verts = gm.oriented(gm.box_triangles([-0.006, -0.006, -0.002], [0.006, 0.006, -0.001]))
+    centre = [0.002, -0.001, -0.001] if where == "face" else [0.006, 0.006, -0.001]
+    m = gm.model(gm.spheres([centre], R, [0], mats), mats, contacts, dt=1e-7, t_end=2e-7,
+                 save_every_steps=1)
+    gm.add_geometry(m, "Plate", verts, 1)
+    job, frames = run(m, tmp_path)
+    assert any(kind == "sphere centre on a wall" for kind, _ in job.warnings)
+    glass, steel = mats
+    e_star = 1 / ((1 - glass.poisson ** 2) / glass.youngs + (1 - steel.poisson ** 2) / steel.youngs)
+    hertz = 4 / 3 * e_star * math.sqrt(R) * R ** 1.5
+    np.testing.assert_allclose(frames[0].force[0], hertz * np.sum(normals, axis=0), rtol=1e-12)
+    for f in frames:
+        assert np.isfinite(f.position).all() and np.isfinite(f.force).all() and np.isfinite(f.triangle_force).all()

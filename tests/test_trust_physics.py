@@ -1,0 +1,133 @@
+"""Trust, round 3 (issue 24), physics: singular inputs are refused or guarded, a run whose
+results would hold nan/inf does not exit 0, and nothing is written then."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from fibrelmp.cardioproof.results import SphFrame
+from fibrelmp.errors import RunError
+from fibrelmp.granmodel import GranularFrame
+from fibrelmp.pipeline import finite
+
+CLI = [sys.executable, "-m", "fibrelmp.cli"]
+
+# two glass spheres (ids 1, 2) and a solid bond (id 3) between them, on a steel triangle
+SCENE = """\
+0 0 1 14 5  23 STEEL 24 0 1e+300 2 0 44 0 0 0 1 0 0 0 1 0 15 0 0 0
+0 1 1 1 5 0.001 0.001 23 GLASS 24 0 1e+300 2 0 12 0 0 0.01 15 0 0 0 31 1 0 0 0
+0 2 1 1 5 0.001 0.001 23 GLASS 24 0 1e+300 2 0 12 0 0 0.012 15 0 0 0 31 1 0 0 0
+0 3 1 9 5 1 2 0.001 0.002 23 GLASS 24 0 1e+300 2 0 12 0 0 0 20 0 0 0
+22 -1 -1 -1 1 1 1
+28 0 0 0 0 0 0 0 0 0 0
+25 Plate GEOKEY 0 0 0 0 0
+26 0 0
+27 1 0
+32 STEEL Steel 0 7800 7 2e11 10 0.3
+32 GLASS Glass 0 2500 7 5e10 10 0.2
+33 STEEL STEEL 200 0.5 201 0.3 202 0.01
+33 GLASS STEEL 200 0.5 201 0.3 202 0.01
+33 GLASS GLASS 200 0.5 201 0.3 202 0.01
+"""
+COINCIDENT = SCENE.replace("12 0 0 0.012 15", "12 0 0 0.01 15")    # sphere 2 onto sphere 1
+SHORT = ["--end-time", "1e-5", "--step", "1e-7", "--save-step", "1e-6"]
+
+
+def cli(args, cwd: Path) -> subprocess.CompletedProcess:
+    return subprocess.run(CLI + [str(a) for a in args], cwd=cwd, capture_output=True, text=True,
+                          timeout=300)
+
+
+@pytest.mark.parametrize("styles", [[], ["--stock-styles"]], ids=["musen-elastic", "stock-bpm"])
+def test_bond_between_coincident_spheres_is_an_input_error(tmp_path, styles):
+    """Was: 252 nan tokens in the MUSEN result, exit 0.  The real cmusen 1.74.2 gives nan for
+    every value of both spheres and the bond from the first step on, so the scene is refused:
+    `path:line` of the bond, exit 2, nothing written."""
+    scene = tmp_path / "scene.txt"
+    scene.write_text(COINCIDENT)
+    res = cli(["run", scene, "-o", tmp_path / "result.txt", *SHORT, *styles], tmp_path)
+    assert res.returncode == 2, res.stderr
+    assert f"error: {scene}:4: solid bond 3 joins spheres 1 and 2, which are at the same position" \
+        in res.stderr
+    assert "Traceback" not in res.stderr
+    assert not (tmp_path / "result.txt").exists()
+
+
+def test_non_finite_frame_is_a_run_error_and_keeps_the_old_result(tmp_path):
+    """Two unbonded spheres at one position under stock pair granular: LAMMPS divides by their
+    zero distance and writes nan forces.  Was: exit 0 with nan in the result; now exit 1
+    naming the sphere, the quantity and the time, and the earlier result is untouched."""
+    scene = tmp_path / "scene.txt"
+    scene.write_text("".join(ln + "\n" for ln in COINCIDENT.splitlines()    # no bond, no wall
+                             if ln.split()[:2] not in (["0", "3"], ["0", "0"]) and ln[:3] not in ("25 ", "26 ", "27 ")))
+    result = tmp_path / "result.txt"
+    result.write_text("an earlier result\n")
+    res = cli(["-q", "run", scene, "-o", result, *SHORT, "--stock-styles", "--force"], tmp_path)
+    assert res.returncode == 1, res.stderr
+    assert "the simulation produced nan in the force of sphere 1 at t = 0 (step 0)" in res.stderr
+    assert "Traceback" not in res.stderr
+    assert result.read_text() == "an earlier result\n"
+    assert not [p.name for p in tmp_path.iterdir() if ".tmp" in p.name]
+
+
+def _granular_frame(**changes) -> GranularFrame:
+    n = 3
+    values = dict(time=0.25, step=250, sphere_rows=np.array([0, 2, 3]), position=np.zeros((n, 3)),
+                  velocity=np.zeros((n, 3)), omega=np.zeros((n, 3)), force=np.zeros((n, 3)),
+                  quaternion=np.tile([1.0, 0, 0, 0], (n, 1)),
+                  bond_alive=np.array([False, True]), bond_end_time=np.array([0.1, np.inf]),
+                  bond_force=np.array([[np.nan] * 3, [0.0] * 3]),
+                  triangle_force=np.zeros((2, 3)))
+    values.update(changes)
+    return GranularFrame(**values)
+
+
+MODEL = SimpleNamespace(spheres=SimpleNamespace(ids=np.array([10, 11, 12, 13])),
+                        bonds=SimpleNamespace(ids=np.array([20, 21])),
+                        triangles=SimpleNamespace(ids=np.array([30, 31])))
+
+
+def test_guard_names_the_first_non_finite_value():
+    finite.check(_granular_frame(), MODEL)     # a broken bond's nan force is its "absent" mark
+    omega = np.zeros((3, 3))
+    omega[2, 1] = -np.inf
+    omega[1, 0] = np.inf
+    with pytest.raises(RunError, match=r"inf in the angular velocity of sphere 12 at t = 0.25 \(step 250\)"):
+        finite.check(_granular_frame(omega=omega), MODEL)
+    bond_force = np.array([[np.nan] * 3, [0, np.nan, 0]])
+    with pytest.raises(RunError, match="nan in the force of bond 21"):
+        finite.check(_granular_frame(bond_force=bond_force), MODEL)
+    tri = np.zeros((2, 3))
+    tri[1, 2] = np.nan
+    with pytest.raises(RunError, match="nan in the force of triangle 31"):
+        finite.check(_granular_frame(triangle_force=tri), MODEL)
+    with pytest.raises(RunError, match="nan in the force of triangle row 1"):
+        finite.check(_granular_frame(triangle_force=tri))
+    sph = SphFrame(step=4, time=0.5, ids=np.array([7, 8]), positions=np.zeros((2, 3)),
+                   velocities=np.zeros((2, 3)), density=np.array([1000.0, np.nan]), pressure=np.zeros(2))
+    with pytest.raises(RunError, match="nan in the density of particle 8 at t = 0.5"):
+        finite.check(sph)
+    dump = SimpleNamespace(step=9, time=None, columns={"id": np.array([5.0, 6.0]),
+                                                       "x": np.array([0.0, 1.0]),
+                                                       "fx": np.array([np.inf, 0.0])})
+    with pytest.raises(RunError, match=r"inf in the dump column 'fx' of atom 5 at \(step 9\)"):
+        finite.check(dump)
+    finite.check(17)                    # a FibreNet frame counter: nothing to check
+
+
+def test_guard_scans_result_text_files(tmp_path):
+    """Results a LAMMPS style wrote itself (FibreNet's files): a nan/inf value is found by its
+    line; a type named like a number word is not a value."""
+    good = tmp_path / "a_coord.xyz"
+    good.write_text("2\nFRAME\t0\t0.001\t8\t7\t8\ninf\t1.5\t3.5\t5\nN1\t1\t2\t3\n")
+    finite.scan_text_files([good])
+    bad = tmp_path / "b_vel.xyz"
+    bad.write_text("2\nFRAME\t0\t0.001\t8\t7\t8\nN1\t1.5\t3.5\t5\nN1\t1\tnan\t3\n")
+    with pytest.raises(RunError, match=rf"{bad}:4: the simulation produced nan"):
+        finite.scan_text_files([good, bad])

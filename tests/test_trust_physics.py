@@ -131,3 +131,37 @@ def test_guard_scans_result_text_files(tmp_path):
     bad.write_text("2\nFRAME\t0\t0.001\t8\t7\t8\nN1\t1.5\t3.5\t5\nN1\t1\tnan\t3\n")
     with pytest.raises(RunError, match=rf"{bad}:4: the simulation produced nan"):
         finite.scan_text_files([good, bad])
+
+
+# two touching A beads (R 0.3, 0.5 apart: overlap 0.1) of different fibres, a B bead far away
+FIBRE_MODEL = ("BEAD\tA\t0\t0\t0.3\t1.0\t1.0\t1.0\t1.0\t0\t0\t0\t0\t0\t0\t1.0\t1.0\t1.0\n"
+               "BEAD\tA\t1\t0\t0.3\t1.0\t1.5\t1.0\t1.0\t0\t0\t0\t0\t0\t0\t1.5\t1.0\t1.0\n"
+               "BEAD\tB\t2\t0\t0.2\t1.0\t3.0\t3.0\t3.0\t0\t0\t0\t0\t0\t0\t3.0\t3.0\t3.0\n")
+FIBRE_INPUT = ("model_file model.txt\noutput_file out\ntype A\ntype B\npair hs A A 100\n"
+               "pair hs B B 100\npair hs A B 100\nbox_size 5 5 5\nbox_type finite\nbox_wall_rep 100\n"
+               "box_unit_cell 1.0\ncutoff 1.0\nstep 0.001\nlambda 0.5\nrun 20\noutput_freq 10\noutput_data all\n"
+               "output_type all\n")
+
+
+@pytest.mark.parametrize("skin,kind,listed", [
+    ("0.1", "skin radius below the bead radius", "0.4"),   # lists r < 0.3 + 0.1: misses 0.5
+    ("0.3", "skin radius", None),                          # lists r < 0.6: every contact
+])
+def test_skin_radius_below_the_radius_warns_how_fibrenet_differs(tmp_path, skin, kind, listed):
+    """Was: skin_radius below the bead radius was said to have 'no effect', yet the real
+    FibreNet lists an hs pair only when r < max(R_i, R_j) + min(skin_i, skin_j) at its list
+    builds (kernel.cl) and so misses overlapping pairs (forces up to 328 different).  That
+    depends on when its list was built (an artefact, no cut-off LAMMPS could express):
+    fibrelmp keeps every contact and warns, naming the listing distance."""
+    from fibrelmp.translate.fibrenet.reader import read as read_fibrenet
+
+    (tmp_path / "model.txt").write_text(FIBRE_MODEL)
+    (tmp_path / "input.txt").write_text(FIBRE_INPUT + f"modif_bead type A skin_radius {skin}\n")
+    model = read_fibrenet(tmp_path / "input.txt")
+    notes = [msg for k, msg in model.warnings if k.startswith("skin radius")]
+    assert [k for k, _ in model.warnings if k.startswith("skin radius")] == [kind]
+    assert notes[0].startswith(f"{tmp_path / 'input.txt'}:19: skin_radius {skin} ")
+    if listed:
+        assert f"(here {listed})" in notes[0] and f"{listed} <= r < 0.6" in notes[0]
+    else:
+        assert "no effect" in notes[0]

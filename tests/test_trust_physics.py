@@ -165,3 +165,58 @@ def test_skin_radius_below_the_radius_warns_how_fibrenet_differs(tmp_path, skin,
         assert f"(here {listed})" in notes[0] and f"{listed} <= r < 0.6" in notes[0]
     else:
         assert "no effect" in notes[0]
+
+
+# ------------------------------------------------------------------ DEMDF keys
+DROP = (Path(__file__).resolve().parents[1] / "examples" / "demdf" / "drop_on_wall.json").read_text()
+
+
+@pytest.mark.parametrize("old,new,line,where,hint", [
+    ('"bodyForce"', '"bodyforce"', 17, "", "did you mean 'bodyForce'?"),
+    ('"radius"', '"raduis"', 22, "objectTypes[0]: ", "did you mean 'radius'?"),
+    ('"type": "wall",\n            "restitutionCoefficient"', '"type": "wall",\n            "restitution"',
+     29, "objectTypes[1]: ", "did you mean 'restitutionCoefficient'?"),
+    ('"particles": [\n', '"particle": [\n', 33, "objects: ", "did you mean 'particles'?"),
+    ('"normal"', '"norma1"', 38, "objects.walls[0]: ", "did you mean 'normal'?"),
+    ('"name": "wallInelastic",\n            "objectTypes"', '"name": "wallInelastic",\n            "objecttypes"',
+     51, "interactions[1]: ", "did you mean 'objectTypes'?"),
+    ('"savePeriodInTime"', '"savePeriodInTim"', 13, "output.snapshot: ", "did you mean 'savePeriodInTime'?"),
+    ('"snapshot"', '"snapshots"', 9, "output: ", "did you mean 'snapshot'?"),
+    ('"dimensionality": 3,', '"dimensionality": 3, "fibrelmp": {"maxOverlapp": 0.02},', 5, "fibrelmp: ",
+     "did you mean 'maxOverlap'?"),
+    ('"dimensionality": 3,', '"dimensionality": 3, "colour": "red",', 5, "", "unknown key 'colour';"),
+], ids=["top", "particle-type", "wall-type", "objects", "wall", "interaction", "snapshot", "output",
+        "extension", "no-match"])
+def test_demdf_unknown_key_is_an_input_error_at_its_line(tmp_path, old, new, line, where, hint):
+    """Was: "bodyforce" ran with gravity 0 and "raduis" with the default radius (a mere
+    warning), exit 0.  Now every object level refuses keys it does not read, at the key's line,
+    with the key it most resembles."""
+    from fibrelmp.errors import InputError
+    from fibrelmp.translate.demdf.reader import read
+
+    assert DROP.count(old) == 1
+    path = tmp_path / "drop.json"
+    path.write_text(DROP.replace(old, new))
+    with pytest.raises(InputError) as exc:
+        read(path)
+    assert str(exc.value).startswith(f"{path}:{line}: {where}unknown key"), str(exc.value)
+    assert hint in str(exc.value)
+
+
+def test_demdf_unknown_key_in_a_particles_file_and_other_outputs(tmp_path):
+    """The particles file is checked too; an output routine other than the snapshot (one
+    that does not resemble it) stays a warning: DEMDF's output holds any routines."""
+    from fibrelmp.errors import InputError
+    from fibrelmp.translate.demdf.reader import read
+
+    (tmp_path / "parts.json").write_text('{\n "particles": [[2, 2, 2, 0, 0, 0, 0]],\n "particels": []\n}\n')
+    path = tmp_path / "drop.json"
+    path.write_text(DROP.replace('"particles": [\n            [2.0, 2.0, 2.0, 0.0, 0.0, 0.0, 0]\n        ]',
+                                 '"particles": "parts.json"'))
+    with pytest.raises(InputError) as exc:
+        read(path)
+    assert str(exc.value).startswith(f"{tmp_path / 'parts.json'}:3: unknown key 'particels' "
+                                     "(did you mean 'particles'?)"), str(exc.value)
+    path.write_text(DROP.replace('"snapshot": {', '"energyMeasurement": {"every": 1}, "snapshot": {'))
+    kinds = [msg for _, msg in read(path).warnings]
+    assert "output.energyMeasurement is not an output fibrelmp writes; ignored" in kinds

@@ -220,3 +220,50 @@ def test_demdf_unknown_key_in_a_particles_file_and_other_outputs(tmp_path):
     path.write_text(DROP.replace('"snapshot": {', '"energyMeasurement": {"every": 1}, "snapshot": {'))
     kinds = [msg for _, msg in read(path).warnings]
     assert "output.energyMeasurement is not an output fibrelmp writes; ignored" in kinds
+
+
+# ------------------------------------------------------------------ packages and the plugin
+def _header_packages(script: str) -> list[str]:
+    line = next(ln for ln in script.splitlines() if "Needs package" in ln)
+    return [p.strip() for p in line.split("Needs package")[1].lstrip("s ").split("(")[0]
+            .rstrip(".").split(",")]
+
+
+def test_demdf_job_loads_no_plugin_and_names_its_packages(tmp_path):
+    """Was: the DEMDF job loaded fibrelmp's plugin (it uses stock styles only) while its header
+    said 'Needs packages GRANULAR and BPM'.  Now a job loads the plugin only for a style of
+    its own and its header lists what the script uses."""
+    from fibrelmp import lammps_styles
+    from fibrelmp.translate.demdf.reader import read
+    from fibrelmp.translate.granular_job import build_granular_job
+
+    if not lammps_styles.plugin().available:
+        pytest.skip("fibrelmp's LAMMPS styles are not available here: nothing to leave out")
+    model = read(Path(__file__).resolve().parents[1] / "examples" / "demdf" / "drop_on_wall.json")
+    _, script, _ = build_granular_job(model, tmp_path)
+    assert "plugin" not in script.split("Needs package")[1].split("\n", 1)[1]
+    assert _header_packages(script) == ["GRANULAR", "BPM"]
+    words = {ln.split()[0] for ln in script.splitlines() if ln.strip() and not ln.startswith("#")}
+    assert "plugin" not in words
+
+
+def test_musen_jobs_name_plugin_only_when_loaded(tmp_path):
+    """A MUSEN scene with the plugin loads it and says PLUGIN; with stock styles neither."""
+    from fibrelmp import lammps_styles
+    from fibrelmp.translate.granular_job import build_granular_job
+    from fibrelmp.translate.musen import scene as musen
+
+    path = tmp_path / "scene.txt"
+    path.write_text(SCENE)
+    model = musen.read(path)
+    model.plan.dt, model.plan.t_end, model.plan.save_every_time = 1e-7, 1e-5, 1e-6
+    previous = lammps_styles.request_stock(True)
+    try:
+        _, stock, _ = build_granular_job(model, tmp_path / "stock")
+    finally:
+        lammps_styles.request_stock(previous)
+    assert "plugin          load" not in stock and "PLUGIN" not in _header_packages(stock)
+    assert _header_packages(stock)[:2] == ["GRANULAR", "BPM"]
+    if lammps_styles.plugin().available:
+        _, exact, _ = build_granular_job(model, tmp_path / "exact")
+        assert "plugin          load" in exact and _header_packages(exact)[-1] == "PLUGIN"

@@ -634,3 +634,17 @@ def test_sphere_centre_on_a_wall_gives_the_face_normal_force(tmp_path, where, no
     np.testing.assert_allclose(frames[0].force[0], hertz * np.sum(normals, axis=0), rtol=1e-12)
     for f in frames:
         assert np.isfinite(f.position).all() and np.isfinite(f.force).all() and np.isfinite(f.triangle_force).all()
+
+
+def test_sphere_centre_on_a_stock_wall_particle_is_an_input_error(tmp_path):
+    """Without fibrelmp's styles a single triangle is tiled with wall particles; a sphere centred
+    in its plane on a tile (here its corner) met stock pair granular's zero distance: nan, exit 0
+    before the guard.  It is refused before anything runs (MUSEN gives nan there too)."""
+    mats, contacts = gm.two_materials()
+    tri = np.array([[[0, 0, 0], [0.004, 0, 0], [0, 0.004, 0]]], float)
+    m = gm.model(gm.spheres([[0.0, 0.0, 0.0]], R, [0], mats), mats, contacts, dt=1e-7, t_end=2e-7,
+                 save_every_steps=1)
+    gm.add_geometry(m, "Tri", tri, 1)
+    with pytest.raises(InputError, match="sphere 0 has its centre exactly on a wall particle of geometry 'Tri'"):
+        run(m, tmp_path)
+    assert not (tmp_path / "job" / "in.lammps").exists()

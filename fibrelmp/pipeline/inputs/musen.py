@@ -138,6 +138,9 @@ def check_musen_runnable(model: GranularModel) -> None:
     if plan.save_every_time is None and plan.save_every_steps is None:
         raise InputError(model.source, None, "no saving step: give SAVING_STEP in the job script "
                          "or --save-step")
+    from fibrelmp.translate.granular.bonds import check_bond_directions
+
+    check_bond_directions(model)          # before the outputs are locked (nothing written)
 
 
 def bare_scene_settings(model: GranularModel, end_time: float | None, step: float | None,

@@ -110,6 +110,19 @@ def select_bonds(model: GranularModel, run: RunTime, spheres, periodic: np.ndarr
     return out
 
 
+def check_bond_directions(model: GranularModel) -> None:
+    """Refuse a bond alive at the start between two spheres at one position (before anything
+    is locked or written; ``select_bonds`` checks the bonds it simulates again)."""
+    bonds, sp = model.bonds, model.spheres
+    if bonds is None or not bonds.count:
+        return
+    t = model.plan.t_start
+    rows = np.flatnonzero((bonds.active_start <= t) & (bonds.active_end > t))
+    pair = bonds.pair[rows].astype(np.int64)
+    x = np.asarray(sp.position, float)
+    _refuse_coincident(model, rows, np.linalg.norm(x[pair[:, 0]] - x[pair[:, 1]], axis=1))
+
+
 def _refuse_coincident(model: GranularModel, bond_rows: np.ndarray, dist: np.ndarray) -> None:
     """A bond between two spheres at one position has no direction: MUSEN's bond law divides
     by the zero length and every value of both spheres and the bond turns to nan (the real

@@ -125,11 +125,12 @@ def test_guard_scans_result_text_files(tmp_path):
     """Results a LAMMPS style wrote itself (FibreNet's files): a nan/inf value is found by its
     line; a type named like a number word is not a value."""
     good = tmp_path / "a_coord.xyz"
-    good.write_text("2\nFRAME\t0\t0.001\t8\t7\t8\ninf\t1.5\t3.5\t5\nN1\t1\t2\t3\n")
+    good.write_text("2\nFRAME\t0\t0.001\t8\t7\t8\ninf\t1.5\t3.5\t5\nNanofibre\t1\t2\t3\n")
     finite.scan_text_files([good])
     bad = tmp_path / "b_vel.xyz"
-    bad.write_text("2\nFRAME\t0\t0.001\t8\t7\t8\nN1\t1.5\t3.5\t5\nN1\t1\tnan\t3\n")
-    with pytest.raises(RunError, match=rf"{bad}:4: the simulation produced nan"):
+    row = "N1\t1.5\t3.5\t5\n"                    # 70,000 rows: the value is in the second MiB
+    bad.write_text("2\nFRAME\t0\t0.001\t8\t7\t8\n" + row * 70000 + "N1\t1\t-nan\t3\n")
+    with pytest.raises(RunError, match=rf"{bad}:70003: the simulation produced -nan"):
         finite.scan_text_files([good, bad])
 
 

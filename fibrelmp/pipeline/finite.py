@@ -15,7 +15,6 @@ alive).  ``scan_text_files`` does the same for results a LAMMPS style wrote itse
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 from typing import Any, Iterable, Iterator
 
@@ -34,7 +33,9 @@ _GRANULAR = [("position", "position", "sphere"), ("velocity", "velocity", "spher
 _SPH = [("positions", "position"), ("velocities", "velocity"), ("density", "density"),
         ("pressure", "pressure")]
 _BLOCK = 1 << 20
-_NON_FINITE = re.compile(rb"nan|inf", re.IGNORECASE)
+# a nan/inf value after a separator (a type name such as "Nanofibre" is no hit)
+_WORDS = [sep + word for sep in (b"\t", b" ") for word in (b"nan", b"-nan", b"inf", b"-inf")]
+_TAIL = 8
 
 
 def guarded(frames: Iterable[Any], model: Any = None) -> Iterator[Any]:
@@ -131,39 +132,28 @@ def _first_bad(values: Any) -> tuple[int, str] | None:
 
 
 def scan_text_files(paths: Iterable[Path]) -> None:
-    """A RunError when a result text file holds a nan/inf token: its path and line (the
-    files are read in 1 MiB blocks; only a hit is located line by line)."""
+    """A RunError when a result text file holds a nan/inf value: its path and line.  The
+    files are read in 1 MiB blocks (bounded memory) and searched for a separator followed by
+    ``nan``/``inf``/``-inf``, as C's printf and Python write them (a particle row starts with
+    its type name, which is therefore never taken for a value)."""
     for path in paths:
         path = Path(path)
         if not path.is_file():
             continue
         with open(path, "rb") as fh:
-            tail = b""
-            hit = False
+            line, tail, tail_lines = 1, b"", 0
             for block in iter(lambda: fh.read(_BLOCK), b""):
-                if _NON_FINITE.search(tail + block):
-                    hit = True
-                    break
-                tail = block[-3:]
-        if hit:
-            line = _first_line(path)
-            if line is not None:
-                raise RunError(f"{path}:{line[0]}: the simulation produced {line[1]} (this line: "
-                               f"{line[2]!r}): no results written (the run blew up or met a "
-                               "singular case)")
-
-
-def _first_line(path: Path) -> tuple[int, str, str] | None:
-    with open(path, "rb") as fh:
-        for number, raw in enumerate(fh, 1):
-            words = raw.split()
-            # a particle row starts with its type name (FibreNet's xyz and res files)
-            for word in words[1:] if len(words) >= 4 else words:
-                try:
-                    value = float(word)
-                except ValueError:
-                    continue
-                if not np.isfinite(value):
-                    text = raw.decode("utf-8", "replace").strip()
-                    return number, "nan" if value != value else word.decode("ascii", "replace"), text[:120]
-    return None
+                data = tail + block
+                hit = min((i for i in (data.find(word) for word in _WORDS) if i >= 0), default=-1)
+                if hit >= 0:
+                    start = data.rfind(b"\n", 0, hit) + 1
+                    end = data.find(b"\n", hit)
+                    text = data[start:end if end >= 0 else len(data)].decode("utf-8", "replace")
+                    value = data[hit + 1:].split(None, 1)[0].decode("ascii", "replace")
+                    number = line - tail_lines + data.count(b"\n", 0, hit)
+                    raise RunError(f"{path}:{number}: the simulation produced {value} (this line: "
+                                   f"{text.strip()[:120]!r}): no results written (the run blew up "
+                                   "or met a singular case)")
+                tail = data[-_TAIL:]
+                tail_lines = tail.count(b"\n")
+                line += block.count(b"\n")

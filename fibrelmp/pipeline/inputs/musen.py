@@ -30,7 +30,10 @@ class SceneInput(InputFormat):
         """The scene with the command line's settings, and what they set (to say)."""
         if settings.steps is not None:
             raise InputError(path, None, "--steps is for DEMDF inputs; a MUSEN scene takes --end-time")
+        from fibrelmp.translate.granular.bonds import check_bond_directions
+
         model = self.read_scene(path)
+        check_bond_directions(model)          # `check` finds it too, not only `run`
         return model, bare_scene_settings(model, settings.end_time, settings.step, settings.save_step)
 
     def read_scene(self, path: Path) -> "GranularModel":

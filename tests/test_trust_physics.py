@@ -3,6 +3,7 @@ results would hold nan/inf does not exit 0, and nothing is written then."""
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -268,3 +269,73 @@ def test_musen_jobs_name_plugin_only_when_loaded(tmp_path):
     if lammps_styles.plugin().available:
         _, exact, _ = build_granular_job(model, tmp_path / "exact")
         assert "plugin          load" in exact and _header_packages(exact)[-1] == "PLUGIN"
+
+
+# ------------------------------------------------------------------ the real codes (opt-in)
+# What the deviations above rest on, run through the real programs (built as described in
+# shared/oracles/README.md): FIBRELMP_FIBRENET=/path/to/FibreNet (kernel.cl beside it, an
+# OpenCL CPU device), FIBRELMP_CMUSEN=/path/to/CMUSEN.
+FIBRENET_BIN = os.environ.get("FIBRELMP_FIBRENET")
+CMUSEN_BIN = os.environ.get("FIBRELMP_CMUSEN")
+TWO_A_BEADS = FIBRE_MODEL + ("BEAD\tB\t2\t0\t0.2\t1.0\t3.5\t3.0\t3.0\t0\t0\t0\t0\t0\t0\t3.5\t3.0\t3.0\n"
+                             "SPRING\tHR\t2\t2\t3\t0.5\t100\n")       # FibreNet needs a spring
+
+
+@pytest.mark.skipif(not FIBRENET_BIN, reason="set FIBRELMP_FIBRENET to the real FibreNet")
+def test_real_fibrenet_misses_the_contact_a_short_skin_hides(tmp_path):
+    """The two A beads overlap by 0.1 but their skin 0.1 lists them only below r = 0.4: the real
+    FibreNet leaves them where they are for 20 steps; fibrelmp pushes them apart with
+    K (R_i + R_j - r) = 10 (x 0.998107 and 1.501893 after 20 steps) and warns."""
+    from fibrelmp.translate.fibrenet.writer import read_xyz
+
+    (tmp_path / "model.txt").write_text(TWO_A_BEADS)
+    (tmp_path / "input.txt").write_text(FIBRE_INPUT + "modif_bead type A skin_radius 0.1\n")
+    (tmp_path / "kernel.cl").write_bytes((Path(FIBRENET_BIN).parent / "kernel.cl").read_bytes())
+    subprocess.run([FIBRENET_BIN], input="1\n1\ninput.txt\n", cwd=tmp_path, capture_output=True,
+                   text=True, timeout=300, env={**os.environ, "POCL_MAX_PTHREAD_COUNT": "1"})
+    real = read_xyz(tmp_path / "out_coord.xyz")[-1].values
+    assert real[:2, 0].tolist() == [1.0, 1.5]             # no hs force: the contact is missed
+    res = cli(["-q", "run", tmp_path / "input.txt", "-o", tmp_path / "ours"], tmp_path)
+    assert res.returncode == 0 and "skin radius below the bead radius" in res.stderr, res.stderr
+    ours = read_xyz(tmp_path / "ours" / "out_coord.xyz")[-1].values
+    assert ours[0, 0] < 0.999 and ours[1, 0] > 1.501
+
+
+def _cmusen(folder: Path, scene: str) -> str:
+    """cmusen's 17-digit text export of ``scene`` after three 1e-7 s steps."""
+    (folder / "scene.txt").write_text(scene)
+    (folder / "job.txt").write_text(
+        "JOB\nSOURCE_FILE scene.txt\nRESULT_FILE ./init.mdem\nCOMPONENT IMPORT_FROM_TEXT\n"
+        "JOB\nSOURCE_FILE ./init.mdem\nRESULT_FILE ./res.mdem\nCOMPONENT SIMULATOR\n"
+        "SIMULATOR_TYPE CPU\nMODEL_PP ModelPPHertzMindlin\nMODEL_PW ModelPWHertzMindlin\n"
+        "MODEL_SB ModelSBElastic\nSIMULATION_STEP 1e-7\nSAVING_STEP 1e-7\nEND_TIME 3e-7\n"
+        "EXT_ACCEL 0 0 0\nJOB\nSOURCE_FILE ./res.mdem\nRESULT_FILE ./res.txt\n"
+        "COMPONENT EXPORT_TO_TEXT\nTEXT_EXPORT_PRECISION 17\n")
+    subprocess.run([CMUSEN_BIN, "-t=1", "-s=job.txt"], cwd=folder, capture_output=True, timeout=300)
+    return (folder / "res.txt").read_text()
+
+
+@pytest.mark.skipif(not CMUSEN_BIN, reason="set FIBRELMP_CMUSEN to the real cmusen")
+@pytest.mark.parametrize("case", ["centre-on-face", "coincident-bond"])
+def test_real_cmusen_gives_nan_where_fibrelmp_deviates_or_refuses(tmp_path, case):
+    """A sphere centre on a wall face (fibrelmp: the face normal, warned) and a bond between
+    coincident spheres (fibrelmp: an input error): the real cmusen 1.74.2 writes nan."""
+    scene = (Path(__file__).resolve().parents[1] / "examples" / "musen" / "SingelParticle_text.txt").read_text()
+    if case == "centre-on-face":
+        scene = scene.replace("12 0 0 0.005 15 0 0 -0.5", "12 0.002 -0.001 -0.001 15 0 0 0")
+        sphere = 12
+    else:
+        line = next(ln for ln in scene.splitlines() if ln.startswith("0 12 "))
+        line = line.replace("15 0 0 -0.5", "15 0 0 0")
+        bond = "0 14 1 9 5 12 13 0.0002 0.001 23 KF6843H84OPHH3017U3D 24 0 1e+300 2 0 12 0 0 0.005 20 0 0 0"
+        scene = scene.replace(line_of(scene, 12), "\n".join([line, line.replace("0 12 ", "0 13 ", 1), bond]))
+        sphere = 13
+    text = _cmusen(tmp_path, scene)
+    row = next(ln for ln in text.splitlines() if ln.startswith(f"0 {sphere} "))
+    start = row.split()
+    assert start[start.index("12") + 1:start.index("12") + 4] != ["nan"] * 3    # t = 0 is finite
+    assert sum(tok.lstrip("-") == "nan" for tok in start) >= 9             # every later point: nan
+
+
+def line_of(scene: str, ident: int) -> str:
+    return next(ln for ln in scene.splitlines() if ln.startswith(f"0 {ident} "))

@@ -16,7 +16,10 @@ Resuming replays the same rendered script: set-up commands run again (styles, fi
 variables must exist), ``read_data`` becomes ``read_restart``, and commands that change the
 state or write output (run, velocity, displace_atoms, write_dump, ...) are skipped up to the
 checkpoint's position in the command stream (loops included).  Checkpoints are taken only between ``run`` commands of the script, so every
-MPI rank stops at the same command (the stop request is agreed with an MPI all-reduce).
+MPI rank stops at the same command (the stop request is agreed with an MPI all-reduce): one that
+is due after a run is written just before the next ``run``, once the step's frame commands
+have written what an uninterrupted run writes there (a checkpoint's ``run 0`` recomputes the
+wall forces of fix wall/gran/region and fix musen/wall/mesh with full-step velocities).
 """
 
 from __future__ import annotations

@@ -90,6 +90,7 @@ class SolidBonds:
     # state carried over from a later time point of a result file (optional)
     force: np.ndarray | None = None             # (m,3)
     tangential_overlap: np.ndarray | None = None
+    source_line: np.ndarray | None = None       # (m,) line of each bond in a text scene
 
     @property
     def count(self) -> int:

@@ -251,6 +251,9 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
     since = 0
     done = 0                         # commands executed (the position in the command stream)
     saved_state: dict = {}           # the step state at the last checkpoint
+    # a checkpoint (or a stop) due after a run is taken before the next run command, once the
+    # step's frame commands have written what an uninterrupted run writes there
+    due: tuple[int, int] | None = None   # (signal or 0, line of the run that made it due)
     resumed_state = checkpoints.load_step_state() if resume else None
     deferred: list[str] = []         # per-atom fixes: defined after read_restart to get their data
     atomfiles: set[str] = set()      # atomfile variables skipped while replaying
@@ -297,6 +300,23 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
                     continue
                 if words[0] == "read_data":
                     text = f"read_restart {resume['restart']}"
+            if due is not None and words[0] == "run":
+                signum, run_line = due
+                due = None
+                saved_state = step_state(lmp)
+                checkpoints.write(lmp, rank, done - 1, run_line, steps, frames, script_text,
+                                  saved_state)
+                since = 0
+                if signum:
+                    raise CheckpointStop(script.parent, signum)
+                # write_restart re-exchanged the atoms (on several ranks their forces did not
+                # travel) and rebuilt the ghosts: put the step's state back (and the neighbour
+                # lists the "run ... pre no" uses)
+                try:
+                    restore_step_state(lmp, saved_state)
+                except Exception as exc:
+                    raise RunError(f"{script}:{cmd.number}: LAMMPS error after a checkpoint: "
+                                   f"{str(exc).strip()}") from None
             try:
                 if not replaying and resumed_state is not None:
                     # the first command after the checkpoint: computes set up and the step's
@@ -329,21 +349,7 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
             if checkpoints is not None and words[0] == "run":
                 signum = checkpoints.stop_requested(size)
                 if signum or (checkpoints.every and since >= checkpoints.every):
-                    saved_state = step_state(lmp)
-                    checkpoints.write(lmp, rank, done, cmd.number, steps, frames, script_text,
-                                      saved_state)
-                    since = 0
-                    if signum:
-                        raise CheckpointStop(script.parent, signum)
-                    # write_restart re-exchanged the atoms (on several ranks their forces
-                    # did not travel) and rebuilt the ghosts: put the step's state back before
-                    # any command reads it (a frame written right after the checkpoint; a
-                    # "run ... pre no" would use a stale neighbour list)
-                    try:
-                        restore_step_state(lmp, saved_state)
-                    except Exception as exc:
-                        raise RunError(f"{script}:{cmd.number}: LAMMPS error after a checkpoint: "
-                                       f"{str(exc).strip()}") from None
+                    due = (signum, cmd.number)
         if record is not None:
             record.end(lmp, steps, resumed_steps)
         if finished is not None:

@@ -608,3 +608,43 @@ else:
         assert (x[1] == y[1]).all() and (x[3] == y[3]).all()
         np.testing.assert_allclose(x[2], y[2], rtol=0, atol=1e-12)
         np.testing.assert_allclose(x[4], y[4], rtol=1e-9, atol=1e-15)
+
+
+@pytest.mark.parametrize("where,normals", [
+    ("face", [[0, 0, 1]]),                               # on the top face
+    ("vertex", [[1, 0, 0], [0, 1, 0], [0, 0, 1]]),       # on the corner: three faces touch it
+])
+def test_sphere_centre_on_a_wall_gives_the_face_normal_force(tmp_path, where, normals):
+    """Was: a sphere centre exactly on a triangle gave nan nan nan (exit 0): the contact
+    direction divides by the zero centre-to-contact distance, as MUSEN does (the real cmusen
+    1.74.2 gives nan for this scene too).  fibrelmp takes the face normal instead and warns:
+    each touched face (one per normal) pushes with Hertz's 4/3 E* sqrt(R) R^1.5 at overlap R."""
+    mesh_styles()
+    mats, contacts = gm.two_materials()
+    verts = gm.oriented(gm.box_triangles([-0.006, -0.006, -0.002], [0.006, 0.006, -0.001]))
+    centre = [0.002, -0.001, -0.001] if where == "face" else [0.006, 0.006, -0.001]
+    m = gm.model(gm.spheres([centre], R, [0], mats), mats, contacts, dt=1e-7, t_end=2e-7,
+                 save_every_steps=1)
+    gm.add_geometry(m, "Plate", verts, 1)
+    job, frames = run(m, tmp_path)
+    assert any(kind == "sphere centre on a wall" for kind, _ in job.warnings)
+    glass, steel = mats
+    e_star = 1 / ((1 - glass.poisson ** 2) / glass.youngs + (1 - steel.poisson ** 2) / steel.youngs)
+    hertz = 4 / 3 * e_star * math.sqrt(R) * R ** 1.5
+    np.testing.assert_allclose(frames[0].force[0], hertz * np.sum(normals, axis=0), rtol=1e-12)
+    for f in frames:
+        assert np.isfinite(f.position).all() and np.isfinite(f.force).all() and np.isfinite(f.triangle_force).all()
+
+
+def test_sphere_centre_on_a_stock_wall_particle_is_an_input_error(tmp_path):
+    """Without fibrelmp's styles a single triangle is tiled with wall particles; a sphere centred
+    in its plane on a tile (here its corner) met stock pair granular's zero distance: nan, exit 0
+    before the guard.  It is refused before anything runs (MUSEN gives nan there too)."""
+    mats, contacts = gm.two_materials()
+    tri = np.array([[[0, 0, 0], [0.004, 0, 0], [0, 0.004, 0]]], float)
+    m = gm.model(gm.spheres([[0.0, 0.0, 0.0]], R, [0], mats), mats, contacts, dt=1e-7, t_end=2e-7,
+                 save_every_steps=1)
+    gm.add_geometry(m, "Tri", tri, 1)
+    with pytest.raises(InputError, match="sphere 0 has its centre exactly on a wall particle of geometry 'Tri'"):
+        run(m, tmp_path)
+    assert not (tmp_path / "job" / "in.lammps").exists()

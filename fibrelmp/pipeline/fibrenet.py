@@ -132,7 +132,9 @@ def results(model: "Model", folder: Path, prefix: str, viewer_files: bool = Fals
             consume = _move_native(job.native, folder, prefix, spec.fields)
         else:
             def consume(frames: Iterator["Frame"]) -> list[Path]:
-                return convert_frames(model, job, frames, folder, prefix)
+                from fibrelmp.pipeline.finite import guarded
+
+                return convert_frames(model, job, guarded(frames), folder, prefix)
         if viewer_files:
             from fibrelmp.pipeline import viewer
 
@@ -168,6 +170,9 @@ def _move_native(native, folder: Path, prefix: str, fields) -> Consumer:
         for src, dst in moves:
             if not src.is_file():
                 raise RunError(f"{src}: the job did not write this FibreNet file (fix fibrenet/output)")
+        from fibrelmp.pipeline.finite import scan_text_files
+
+        scan_text_files(src for src, _ in moves)      # nan/inf: nothing moves into place
         for src, dst in moves:
             move_file(src, dst)
         return [dst for _, dst in moves]

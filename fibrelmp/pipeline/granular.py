@@ -37,7 +37,7 @@ def granular_request(model: "GranularModel", work: str | Path,
     from fibrelmp.pipeline.granular_frames import FrameBuilder
 
     return RunRequest(model, render(model), lambda rendered: FrameBuilder(model, rendered.job),
-                      lambda rendered: feed(writers()), Path(work))
+                      lambda rendered: feed(writers(), model), Path(work))
 
 
 class _Calls:

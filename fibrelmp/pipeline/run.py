@@ -247,13 +247,16 @@ def prepare_checkpoints(folder: Path, text: str, every: int | None, resume: bool
     return Checkpointing(Path(folder), every, state, list(appended), list(inputs))
 
 
-def feed(writers: list) -> Consumer:
+def feed(writers: list, model: Any = None) -> Consumer:
     """A consumer that adds every frame to each writer (``add``/``close``/``abort``): all are
     closed when the frames end and aborted (their temp files removed) on any failure.  It
-    returns the files the writers report (``close()``'s paths, or their ``written`` list)."""
+    returns the files the writers report (``close()``'s paths, or their ``written`` list).
+    A frame holding nan/inf is a RunError (``pipeline.finite``; ``model`` names its particles)."""
+    from fibrelmp.pipeline.finite import guarded
+
     def consume(frames: Iterator[Any]) -> list[Path]:
         try:
-            for frame in frames:
+            for frame in guarded(frames, model):
                 for writer in writers:
                     writer.add(frame)
         except BaseException:

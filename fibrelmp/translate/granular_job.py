@@ -1,6 +1,7 @@
 """Turn a ``GranularModel`` (MUSEN scene / DEMDF document) into a LAMMPS job on disk.
 
-``in.lammps`` + ``data.lammps`` are stock LAMMPS (GRANULAR + BPM packages, no Python hooks):
+``in.lammps`` + ``data.lammps`` are LAMMPS (GRANULAR + BPM packages, MISC for fix evaporate,
+PLUGIN only when a fibrelmp style is used; no Python hooks):
 ``lmp -in in.lammps`` inside the job folder replays exactly what ``fibrelmp run`` executes
 line by line.  The mapping and every deviation from MUSEN are described in docs/granular.md.
 ``build_granular_job`` runs the steps of the ``translate.granular`` package in order (their
@@ -102,6 +103,19 @@ def write_granular_job(model: GranularModel, folder: str | Path) -> GranularJob:
     return job
 
 
+def granular_packages(uses_plugin: bool, wall_cmds: list[str]) -> list[str]:
+    """The LAMMPS packages a granular script needs (its header names them): BPM (atom_style
+    bpm/sphere, fix nve/bpm/sphere, bpm/rotational bonds), GRANULAR (compute contact/atom,
+    pair granular, fix wall/gran), MISC for fix evaporate (spheres leaving an oversized
+    domain), PLUGIN to load fibrelmp's styles."""
+    packages = ["GRANULAR", "BPM"]
+    if any(" evaporate " in cmd for cmd in wall_cmds):
+        packages.append("MISC")
+    if uses_plugin:
+        packages.append("PLUGIN")
+    return packages
+
+
 def job_facts(model: GranularModel, spheres, tiles, t_start: float, dt: float) -> WorkFacts:
     """What ``fibrelmp post --data`` needs beyond the data file and dump to write the spheres
     as the run does (translate.work_facts): names, MUSEN keys and ids, initial orientations,
@@ -187,8 +201,11 @@ def build_granular_job(model: GranularModel, folder: str | Path):
     mats, tile_mats = spheres.mats, tiles.materials
     if model.kind == "musen" and not musen_hm and stock_pair_deviates(model, spheres.mats):
         warnings.append(("approximate MUSEN physics (particle-particle contact)", STOCK_PAIR_WARNING))
+    # the plugin is loaded only for a style of its own (a DEMDF job uses stock styles only)
+    uses_plugin = bool(styles.path) and (musen_hm or geometry is not None or len(mesh) > 0)
     script = template_environment().get_template("granular.lammps.j2").render(
-        model=model, plugin=lammps_path(styles.path, "plugin") if styles.path else None,
+        model=model, plugin=lammps_path(styles.path, "plugin") if uses_plugin else None,
+        packages=granular_packages(uses_plugin, wall_cmds),
         fmt=float_text, dim=dim, bnd=axes.bnd, data_name=DATA_NAME, frames_name=FRAMES_NAME,
         bonds_name=BONDS_NAME, tiles_name=TILES_NAME, breaks_name=BREAKS_NAME,
         comm_cut=comm_cut, skin=skin, musen_hm=musen_hm, pair_lines=pair_lines, has_bonds=has_bonds,

@@ -318,7 +318,9 @@ def write_job(model: Model, folder: str | Path, write_files: bool = True) -> Job
         radius_expression=_per_type_expression(ltypes[:, 2]), dump_names=DUMP_NAMES,
         rad2deg=180.0 / math.pi, inf=float("inf"), angle_expression=angle_expression,
         extra_packages=_extra_packages(pair_styles, btypes, use_mvv),
-        plugin=lammps_path(styles.path, "plugin") if styles.path else None, native=native,
+        # the plugin is loaded only for a style of its own: angle_style fibrenet, fix fibrenet/output
+        plugin=lammps_path(styles.path, "plugin") if styles.path and (len(atypes) or native) else None,
+        native=native,
         thermo_every=min(out_steps.period or 0, 2 ** 31 - 1),     # thermo N is a C int
     )
     script_path = folder / SCRIPT_NAME

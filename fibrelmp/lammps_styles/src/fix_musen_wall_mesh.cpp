@@ -257,6 +257,7 @@ FixMusenWallMesh::FixMusenWallMesh(LAMMPS *lmp, int narg, char **arg) :
   vector_flag = 1;
   size_vector = 3 * ngeom;
   global_freq = 1;
+  restart_global = 1;
   extarray = 0;
   extvector = 0;
   history_id = std::string(id) + "_HISTORY";
@@ -513,7 +514,17 @@ void FixMusenWallMesh::init()
 
 void FixMusenWallMesh::setup(int vflag)
 {
+  // a set-up at the step of a time step (run 0 after a checkpoint, a resumed run) adds the
+  // wall forces to the atoms again but keeps the triangle forces of that step, which an
+  // uninterrupted run writes in its next frame
+  if (ftri_step != update->ntimestep) {
+    post_force(vflag);
+    return;
+  }
+  std::vector<double> kept(ftri);
   post_force(vflag);
+  ftri.swap(kept);
+  reduced_valid = false;
 }
 
 double FixMusenWallMesh::current_time() const
@@ -905,7 +916,10 @@ void FixMusenWallMesh::post_force(int /*vflag*/)
         std::copy(w.xi, w.xi + 3, h);
       }
   }
-  if (commit) history->sweep(nlocal);
+  if (commit) {
+    history->sweep(nlocal);
+    ftri_step = update->ntimestep;
+  }
 }
 
 /* MUSEN's CModelPWHertzMindlin::CalculatePW for sphere i and one contact: force fo and
@@ -931,7 +945,21 @@ void FixMusenWallMesh::wall_force(int i, const Candidate &cd, double *hist, doub
   for (int k = 0; k < 3; k++) rc[k] = xi[k] - cp[k];
   const double rc_len = std::sqrt(sqlen(rc));
   double rc_n[3];
-  for (int k = 0; k < 3; k++) rc_n[k] = rc[k] / rc_len;
+  if (rc_len > 0) {
+    for (int k = 0; k < 3; k++) rc_n[k] = rc[k] / rc_len;
+  } else {
+    // the centre is on the triangle (face, edge or vertex): MUSEN divides by the zero
+    // distance and its results turn to nan; fibrelmp takes the face normal as the contact
+    // direction (docs/granular.md) and warns once
+    for (int k = 0; k < 3; k++) rc_n[k] = n[k];
+    if (!warned_centre_on_wall) {
+      warned_centre_on_wall = true;
+      error->warning(FLERR, "Fix musen/wall/mesh: sphere {} has its centre exactly on wall "
+                     "triangle {} at step {}: its contact direction is the triangle's normal "
+                     "(MUSEN's results turn to nan here)", atom->tag[i], tr + 1,
+                     update->ntimestep);
+    }
+  }
   const double overlap = R - rc_len;
   // MUSEN returns here and re-applies the collision's previous force; with one radius per
   // sphere (LAMMPS) a detected contact always has overlap >= 0
@@ -1059,6 +1087,32 @@ int FixMusenWallMesh::modify_param(int narg, char **arg)
   MPI_Bcast(&ok, 1, MPI_INT, 0, world);
   if (!ok) error->all(FLERR, "Fix musen/wall/mesh: cannot write {}", arg[1]);
   return used;
+}
+
+/* the triangle forces of the last time step (restart files: a resumed run writes them in a
+   frame taken right after its checkpoint); rank 0 writes and, on reading, holds the sums */
+void FixMusenWallMesh::write_restart(FILE *fp)
+{
+  reduce_forces();
+  if (comm->me != 0) return;
+  std::vector<double> list;
+  list.reserve(2 + ftri_all.size());
+  list.push_back(static_cast<double>(ftri_step));
+  list.push_back(static_cast<double>(ntri));
+  list.insert(list.end(), ftri_all.begin(), ftri_all.end());
+  const int size = static_cast<int>(list.size() * sizeof(double));
+  fwrite(&size, sizeof(int), 1, fp);
+  fwrite(list.data(), sizeof(double), list.size(), fp);
+}
+
+void FixMusenWallMesh::restart(char *buf)
+{
+  const auto *list = reinterpret_cast<const double *>(buf);
+  if (static_cast<int>(list[1]) != ntri) return;    // another wall file: forces recomputed
+  std::fill(ftri.begin(), ftri.end(), 0.0);
+  if (comm->me == 0) std::copy(list + 2, list + 2 + 3 * (size_t) ntri, ftri.begin());
+  ftri_step = static_cast<bigint>(list[0]);
+  reduced_valid = false;
 }
 
 double FixMusenWallMesh::memory_usage()

@@ -34,6 +34,10 @@
      not touched by an image.
    A set-up force evaluation (every run, run 0) computes forces without advancing the
    contacts (as LAMMPS's granular styles): only time steps change the tangential overlaps.
+   The triangle forces a set-up evaluation finds at the step a time step already computed
+   (a checkpoint's "run 0") are not kept: the step's own (made with half-step velocities)
+   stay, and the restart file keeps them, so checkpointed, resumed and uninterrupted runs
+   write the same triangle forces.
    Triangle positions follow the exact solution x(t) = R(t) x0 + b(t) of the motion (the
    coefficients come from FILE: fibrelmp's translation writes the same ones it reports wall
    positions with), evaluated at the current time of every force computation.
@@ -90,6 +94,8 @@ class FixMusenWallMesh : public Fix {
   double compute_array(int, int) override;
   double compute_vector(int) override;
   int modify_param(int, char **) override;
+  void write_restart(FILE *) override;
+  void restart(char *) override;
   double memory_usage() override;
 
   // contact kinds of MUSEN's EIntersectionType
@@ -140,11 +146,13 @@ class FixMusenWallMesh : public Fix {
   bool any_moving;
   double t_placed;                     // time the triangles were last placed at
   bool placed;
+  bool warned_centre_on_wall = false;    // a sphere centre on a triangle was met (warned once)
 
   // per-triangle force on the walls (local sums; reduced on demand)
   std::vector<double> ftri, ftri_all, fgeom_all;
   bigint reduced_step;
   bool reduced_valid;
+  bigint ftri_step = -1;    // the time step whose contacts made ftri (-1: a set-up evaluation)
 
   class FixMusenHistory *history;
   std::string history_id;

@@ -30,7 +30,10 @@ class SceneInput(InputFormat):
         """The scene with the command line's settings, and what they set (to say)."""
         if settings.steps is not None:
             raise InputError(path, None, "--steps is for DEMDF inputs; a MUSEN scene takes --end-time")
+        from fibrelmp.translate.granular.bonds import check_bond_directions
+
         model = self.read_scene(path)
+        check_bond_directions(model)          # `check` finds it too, not only `run`
         return model, bare_scene_settings(model, settings.end_time, settings.step, settings.save_step)
 
     def read_scene(self, path: Path) -> "GranularModel":
@@ -138,6 +141,9 @@ def check_musen_runnable(model: GranularModel) -> None:
     if plan.save_every_time is None and plan.save_every_steps is None:
         raise InputError(model.source, None, "no saving step: give SAVING_STEP in the job script "
                          "or --save-step")
+    from fibrelmp.translate.granular.bonds import check_bond_directions
+
+    check_bond_directions(model)          # before the outputs are locked (nothing written)
 
 
 def bare_scene_settings(model: GranularModel, end_time: float | None, step: float | None,

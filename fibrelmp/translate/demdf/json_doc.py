@@ -6,10 +6,12 @@ the JSON path (``objects.particles[3][6]``); syntax errors carry the line and co
 
 from __future__ import annotations
 
+import difflib
 import json
 import math
+from json.decoder import scanstring
 from pathlib import Path
-from typing import Any, NoReturn
+from typing import Any, Iterable, NoReturn
 
 import numpy as np
 
@@ -87,14 +89,69 @@ def is_number(value: Any) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
+def key_line(text: str, location: tuple) -> int | None:
+    """The line of the key at ``location`` (object keys and array indices from the top, the
+    key last, e.g. ``("objectTypes", 0, "raduis")``) in the JSON ``text`` (None: not found).
+    A scan of the valid document's tokens: only run to report an error."""
+    stack: list[list] = []             # per open container: [kind, key or index, expecting key]
+    i, n = 0, len(text)
+    while i < n:
+        c = text[i]
+        if c == "{":
+            stack.append(["o", None, True])
+        elif c == "[":
+            stack.append(["a", 0, False])
+        elif c in "]}":
+            stack.pop()
+        elif c == "," and stack:
+            if stack[-1][0] == "a":
+                stack[-1][1] += 1
+            else:
+                stack[-1][2] = True
+        elif c == ":" and stack:
+            stack[-1][2] = False
+        elif c == '"':
+            value, end = scanstring(text, i + 1)
+            if stack and stack[-1][0] == "o" and stack[-1][2]:
+                stack[-1][1] = value
+                if tuple(entry[1] for entry in stack) == location:
+                    return text.count("\n", 0, i) + 1
+            i = end
+            continue
+        i += 1
+    return None
+
+
 class JsonDoc:
     """Typed getters that name the JSON location on failure."""
 
     def __init__(self, path: Path):
         self.path = path
 
-    def fail(self, where: str, message: str) -> NoReturn:
-        raise InputError(self.path, None, f"{where}: {message}" if where else message)
+    def fail(self, where: str, message: str, line: int | None = None) -> NoReturn:
+        raise InputError(self.path, line, f"{where}: {message}" if where else message)
+
+    def check_keys(self, obj: dict, where: str, location: tuple, known: Iterable[str],
+                   lenient: bool = False) -> list[str]:
+        """Every key of ``obj`` (at JSON path ``where``, ``location`` as for ``key_line``) must
+        be one of ``known``: an unknown one is an error at its line, with the known key it
+        most resembles (a misspelt key would otherwise leave its default in force silently).
+        ``lenient``: where the format allows other entries (other output routines), only a
+        key that resembles a known one is an error; the others are returned."""
+        known = list(known)
+        others = []
+        for key in obj:
+            if key in known:
+                continue
+            close = difflib.get_close_matches(key, known, n=1, cutoff=0.6)
+            if lenient and not close:
+                others.append(key)
+                continue
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
+            line = key_line(read_text(self.path, "JSON file"), location + (key,))
+            self.fail(f"{where}" if where else "", f"unknown key {key!r}{hint}; the keys read "
+                      f"here are {', '.join(known)}", line)
+        return others
 
     def number(self, value: Any, where: str, *, minimum: float | None = None,
                positive: bool = False) -> float:

@@ -18,6 +18,9 @@ from fibrelmp.errors import InputError
 from fibrelmp.granmodel import GranularPlan
 from fibrelmp.translate.demdf.json_doc import describe
 
+# the keys of a snapshot output entry (BOS: output.snapshot; the draft: output[i] named "demdf")
+_SNAPSHOT_KEYS = ("name", "filename", "saveCount", "savePeriodInTime", "savePeriodInTimeSteps")
+
 LONG_RUN_STEPS = 20_000_000
 
 
@@ -181,18 +184,24 @@ class PlanMixin:
             for i, entry in enumerate(value):
                 entry = self.j.obj(entry, f"output[{i}]")
                 name = entry.get("name", "demdf")
+                if name == "demdf":
+                    self.j.check_keys(entry, f"output[{i}]", ("output", i), _SNAPSHOT_KEYS)
                 if name == "demdf" and spec is None:
                     spec, where, location = entry, f"output[{i}]", ("output", i)
                 else:
                     self.warn("demdf", f"output[{i}] ({describe(name)}) is not a demdf snapshot "
                               "output (or not the first); ignored")
         elif isinstance(value, dict):
+            # other output routines (measurements) may sit beside the snapshot: only a key
+            # resembling "snapshot" is taken for a misspelling
+            others = self.j.check_keys(value, "output", ("output",), ("snapshot",) if "filename"
+                                       not in value else _SNAPSHOT_KEYS, lenient="filename" not in value)
             if "snapshot" in value:
                 spec = self.j.obj(value["snapshot"], "output.snapshot")
                 where, location = "output.snapshot", ("output", "snapshot")
-                for key in value:
-                    if key != "snapshot":
-                        self.warn("demdf", f"output.{key} is not an output fibrelmp writes; ignored")
+                self.j.check_keys(spec, where, location, _SNAPSHOT_KEYS)
+                for key in others:
+                    self.warn("demdf", f"output.{key} is not an output fibrelmp writes; ignored")
             elif "filename" in value:
                 spec, location = value, ("output",)
             else:

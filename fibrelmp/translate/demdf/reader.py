@@ -33,10 +33,15 @@ STEPS_PER_CONTACT = 50
 _LAYOUT = {3: "[x, y, z, vx, vy, vz, type]", 2: "[x, y, vx, vy, type]"}
 _VECTOR = {3: "[x, y, z]", 2: "[x, y]"}
 _EXTENSION_KEYS = ("youngsModulus", "poissonRatio", "maxOverlap", "stepsPerContact")
-_KNOWN_KEYS = {"fileFormat", "fileFormatVersion", "name", "dimensionality", "time", "timeEnd",
+_KNOWN_KEYS = ("fileFormat", "fileFormatVersion", "name", "dimensionality", "time", "timeEnd",
                "timeStep", "timeStepCount", "timeStepCountEnd", "eventCount", "eventCountEnd",
                "output", "domain", "bodyForce", "objectTypes", "objects", "interactions",
-               "particleRadius", "fibrelmp"}
+               "particleRadius", "fibrelmp")
+_PARTICLE_TYPE_KEYS = ("type", "id", "radius", "mass", "restitutionCoefficient")
+_WALL_TYPE_KEYS = ("type", "id", "restitutionCoefficient")
+_INTERACTION_KEYS = ("name", "objectTypes")
+_OBJECT_KEYS = ("particles", "walls")
+_WALL_KEYS = ("normal", "point", "objectType", "typename")
 
 
 def read(path: str | Path, time_end: float | None = None, steps: int | None = None,
@@ -81,6 +86,7 @@ class _Reader(PlanMixin):
     def build(self, time_end: float | None = None, steps: int | None = None,
               save_every: float | int | str | None = None) -> GranularModel:
         doc = self._header()
+        self.j.check_keys(doc, "", (), _KNOWN_KEYS)
         self.dim = self._dimensionality(doc)
         out = self._output(doc)
         if not self.snapshot:
@@ -90,10 +96,8 @@ class _Reader(PlanMixin):
         gravity = self._vector3(doc["bodyForce"], "bodyForce") if "bodyForce" in doc else np.zeros(3)
         ptypes, type_of_position = self._object_types(doc)
         objects = self.j.obj(doc.get("objects", {}), "objects")
+        self.j.check_keys(objects, "objects", ("objects",), _OBJECT_KEYS)
         particle_kind, wall_kind = self._interactions(doc, bool(objects.get("walls")))
-        for key in objects:
-            if key not in ("particles", "walls"):
-                self.warn("demdf", f"objects.{key} is not a DEMDF object list; ignored")
         planes = self._walls(objects.get("walls", []), type_of_position)
         table, types, rows, source_file = self._particles(objects, ptypes)
         spheres = self._spheres(table, types, ptypes)
@@ -111,9 +115,6 @@ class _Reader(PlanMixin):
                         f"choose a contact stiffness and time step (E* {bad[0] if bad else '-'}, "
                         f"time step {dt_need:g})")
         plan = self._plan(doc, out, dt_need, gravity, domain, time_end, steps, save_every)
-        for key in doc:
-            if key not in _KNOWN_KEYS:
-                self.warn("demdf", f"{key} is not a DEMDF field; copied to snapshots unchanged")
         model = GranularModel(source=self.path, kind="demdf", materials=self.materials,
                               contacts=contacts, spheres=spheres, plan=plan, planes=planes,
                               units=DIMENSIONLESS.name)
@@ -205,6 +206,8 @@ class _Reader(PlanMixin):
                 self.warn("demdf", f"{where}: type {describe(kind)} is neither \"particle\" nor "
                           "\"wall\"; ignored")
                 continue
+            self.j.check_keys(entry, where, ("objectTypes", i),
+                              _PARTICLE_TYPE_KEYS if kind == "particle" else _WALL_TYPE_KEYS)
             self.materials.append(Material(key=str(ident if ident is not None else i),
                                            name=f"{kind} {ident if ident is not None else i}"))
             material = len(self.materials) - 1
@@ -253,6 +256,8 @@ class _Reader(PlanMixin):
             where = f"interactions[{i}]"
             entry = self.j.obj(entry, where)
             name = self.j.string(entry.get("name"), f"{where}.name")
+            if name in ("particleElastic", "particleInelastic", "wallElastic", "wallInelastic"):
+                self.j.check_keys(entry, where, ("interactions", i), _INTERACTION_KEYS)
             if name in ("particleElastic", "particleInelastic"):
                 if particle is not None and particle != name:
                     self.warn("demdf", f"{where}: a second particle interaction; as in BOS the last "
@@ -280,6 +285,7 @@ class _Reader(PlanMixin):
         for i, wall in enumerate(self.j.array(walls, "objects.walls")):
             where = f"objects.walls[{i}]"
             wall = self.j.obj(wall, where)
+            self.j.check_keys(wall, where, ("objects", "walls", i), _WALL_KEYS)
             for key in ("normal", "point"):
                 if key not in wall:
                     self.j.fail(where, f"a wall needs \"normal\" and \"point\" ({_VECTOR[self.dim]}); "
@@ -329,6 +335,7 @@ class _Reader(PlanMixin):
             if not isinstance(sub, dict) or "particles" not in sub:
                 j.fail("", "a DEMDF particles file is an object {\"particles\": [...]}, got "
                        f"{describe(sub) if not isinstance(sub, dict) else 'no particles key'}")
+            j.check_keys(sub, "", (), ("particles",))
             value = sub["particles"]
         elif not isinstance(value, list):
             self.j.fail(where, f"expected an array of particles or a particles file name, got "
@@ -410,10 +417,7 @@ class _Reader(PlanMixin):
     # ------------------------------------------------------------------ physics
     def _extension(self, doc: dict) -> dict[str, float]:
         ext = self.j.obj(doc.get("fibrelmp", {}), "fibrelmp")
-        for key in ext:
-            if key not in _EXTENSION_KEYS:
-                self.warn("demdf", f"fibrelmp.{key} is not a fibrelmp setting ({', '.join(_EXTENSION_KEYS)}); "
-                          "ignored")
+        self.j.check_keys(ext, "fibrelmp", ("fibrelmp",), _EXTENSION_KEYS)
         out: dict[str, float] = {}
         if "youngsModulus" in ext:
             out["youngs"] = self.j.number(ext["youngsModulus"], "fibrelmp.youngsModulus", positive=True)

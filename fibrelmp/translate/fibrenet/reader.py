@@ -162,7 +162,7 @@ def read(path: str | Path) -> Model:
 
     # restart, modif_bead, modif_spring: FibreNet's order
     restart = _apply_restart(inp, particles, type_names, notes)
-    _apply_modif_bead(inp, particles, type_index, notes)
+    _apply_modif_bead(inp, particles, type_index, notes, pairs)
     quirk = (particles.velocities != particles.display_velocities).any(axis=1)
     if quirk.any():
         row = int(np.flatnonzero(quirk)[0])
@@ -563,7 +563,8 @@ def _select(tokens: list[str], particles: Particles, type_index: dict[str, int],
     raise InputError(path, number, f"modif_bead selects by type, tag or id, got '{how}'")
 
 
-def _apply_modif_bead(inp: _InputFile, p: Particles, type_index: dict[str, int], notes: list) -> None:
+def _apply_modif_bead(inp: _InputFile, p: Particles, type_index: dict[str, int], notes: list,
+                      pairs: list = ()) -> None:
     for line in inp.all("modif_bead"):
         t, ln = line.tokens, line.number
         if len(t) < 5:
@@ -587,12 +588,43 @@ def _apply_modif_bead(inp: _InputFile, p: Particles, type_index: dict[str, int],
             if len(t) != 5:
                 raise InputError(inp.path, ln, "modif_bead ... skin_radius takes 1 value")
             skin = to_float(t[4], inp.path, ln, "skin_radius")
-            notes.append(("skin radius", f"{inp.path}:{ln}: skin_radius only tunes FibreNet's hs "
-                          f"contact list; LAMMPS lists neighbours with its own skin, so contacts "
-                          f"are never detected late (skin {skin:g} has no effect)"))
+            notes.append(_skin_note(f"{inp.path}:{ln}", skin, p, mask, pairs))
         else:
             raise InputError(inp.path, ln, f"modif_bead property must be mass, velocity or "
                              f"skin_radius, got '{prop}'")
+
+
+def _skin_note(where: str, skin: float, p: Particles, mask: np.ndarray, pairs) -> tuple[str, str]:
+    """The warning of ``modif_bead ... skin_radius``.  FibreNet lists an hs pair only when, at
+    its list build (every grid_update_freq steps), r < max(R_i, R_j) + min(skin_i, skin_j)
+    (kernel.cl), and pushes listed pairs while they overlap until the next build.  A skin
+    below the radii therefore makes the real code miss overlapping pairs (how long depends on
+    when its list was built: an artefact, not a cut-off); fibrelmp keeps every contact."""
+    selected = set(int(x) for x in np.unique(p.types[mask]))
+    missed = None                        # (contact distance, listing distance) of a missed pair
+    for law in pairs:
+        if law.kind != "hs":
+            continue
+        for a, b in ((law.type_i, law.type_j), (law.type_j, law.type_i)):
+            if a not in selected or not (p.types == b).any():
+                continue
+            r_a = float(p.radii[mask & (p.types == a)].max())
+            r_b = float(p.radii[p.types == b].max())
+            if skin < min(r_a, r_b) and (missed is None or r_a + r_b > missed[0]):
+                missed = (r_a + r_b, max(r_a, r_b) + skin)
+    if missed is None:
+        return ("skin radius", f"{where}: skin_radius {skin:g} only sets how far FibreNet's hs "
+                "contact list reaches (max(R_i, R_j) + min(skin_i, skin_j), built every "
+                "grid_update_freq steps); it reaches every contact here, and LAMMPS's neighbour "
+                "lists never see a contact late, so it has no effect in fibrelmp")
+    contact, listed = missed
+    return ("skin radius below the bead radius",
+            f"{where}: skin_radius {skin:g} is below the radius of these beads: the real FibreNet "
+            f"lists an hs pair only when r < max(R_i, R_j) + min(skin_i, skin_j) (here {listed:g}) "
+            f"at its list builds, so pairs overlapping at {listed:g} <= r < {contact:g} (R_i + R_j) "
+            "get no hs force there until a list build finds them closer (then the force jumps in); "
+            "fibrelmp keeps the full contact force K (R_i + R_j - r) for every overlap, so its "
+            "results differ from FibreNet's while such pairs overlap (docs/fibrenet.md)")
 
 
 def _apply_modif_spring(inp: _InputFile, springs: _Springs, notes: list) -> None:

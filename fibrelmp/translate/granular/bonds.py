@@ -77,6 +77,7 @@ def select_bonds(model: GranularModel, run: RunTime, spheres, periodic: np.ndarr
             raise InputError(model.source, None, "solid bonds need diameter > 0 and initial length > 0")
         bm = bonds.material[bond_rows].astype(np.int64)
         dist = np.linalg.norm(x[pair[bond_rows, 0]] - x[pair[bond_rows, 1]], axis=1)
+        _refuse_coincident(model, bond_rows, dist)
         out.max_length = float(max(L0.max(), dist.max() if not periodic.any() else L0.max()))
         if exact:
             mats, btype = np.unique(bm, return_inverse=True)
@@ -107,6 +108,35 @@ def select_bonds(model: GranularModel, run: RunTime, spheres, periodic: np.ndarr
                              "differs from the stored initial length by > 0.1 %: LAMMPS bonds "
                              "start unstressed at the current distance"))
     return out
+
+
+def check_bond_directions(model: GranularModel) -> None:
+    """Refuse a bond alive at the start between two spheres at one position (before anything
+    is locked or written; ``select_bonds`` checks the bonds it simulates again)."""
+    bonds, sp = model.bonds, model.spheres
+    if bonds is None or not bonds.count:
+        return
+    t = model.plan.t_start
+    rows = np.flatnonzero((bonds.active_start <= t) & (bonds.active_end > t))
+    pair = bonds.pair[rows].astype(np.int64)
+    x = np.asarray(sp.position, float)
+    _refuse_coincident(model, rows, np.linalg.norm(x[pair[:, 0]] - x[pair[:, 1]], axis=1))
+
+
+def _refuse_coincident(model: GranularModel, bond_rows: np.ndarray, dist: np.ndarray) -> None:
+    """A bond between two spheres at one position has no direction: MUSEN's bond law divides
+    by the zero length and every value of both spheres and the bond turns to nan (the real
+    cmusen 1.74.2 does), so such a scene is refused."""
+    same = np.flatnonzero(dist == 0)
+    if not len(same):
+        return
+    b, row = model.bonds, int(bond_rows[same[0]])
+    line = int(b.source_line[row]) if b.source_line is not None else None
+    left, right = (int(model.spheres.ids[k]) for k in b.pair[row])
+    more = f" (and {len(same) - 1} more)" if len(same) > 1 else ""
+    raise InputError(model.source, line, f"solid bond {int(b.ids[row])} joins spheres {left} and "
+                     f"{right}, which are at the same position{more}: the bond has no direction "
+                     "(MUSEN's bond law divides by its zero length and gives nan); move one sphere")
 
 
 def bond_geometry(model: GranularModel, bonds: SimulatedBonds, atom_rows: np.ndarray,

@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from fibrelmp.errors import InputError
 from fibrelmp.granmodel import GranularModel
 from fibrelmp.translate.granular.geometry import (particle_side, tile_triangles, tile_triangles_within,
                                                   triangle_normals)
@@ -95,6 +96,7 @@ def place_tiles(model: GranularModel, wall_plans, tiles: WallTiles, spheres, axe
             warnings.append(("wall tiles outside domain", f"{wp.name}: {int((~inbox).sum())} wall "
                              "particle(s) outside the simulation domain are left out"))
         p, owner = p[inbox], owner[inbox]
+        _refuse_centre_on_tile(model, wp.name, x[rows], sp.ids[rows], p)
         ids = np.arange(next_id, next_id + len(p))
         next_id += len(p)
         tile_total += len(p)
@@ -118,6 +120,24 @@ def place_tiles(model: GranularModel, wall_plans, tiles: WallTiles, spheres, axe
     if tile_x:
         tiles.x, tiles.types = np.concatenate(tile_x), np.concatenate(tile_type)
         tiles.v, tiles.ids = np.concatenate(tile_v), np.concatenate(tile_ids_all)
+
+
+def _refuse_centre_on_tile(model: GranularModel, name: str, centres: np.ndarray, ids: np.ndarray,
+                           tiles: np.ndarray) -> None:
+    """A sphere whose centre is exactly a wall particle's (a sphere centred in a tiled wall's
+    plane, where no side is known to put the particles behind): stock pair granular divides by
+    their zero distance and gives nan, as MUSEN does for a centre on a wall, so the scene is
+    refused (fibrelmp's fix musen/wall/mesh takes the face normal there instead)."""
+    if not len(centres) or not len(tiles):
+        return
+    as_rows = lambda a: np.ascontiguousarray(a, float).view([("", float)] * 3).ravel()  # noqa: E731
+    on = np.flatnonzero(np.isin(as_rows(centres), as_rows(tiles)))
+    if len(on):
+        raise InputError(model.source, None, f"sphere {int(ids[on[0]])} has its centre exactly on a "
+                         f"wall particle of geometry '{name}' (the stock LAMMPS stand-in for its "
+                         "triangles): the contact has no direction (LAMMPS and MUSEN give nan); "
+                         "move the sphere off the wall, or use fibrelmp's styles (fix "
+                         "musen/wall/mesh takes the face normal there)")
 
 
 def _keep_box(model: GranularModel, wall_plans, tiles: WallTiles, spheres, axes, travel) -> None:

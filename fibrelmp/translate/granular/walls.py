@@ -19,7 +19,8 @@ from fibrelmp.errors import InputError
 from fibrelmp.granmodel import Geometry, GranularModel
 from fibrelmp.lammps_text import LammpsText, comment_text
 from fibrelmp.translate.granular.contacts import check_law, law_args, rolling_spring
-from fibrelmp.translate.granular.geometry import (BoxShape, CylinderShape, Kinematics, detect_cylinder,
+from fibrelmp.translate.granular.geometry import (BoxShape, CylinderShape, Kinematics, closest_points,
+                                                  detect_cylinder,
                                                   detect_oriented_box, geometry_kinematics,
                                                   geometry_triangle_rows, piecewise_expression)
 from fibrelmp.translate.granular.mesh import MESH_FIX, MESH_NAME
@@ -175,6 +176,23 @@ def spheres_behind(v: np.ndarray, x: np.ndarray, r: np.ndarray) -> int:
     return count
 
 
+def spheres_on_triangles(v: np.ndarray, x: np.ndarray, r: np.ndarray) -> int:
+    """How many spheres (centres x, radii r) have their centre on one of the triangles v
+    (k,3,3): closer than 1e-12 radii (fix musen/wall/mesh then takes the face normal as the
+    contact direction, where MUSEN divides by the zero distance)."""
+    if not len(v) or not len(x):
+        return 0
+    lo, hi = v.min(axis=(0, 1)), v.max(axis=(0, 1))
+    near = np.flatnonzero(((x >= lo - r[:, None]) & (x <= hi + r[:, None])).all(axis=1))
+    count = 0
+    step = max(1, 2_000_000 // len(v))            # bounded memory: (chunk, k) distances
+    for s in range(0, len(near), step):
+        rows = near[s:s + step]
+        d2 = closest_points(x[rows], v).min(axis=1)
+        count += int((d2 <= (1e-12 * r[rows]) ** 2).sum())
+    return count
+
+
 def wall_warnings(model: GranularModel, wall_plans: list[WallPlan], t_start: float,
                   t_end: float, spheres=None) -> list[tuple[str, str]]:
     """What the job's wall representation does not reproduce (stock walls standing in for
@@ -193,6 +211,15 @@ def wall_warnings(model: GranularModel, wall_plans: list[WallPlan], t_start: flo
                             "points away from): MUSEN's particle-wall law pushes spheres along the "
                             "normal, so it pushes these through the wall; check the orientation of "
                             "the triangles"))
+        if wp.kind == "mesh" and spheres is not None and len(spheres.rows):
+            on = spheres_on_triangles(model.triangles.vertices[wp.triangle_rows],
+                                      spheres.x[spheres.rows], spheres.crad[spheres.rows])
+            if on:
+                out.append(("sphere centre on a wall", f"geometry '{wp.name}': {on} sphere(s) have "
+                            "their centre on one of its triangles (closer than 1e-12 radii): "
+                            "MUSEN's contact direction (centre minus contact point) is undefined "
+                            "there and its results turn to nan; fibrelmp uses the triangle's "
+                            "normal (docs/granular.md)"))
         if wp.kind in ("box", "cylinder", "tiles"):
             out.append(("approximate MUSEN physics", f"wall geometry '{wp.name}' represented as "
                         f"{wp.description}: LAMMPS's granular wall law stands in for MUSEN's "

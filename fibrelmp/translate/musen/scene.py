@@ -232,7 +232,8 @@ def _bonds(scan, rows, ids, types, sphere_rows, key_index, t, late, path) -> Sol
                       active_start=start, active_end=end,
                       compound_key=[scan.keys[r] for r in rows],
                       force=force if force.any() else None,
-                      tangential_overlap=overlap if overlap.any() else None)
+                      tangential_overlap=overlap if overlap.any() else None,
+                      source_line=np.array([scan.lines[r] for r in rows], np.int64))
 
 
 def _walls(scan, rows, key_index, t, late, path) -> Triangles | None:

@@ -20,7 +20,7 @@ from typing import Any, BinaryIO, Iterator
 import numpy as np
 
 from fibrelmp.errors import InputError
-from fibrelmp.translate.musen.mdem import timepoints
+from fibrelmp.translate.musen.mdem import bounds, timepoints
 from fibrelmp.translate.musen.mdem.container import Container, ContainerWriter, Layout
 from fibrelmp.translate.musen.mdem.messages import new
 
@@ -54,9 +54,10 @@ class MdemFile:
         self.container = Container(self.path)
         try:
             packed = self.container.read(0, 0, self.container.sizes[0])
-            # a scene compresses a few times (MUSEN's examples: 2.6x-6.5x); far more is a bomb
-            raw = _inflate(packed, 200 * len(packed) + (16 << 20), "the scene (file thread 0)",
+            # a scene compresses a few times (MUSEN's examples: 2.6x-29x); far more is a bomb
+            raw = _inflate(packed, bounds.scene_limit(len(packed)), "the scene (file thread 0)",
                            self.path)
+            self._check_scene_messages(raw, len(packed))
             try:
                 self.storage: Any = new("ProtoSimulationStorage", raw)
             except DecodeError:
@@ -67,6 +68,23 @@ class MdemFile:
         except BaseException:
             self.container.close()
             raise
+
+    def _check_scene_messages(self, raw: bytes, stored: int) -> None:
+        """Count the scene's messages on the wire before protobuf allocates them (~80 bytes
+        each, from 2 bytes of wire): at most ``bounds.message_budget`` of its stored size."""
+        budget = bounds.message_budget(stored)
+        try:
+            bounds.count_messages(raw, "ProtoSimulationStorage", budget)
+        except bounds.TooMany:
+            raise InputError(self.path, None, f"corrupt .mdem file: the scene (file thread 0, "
+                             f"{stored} bytes stored) lists more than {budget} objects and other "
+                             f"entries, more than a MUSEN file of its size holds (at most "
+                             f"{bounds.MESSAGES_PER_BYTE} per stored byte + "
+                             f"{bounds.MESSAGES_SLACK}; each costs ~80 bytes of memory); "
+                             "refused before allocating them") from None
+        except ValueError as exc:
+            raise InputError(self.path, None, f"corrupt .mdem file: the scene message cannot "
+                             f"be decoded ({exc})") from None
 
     def _check_blocks(self) -> None:
         size = self.container.sizes[1]
@@ -84,6 +102,38 @@ class MdemFile:
                 raise InputError(self.path, None, f"unsupported .mdem file: time-point block {i} "
                                  f"has storage format {d.format}")
         self.block_times = [d.start_time for d in self.storage.data_blocks]
+        self._block_limits = self._check_block_sizes()
+
+    def _check_block_sizes(self) -> list[int]:
+        """The most bytes each time-point block may decompress to: its declared size, which
+        must fit both zlib's largest expansion of its stored bytes and what its time points
+        can hold for the scene's objects (``bounds.block_bound``); checked for every block
+        here, before any is decompressed."""
+        entries = len(self.storage.info.particles)
+        saved = np.sort(np.array(self.storage.info.savedTimePoints, dtype=float))
+        # MUSEN saves one time point per block; a block holds the saved times from its start
+        # up to the next block's (one where the file lists no saved times)
+        starts = np.array(self.block_times + [np.inf])
+        counts = (np.searchsorted(saved, starts[1:]) - np.searchsorted(saved, starts[:-1])
+                  if saved.size else np.ones(len(self.block_times), int))
+        limits = []
+        for i, d in enumerate(self.storage.data_blocks):
+            points = max(int(counts[i]), 1)
+            need = bounds.block_bound(entries, points)
+            if d.format != ZIPPED:
+                limits.append(d.size)
+                continue
+            where = f"corrupt .mdem file: time-point block {i} declares {d.uncompressed_size} bytes"
+            if d.uncompressed_size > bounds.ZLIB_MAX_RATIO * d.size + 64:
+                raise InputError(self.path, None, f"{where} from {d.size} stored bytes, more than "
+                                 f"zlib can expand them to ({bounds.ZLIB_MAX_RATIO}x)")
+            if d.uncompressed_size > need:
+                raise InputError(self.path, None, f"{where}, more than {points} time "
+                                 f"point(s) of a scene of {entries} objects can take (at most "
+                                 f"{need} bytes: {bounds.MAX_ENTRY} per object entry); refused "
+                                 "before decompressing it")
+            limits.append(d.uncompressed_size)
+        return limits
 
     def _check_layout(self) -> None:
         """Files of header version 0 may keep the oldest time-point layout (Euler angles,
@@ -127,7 +177,7 @@ class MdemFile:
         d = self.storage.data_blocks[index]
         raw = self.block_raw(index)
         if d.format == ZIPPED:
-            raw = _inflate(raw, d.uncompressed_size, f"time-point block {index}", self.path)
+            raw = _inflate(raw, self._block_limits[index], f"time-point block {index}", self.path)
         return raw
 
     def block(self, index: int) -> Any:
@@ -147,8 +197,9 @@ class MdemFile:
             try:
                 for payload in _messages(self.block_bytes(index), 2):
                     # entries of removed trailing objects may outlast the object list a little;
-                    # far more is a hostile file (each empty entry costs 2 bytes, 272 decoded)
-                    point = (timepoints.decode(payload, 2 * len(self.info.particles) + 1024) if decode
+                    # far more is a hostile file (each empty entry costs 2 bytes, 276 decoded)
+                    point = (timepoints.decode(payload, bounds.objects_per_point(len(self.info.particles)))
+                             if decode
                              else (timepoints.time_of(payload),))
                     yield point
             except ValueError as exc:
@@ -241,6 +292,8 @@ def _messages(data: bytes, field: int) -> Iterator[memoryview]:
     view, at = memoryview(data), 0
     while at < len(data):
         tag, at = _varint(data, at)
+        if tag < 8:                      # field number 0: not protobuf (e.g. a run of zeros)
+            raise ValueError("field number 0 (not a protobuf message)")
         kind = tag & 7
         if kind == 2:
             size, at = _varint(data, at)

@@ -80,26 +80,41 @@ def block_bomb(tmp_path_factory) -> Path:
     return path
 
 
-@pytest.fixture(scope="module")
-def scene_bomb(tmp_path_factory) -> Path:
-    """Issue 24: a 1.3 MB scene listing 90 million removed objects (MUSEN's empty entries)."""
+def _removed_objects_scene(path: Path, copies: int, padding: int) -> Path:
+    """A scene of ``copies`` x 2^21 removed objects (MUSEN's empty entries, "32 00"), and
+    ``padding`` random bytes in an unknown field 15 of the storage message (they raise the
+    stored size, so the entries decompress within the scene's size bound)."""
     point = _field(2, tp.encode(0.0, np.zeros((0, tp.NCOLS)), np.zeros(0, np.uint32)))
     block = zlib.compress(point, 1)
-    copies = 43                                           # x 2^21 entries = 90.2 million
     removed = copies << 21
     descriptor = new("ProtoBlockDescriptor")
     descriptor.start_time, descriptor.size, descriptor.format = 0.0, len(block), 2
     descriptor.uncompressed_size = len(point)
-    # ProtoSimulationStorage: field 1 (info: the entries "32 00"), field 3 (the descriptor),
-    # and 0.6 MB of random bytes in an unknown field 15 (the scene's stored size then lets it
-    # decompress to 295 MB, so the entries reach the parser as they did in the report)
+    # ProtoSimulationStorage: field 1 (info: the entries), field 3 (the block's descriptor)
     head = _field(1, bytes(2 * removed))[:-2 * removed]
-    padding = _field(15, np.random.default_rng(24).bytes(600_000))
-    stream = _stream(head, b"\x32\x00" * (1 << 21), copies,
-                     _field(3, descriptor.SerializeToString()) + padding, level=1)
-    path = tmp_path_factory.mktemp("bomb") / "scene_bomb.mdem"
-    _write(path, stream, block)
-    assert 1.0e6 < path.stat().st_size < 1.6e6
+    tail = _field(3, descriptor.SerializeToString())
+    if padding:
+        tail += _field(15, np.random.default_rng(24).bytes(padding))
+    stream = _stream(head, b"\x32\x00" * (1 << 21), copies, tail, level=1)
+    return _write(path, stream, block)
+
+
+@pytest.fixture(scope="module")
+def scene_bomb(tmp_path_factory) -> Path:
+    """Issue 24: a 1.3 MB scene listing 90 million removed objects (180 MB decompressed)."""
+    path = _removed_objects_scene(tmp_path_factory.mktemp("bomb") / "scene_bomb.mdem", 43, 600_000)
+    assert 1.2e6 < path.stat().st_size < 1.6e6
+    return path
+
+
+@pytest.fixture(scope="module")
+def scene_entries_bomb(tmp_path_factory) -> Path:
+    """40 million removed objects (80 MB decompressed) in a 1.35 MB scene: within the scene's
+    decompression bound, so the entries reach the count before protobuf."""
+    path = _removed_objects_scene(tmp_path_factory.mktemp("bomb") / "entries_bomb.mdem", 19,
+                                  1_000_000)
+    stored = path.stat().st_size
+    assert 80e6 < bounds.scene_limit(stored) and bounds.message_budget(stored) < 40e6
     return path
 
 
@@ -117,7 +132,8 @@ def _cli(*args: str, cwd: Path) -> tuple[subprocess.CompletedProcess, float]:
 @pytest.mark.parametrize("bomb, message", [
     ("block_bomb", "time-point block 0 declares 1497366528 bytes, more than 1 time point(s) of "
                    "a scene of 1 objects can take"),
-    ("scene_bomb", "lists more than"),
+    ("scene_bomb", "the scene (file thread 0) is larger than a MUSEN scene of"),
+    ("scene_entries_bomb", "objects and other entries, more than a MUSEN file of its size holds"),
 ])
 @pytest.mark.parametrize("command", ["convert", "check"])
 def test_mdem_bombs_are_refused_at_once(request, tmp_path, bomb, message, command):

@@ -5,7 +5,7 @@ gigabytes, since zlib expands up to 1032 times and an empty protobuf entry costs
 the wire but about 80 bytes once parsed.  Two bounds keep memory proportional to the file:
 
 * **scene** (file thread 0): decompressed to at most ``SCENE_RATIO`` x its stored size +
-  ``SCENE_SLACK``; then, before the protobuf parse, its messages are counted on the wire
+  ``SCENE_SLACK`` (zlib holds the output twice while it finishes); then, before the protobuf parse, its messages are counted on the wire
   (``count_messages``): at most ``MESSAGES_PER_BYTE`` per stored byte + ``MESSAGES_SLACK``
   (MUSEN's densest scene, identical spheres, stores about 2.4 bytes per object at zlib
   level 1; removed objects' empty entries ~0.25 bytes each, so up to ~7 removed objects
@@ -26,7 +26,10 @@ from functools import lru_cache
 from fibrelmp.translate.musen.mdem.messages import fields
 
 ZLIB_MAX_RATIO = 1032            # deflate's largest expansion (258 bytes per 2-bit code)
-SCENE_RATIO = 200                # real scenes: 2.6x-6.5x (MUSEN's examples), 29x (monodisperse)
+# real scenes compress 2.6x-6.5x (MUSEN's examples), 29x (identical spheres), 35x (90% of
+# them removed); only runs of removed objects compress more (229x), and those are capped by
+# the message count below
+SCENE_RATIO = 64
 SCENE_SLACK = 16 << 20
 MESSAGES_PER_BYTE = 2
 MESSAGES_SLACK = 1 << 20

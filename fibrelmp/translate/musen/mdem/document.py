@@ -29,14 +29,15 @@ PLAIN = 1             # kProtoBuf
 _LEVEL = 1            # MUSEN's GzipOutputStream compression level
 
 
-def _inflate(data: bytes, limit: int | None, what: str, path: Path) -> bytes:
-    """zlib data, decompressed (at most ``limit`` bytes if given)."""
+def _inflate(data: bytes, limit: int | None, what: str, path: Path,
+             limit_is: str = "its descriptor says") -> bytes:
+    """zlib data, decompressed (at most ``limit`` bytes if given: memory holds no more)."""
     d = zlib.decompressobj()
     try:
-        out = d.decompress(data, limit if limit else 0)
+        out = d.decompress(data, 0 if limit is None else max(limit, 1))
         if limit is not None and (d.unconsumed_tail or len(out) > limit):
-            raise InputError(path, None, f"corrupt .mdem file: {what} is larger than its "
-                             f"descriptor says ({limit} bytes)")
+            raise InputError(path, None, f"corrupt .mdem file: {what} is larger than "
+                             f"{limit_is} ({limit} bytes)")
         if not d.eof:
             raise InputError(path, None, f"truncated .mdem file: {what} ends early")
     except zlib.error as exc:
@@ -54,9 +55,9 @@ class MdemFile:
         self.container = Container(self.path)
         try:
             packed = self.container.read(0, 0, self.container.sizes[0])
-            # a scene compresses a few times (MUSEN's examples: 2.6x-29x); far more is a bomb
             raw = _inflate(packed, bounds.scene_limit(len(packed)), "the scene (file thread 0)",
-                           self.path)
+                           self.path, f"a MUSEN scene of {len(packed)} stored bytes decompresses "
+                           f"to ({bounds.SCENE_RATIO}x + {bounds.SCENE_SLACK >> 20} MiB)")
             self._check_scene_messages(raw, len(packed))
             try:
                 self.storage: Any = new("ProtoSimulationStorage", raw)

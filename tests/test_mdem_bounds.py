@@ -59,10 +59,10 @@ def _write(path: Path, scene_stream: bytes, block: bytes) -> Path:
     return path
 
 
-def _one_sphere_scene(block_size: int, uncompressed: int) -> bytes:
+def _one_sphere_scene(block_size: int, uncompressed: int, saved: int = 1) -> bytes:
     storage = new("ProtoSimulationStorage")
     storage.info.particles.add(id=0, type=1, encoded_properties=struct.pack("<dd", 1e-3, 1e-3))
-    storage.info.savedTimePoints.append(0.0)
+    storage.info.savedTimePoints.extend(np.arange(saved) * 1e-3)
     storage.data_blocks.add(start_time=0.0, offset_in_file=0, size=block_size,
                             uncompressed_size=uncompressed, format=2)
     return zlib.compress(storage.SerializeToString(), 1)
@@ -77,6 +77,17 @@ def block_bomb(tmp_path_factory) -> Path:
     path = tmp_path_factory.mktemp("bomb") / "block_bomb.mdem"
     _write(path, _one_sphere_scene(len(block), copies << 22), block)
     assert 1.3e6 < path.stat().st_size < 1.6e6
+    return path
+
+
+@pytest.fixture(scope="module")
+def saved_times_bomb(tmp_path_factory) -> Path:
+    """The block bomb, with 5000 saved times listed in the scene: the declared 1.5e9 bytes
+    then fit 5000 time points of one sphere, so the block is read, one time point at a time."""
+    copies = 357
+    block = _stream(b"", bytes(1 << 22), copies, b"")
+    path = tmp_path_factory.mktemp("bomb") / "saved_times_bomb.mdem"
+    _write(path, _one_sphere_scene(len(block), copies << 22, saved=5000), block)
     return path
 
 
@@ -132,13 +143,16 @@ def _cli(*args: str, cwd: Path) -> tuple[subprocess.CompletedProcess, float]:
 @pytest.mark.parametrize("bomb, message", [
     ("block_bomb", "time-point block 0 declares 1497366528 bytes, more than 1 time point(s) of "
                    "a scene of 1 objects can take"),
+    ("saved_times_bomb", "corrupt .mdem file: time-point block 0: field number 0 (not a protobuf"),
     ("scene_bomb", "the scene (file thread 0) is larger than a MUSEN scene of"),
     ("scene_entries_bomb", "objects and other entries, more than a MUSEN file of its size holds"),
 ])
-@pytest.mark.parametrize("command", ["convert", "check"])
+@pytest.mark.parametrize("command", ["convert", "check", "copy"])
 def test_mdem_bombs_are_refused_at_once(request, tmp_path, bomb, message, command):
+    """``convert`` to text, ``check``, and ``convert`` to .mdem (the byte-identical copy)."""
     path = request.getfixturevalue(bomb)
-    args = [command, str(path)] + (["-o", str(tmp_path / "out.txt")] if command == "convert" else [])
+    out = {"convert": ["-o", str(tmp_path / "out.txt")], "copy": ["-o", str(tmp_path / "out.mdem")]}
+    args = ["convert" if command == "copy" else command, str(path)] + out.get(command, [])
     proc, seconds = _cli(*args, cwd=tmp_path)
     assert proc.returncode == 2, proc.stderr[-2000:]
     error = [line for line in proc.stderr.splitlines() if line.startswith("error:")]

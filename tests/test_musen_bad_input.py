@@ -212,6 +212,7 @@ SCRIPT_ERRORS = [
     ("EXT_ACCEL 0 0\n", 1, "needs 3 number"),
     ("MODEL_SB_PARAMS CONSIDER_BREAKAGE 0\n", 1, "no MODEL_SB line before it"),
     ("MODEL_PARAMS ModelSBElastic CONSIDER_BREAKAGE 0\n", 1, "not selected in this job"),
+    ("MODEL ModelSBElastic\nMODEL_SB_PARAMS CONSIDER_BREAKAGE 0\n", 2, "no MODEL_SB line before it"),
     ("MATERIAL_PROPERTY DENSTY K 1\n", 1, "did you mean DENSITY?"),
     ("MATERIAL_PROPERTY DENSITY K\n", 1, "needs PROPERTY COMPOUND_KEY VALUE"),
     ("INTERACTION_PROPERTY FRICTION A B 0.1\n", 1, "unknown interaction property"),

@@ -267,8 +267,11 @@ def _model(kind: str):
 
 def _model_params(kind: str):
     def handler(job: MusenJob, line: _Line) -> None:
+        # cmusen (ScriptAnalyzer's ReadModelParamsOld) gives them to the first model selected
+        # by a MODEL_<kind> keyword of this kind; a model named by the generic MODEL keyword
+        # does not count
         for m in job.models:
-            if model_kind(m) == kind:
+            if m.kind == kind:
                 m.params = line.rest
                 return
         raise line.error(f"no MODEL_{kind} line before it in this job (cmusen drops the "

@@ -203,3 +203,37 @@ def test_scene_messages_are_counted_as_protobuf_parses_them():
         bounds.count_messages(raw, "ProtoSimulationStorage", expected - 1)
     with pytest.raises(ValueError):
         bounds.count_messages(b"\0\0\0\0", "ProtoSimulationStorage", 10)
+
+
+def test_a_block_of_several_time_points_is_read_one_at_a_time(tmp_path):
+    """A block holding two time points of 5000 spheres (0.8 MB each, so they cross the 1 MiB
+    pieces the block is decompressed in) reads back exactly; listing only one saved time
+    for it makes the second a corrupt-file error."""
+    from fibrelmp.errors import InputError
+    from fibrelmp.translate.musen.mdem.document import MdemFile
+
+    rng = np.random.default_rng(7)
+    n = 5000
+    masks = np.full(n, tp.bit("coord", "vel", "angle_vel", "force", "quaternion"), np.uint32)
+    points = [(t, rng.standard_normal((n, tp.NCOLS))) for t in (0.0, 1e-3)]
+    block = b"".join(_field(2, tp.encode(t, v, masks)) for t, v in points)
+    packed = zlib.compress(block, 1)
+    for saved, ok in ((2, True), (1, False)):
+        storage = new("ProtoSimulationStorage")
+        for i in range(n):
+            storage.info.particles.add(id=i, type=1, encoded_properties=struct.pack("<dd", 1e-3, 1e-3))
+        storage.info.savedTimePoints.extend([0.0, 1e-3][:saved])
+        storage.data_blocks.add(start_time=0.0, offset_in_file=0, size=len(packed),
+                                uncompressed_size=len(block), format=2)
+        path = _write(tmp_path / f"two_{saved}.mdem", zlib.compress(storage.SerializeToString(), 1), packed)
+        with MdemFile(path) as mdem:
+            if ok:
+                got = list(mdem.time_points())
+                assert [g[0] for g in got] == [t for t, _ in points]
+                for (_, values, m), (_, want) in zip(got, points):
+                    cols = np.concatenate([np.r_[tp.columns(f)] for f in
+                                           ("coord", "vel", "angle_vel", "force", "quaternion")])
+                    assert np.array_equal(values[:, cols], want[:, cols]) and np.array_equal(m, masks)
+            else:
+                with pytest.raises(InputError, match="more than the 1 time point"):
+                    list(mdem.time_points())

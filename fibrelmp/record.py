@@ -36,7 +36,9 @@ LOG_NAME = "log.lammps"
 SUMMARY_NAME = "summary.json"
 SUMMARY_VERSION = 1
 # thermo columns (templates/*.j2) -> summary energy names
-ENERGY_COLUMNS = {"KinEng": "kinetic", "RotEng": "rotational", "PotEng": "potential", "TotEng": "total"}
+# (granular runs: KinGravEng = kinetic + rotational + gravity's, no contact or bond energy)
+ENERGY_COLUMNS = {"KinEng": "kinetic", "RotEng": "rotational", "PotEng": "potential", "TotEng": "total",
+                  "KinGravEng": "kinetic_plus_gravity"}
 
 
 # ---------------------------------------------------------------------------------------

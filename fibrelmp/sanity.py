@@ -73,38 +73,82 @@ def hertz_contact_time(m_eff: float, r_eff: float, e_star: float, speed: float) 
     return HERTZ_DURATION * hertz_peak_overlap(m_eff, r_eff, e_star, speed) / speed
 
 
-def _fastest_approach(model: GranularModel) -> float:
-    """The fastest sphere speed in the input plus what gravity adds over the domain height
-    (a lower bound of 1e-12 keeps resting inputs finite)."""
+def speed_bounds(velocity: np.ndarray, gravity: np.ndarray, extent: np.ndarray) -> np.ndarray:
+    """Per sphere: the fastest it can move, ``sqrt(|v|^2 + 2 |g| L)``: its own speed plus
+    what gravity can add over the extent ``L`` of the domain along g."""
+    g = float(np.linalg.norm(gravity))
+    fall = 0.0
+    if g > 0:
+        fall = float(np.sum(np.abs(gravity) / g * extent))   # extent of the box along g
+    return np.sqrt(np.einsum("ij,ij->i", velocity, velocity) + 2.0 * g * fall)
+
+
+def pair_speed(bounds_a: np.ndarray, bounds_b: np.ndarray | None) -> float:
+    """Largest possible approach speed: same group -> its two fastest; else the fastest of
+    each; ``bounds_b`` None -> a wall (the sphere's own bound).  0 when no such pair exists."""
+    if bounds_b is None:
+        return float(bounds_a.max()) if bounds_a.size else 0.0
+    if bounds_a is bounds_b:
+        return float(np.sort(bounds_a)[-2:].sum()) if bounds_a.size >= 2 else 0.0
+    if not bounds_a.size or not bounds_b.size:
+        return 0.0
+    return float(bounds_a.max() + bounds_b.max())
+
+
+def granular_extent(model: GranularModel) -> np.ndarray:
+    """The box gravity can accelerate spheres over: the domain, else the spheres' and walls'
+    bounding box grown by a diameter."""
+    if model.plan.domain is not None:
+        return model.plan.domain[1] - model.plan.domain[0]
     s = model.spheres
-    speed = float(np.max(np.linalg.norm(s.velocity, axis=1))) if s.count else 0.0
-    g = float(np.linalg.norm(model.plan.gravity))
-    if model.plan.domain is not None and g > 0:
-        height = float(np.max(model.plan.domain[1] - model.plan.domain[0]))
-        speed = math.sqrt(speed ** 2 + 2 * g * height)
-    return max(speed, 1e-12)
+    parts = [s.position] + [p.point[None, :] for p in model.planes]
+    if model.triangles is not None and model.triangles.count:
+        parts.append(model.triangles.vertices.reshape(-1, 3))
+    points = np.vstack(parts)
+    return points.max(axis=0) - points.min(axis=0) + 2 * float(s.contact_radius.max(initial=0))
 
 
 def granular_contact_time(model: GranularModel) -> tuple[float, str] | None:
-    """Shortest Hertz contact duration over the material pairs present: two of the smallest
-    spheres of each material (R* = r/2, m* = m/2) meeting at the fastest approach speed.
-    None when there are no spheres."""
+    """The shortest Hertz contact duration of the contacts the input can have, at the fastest
+    approach: for each material pair with a contact law, the smallest spheres of each
+    (m* = m1 m2 / (m1 + m2), R* = r1 r2 / (r1 + r2); a sphere-sphere pair of one material
+    needs two spheres of it) approaching at the sum of the two fastest speed bounds, and
+    for a wall material, the smallest sphere (m* = m, R* = r) at its material's fastest
+    bound (``speed_bounds``).  Where nothing can move (no speed, no gravity), at an
+    approach speed of 1.  (time, "material-material"); None when there are no spheres.
+    DEMDF's reader sizes its contact stiffness and time step by this same figure."""
     s = model.spheres
     if s.count == 0:
         return None
-    speed = _fastest_approach(model)
+    bounds = speed_bounds(s.velocity, model.plan.gravity, granular_extent(model))
+    walls = {int(p.material) for p in model.planes}
+    if model.triangles is not None and model.triangles.count:
+        walls |= {int(m) for m in np.unique(model.triangles.material)}
+    smallest: dict[int, tuple[float, float, np.ndarray]] = {}
+    for mat in np.unique(s.material).tolist():
+        rows = np.flatnonzero(s.material == mat)
+        # the contact time grows as (m^2 / r)^(1/5): the smallest sphere of a material
+        k = rows[int(np.argmin(s.mass[rows] ** 2 / s.contact_radius[rows]))]
+        smallest[mat] = (float(s.mass[k]), float(s.contact_radius[k]), bounds[rows])
+    partners = []                      # (m*, R*, E*, approach speed, name)
+    for (a, b), law in model.contacts.items():
+        if not law.youngs_eff > 0:
+            continue
+        name = f"{model.materials[a].name}-{model.materials[b].name}"
+        if a in smallest and b in smallest:
+            (ma, ra, va), (mb, rb, vb) = smallest[a], smallest[b]
+            partners.append((ma * mb / (ma + mb), ra * rb / (ra + rb), law.youngs_eff,
+                             pair_speed(va, va if a == b else vb), name))
+        for sphere, wall in ((a, b), (b, a)):
+            if sphere in smallest and wall in walls:
+                m, r, v = smallest[sphere]
+                partners.append((m, r, law.youngs_eff, pair_speed(v, None), name))
+    possible = [p for p in partners if p[3] > 0] or [p[:3] + (1.0,) + p[4:] for p in partners]
     best = None
-    for mat in np.unique(s.material):
-        rows = s.material == mat
-        r = float(s.contact_radius[rows].min())
-        m = float(s.mass[rows].min())
-        for (a, b), law in model.contacts.items():
-            if int(mat) not in (a, b) or not law.youngs_eff > 0:
-                continue
-            tc = hertz_contact_time(m / 2, r / 2, law.youngs_eff, speed)
-            name = f"{model.materials[a].name}-{model.materials[b].name}"
-            if best is None or tc < best[0]:
-                best = (tc, name)
+    for m_eff, r_eff, e_star, speed, name in possible:
+        tc = hertz_contact_time(m_eff, r_eff, e_star, speed)
+        if best is None or tc < best[0]:
+            best = (tc, name)
     return best
 
 

@@ -134,6 +134,22 @@ def test_convert_refuses_precision_for_a_binary_output(tmp_path):
     assert invoke("convert", tmp_path / "s.mdem", "-o", tmp_path / "s.txt", "--precision", "17").exit_code == 0
 
 
+def test_readme_convert_row_runs_as_written(tmp_path):
+    """Issue 24: README's ``convert`` row gave ``--precision`` to a ``.mdem`` output, which is
+    refused; every command of the row (optional parts included) now runs as written."""
+    row = next(line for line in (REPO / "README.md").read_text().splitlines()
+               if line.startswith("| `fibrelmp convert scene.mdem"))
+    commands = re.findall(r"`((?:fibrelmp )?convert [^`]+)`", row.split(" | ")[0])
+    assert len(commands) == 2, row
+    (tmp_path / "scene.txt").write_bytes(SCENE.read_bytes())
+    (tmp_path / "scene.mdem").write_bytes((EXAMPLES / "musen" / "SingelParticle.mdem").read_bytes())
+    for command in commands:
+        words = command.replace("[", "").replace("]", "").split()
+        words = [str(tmp_path / w) if w.startswith("scene.") else w for w in words[words.index("convert"):]]
+        result = invoke(*words, "--force")
+        assert result.exit_code == 0, (command, result.output)
+
+
 def significant_digits(token: str) -> int:
     """Digits of a %g number: its mantissa without sign, point, leading and trailing zeros."""
     mantissa = re.split("[eE]", token.lstrip("+-"))[0].replace(".", "")

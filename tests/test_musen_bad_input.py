@@ -212,6 +212,7 @@ SCRIPT_ERRORS = [
     ("EXT_ACCEL 0 0\n", 1, "needs 3 number"),
     ("MODEL_SB_PARAMS CONSIDER_BREAKAGE 0\n", 1, "no MODEL_SB line before it"),
     ("MODEL_PARAMS ModelSBElastic CONSIDER_BREAKAGE 0\n", 1, "not selected in this job"),
+    ("MODEL ModelSBElastic\nMODEL_SB_PARAMS CONSIDER_BREAKAGE 0\n", 2, "no MODEL_SB line before it"),
     ("MATERIAL_PROPERTY DENSTY K 1\n", 1, "did you mean DENSITY?"),
     ("MATERIAL_PROPERTY DENSITY K\n", 1, "needs PROPERTY COMPOUND_KEY VALUE"),
     ("INTERACTION_PROPERTY FRICTION A B 0.1\n", 1, "unknown interaction property"),
@@ -242,7 +243,11 @@ GOOD = ("MODEL_PP ModelPPHertzMindlin\nMODEL_PW ModelPWHertzMindlin\nMODEL_SB Mo
 
 APPLY_ERRORS = [  # script, line, words: parsed fine, refused when the job is applied
     (GOOD.replace("ModelSBElastic", "ModelSBAerogel"), 3, "not supported; fibrelmp translates "
-     "ModelSBElastic only"),
+     "ModelSBElastic and ModelSBKelvin (with fibrelmp's LAMMPS styles)"),
+    (GOOD.replace("ModelSBElastic", "ModelSBPlasticConcrete"), 3, "ModelSBPlasticConcrete: this "
+     "solid-bond model is not supported; fibrelmp translates ModelSBElastic and ModelSBKelvin"),
+    (GOOD + "MODEL_EF ModelEFViscousField\nMODEL_EF_PARAMS MEDIUM_VISCOSITY 1e-5\n", 7,
+     "external-force model is not supported; fibrelmp translates no external-force model"),
     (GOOD.replace("ModelPPHertzMindlin", "ModelPPHertzMindlln"), 1, "did you mean ModelPPHertzMindlin?"),
     (GOOD.replace("MODEL_PW ModelPWHertzMindlin", "MODEL_PW ModelPPHertz"), 2,
      "is a PP model, given as MODEL_PW"),
@@ -351,3 +356,37 @@ def test_script_mutations_only_input_errors(tmp_path):
                     ms.apply_simulator_settings(musen.read(scene(tmp_path, BASE)), job)
             except InputError as exc:
                 assert str(exc).startswith(str(path)), str(exc)
+
+
+def test_check_reads_model_params_after_a_refused_model(tmp_path):
+    """Issue 24: ``check`` said 'no MODEL_EF line before it' of a MODEL_EF_PARAMS line right
+    after a (refused) MODEL_EF line: cmusen gives those parameters to that model, so the one
+    error is the model's; a PARAMS line with no model line before it is still an error."""
+    from pathlib import Path
+
+    from typer.testing import CliRunner
+
+    from fibrelmp.cli import app
+
+    corpus = Path(__file__).resolve().parent / "bad_inputs" / "musen_script"
+    (tmp_path / "scene.txt").write_bytes((corpus / "scene.txt").read_bytes())
+    good = (corpus / "good.txt").read_text()
+    assert "MODEL_SB" in good and "MODEL_EF" not in good
+    extra = ("MODEL_EF ModelEFViscousField\nMODEL_EF_PARAMS MEDIUM_VISCOSITY 1e-5\n"
+             "MODEL_LB ModelLBCapilarViscous\nMODEL_LB_PARAMS MIN_THICKNESS 1e-5\n"
+             "MODEL_EXT_FORCE_PARAMS MEDIUM_DENSITY 1\nMODEL_SB_PARAMS CONSIDER_BREAKAGE 7\n")
+    (tmp_path / "job.txt").write_text(good + extra)
+    n = good.count("\n")
+    result = CliRunner().invoke(app, ["check", str(tmp_path / "job.txt")])
+    assert result.exit_code == 2
+    errors = [line.split("job.txt", 1)[1] for line in result.stderr.splitlines()
+              if line.startswith("error:")]
+    assert errors == [
+        f":{n + 1}: ModelEFViscousField: this external-force model is not supported; fibrelmp "
+        "translates no external-force model",
+        f":{n + 3}: ModelLBCapilarViscous: this liquid-bond model is not supported; fibrelmp "
+        "translates no liquid-bond model",
+        f":{n + 6}: CONSIDER_BREAKAGE must be 0, 1 or 2 (got 7)"], result.stderr
+    (tmp_path / "orphan.txt").write_text(good + "MODEL_EF_PARAMS MEDIUM_VISCOSITY 1e-5\n")
+    with pytest.raises(InputError, match=f":{n + 1}: MODEL_EF_PARAMS: no MODEL_EF line before it"):
+        ms.read_script(tmp_path / "orphan.txt")

@@ -21,24 +21,15 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numpy as np
-
-# the Hertz impact formulas live in fibrelmp.sanity (``fibrelmp check`` uses them too)
+# the Hertz impact formulas and speed bounds live in fibrelmp.sanity (``fibrelmp check``
+# prints the same contact time)
 from fibrelmp.sanity import hertz_contact_time as contact_time  # noqa: F401
 from fibrelmp.sanity import hertz_peak_overlap as peak_overlap  # noqa: F401
+from fibrelmp.sanity import pair_speed, speed_bounds  # noqa: F401
 
 
 def modulus_for_overlap(m_eff: float, r_eff: float, speed: float, overlap: float) -> float:
     return 15.0 * m_eff * speed ** 2 / (16.0 * math.sqrt(r_eff) * overlap ** 2.5)
-
-
-def speed_bounds(velocity: np.ndarray, gravity: np.ndarray, extent: np.ndarray) -> np.ndarray:
-    """Per particle: the fastest it can move, |v| plus the fall over the domain along g."""
-    g = float(np.linalg.norm(gravity))
-    fall = 0.0
-    if g > 0:
-        fall = float(np.sum(np.abs(gravity) / g * extent))   # extent of the box along g
-    return np.sqrt(np.einsum("ij,ij->i", velocity, velocity) + 2.0 * g * fall)
 
 
 @dataclass
@@ -52,15 +43,3 @@ class Partner:
     speed: float                  # approach speed bound (> 0)
     restitution: float
     label: str
-
-
-def pair_speed(bounds_a: np.ndarray, bounds_b: np.ndarray | None) -> float:
-    """Largest possible approach speed: same type -> two fastest; else fastest of each;
-    ``bounds_b`` None -> a wall (the particle's own bound).  0 when no such pair exists."""
-    if bounds_b is None:
-        return float(bounds_a.max()) if bounds_a.size else 0.0
-    if bounds_a is bounds_b:
-        return float(np.sort(bounds_a)[-2:].sum()) if bounds_a.size >= 2 else 0.0
-    if not bounds_a.size or not bounds_b.size:
-        return 0.0
-    return float(bounds_a.max() + bounds_b.max())

@@ -480,13 +480,19 @@ class _Reader(PlanMixin):
                 e_star = ext["youngs"] / (2.0 * (1.0 - ext["poisson"] ** 2))
             else:
                 e_star = hertz.modulus_for_overlap(p.m_eff, p.r_eff, speed, ext["overlap"] * p.r_min)
-            ratio = hertz.peak_overlap(p.m_eff, p.r_eff, e_star, speed) / p.r_min
-            timing.append((possible, hertz.contact_time(p.m_eff, p.r_eff, e_star, speed), ratio,
-                           p.label))
             law = ContactLaw(youngs_eff=e_star, shear_eff=0.0, restitution=p.restitution)
             old = contacts.get(p.key)
             if old is None or old.youngs_eff < e_star:
                 contacts[p.key] = law
+        for p in partners:
+            # with the law that runs (the stiffest of a material pair's): the contact time
+            # ``fibrelmp check`` prints (sanity.granular_contact_time) is this same figure
+            possible = p.speed > 0
+            speed = p.speed if possible else fastest
+            e_star = contacts[p.key].youngs_eff
+            ratio = hertz.peak_overlap(p.m_eff, p.r_eff, e_star, speed) / p.r_min
+            timing.append((possible, hertz.contact_time(p.m_eff, p.r_eff, e_star, speed), ratio,
+                           p.label))
         real = [t for t in timing if t[0]] or timing     # contacts that can happen
         t_min = min((t[1] for t in real), default=1.0)
         worst = max(((t[2], t[3]) for t in real), default=(0.0, ""))

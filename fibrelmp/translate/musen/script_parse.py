@@ -37,6 +37,10 @@ MATERIAL_PROPERTIES = {"DENSITY": 0, "HEAT_CAPACITY": 1, "DYNAMIC_VISCOSITY": 2,
 INTERACTION_PROPERTIES = {"RESTITUTION_COEFFICIENT": 200, "SLIDING_FRICTION": 201,
                           "ROLLING_FRICTION": 202}
 SUPPORTED_MODELS = {"PP": "ModelPPHertzMindlin", "PW": "ModelPWHertzMindlin", "SB": "ModelSBElastic"}
+# what ``fibrelmp check`` puts in place of a model line of a kind fibrelmp translates none of
+# (LB, EF) after reporting it: the job keeps a model of that kind, so the kind's PARAMS lines
+# below it read as cmusen reads them (not as "no MODEL_EF line"), and the settings skip it
+REFUSED_MODEL = "fibrelmp:refused-above:"            # + the kind (names must differ per kind)
 MUSEN_MODELS = {  # every model in MUSEN's Models/ folder, by kind
     "PP": ("ModelPPChealNess", "ModelPPHeatConduction", "ModelPPHertz", "ModelPPHertzMindlin",
            "ModelPPHertzMindlinLiquid", "ModelPPHertzMindlinVdW", "ModelPPJKR",
@@ -263,8 +267,11 @@ def _model(kind: str):
 
 def _model_params(kind: str):
     def handler(job: MusenJob, line: _Line) -> None:
+        # cmusen (ScriptAnalyzer's ReadModelParamsOld) gives them to the first model selected
+        # by a MODEL_<kind> keyword of this kind; a model named by the generic MODEL keyword
+        # does not count
         for m in job.models:
-            if model_kind(m) == kind:
+            if m.kind == kind:
                 m.params = line.rest
                 return
         raise line.error(f"no MODEL_{kind} line before it in this job (cmusen drops the "
@@ -448,8 +455,11 @@ def check_patch(err: InputError, line: str | None, attempt: int) -> str | None:
         return scene_patch(err, line, attempt)
     candidates: list[str] = []
     kind = key[len("MODEL_"):] if key.startswith("MODEL_") else ""
+    kind = {"EXT_FORCE": "EF", "PPHT": "PP"}.get(kind, kind)
     if kind in SUPPORTED_MODELS:
         candidates.append(f"{key} {SUPPORTED_MODELS[kind]}")
+    elif kind in ("LB", "EF"):
+        candidates.append(f"{key} {REFUSED_MODEL}{kind}")
     elif key in _NEUTRAL_TIMES:
         candidates.append(f"{key} {_NEUTRAL_TIMES[key]}")
     candidates.append("")

@@ -15,7 +15,8 @@ from fibrelmp.errors import InputError
 from fibrelmp.granmodel import GranularModel
 from fibrelmp.translate.musen.scene import (INTERACTION_DEFAULTS, _check_material, check_simulable, contact_law,
                     domain_warning)
-from fibrelmp.translate.musen.script_parse import MUSEN_MODELS, SUPPORTED_MODELS, MusenJob, model_kind
+from fibrelmp.translate.musen.script_parse import (MUSEN_MODELS, REFUSED_MODEL, SUPPORTED_MODELS,
+                                                   MusenJob, model_kind)
 
 MODEL_PARAMETERS = {"ModelSBElastic": {"CONSIDER_BREAKAGE": 1.0},    # AddParameter(...) defaults
                     "ModelSBKelvin": {"CONSIDER_BREAKAGE": 1.0, "MAX_DAMP_RATIO": 1.0}}
@@ -34,9 +35,16 @@ def _resolve_models(model: GranularModel, job: MusenJob) -> dict[str, tuple[str,
             kind, choice = _model_choice(model, spec, model.source, None)
             chosen[kind] = choice
     for spec in job.models:
+        if spec.name.startswith(REFUSED_MODEL):    # check's stand-in for a model refused above
+            continue
         kind, choice = _model_choice(model, spec, job.path, spec.line)
         chosen[kind] = choice
     return chosen
+
+
+def accepted_models(kind: str) -> list[str]:
+    """The MUSEN models of ``kind`` fibrelmp translates (with its LAMMPS styles, if any)."""
+    return ([SUPPORTED_MODELS[kind]] if kind in SUPPORTED_MODELS else []) + list(STYLE_MODELS.get(kind, {}))
 
 
 def _model_choice(model: GranularModel, spec, path, line: int | None) -> tuple[str, tuple[str, dict]]:
@@ -61,9 +69,11 @@ def _model_choice(model: GranularModel, spec, path, line: int | None) -> tuple[s
     elif SUPPORTED_MODELS.get(kind) != spec.name:
         what = {"PP": "particle-particle", "PW": "particle-wall", "SB": "solid-bond",
                 "LB": "liquid-bond", "EF": "external-force"}[kind]
-        ok = SUPPORTED_MODELS.get(kind)
+        ok = [f"{name} (with fibrelmp's LAMMPS styles)" if name in STYLE_MODELS.get(kind, {})
+              else name for name in accepted_models(kind)]
         raise InputError(path, line, f"{where}{spec.name}: this {what} model is not supported"
-                         + (f"; fibrelmp translates {ok} only" if ok else "")
+                         + (f"; fibrelmp translates {' and '.join(ok)}" if ok
+                            else f"; fibrelmp translates no {what} model")
                          + ("; name another in the job script (MODEL_" + kind + ")" if line is None else ""))
     params = dict(MODEL_PARAMETERS.get(spec.name, {}))
     tok = spec.params.split()

@@ -20,7 +20,7 @@ from typing import Any, BinaryIO, Iterator
 import numpy as np
 
 from fibrelmp.errors import InputError
-from fibrelmp.translate.musen.mdem import timepoints
+from fibrelmp.translate.musen.mdem import bounds, timepoints
 from fibrelmp.translate.musen.mdem.container import Container, ContainerWriter, Layout
 from fibrelmp.translate.musen.mdem.messages import new
 
@@ -29,14 +29,15 @@ PLAIN = 1             # kProtoBuf
 _LEVEL = 1            # MUSEN's GzipOutputStream compression level
 
 
-def _inflate(data: bytes, limit: int | None, what: str, path: Path) -> bytes:
-    """zlib data, decompressed (at most ``limit`` bytes if given)."""
+def _inflate(data: bytes, limit: int | None, what: str, path: Path,
+             limit_is: str = "its descriptor says") -> bytes:
+    """zlib data, decompressed (at most ``limit`` bytes if given: memory holds no more)."""
     d = zlib.decompressobj()
     try:
-        out = d.decompress(data, limit if limit else 0)
+        out = d.decompress(data, 0 if limit is None else max(limit, 1))
         if limit is not None and (d.unconsumed_tail or len(out) > limit):
-            raise InputError(path, None, f"corrupt .mdem file: {what} is larger than its "
-                             f"descriptor says ({limit} bytes)")
+            raise InputError(path, None, f"corrupt .mdem file: {what} is larger than "
+                             f"{limit_is} ({limit} bytes)")
         if not d.eof:
             raise InputError(path, None, f"truncated .mdem file: {what} ends early")
     except zlib.error as exc:
@@ -54,9 +55,10 @@ class MdemFile:
         self.container = Container(self.path)
         try:
             packed = self.container.read(0, 0, self.container.sizes[0])
-            # a scene compresses a few times (MUSEN's examples: 2.6x-6.5x); far more is a bomb
-            raw = _inflate(packed, 200 * len(packed) + (16 << 20), "the scene (file thread 0)",
-                           self.path)
+            raw = _inflate(packed, bounds.scene_limit(len(packed)), "the scene (file thread 0)",
+                           self.path, f"a MUSEN scene of {len(packed)} stored bytes decompresses "
+                           f"to ({bounds.SCENE_RATIO}x + {bounds.SCENE_SLACK >> 20} MiB)")
+            self._check_scene_messages(raw, len(packed))
             try:
                 self.storage: Any = new("ProtoSimulationStorage", raw)
             except DecodeError:
@@ -67,6 +69,23 @@ class MdemFile:
         except BaseException:
             self.container.close()
             raise
+
+    def _check_scene_messages(self, raw: bytes, stored: int) -> None:
+        """Count the scene's messages on the wire before protobuf allocates them (~80 bytes
+        each, from 2 bytes of wire): at most ``bounds.message_budget`` of its stored size."""
+        budget = bounds.message_budget(stored)
+        try:
+            bounds.count_messages(raw, "ProtoSimulationStorage", budget)
+        except bounds.TooMany:
+            raise InputError(self.path, None, f"corrupt .mdem file: the scene (file thread 0, "
+                             f"{stored} bytes stored) lists more than {budget} objects and other "
+                             f"entries, more than a MUSEN file of its size holds (at most "
+                             f"{bounds.MESSAGES_PER_BYTE} per stored byte + "
+                             f"{bounds.MESSAGES_SLACK}; each costs ~80 bytes of memory); "
+                             "refused before allocating them") from None
+        except ValueError as exc:
+            raise InputError(self.path, None, f"corrupt .mdem file: the scene message cannot "
+                             f"be decoded ({exc})") from None
 
     def _check_blocks(self) -> None:
         size = self.container.sizes[1]
@@ -84,6 +103,41 @@ class MdemFile:
                 raise InputError(self.path, None, f"unsupported .mdem file: time-point block {i} "
                                  f"has storage format {d.format}")
         self.block_times = [d.start_time for d in self.storage.data_blocks]
+        self._block_limits = self._check_block_sizes()
+
+    def _check_block_sizes(self) -> list[int]:
+        """The most bytes each time-point block may decompress to: its declared size, which
+        must fit both zlib's largest expansion of its stored bytes and what its time points
+        can hold for the scene's objects (``bounds.block_bound``); checked for every block
+        here, before any is decompressed."""
+        entries = len(self.storage.info.particles)
+        # distinct: MUSEN writes one time point per time (and one per block)
+        saved = np.unique(np.array(self.storage.info.savedTimePoints, dtype=float))
+        # a block holds the saved times from its start up to the next block's (one where the
+        # file lists no saved times)
+        starts = np.array(self.block_times + [np.inf])
+        counts = (np.searchsorted(saved, starts[1:]) - np.searchsorted(saved, starts[:-1])
+                  if saved.size else np.ones(len(self.block_times), int))
+        limits = []
+        self._block_points = []
+        for i, d in enumerate(self.storage.data_blocks):
+            points = max(int(counts[i]), 1)
+            self._block_points.append(points)
+            need = bounds.block_bound(entries, points)
+            if d.format != ZIPPED:
+                limits.append(d.size)
+                continue
+            where = f"corrupt .mdem file: time-point block {i} declares {d.uncompressed_size} bytes"
+            if d.uncompressed_size > bounds.ZLIB_MAX_RATIO * d.size + 64:
+                raise InputError(self.path, None, f"{where} from {d.size} stored bytes, more than "
+                                 f"zlib can expand them to ({bounds.ZLIB_MAX_RATIO}x)")
+            if d.uncompressed_size > need:
+                raise InputError(self.path, None, f"{where}, more than {points} time "
+                                 f"point(s) of a scene of {entries} objects can take (at most "
+                                 f"{need} bytes: {bounds.MAX_ENTRY} per object entry); refused "
+                                 "before decompressing it")
+            limits.append(d.uncompressed_size)
+        return limits
 
     def _check_layout(self) -> None:
         """Files of header version 0 may keep the oldest time-point layout (Euler angles,
@@ -127,7 +181,7 @@ class MdemFile:
         d = self.storage.data_blocks[index]
         raw = self.block_raw(index)
         if d.format == ZIPPED:
-            raw = _inflate(raw, d.uncompressed_size, f"time-point block {index}", self.path)
+            raw = _inflate(raw, self._block_limits[index], f"time-point block {index}", self.path)
         return raw
 
     def block(self, index: int) -> Any:
@@ -142,18 +196,52 @@ class MdemFile:
 
     def time_points(self, decode: bool = True) -> Iterator[tuple[float, np.ndarray, np.ndarray] | tuple[float]]:
         """Every stored time point in order: (time, values (n, 34), masks (n,)) -- see
-        ``timepoints`` -- one block in memory at a time; ``decode=False`` gives (time,)."""
+        ``timepoints`` -- one time point in memory at a time (blocks are decompressed as
+        they are read); ``decode=False`` gives (time,)."""
+        # entries of removed trailing objects may outlast the object list a little; far more
+        # is a hostile file (each empty entry costs 2 bytes, 276 decoded)
+        most = bounds.objects_per_point(len(self.info.particles))
         for index in range(len(self.storage.data_blocks)):
             try:
-                for payload in _messages(self.block_bytes(index), 2):
-                    # entries of removed trailing objects may outlast the object list a little;
-                    # far more is a hostile file (each empty entry costs 2 bytes, 272 decoded)
-                    point = (timepoints.decode(payload, 2 * len(self.info.particles) + 1024) if decode
-                             else (timepoints.time_of(payload),))
-                    yield point
+                for payload in self._point_payloads(index):
+                    yield timepoints.decode(payload, most) if decode else (timepoints.time_of(payload),)
             except ValueError as exc:
                 raise InputError(self.path, None, f"corrupt .mdem file: time-point block "
                                  f"{index}: {exc}") from None
+
+    def _point_payloads(self, index: int) -> Iterator[bytes]:
+        """The serialized time points of block ``index`` (field 2 of its
+        ``ProtoBlockOfTimePoints``; other fields skipped), decompressed as they are read: at
+        most ``bounds.block_bound(n, 1)`` bytes each and as many as the block's saved times."""
+        d = self.storage.data_blocks[index]
+        stream = _BlockStream(self.block_raw(index), d.format == ZIPPED, self._block_limits[index],
+                              f"time-point block {index}", self.path)
+        most_bytes = bounds.block_bound(len(self.info.particles), 1)
+        points = 0
+        while not stream.done():
+            tag = stream.varint()
+            if tag < 8:                  # field number 0: not protobuf (e.g. a run of zeros)
+                raise ValueError("field number 0 (not a protobuf message)")
+            wire = tag & 7
+            if wire == 2:
+                size = stream.varint()
+                if tag >> 3 != 2:
+                    stream.skip(size)
+                    continue
+                if size > most_bytes:
+                    raise ValueError(f"a time point of {size} bytes, more than the scene's "
+                                     f"{len(self.info.particles)} objects can take ({most_bytes})")
+                points += 1
+                if points > self._block_points[index]:
+                    raise ValueError(f"more than the {self._block_points[index]} time point(s) "
+                                     "the file's saved times place in it")
+                yield stream.read(size)
+            elif wire == 0:
+                stream.varint()
+            elif wire in (1, 5):
+                stream.skip(8 if wire == 1 else 4)
+            else:
+                raise ValueError(f"unknown wire type {wire}")
 
     # -- whole file -----------------------------------------------------------------------
     def copy_to(self, fh: BinaryIO) -> None:
@@ -163,6 +251,14 @@ class MdemFile:
         layout: Layout = self.container.layout()
         out = ContainerWriter(fh, layout)
         for index, d in enumerate(self.storage.data_blocks):
+            # read through once a time point at a time (one in memory), so that a block of
+            # garbage is refused before it is decompressed whole
+            try:
+                for _ in self._point_payloads(index):
+                    pass
+            except ValueError as exc:
+                raise InputError(self.path, None, f"corrupt .mdem file: time-point block "
+                                 f"{index}: {exc}") from None
             stored = self.block_raw(index)
             block = self.block(index).SerializeToString()
             again = zlib.compress(block, _LEVEL) if d.format == ZIPPED else block
@@ -222,6 +318,69 @@ class MdemWriter:
         self.out.finish()
 
 
+class _BlockStream:
+    """A time-point block's bytes, decompressed 1 MiB at a time as they are read (at most
+    ``limit`` bytes in all: the block's declared size); ValueError past its end."""
+
+    _CHUNK = 1 << 20
+
+    def __init__(self, raw: bytes, zipped: bool, limit: int, what: str, path: Path):
+        self.inflater = zlib.decompressobj() if zipped else None
+        self.pending = raw if zipped else b""
+        self.buf = bytearray() if zipped else bytearray(raw)
+        self.pos = 0
+        self.total = 0 if zipped else len(raw)
+        self.limit, self.what, self.path = limit, what, path
+
+    def _fill(self, need: int) -> None:
+        while len(self.buf) - self.pos < need and self.inflater is not None and not self.inflater.eof:
+            try:
+                # what is needed in one piece (a time point is bounded before it is read)
+                out = self.inflater.decompress(self.pending,
+                                               max(self._CHUNK, need - len(self.buf) + self.pos))
+            except zlib.error as exc:
+                raise InputError(self.path, None, f"corrupt .mdem file: {self.what} cannot be "
+                                 f"decompressed ({exc})") from None
+            self.pending = self.inflater.unconsumed_tail
+            self.total += len(out)
+            if self.total > self.limit:
+                raise InputError(self.path, None, f"corrupt .mdem file: {self.what} is larger "
+                                 f"than its descriptor says ({self.limit} bytes)")
+            if not out and not self.pending and not self.inflater.eof:
+                raise InputError(self.path, None, f"truncated .mdem file: {self.what} ends early")
+            if self.pos == len(self.buf):
+                self.buf, self.pos = bytearray(out), 0
+            else:
+                del self.buf[:self.pos]
+                self.pos = 0
+                self.buf += out
+
+    def done(self) -> bool:
+        self._fill(1)
+        return len(self.buf) == self.pos
+
+    def read(self, size: int) -> bytes:
+        self._fill(size)
+        if len(self.buf) - self.pos < size:
+            raise ValueError("a field runs past its message")
+        with memoryview(self.buf) as view:
+            out = bytes(view[self.pos:self.pos + size])
+        self.pos += size
+        return out
+
+    def skip(self, size: int) -> None:
+        while size:
+            step = min(size, self._CHUNK)
+            self.read(step)
+            size -= step
+
+    def varint(self) -> int:
+        self._fill(10)
+        value, at = _varint(self.buf, self.pos)
+        self.pos = at
+        return value
+
+
 def _varint(data: bytes, at: int) -> tuple[int, int]:
     value = shift = 0
     while True:
@@ -233,30 +392,6 @@ def _varint(data: bytes, at: int) -> tuple[int, int]:
         if byte < 0x80:
             return value, at
         shift += 7
-
-
-def _messages(data: bytes, field: int) -> Iterator[memoryview]:
-    """The payloads of length-delimited ``field`` of a serialized message (others skipped),
-    without decoding them: a block's time points go straight to the array decoder."""
-    view, at = memoryview(data), 0
-    while at < len(data):
-        tag, at = _varint(data, at)
-        kind = tag & 7
-        if kind == 2:
-            size, at = _varint(data, at)
-            if at + size > len(data):
-                raise ValueError("a field runs past its message")
-            if tag >> 3 == field:
-                yield view[at:at + size]
-            at += size
-        elif kind == 0:
-            _, at = _varint(data, at)
-        elif kind in (1, 5):
-            at += 8 if kind == 1 else 4
-        else:
-            raise ValueError(f"unknown wire type {kind}")
-    if at != len(data):
-        raise ValueError("the last field runs past its message")
 
 
 def _field2(payload: bytes) -> bytes:

@@ -18,6 +18,8 @@ from __future__ import annotations
 
 import json
 import math
+import os
+import re
 import shutil
 import sys
 from pathlib import Path
@@ -462,3 +464,93 @@ def test_motion_from_a_series_of_meshes(tmp_path):
     crossed = summary["openings"]["top"]["crossed_particles"]
     assert crossed > 0
     assert summary["particles"]["fluid_start"] == summary["particles"]["fluid_end"] + crossed
+
+
+# ------------------------------------------------------------------------------------------
+# hostile case files (issue 24): each is `path: message` on the CLI, exit 2, no traceback,
+# nothing written, and an InputError (never SystemExit) from the Python API
+def _cli(*args):
+    from typer.testing import CliRunner
+
+    from fibrelmp.cli import app
+
+    result = CliRunner().invoke(app, [str(a) for a in args])
+    return result, result.output + (result.stderr if result.stderr_bytes is not None else "")
+
+
+def _refused(case: Path, message: str) -> None:
+    folder = case.parent
+    before = {p: p.stat().st_mtime_ns for p in folder.rglob("*")}
+    result, output = _cli("run", case)
+    assert result.exit_code == 2, output
+    assert "error: " in output and message in output and "Traceback" not in output, output
+    assert {p: p.stat().st_mtime_ns for p in folder.rglob("*")} == before
+    with pytest.raises(InputError, match=re.escape(message)):
+        python_api.check(case)
+
+
+def _edit_elem(tmp: Path) -> None:
+    lines = (tmp / "piston_tube.elem").read_text().splitlines()
+    lines[1] = " ".join(lines[1].split()[:-1] + ["1" + "0" * 23])       # an exact integer, 1e23
+    (tmp / "piston_tube.elem").write_text("\n".join(lines) + "\n")
+
+
+def _lying_vtu(tmp: Path) -> None:
+    text = (tmp / "cube.vtu").read_text()
+    (tmp / "cube.vtu").write_text(text.replace('NumberOfCells="12"', 'NumberOfCells="999999999"'))
+
+
+@pytest.mark.parametrize("make, message", [
+    (lambda tmp: (_copy(tmp), _edit_elem(tmp))[0], "piston_tube.elem:2: region tag 1" + "0" * 23),
+    (lambda tmp: _bad(tmp, lambda d: d["motion"].update(file="piston\0tube.dynpt")),
+     "motion.file: a file name cannot contain a NUL character"),
+    (lambda tmp: _bad(tmp, lambda d: d["mesh"].update(file="")), "mesh.file: an empty file name"),
+    (lambda tmp: (_cube(tmp), (tmp / "cube.vtu").write_bytes(np.random.default_rng(1).bytes(4000)))[0],
+     "cube.vtu: cannot read as a VTK mesh"),
+    (lambda tmp: (_cube(tmp), _lying_vtu(tmp))[0], "cube.vtu: cannot read as a VTK mesh"),
+])
+def test_hostile_mesh_and_path_keys_are_input_errors(tmp_path, make, message):
+    """An .elem region tag of 1e23 (was OverflowError), a NUL in motion.file (was ValueError:
+    embedded null byte), a .vtu of random bytes or a lying NumberOfCells (was meshio's
+    sys.exit(1): exit 1 without an error line, SystemExit from fibrelmp.check())."""
+    _refused(make(tmp_path), message)
+
+
+@pytest.mark.parametrize("edit, message", [
+    (lambda d: d["fluid"].update(sound_speed=1e12), "fluid.sound_speed: 1e+12 m/s: at most 100000 m/s"),
+    (lambda d: d["run"].update(time_step=1e-15), "1e+13 steps; LAMMPS counts a run's steps in 32-bit integers"),
+    (lambda d: d["openings"][0].update(search_distance=1e300),
+     "openings[0].search_distance: 1e+300 m: must be from fluid.spacing"),
+    (lambda d: d["output"].update(name="a" * 300), "over the 255-byte limit"),
+    (lambda d: d["fluid"].update(spacing=1e-300), "lattice cells (at most 4,000,000)"),
+    (lambda d: (d["run"].update(time_step=1e-9), d["output"].update(interval=1e-9)), "frames: at most 100000"),
+    (lambda d: (d["run"].update(time_step=1e-9), d["output"].update(series_interval=1e-9)), "rows per opening"),
+])
+def test_impossible_runs_are_refused_before_anything_is_written(tmp_path, edit, message):
+    """Were LAMMPS's 'Integer out of range', numpy overflow + 'Bad grid of processors' and
+    'File name too long' after the work folder was written (exit 1)."""
+    if "255-byte" in message and os.pathconf(tmp_path, "PC_NAME_MAX") != 255:
+        pytest.skip("the folder's file system has another name limit")
+    _refused(_bad(tmp_path, edit), message)
+
+
+def test_relative_mesh_series_runs_from_the_case_folder(tmp_path, monkeypatch):
+    """motion.meshes by relative names, run as `fibrelmp run cube.json` from the case's own
+    folder: the later frames were opened after the runner changed into the work folder."""
+    import meshio
+
+    frames = []
+    for k in range(3):
+        points = CUBE_POINTS.copy()
+        points[:4, 2] += 2e-5 * k
+        meshio.write(tmp_path / f"cube_{k}.vtu", meshio.Mesh(points, [("triangle", np.array(CUBE_TRIANGLES))],
+                                                            cell_data={"region": [np.array(CUBE_TAGS)]}))
+        frames.append(f"cube_{k}.vtu")
+    _cube(tmp_path, mesh="cube_0.vtu", motion={"meshes": frames, "frame_interval": 1e-4}, run={"end_time": 2e-4})
+    monkeypatch.chdir(tmp_path)
+    result, output = _cli("run", "cube.json")
+    assert result.exit_code == 0, output
+    walls = list(iter_frames(tmp_path / "cube_work" / "moving_walls.dump"))
+    z0 = walls[0].columns["z"]
+    # the floor's wall particles (below z = 0) are 40 um higher at the end: the last frame was read
+    np.testing.assert_allclose((walls[-1].columns["z"] - z0)[z0 < 0], 4e-5, atol=1e-13)

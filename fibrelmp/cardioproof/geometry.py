@@ -23,6 +23,7 @@ Rules (docs/cardioproof.md):
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Iterator
@@ -36,6 +37,10 @@ if TYPE_CHECKING:
     from fibrelmp.cardioproof.case import SphCase
 
 SHELL = ("triangle", "quad")
+# memory bounds (docs/cardioproof.md): the fluid lattice over the mesh's bounding box and the
+# wall's fine samples are arrays of this many points at most (~100 bytes each while built)
+MAX_LATTICE = 4_000_000
+MAX_WALL_SAMPLES = 4_000_000
 
 
 def shell_elements(mesh: Mesh, source: Path | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -147,7 +152,13 @@ def enclosed_volume(x: np.ndarray, tri: np.ndarray) -> float:
 def sample(x: np.ndarray, tri: np.ndarray, spacing: float) -> tuple[np.ndarray, np.ndarray]:
     """Points on the triangles, at most ``spacing`` apart: (triangle row (m,), barycentric
     coordinates (m, 3))."""
-    parts = np.maximum(np.ceil(edge_lengths(x, tri) / spacing), 1).astype(np.int64)
+    parts = np.maximum(np.ceil(edge_lengths(x, tri) / spacing), 1)
+    # (n + 1)(n + 2) / 2 samples per triangle, counted in floating point before anything is made
+    count = float(((parts + 1) * (parts + 2) / 2).sum())
+    if not count <= MAX_WALL_SAMPLES:
+        raise InputError(None, None, f"the wall triangles at fluid.spacing / 3 would be {count:.3g} "
+                         f"samples (at most {MAX_WALL_SAMPLES:,}): a coarser fluid.spacing")
+    parts = parts.astype(np.int64)
     rows, bary = [], []
     for n in np.unique(parts):
         which = np.flatnonzero(parts == n)
@@ -207,11 +218,22 @@ def wall_particles(x: np.ndarray, tri: np.ndarray, spacing: float, layers: int,
     return WallParticles(np.concatenate(keep_rows), np.concatenate(keep_bary), np.concatenate(keep_layer))
 
 
+def lattice_counts(x: np.ndarray, spacing: float) -> np.ndarray:
+    """(3,) lattice cells along each side of the bounding box of ``x``; at most MAX_LATTICE
+    in all (checked before anything of that size is made)."""
+    cells = np.maximum(np.floor(np.ptp(x, axis=0) / spacing), 1)
+    total = math.prod(cells.tolist())          # Python floats: inf rather than a numpy warning
+    if not total <= MAX_LATTICE:
+        raise InputError(None, None, f"fluid.spacing {spacing:g} m cuts the mesh's bounding box into "
+                         f"{total:.3g} lattice cells (at most {MAX_LATTICE:,}): a coarser spacing")
+    return cells.astype(np.int64)
+
+
 def fluid_points(x: np.ndarray, tri: np.ndarray, spacing: float) -> np.ndarray:
     """Cell centres of a cubic lattice over the bounding box that are inside the closed
     surface ``tri``."""
     lo, hi = x.min(axis=0), x.max(axis=0)
-    counts = np.maximum(np.floor((hi - lo) / spacing).astype(np.int64), 1)
+    counts = lattice_counts(x, spacing)
     # the lattice is centred in the box, so a box-aligned wall is half a spacing from the
     # nearest points on both sides
     start = lo + 0.5 * ((hi - lo) - counts * spacing)

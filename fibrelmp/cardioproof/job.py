@@ -188,7 +188,7 @@ def _plan(case: SphCase) -> dict:
     dx = case.spacing
     margin = (case.layers + 2) * dx + max((3 * o.search_distance for o in case.openings), default=0.0)
     box_lo, box_hi = lo - margin, hi + margin
-    fluid = geometry.fluid_points(x0, tri, dx)
+    fluid = geometry.fluid_points(x0, tri, dx, wall_tri)
     if not len(fluid):
         raise InputError(case.source, None, "the walls and openings enclose no fluid: they must close "
                          f"the cavity, and the cavity must be wider than fluid.spacing {dx:g} m")
@@ -336,7 +336,7 @@ def pressure_expression(table: np.ndarray) -> str:
     return expr
 
 
-def opening_context(o: OpeningGeometry) -> dict:
+def opening_context(o: OpeningGeometry, particle_volume: float) -> dict:
     """What the script says about an opening: its region, deletion and variable commands
     (rendered again, after the deletions, when a moving opening is put in its next place)."""
     f = float_text
@@ -374,8 +374,12 @@ def opening_context(o: OpeningGeometry) -> dict:
                  *(f"variable        f{a}_{name} atom v_F_{name}*({na})*v_w_{name}/v_wsum_{name}"
                    for a, na in zip("xyz", (nx, ny, nz))),
                  # the fluid's normal velocity relative to the opening's
-                 f"variable        vn_{name} atom vx*({nx})+vy*({ny})+vz*({nz})-({f(float(o.velocity @ n))})",
-                 f"variable        flux_{name} equal {area}*c_vn_{name}"]
+                 # times the particle's SPH volume m / rho: the near slab's volume flux is sum(V v_n) / d
+                 # (it counts the fluid that is there and its expansion; A x the mean v_n counted
+                 # particles, and read high when the slab was not full: near a wall's clearance)
+                 f"variable        vn_{name} atom (vx*({nx})+vy*({ny})+vz*({nz})-({f(float(o.velocity @ n))}))"
+                 "*mass/c_rho",
+                 f"variable        flux_{name} equal c_vn_{name}/{f(d)}"]
     return dict(name=name, nx=nx, ny=ny, nz=nz, area=area, d=f(d), pressure=pressure_expression(o.pressure),
                 regions=regions, deletes=deletes, variables=variables, series=o.series_name())
 
@@ -401,10 +405,11 @@ def write_job(case: SphCase, folder: str | Path, write_files: bool = True) -> tu
         frame = step // frame_steps if frames_matter and step % frame_steps == 0 and step // frame_steps < intervals \
             else None
         # a moving opening is put where the mesh is halfway through each motion interval
-        redefine = [opening_context(shapes[frame]) for shapes in moving_openings.values()] if frame else []
+        redefine = [opening_context(shapes[frame], p["particle_volume"]) for shapes in moving_openings.values()] \
+            if frame else []
         chunks.append(dict(step=step, frame=frame, save=step in p["saves"], redefine=redefine,
                            run=(events[k + 1] - step) if k + 1 < len(events) else 0))
-    openings = [opening_context(moving_openings[o.name][0] if o.name in moving_openings else o)
+    openings = [opening_context(moving_openings[o.name][0] if o.name in moving_openings else o, p["particle_volume"])
                 for o in p["openings"]]
     script = template_environment().get_template("sph.lammps.j2").render(
         case=case, fmt=float_text, data_name=DATA_NAME, frames_name=FRAMES_NAME, walls_name=WALLS_NAME,

@@ -197,5 +197,7 @@ class SphRecorder:
             "particles": {"kind": "sph", "fluid_start": job.fluid_count, "wall": walls,
                           "fluid_end": self.final.get("fluid")},
             "openings": openings, "final_step": self.final.get("step"),
+            # fluid particles beyond a wall's surface at the saved frames (BeyondWalls)
+            "fluid_beyond_walls": tally,
             "warnings": warning_counts(warnings),
         }

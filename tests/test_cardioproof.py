@@ -529,10 +529,16 @@ def test_hostile_mesh_and_path_keys_are_input_errors(tmp_path, make, message):
     (lambda d: d["fluid"].update(spacing=1e-300), "lattice cells (at most 4,000,000)"),
     (lambda d: (d["run"].update(time_step=1e-9), d["output"].update(interval=1e-9)), "frames: at most 100000"),
     (lambda d: (d["run"].update(time_step=1e-9), d["output"].update(series_interval=1e-9)), "rows per opening"),
+    (lambda d: d["openings"][0].update(pressure=1e300), "above the Tait stiffness B = c0^2 rho0 / 7 = 3571.43 Pa"),
+    (lambda d: d["fluid"].update(density=1e-300), "fluid.density: 1e-300 kg/m^3: expected 0.001 to 100000"),
+    (lambda d: d["fluid"].update(artificial_viscosity=1e300), "fluid.artificial_viscosity: 1e+300: at most 10"),
+    (lambda d: d["mesh"].update(unit=1e300), "mesh.unit: the mesh spans 2e+303 m"),
 ])
 def test_impossible_runs_are_refused_before_anything_is_written(tmp_path, edit, message):
     """Were LAMMPS's 'Integer out of range', numpy overflow + 'Bad grid of processors' and
-    'File name too long' after the work folder was written (exit 1)."""
+    'File name too long' after the work folder was written (exit 1); a pressure of 1e300 Pa or
+    an artificial viscosity of 1e300 ran to exit 0 with most fluid lost, a density of 1e-300
+    ended in LAMMPS's 'Non-numeric atom coords' (exit 1)."""
     if "255-byte" in message and os.pathconf(tmp_path, "PC_NAME_MAX") != 255:
         pytest.skip("the folder's file system has another name limit")
     _refused(_bad(tmp_path, edit), message)

@@ -38,6 +38,9 @@ CFL = 0.1                      # dt <= CFL h / c0 (LAMMPS's SPH examples)
 # the weakly compressible model needs c0 >= 10x the fastest flow; above this (70x water's real
 # 1480 m/s) the Tait pressure's B = c0^2 rho0 / 7 and the step count only grow
 MAX_SOUND_SPEED = 1e5          # m/s
+DENSITY_RANGE = (1e-3, 1e5)    # kg/m^3: thin gas .. 7x mercury (a tiny one gave NaN positions)
+MAX_ARTIFICIAL_VISCOSITY = 10.0   # Monaghan's alpha: LAMMPS's examples use 0.1 .. 1
+EXTENT_RANGE = (1e-9, 1e3)     # m: the mesh's largest extent (catches a wrong mesh.unit)
 KEYS = {"cardioproof", "mesh", "motion", "fluid", "wall", "openings", "run", "output", "comment"}
 # the keys of each object (a misspelt key must not silently give a default)
 OBJECT_KEYS = {
@@ -138,10 +141,16 @@ def read_case(path: str | Path) -> SphCase:
     mesh_file = _file(j, mesh_spec.get("file"), "mesh.file", folder)
     unit = mesh_spec.get("unit")
     mesh = read_mesh(mesh_file, None if unit is None else j.number(unit, "mesh.unit", positive=True))
+    extent = float(np.ptp(mesh.points_m, axis=0).max()) if len(mesh.points) else 0.0
+    if not EXTENT_RANGE[0] <= extent <= EXTENT_RANGE[1]:
+        j.fail("mesh.unit" if unit is not None else "mesh.file", f"the mesh spans {extent:g} m: expected "
+               f"{EXTENT_RANGE[0]:g} to {EXTENT_RANGE[1]:g} m (is mesh.unit, metres per coordinate unit, right?)")
 
     fluid = _known(j, j.obj(doc.get("fluid"), "fluid"), "fluid", "fluid")
     dx = j.number(fluid.get("spacing"), "fluid.spacing", positive=True)
     density = j.number(fluid.get("density", 1000.0), "fluid.density", positive=True)
+    if not DENSITY_RANGE[0] <= density <= DENSITY_RANGE[1]:
+        j.fail("fluid.density", f"{density:g} kg/m^3: expected {DENSITY_RANGE[0]:g} to {DENSITY_RANGE[1]:g}")
     if "viscosity" in fluid and "artificial_viscosity" in fluid:
         j.fail("fluid", "give either viscosity (laminar, Morris) or artificial_viscosity (Monaghan's "
                "alpha): LAMMPS's Tait-water styles take one of them")
@@ -152,6 +161,9 @@ def read_case(path: str | Path) -> SphCase:
         alpha = None
     elif "artificial_viscosity" in fluid:
         alpha = j.number(fluid["artificial_viscosity"], "fluid.artificial_viscosity", minimum=0.0)
+        if alpha > MAX_ARTIFICIAL_VISCOSITY:
+            j.fail("fluid.artificial_viscosity", f"{alpha:g}: at most {MAX_ARTIFICIAL_VISCOSITY:g} "
+                   "(Monaghan's alpha is usually 0.01 to 1)")
     c0 = fluid.get("sound_speed")
     c0 = None if c0 is None else j.number(c0, "fluid.sound_speed", positive=True)
     if c0 is not None and c0 > MAX_SOUND_SPEED:

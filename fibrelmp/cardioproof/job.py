@@ -212,6 +212,13 @@ def _plan(case: SphCase) -> dict:
     particle_volume = volume / len(fluid)
     wall_moving = moved[wall_tri[walls.rows]].any(axis=1)
     c0 = sound_speed(case, wall_speed)
+    pmax = max((float(np.abs(o.pressure[:, 1]).max()) for o in case.openings), default=0.0)
+    stiffness = c0 * c0 * case.density / 7.0
+    if pmax > stiffness:
+        # Tait water at p = B is 10 % denser (2^(1/7)): far outside the weakly compressible model
+        raise InputError(case.source, None, f"an opening's pressure {pmax:g} Pa is above the Tait stiffness "
+                         f"B = c0^2 rho0 / 7 = {stiffness:g} Pa (it would compress the water by over 10 %): "
+                         f"fluid.sound_speed at least {math.sqrt(7 * pmax / case.density):.3g} m/s")
     dt = time_step(case, c0)
     _step_counts(case, dt)                   # the run's length first (dt only shrinks below)
     if case.motion is not None:

@@ -42,6 +42,7 @@ SHELL = ("triangle", "quad")
 # wall's fine samples are arrays of this many points at most (~100 bytes each while built)
 MAX_LATTICE = 4_000_000
 MAX_WALL_SAMPLES = 4_000_000
+CHUNK = 262_144               # points a triangle's distance test takes at once
 
 
 def shell_elements(mesh: Mesh, source: Path | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -266,10 +267,12 @@ def nearest_within(x: np.ndarray, tri: np.ndarray, q: np.ndarray, limit: float) 
     stop = np.searchsorted(sx, hi[:, 0], "right")
     nearest = np.full(len(q), np.inf)
     for k in np.flatnonzero(stop > start):
-        rows = order[start[k]:stop[k]]
-        rows = rows[np.all((q[rows, 1:] >= lo[k, 1:]) & (q[rows, 1:] <= hi[k, 1:]), axis=1)]
-        if len(rows):
-            nearest[rows] = np.minimum(nearest[rows], triangle_distance(q[rows], a[k], b[k], c[k]))
+        # in chunks: a large slanted triangle's box can hold the whole lattice
+        for first in range(start[k], stop[k], CHUNK):
+            rows = order[first:min(first + CHUNK, stop[k])]
+            rows = rows[np.all((q[rows, 1:] >= lo[k, 1:]) & (q[rows, 1:] <= hi[k, 1:]), axis=1)]
+            if len(rows):
+                nearest[rows] = np.minimum(nearest[rows], triangle_distance(q[rows], a[k], b[k], c[k]))
     nearest[nearest >= limit] = np.inf
     return nearest
 

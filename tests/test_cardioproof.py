@@ -499,6 +499,17 @@ def _edit_elem(tmp: Path) -> None:
     (tmp / "piston_tube.elem").write_text("\n".join(lines) + "\n")
 
 
+def _edit_dynpt(case: Path, old: bytes, new: bytes) -> Path:
+    """``case`` with one item of its .dynpt's header replaced (the 1024-byte header kept)."""
+    tmp = case.parent
+    data = (tmp / "piston_tube.dynpt").read_bytes()
+    assert old in data[:1024]
+    head = data[:1024].replace(old, new)
+    head = head[:1023].ljust(1023) + b"\f" if len(head) >= 1024 else head[:-1].ljust(1023) + b"\f"
+    (tmp / "piston_tube.dynpt").write_bytes(head + data[1024:])
+    return case
+
+
 def _lying_vtu(tmp: Path) -> None:
     text = (tmp / "cube.vtu").read_text()
     (tmp / "cube.vtu").write_text(text.replace('NumberOfCells="12"', 'NumberOfCells="999999999"'))
@@ -509,6 +520,10 @@ def _lying_vtu(tmp: Path) -> None:
     (lambda tmp: _bad(tmp, lambda d: d["motion"].update(file="piston\0tube.dynpt")),
      "motion.file: a file name cannot contain a NUL character"),
     (lambda tmp: _bad(tmp, lambda d: d["mesh"].update(file="")), "mesh.file: an empty file name"),
+    (lambda tmp: _edit_dynpt(_bad(tmp, lambda d: d["motion"].pop("frame_interval")), b"inc_t:0.5", b"inc_t:0.0"),
+     "piston_tube.dynpt: inc_t:0: the time between frames must be positive"),
+    (lambda tmp: _edit_dynpt(_bad(tmp, lambda d: None), b"x:266 ", b"x:266000000000000 "),
+     "the header says 21 frames of 266000000000000 nodes (67032000000001024 bytes) but the file has"),
     (lambda tmp: (_cube(tmp), (tmp / "cube.vtu").write_bytes(np.random.default_rng(1).bytes(4000)))[0],
      "cube.vtu: cannot read as a VTK mesh"),
     (lambda tmp: (_cube(tmp), _lying_vtu(tmp))[0], "cube.vtu: cannot read as a VTK mesh"),

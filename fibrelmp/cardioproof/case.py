@@ -235,6 +235,9 @@ def _motion(j: JsonDoc, spec: Any, folder: Path, mesh: Mesh) -> Motion | None:
             # openCARP's time unit is the millisecond (unites_t says otherwise)
             scale = 1.0 if reader.header.get("unites_t", "ms") == "s" else 1e-3
             interval = reader.inc_t * scale
+            if not interval > 0:
+                raise InputError(file, None, f"inc_t:{reader.inc_t:g}: the time between frames must be "
+                                 "positive (or give motion.frame_interval)")
         count, files, kind = reader.count, [file], "dynpt"
     elif "meshes" in spec:
         items = j.array(spec["meshes"], "motion.meshes")

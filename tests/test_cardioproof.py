@@ -18,6 +18,8 @@ from __future__ import annotations
 
 import json
 import math
+import os
+import re
 import shutil
 import sys
 from pathlib import Path
@@ -299,14 +301,18 @@ def test_a_moving_opening_is_placed_where_the_mesh_is_each_interval(moving_outle
     summary = result.summaries[0]
     assert summary["particles"]["fluid_start"] == (summary["particles"]["fluid_end"]
                                                    + summary["openings"]["outlet"]["crossed_particles"])
-    # through an outlet receding at 0.02 m/s: (0.1 - 0.02) x the piston area.  The tube's last
-    # quads stretch, so their wall particles open gaps (warned) and some fluid goes through:
-    # a looser bound than the static tube's (the computed stretch: 1.34x, below)
+    # through an outlet receding at 0.02 m/s a full cavity would pass (0.1 - 0.02) x the piston
+    # area.  The fluid does not follow the receding outlet: its near slab holds ~12 % fewer
+    # particles than the static outlet's, and the volume flux (velocity estimate, sum of the
+    # near particles' m/rho v_n / d) is 0.73 of it (the crossing estimate 0.63; with the fill
+    # without wall clearance 0.85 and 0.77; A x the mean v_n, the former estimate, said 0.985
+    # because it ignored the missing fluid).  A known limit (docs/cardioproof.md): bounded
+    # from both sides so a change either way shows
     steady = rows["time_s"] >= 5e-3
     q = opening.area * (SPEED - 0.02)
     velocity = rows["flux_velocity_m3_s"][steady].mean()
     print(f"moving outlet: velocity estimate / (A (u_piston - u_outlet)) = {velocity / q:.4f}")
-    assert abs(velocity / q - 1) < 0.10
+    assert 0.65 < velocity / q < 0.85
     # the stretch warned about: the last quads' diagonals grow from sqrt(h^2 + c^2) to
     # sqrt((h + 0.02 x 8 ms)^2 + c^2), h = 2 mm / 8 rows, c the 24-gon's chord
     chord, h = 2e-3 * math.sin(math.pi / 24), 2e-3 / 8
@@ -466,3 +472,192 @@ def test_motion_from_a_series_of_meshes(tmp_path):
     crossed = summary["openings"]["top"]["crossed_particles"]
     assert crossed > 0
     assert summary["particles"]["fluid_start"] == summary["particles"]["fluid_end"] + crossed
+
+
+# ------------------------------------------------------------------------------------------
+# hostile case files (issue 24): each is `path: message` on the CLI, exit 2, no traceback,
+# nothing written, and an InputError (never SystemExit) from the Python API
+def _cli(*args):
+    from typer.testing import CliRunner
+
+    from fibrelmp.cli import app
+
+    result = CliRunner().invoke(app, [str(a) for a in args])
+    return result, result.output + (result.stderr if result.stderr_bytes is not None else "")
+
+
+def _refused(case: Path, message: str) -> None:
+    folder = case.parent
+    before = {p: p.stat().st_mtime_ns for p in folder.rglob("*")}
+    result, output = _cli("run", case)
+    assert result.exit_code == 2, output
+    assert "error: " in output and message in output and "Traceback" not in output, output
+    assert {p: p.stat().st_mtime_ns for p in folder.rglob("*")} == before
+    with pytest.raises(InputError, match=re.escape(message)):
+        python_api.check(case)
+
+
+def _edit_elem(tmp: Path) -> None:
+    lines = (tmp / "piston_tube.elem").read_text().splitlines()
+    lines[1] = " ".join(lines[1].split()[:-1] + ["1" + "0" * 23])       # an exact integer, 1e23
+    (tmp / "piston_tube.elem").write_text("\n".join(lines) + "\n")
+
+
+def _edit_dynpt(case: Path, old: bytes, new: bytes) -> Path:
+    """``case`` with one item of its .dynpt's header replaced (the 1024-byte header kept)."""
+    tmp = case.parent
+    data = (tmp / "piston_tube.dynpt").read_bytes()
+    assert old in data[:1024]
+    head = data[:1024].replace(old, new)
+    head = head[:1023].ljust(1023) + b"\f" if len(head) >= 1024 else head[:-1].ljust(1023) + b"\f"
+    (tmp / "piston_tube.dynpt").write_bytes(head + data[1024:])
+    return case
+
+
+def _lying_vtu(tmp: Path) -> None:
+    text = (tmp / "cube.vtu").read_text()
+    (tmp / "cube.vtu").write_text(text.replace('NumberOfCells="12"', 'NumberOfCells="999999999"'))
+
+
+@pytest.mark.parametrize("make, message", [
+    (lambda tmp: (_copy(tmp), _edit_elem(tmp))[0], "piston_tube.elem:2: region tag 1" + "0" * 23),
+    (lambda tmp: _bad(tmp, lambda d: d["motion"].update(file="piston\0tube.dynpt")),
+     "motion.file: a file name cannot contain a NUL character"),
+    (lambda tmp: _bad(tmp, lambda d: d["mesh"].update(file="")), "mesh.file: an empty file name"),
+    (lambda tmp: _edit_dynpt(_bad(tmp, lambda d: d["motion"].pop("frame_interval")), b"inc_t:0.5", b"inc_t:0.0"),
+     "piston_tube.dynpt: inc_t:0: the time between frames must be positive"),
+    (lambda tmp: _edit_dynpt(_bad(tmp, lambda d: None), b"x:266 ", b"x:266000000000000 "),
+     "the header says 21 frames of 266000000000000 nodes (67032000000001024 bytes) but the file has"),
+    (lambda tmp: (_cube(tmp), (tmp / "cube.vtu").write_bytes(np.random.default_rng(1).bytes(4000)))[0],
+     "cube.vtu: cannot read as a VTK mesh"),
+    (lambda tmp: (_cube(tmp), _lying_vtu(tmp))[0], "cube.vtu: cannot read as a VTK mesh"),
+])
+def test_hostile_mesh_and_path_keys_are_input_errors(tmp_path, make, message):
+    """An .elem region tag of 1e23 (was OverflowError), a NUL in motion.file (was ValueError:
+    embedded null byte), a .vtu of random bytes or a lying NumberOfCells (was meshio's
+    sys.exit(1): exit 1 without an error line, SystemExit from fibrelmp.check())."""
+    _refused(make(tmp_path), message)
+
+
+@pytest.mark.parametrize("edit, message", [
+    (lambda d: d["fluid"].update(sound_speed=1e12), "fluid.sound_speed: 1e+12 m/s: at most 100000 m/s"),
+    (lambda d: d["run"].update(time_step=1e-15), "1e+13 steps; LAMMPS counts a run's steps in 32-bit integers"),
+    (lambda d: d["openings"][0].update(search_distance=1e300),
+     "openings[0].search_distance: 1e+300 m: must be from fluid.spacing"),
+    (lambda d: d["output"].update(name="a" * 300), "over the 255-byte limit"),
+    (lambda d: d["fluid"].update(spacing=1e-300), "lattice cells (at most 4,000,000)"),
+    (lambda d: (d["run"].update(time_step=1e-9), d["output"].update(interval=1e-9)), "frames: at most 100000"),
+    (lambda d: (d["run"].update(time_step=1e-9), d["output"].update(series_interval=1e-9)), "rows per opening"),
+    (lambda d: d["openings"][0].update(pressure=1e300), "above the Tait stiffness B = c0^2 rho0 / 7 = 3571.43 Pa"),
+    (lambda d: d["fluid"].update(density=1e-300), "fluid.density: 1e-300 kg/m^3: expected 0.001 to 100000"),
+    (lambda d: d["fluid"].update(artificial_viscosity=1e300), "fluid.artificial_viscosity: 1e+300: at most 10"),
+    (lambda d: d["mesh"].update(unit=1e300), "mesh.unit: the mesh spans 2e+303 m"),
+])
+def test_impossible_runs_are_refused_before_anything_is_written(tmp_path, edit, message):
+    """Were LAMMPS's 'Integer out of range', numpy overflow + 'Bad grid of processors' and
+    'File name too long' after the work folder was written (exit 1); a pressure of 1e300 Pa or
+    an artificial viscosity of 1e300 ran to exit 0 with most fluid lost, a density of 1e-300
+    ended in LAMMPS's 'Non-numeric atom coords' (exit 1)."""
+    if "255-byte" in message and os.pathconf(tmp_path, "PC_NAME_MAX") != 255:
+        pytest.skip("the folder's file system has another name limit")
+    _refused(_bad(tmp_path, edit), message)
+
+
+def test_relative_mesh_series_runs_from_the_case_folder(tmp_path, monkeypatch):
+    """motion.meshes by relative names, run as `fibrelmp run cube.json` from the case's own
+    folder: the later frames were opened after the runner changed into the work folder."""
+    import meshio
+
+    frames = []
+    for k in range(3):
+        points = CUBE_POINTS.copy()
+        points[:4, 2] += 2e-5 * k
+        meshio.write(tmp_path / f"cube_{k}.vtu", meshio.Mesh(points, [("triangle", np.array(CUBE_TRIANGLES))],
+                                                            cell_data={"region": [np.array(CUBE_TAGS)]}))
+        frames.append(f"cube_{k}.vtu")
+    _cube(tmp_path, mesh="cube_0.vtu", motion={"meshes": frames, "frame_interval": 1e-4}, run={"end_time": 2e-4})
+    monkeypatch.chdir(tmp_path)
+    result, output = _cli("run", "cube.json")
+    assert result.exit_code == 0, output
+    walls = list(iter_frames(tmp_path / "cube_work" / "moving_walls.dump"))
+    z0 = walls[0].columns["z"]
+    # the floor's wall particles (below z = 0) are 40 um higher at the end: the last frame was read
+    np.testing.assert_allclose((walls[-1].columns["z"] - z0)[z0 < 0], 4e-5, atol=1e-13)
+
+
+# ------------------------------------------------------------------------------------------
+# fluid in the wall layer (issue 24: 36-108 fluid particles per frame up to dx/2 beyond the
+# tube's wall, with "warnings none")
+def _beyond_side_wall(x: np.ndarray) -> np.ndarray:
+    """How far each point is beyond the tube's 24-gon side faces (m; negative: inside), from
+    the polygon's geometry: its support function, independent of fibrelmp's geometry code."""
+    sector = 2 * np.pi / 24
+    face = (np.floor(np.arctan2(x[:, 1], x[:, 0]) / sector) + 0.5) * sector
+    return x[:, 0] * np.cos(face) + x[:, 1] * np.sin(face) - 1e-3 * np.cos(sector / 2)
+
+
+def test_fill_starts_a_quarter_spacing_from_the_walls(tmp_path):
+    """The lattice's points nearest the tube's wall were 0.035 dx from it (0.535 dx from the
+    first wall sheet): the fill now keeps dx/4; a lattice-aligned wall keeps its dx/2 row."""
+    from fibrelmp.cardioproof.case import read_case
+    from fibrelmp.cardioproof.job import plan_job
+
+    dx = 1.25e-4
+    fluid = plan_job(read_case(_copy(tmp_path)))["fluid"]
+    gap = -_beyond_side_wall(fluid)
+    assert gap.min() >= 0.25 * dx * (1 - 1e-6)
+    assert fluid[:, 2].min() == pytest.approx(0.5 * dx, rel=1e-9)         # the piston's face, z = 0
+    # the fluid is exactly the lattice (16 x 16 x 16 cells over the tube's box, centres at
+    # (i + 1/2) dx from its corner) with at least dx/4 to the side faces (numpy, independent)
+    axis = -1e-3 + (np.arange(16) + 0.5) * dx
+    grid = np.stack(np.meshgrid(axis, axis, (np.arange(16) + 0.5) * dx, indexing="ij"), -1).reshape(-1, 3)
+    expected = grid[-_beyond_side_wall(grid) >= 0.25 * dx]
+    order = lambda a: a[np.lexsort(a.T)]                                  # noqa: E731
+    np.testing.assert_allclose(order(fluid), order(expected), rtol=0, atol=1e-15)
+    (tmp_path / "cube").mkdir()
+    cube = plan_job(read_case(_cube(tmp_path / "cube")))   # 10 x 10 x 10 cells, every one kept
+    assert len(cube["fluid"]) == 1000
+
+
+def test_no_fluid_in_the_wall_layer_at_any_frame(piston_run):
+    """An independent count at every saved frame: no fluid particle beyond the tube's side
+    faces or behind the piston's face; the run summary counts none and warns of none."""
+    tmp, result = piston_run
+    frames = list(DynptReader(tmp / "piston_tube.dynpt"))
+    dz = np.array([(fr.points[:, 2] - frames[0].points[:, 2]).max() * 1e-6 for fr in frames])
+    checked = 0
+    for f in iter_frames(tmp / "piston_tube_work" / "frames.dump"):
+        x = np.column_stack([f.columns["x"], f.columns["y"], f.columns["z"]])
+        tube = x[:, 2] < 2e-3                                  # beyond the outlet: leaving
+        assert (_beyond_side_wall(x[tube]) <= 0).all(), f.time
+        assert (x[:, 2] > np.interp(f.time, np.arange(len(dz)) * 5e-4, dz)).all()
+        checked += 1
+    assert checked == 11
+    summary = result.summaries[0]["fluid_beyond_walls"]
+    assert summary["frames"] == 11 and summary["frames_with"] == 0
+    assert not [w for w in result.warnings if w[0] == "fluid in wall"]
+
+
+def test_fluid_beyond_a_wall_is_counted_and_warned(tmp_path):
+    """The run's counter (results.BeyondWalls) against particles put at known places in the
+    static cube: 0.3 dx beyond the side wall x = 0 and 0.2 dx below the floor count; inside,
+    or over the top opening (leaving), they do not."""
+    from fibrelmp.cardioproof.case import read_case
+    from fibrelmp.cardioproof.job import write_job
+    from fibrelmp.cardioproof.results import BeyondWalls, SphFrame
+
+    case = read_case(_cube(tmp_path))
+    job, _ = write_job(case, tmp_path / "job", write_files=False)
+    dx = 1e-4
+    x = np.array([[0.5e-3, 0.5e-3, 0.5e-3], [-0.3 * dx, 0.5e-3, 0.5e-3], [0.4e-3, 0.6e-3, -0.2 * dx],
+                  [0.5e-3, 0.5e-3, 1e-3 + 0.5 * dx], [-0.3 * dx, 0.2e-3, 0.3e-3]])
+    counter = BeyondWalls(case, job)
+    for t, rows in ((0.0, [0, 3]), (1e-4, [0, 1, 2, 3, 4])):
+        n = len(rows)
+        counter.add(SphFrame(0, t, np.arange(n), x[rows], np.zeros((n, 3)), np.full(n, 1000.0), np.zeros(n),
+                             nodes=CUBE_POINTS))
+    assert counter.summary() == {"frames": 2, "frames_with": 1, "most_particles": 3,
+                                 "deepest_m": pytest.approx(0.3 * dx, rel=1e-12), "first_time": 1e-4}
+    counter.warn()
+    [(kind, text)] = case.warnings
+    assert kind == "fluid in wall" and "in 1 of 2 frames (up to 3 per frame, up to 0.30 spacings deep" in text

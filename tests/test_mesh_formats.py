@@ -3,7 +3,9 @@ openCARP layouts checked byte by byte against hand-made files, .dynpt frames."""
 
 from __future__ import annotations
 
+import re
 import struct
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -162,3 +164,90 @@ def test_bad_dynpt_files(tmp_path, edit, message):
     (tmp_path / "b.dynpt").write_bytes(edit(good))
     with pytest.raises(InputError, match=message):
         list(DynptReader(tmp_path / "b.dynpt"))
+
+
+# -- hostile files (issue 24): every problem an InputError, no traceback, no huge allocation --
+def test_text_region_tag_beyond_32_bits_is_an_input_error(tmp_path):
+    """A tag of 1e23 (an exact integer) overflowed the int64 tag array (OverflowError)."""
+    (tmp_path / "m.pts").write_text("3\n0 0 0\n1 0 0\n0 1 0\n")
+    (tmp_path / "m.elem").write_text("1\nTr 0 1 2 " + "1" + "0" * 23 + "\n")
+    with pytest.raises(InputError) as err:
+        OpenCarpMeshReader(tmp_path / "m.pts").read()
+    assert err.value.line == 2 and "region tag" in err.value.message
+
+
+@pytest.mark.parametrize("points, x, elements, message", [
+    (b"-1 0 666", 0.0, b"0 0 666", "says -1 entries (negative)"),
+    (b"1 0 666", 0.0, b"-3 0 666", "says -3 entries (negative)"),
+    (b"1 0 666", np.nan, b"0 0 666", "point 0: coordinates must be finite"),
+])
+def test_bad_binary_headers_and_values(tmp_path, points, x, elements, message):
+    point = np.array([x, 0, 0], "<f4").tobytes() if points.startswith(b"1 ") else b""
+    (tmp_path / "m.bpts").write_bytes(points.ljust(1024, b"\0") + point)
+    (tmp_path / "m.belem").write_bytes(elements.ljust(1024, b"\0"))
+    with pytest.raises(InputError, match=re.escape(message)):
+        OpenCarpMeshReader(tmp_path / "m").read()
+
+
+@pytest.mark.parametrize("edit, message", [
+    (lambda d: d.replace(b"inc_t:1.0", b"inc_t:inf"), "must be finite"),
+    (lambda d: d.replace(b"org_t:0.0", b"org_t:nan"), "must be finite"),
+    (lambda d: d.replace(b"x:2 ", b"x:" + b"9" * 30 + b" "), "header says 3 frames of 9999"),
+    (lambda d: d[:HEADER] + np.full(18, np.nan, "<f4").tobytes(), "frame 0: positions must be finite"),
+])
+def test_hostile_dynpt_headers_and_values(tmp_path, edit, message):
+    good = igb_header(2, 3, 1.0, 0.0, "ms") + np.zeros(18, "<f4").tobytes()
+    bad = edit(good)
+    if len(bad[:HEADER]) != HEADER:              # an edit that changed the header's length
+        bad = bad[:HEADER - 1].ljust(HEADER - 1) + b"\f" + bad[HEADER:]
+    (tmp_path / "b.dynpt").write_bytes(bad)
+    with pytest.raises(InputError, match=message):
+        list(DynptReader(tmp_path / "b.dynpt"))
+
+
+def _vtu_text(tmp: Path, binary: bool) -> str:
+    meshio = pytest.importorskip("meshio")
+    mesh = _mesh()
+    meshio.write(tmp / "good.vtu", meshio.Mesh(mesh.points_m, [(b.kind, b.nodes) for b in mesh.cells],
+                                               cell_data={"region": [b.tags for b in mesh.cells]}), binary=binary)
+    return (tmp / "good.vtu").read_text()
+
+
+@pytest.mark.parametrize("make, message", [
+    (lambda tmp: bytes(np.random.default_rng(3).integers(0, 256, 3000, np.uint8)), "cannot read as a VTK mesh"),
+    (lambda tmp: _vtu_text(tmp, True).replace('NumberOfCells="', 'NumberOfCells="99999').encode(), "cannot read"),
+    (lambda tmp: _vtu_text(tmp, False).replace('NumberOfPoints="', 'NumberOfPoints="99999').encode(), "cannot read"),
+])
+def test_hostile_vtu_is_an_input_error_not_a_system_exit(tmp_path, make, message):
+    """meshio.read() prints and calls sys.exit(1) on a file it cannot read: the CLI then said
+    nothing and fibrelmp.check() raised SystemExit."""
+    pytest.importorskip("meshio")
+    from fibrelmp.mesh.vtkmesh.mesh import VtkMeshReader
+
+    (tmp_path / "m.vtu").write_bytes(make(tmp_path))
+    with pytest.raises(InputError, match=message):
+        VtkMeshReader(tmp_path / "m.vtu").read()
+
+
+def test_structured_vtk_header_cannot_allocate_gigabytes(tmp_path):
+    """A legacy STRUCTURED_POINTS header of 1e5^3 points: meshio would generate 1e15 hexahedra
+    from three numbers.  Refused from the header, in a subprocess capped at 1.5 GB."""
+    import resource
+    import subprocess
+    import sys
+
+    pytest.importorskip("meshio")
+    (tmp_path / "m.vtk").write_text("# vtk DataFile Version 4.2\nhostile\nASCII\nDATASET STRUCTURED_POINTS\n"
+                                    "DIMENSIONS 100000 100000 100000\nORIGIN 0 0 0\nSPACING 1 1 1\n")
+    code = ("from fibrelmp.mesh.vtkmesh.mesh import VtkMeshReader\n"
+            "from fibrelmp.errors import InputError\n"
+            f"try:\n    VtkMeshReader({str(tmp_path / 'm.vtk')!r}).read()\n"
+            "except InputError as e:\n    print(e)\n")
+
+    def cap():
+        resource.setrlimit(resource.RLIMIT_AS, (1536 << 20, 1536 << 20))
+
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60,
+                         preexec_fn=cap, env={**__import__("os").environ, "OPENBLAS_NUM_THREADS": "1"})
+    assert out.returncode == 0, out.stderr
+    assert "m.vtk:4: expected DATASET UNSTRUCTURED_GRID or POLYDATA" in out.stdout

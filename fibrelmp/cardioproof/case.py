@@ -35,6 +35,12 @@ VERSION = 1
 ARTIFICIAL_VISCOSITY = 0.1   # Monaghan's alpha when the case gives no viscosity
 SMOOTHING_RATIO = 2.6          # kernel cutoff h / particle spacing (LAMMPS's SPH examples)
 CFL = 0.1                      # dt <= CFL h / c0 (LAMMPS's SPH examples)
+# the weakly compressible model needs c0 >= 10x the fastest flow; above this (70x water's real
+# 1480 m/s) the Tait pressure's B = c0^2 rho0 / 7 and the step count only grow
+MAX_SOUND_SPEED = 1e5          # m/s
+DENSITY_RANGE = (1e-3, 1e5)    # kg/m^3: thin gas .. 7x mercury (a tiny one gave NaN positions)
+MAX_ARTIFICIAL_VISCOSITY = 10.0   # Monaghan's alpha: LAMMPS's examples use 0.1 .. 1
+EXTENT_RANGE = (1e-9, 1e3)     # m: the mesh's largest extent (catches a wrong mesh.unit)
 KEYS = {"cardioproof", "mesh", "motion", "fluid", "wall", "openings", "run", "output", "comment"}
 # the keys of each object (a misspelt key must not silently give a default)
 OBJECT_KEYS = {
@@ -46,6 +52,16 @@ OBJECT_KEYS = {
     "run": {"end_time", "time_step", "cfl"},
     "output": {"interval", "series_interval", "name"},
 }
+
+
+def _file(j: JsonDoc, value: Any, where: str, folder: Path) -> Path:
+    """A file the case names, as an absolute path (relative names: to the case's folder)."""
+    name = j.string(value, where)
+    if not name.strip():
+        j.fail(where, "an empty file name")
+    if "\0" in name:
+        j.fail(where, "a file name cannot contain a NUL character")
+    return folder / name
 
 
 def _known(j: JsonDoc, obj: dict, kind: str, where: str) -> dict:
@@ -114,19 +130,27 @@ def read_case(path: str | Path) -> SphCase:
     version = j.integer(doc.get("cardioproof"), "cardioproof")
     if version != VERSION:
         j.fail("cardioproof", f"case file version {version}: this fibrelmp reads version {VERSION}")
-    folder = path.parent
+    # every file the case names is resolved now: the run changes directory before the motion
+    # frames are read
+    folder = path.absolute().parent
 
     mesh_spec = doc.get("mesh")
     if isinstance(mesh_spec, str):
         mesh_spec = {"file": mesh_spec}
     mesh_spec = _known(j, j.obj(mesh_spec, "mesh"), "mesh", "mesh")
-    mesh_file = folder / j.string(mesh_spec.get("file"), "mesh.file")
+    mesh_file = _file(j, mesh_spec.get("file"), "mesh.file", folder)
     unit = mesh_spec.get("unit")
     mesh = read_mesh(mesh_file, None if unit is None else j.number(unit, "mesh.unit", positive=True))
+    extent = float(np.ptp(mesh.points_m, axis=0).max()) if len(mesh.points) else 0.0
+    if not EXTENT_RANGE[0] <= extent <= EXTENT_RANGE[1]:
+        j.fail("mesh.unit" if unit is not None else "mesh.file", f"the mesh spans {extent:g} m: expected "
+               f"{EXTENT_RANGE[0]:g} to {EXTENT_RANGE[1]:g} m (is mesh.unit, metres per coordinate unit, right?)")
 
     fluid = _known(j, j.obj(doc.get("fluid"), "fluid"), "fluid", "fluid")
     dx = j.number(fluid.get("spacing"), "fluid.spacing", positive=True)
     density = j.number(fluid.get("density", 1000.0), "fluid.density", positive=True)
+    if not DENSITY_RANGE[0] <= density <= DENSITY_RANGE[1]:
+        j.fail("fluid.density", f"{density:g} kg/m^3: expected {DENSITY_RANGE[0]:g} to {DENSITY_RANGE[1]:g}")
     if "viscosity" in fluid and "artificial_viscosity" in fluid:
         j.fail("fluid", "give either viscosity (laminar, Morris) or artificial_viscosity (Monaghan's "
                "alpha): LAMMPS's Tait-water styles take one of them")
@@ -137,8 +161,14 @@ def read_case(path: str | Path) -> SphCase:
         alpha = None
     elif "artificial_viscosity" in fluid:
         alpha = j.number(fluid["artificial_viscosity"], "fluid.artificial_viscosity", minimum=0.0)
+        if alpha > MAX_ARTIFICIAL_VISCOSITY:
+            j.fail("fluid.artificial_viscosity", f"{alpha:g}: at most {MAX_ARTIFICIAL_VISCOSITY:g} "
+                   "(Monaghan's alpha is usually 0.01 to 1)")
     c0 = fluid.get("sound_speed")
     c0 = None if c0 is None else j.number(c0, "fluid.sound_speed", positive=True)
+    if c0 is not None and c0 > MAX_SOUND_SPEED:
+        j.fail("fluid.sound_speed", f"{c0:g} m/s: at most {MAX_SOUND_SPEED:g} m/s (the model needs 10x the "
+               "fastest flow; water's real sound speed is 1480 m/s)")
     ratio = j.number(fluid.get("smoothing_ratio", SMOOTHING_RATIO), "fluid.smoothing_ratio", positive=True)
     if not 1.5 <= ratio <= 4.0:
         j.fail("fluid.smoothing_ratio", f"{ratio:g}: the kernel cutoff must be 1.5 to 4 spacings")
@@ -197,7 +227,7 @@ def _motion(j: JsonDoc, spec: Any, folder: Path, mesh: Mesh) -> Motion | None:
     if "file" in spec:
         from fibrelmp.mesh.opencarp.dynpt import DynptReader
 
-        file = folder / j.string(spec["file"], "motion.file")
+        file = _file(j, spec["file"], "motion.file", folder)
         reader = DynptReader(file)
         if reader.nodes != len(mesh.points):
             raise InputError(file, None, f"{reader.nodes} nodes per frame, the mesh has {len(mesh.points)}")
@@ -205,10 +235,13 @@ def _motion(j: JsonDoc, spec: Any, folder: Path, mesh: Mesh) -> Motion | None:
             # openCARP's time unit is the millisecond (unites_t says otherwise)
             scale = 1.0 if reader.header.get("unites_t", "ms") == "s" else 1e-3
             interval = reader.inc_t * scale
+            if not interval > 0:
+                raise InputError(file, None, f"inc_t:{reader.inc_t:g}: the time between frames must be "
+                                 "positive (or give motion.frame_interval)")
         count, files, kind = reader.count, [file], "dynpt"
     elif "meshes" in spec:
         items = j.array(spec["meshes"], "motion.meshes")
-        files = [folder / j.string(f, f"motion.meshes[{k}]") for k, f in enumerate(items)]
+        files = [_file(j, f, f"motion.meshes[{k}]", folder) for k, f in enumerate(items)]
         count, kind = len(files), "meshes"
         if interval is None:
             j.fail("motion.frame_interval", "needed with a mesh series")
@@ -226,6 +259,7 @@ def _openings(j: JsonDoc, spec: Any, mesh: Mesh, dx: float, mesh_file: Path) -> 
     items = j.array(spec, "openings")
     _, tags = shell_elements(mesh, mesh_file)
     out, taken, names = [], np.zeros(len(tags), bool), set()
+    extent = float(np.ptp(mesh.points_m, axis=0).max())
     for k, item in enumerate(items):
         where = f"openings[{k}]"
         item = _known(j, j.obj(item, where), "openings", where)
@@ -259,6 +293,11 @@ def _openings(j: JsonDoc, spec: Any, mesh: Mesh, dx: float, mesh_file: Path) -> 
         else:
             table = np.array([[0.0, j.number(pressure, f"{where}.pressure")]])
         d = j.number(item.get("search_distance", 2.0 * dx), f"{where}.search_distance", positive=True)
+        if not dx <= d <= extent:
+            # below dx no lattice layer is within reach (the force would go to nobody); beyond the
+            # mesh's size every particle is near and the box (enlarged by 3d) loses all scale
+            j.fail(f"{where}.search_distance", f"{d:g} m: must be from fluid.spacing ({dx:g} m) to the "
+                   f"mesh's largest extent ({extent:g} m)")
         out.append(Opening(name, np.flatnonzero(chosen), table, d))
     if taken.all():
         j.fail("openings", "every shell element is an opening: there is no wall")

@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from fibrelmp.cardioproof import geometry
-from fibrelmp.cardioproof.case import SphCase
+from fibrelmp.cardioproof.case import MAX_SOUND_SPEED, SphCase
 from fibrelmp.errors import InputError
 from fibrelmp.mesh.outflow import MARGIN
 from fibrelmp.translate.lammps_format import float_text
@@ -38,6 +38,9 @@ VELOCITY_NAMES = ("wall_vx.txt", "wall_vy.txt", "wall_vz.txt")
 FLUID, WALL, MOVING = 1, 2, 3
 EVAPORATE_EVERY = 10          # steps between removals of the fluid that left by an opening
 VISCOUS_LIMIT = 0.125         # dt <= 0.125 h^2 rho0 / mu
+MAX_STEPS = 2 ** 31 - 1       # LAMMPS reads run lengths and every-N settings as C ints
+MAX_FRAMES = 100_000          # saved VTK frames (each a run chunk in in.lammps and a file pair)
+MAX_SERIES_ROWS = 1_000_000   # rows of each opening's series (~200 bytes each, twice)
 
 
 @dataclass
@@ -89,6 +92,10 @@ def sound_speed(case: SphCase, wall_speed: float) -> float:
     if speed <= 0:
         raise InputError(case.source, None, "nothing moves the fluid and no pressure drives it: "
                          "give fluid.sound_speed")
+    if not 10.0 * speed <= MAX_SOUND_SPEED:
+        raise InputError(case.source, None, f"the fastest expected speed, {speed:g} m/s (mesh nodes, or "
+                         f"sqrt(2 |p| / rho0) of the largest pressure), asks for a sound speed of {10 * speed:g} "
+                         f"m/s, above {MAX_SOUND_SPEED:g} m/s: check the motion's units and frame interval")
     return 10.0 * speed
 
 
@@ -146,6 +153,7 @@ def _plan(case: SphCase) -> dict:
         longest = np.maximum(longest, edges)
         prev = x
     x0 = first
+    geometry.lattice_counts(x0, case.spacing)       # the spacing's scale first: every test below uses it
     _check_surface(case, x0, tri4)
     tri, unclear = geometry.orient_outward(x0, tri4[:, :3], case.spacing)
     if (unclear & (opening_of >= 0)).any():
@@ -180,7 +188,7 @@ def _plan(case: SphCase) -> dict:
     dx = case.spacing
     margin = (case.layers + 2) * dx + max((3 * o.search_distance for o in case.openings), default=0.0)
     box_lo, box_hi = lo - margin, hi + margin
-    fluid = geometry.fluid_points(x0, tri, dx)
+    fluid = geometry.fluid_points(x0, tri, dx, wall_tri)
     if not len(fluid):
         raise InputError(case.source, None, "the walls and openings enclose no fluid: they must close "
                          f"the cavity, and the cavity must be wider than fluid.spacing {dx:g} m")
@@ -204,20 +212,58 @@ def _plan(case: SphCase) -> dict:
     particle_volume = volume / len(fluid)
     wall_moving = moved[wall_tri[walls.rows]].any(axis=1)
     c0 = sound_speed(case, wall_speed)
+    pmax = max((float(np.abs(o.pressure[:, 1]).max()) for o in case.openings), default=0.0)
+    stiffness = c0 * c0 * case.density / 7.0
+    if pmax > stiffness:
+        # Tait water at p = B is 10 % denser (2^(1/7)): far outside the weakly compressible model
+        raise InputError(case.source, None, f"an opening's pressure {pmax:g} Pa is above the Tait stiffness "
+                         f"B = c0^2 rho0 / 7 = {stiffness:g} Pa (it would compress the water by over 10 %): "
+                         f"fluid.sound_speed at least {math.sqrt(7 * pmax / case.density):.3g} m/s")
     dt = time_step(case, c0)
+    _step_counts(case, dt)                   # the run's length first (dt only shrinks below)
     if case.motion is not None:
-        frame_steps = max(1, math.ceil(case.motion.frame_interval / dt * (1 - 1e-12)))
+        per_frame = case.motion.frame_interval / dt
+        if not per_frame <= MAX_STEPS:
+            raise InputError(case.source, None, f"motion.frame_interval {case.motion.frame_interval:g} s is "
+                             f"{per_frame:.3g} time steps of {dt:g} s; LAMMPS counts steps in 32-bit integers "
+                             f"(at most {MAX_STEPS})")
+        frame_steps = max(1, math.ceil(per_frame * (1 - 1e-12)))
         dt = case.motion.frame_interval / frame_steps
     else:
         frame_steps = None
-    total = max(1, round(case.end_time / dt))
-    every = max(1, round(case.save_interval / dt))
+    total, every, series = _step_counts(case, dt)
     saves = list(range(0, total, every)) + [total]
-    series = max(1, round(case.series_interval / dt)) if case.series_interval else max(1, every // 10)
     return dict(moving_openings=moving_openings, particle_volume=particle_volume, x0=x0, wall_tri=wall_tri,
                 surface=tri4[:, :3], opening_of=opening_of, walls=walls, wall_moving=wall_moving, fluid=fluid,
                 openings=openings, c0=c0, dt=dt, frame_steps=frame_steps, total=total, saves=saves,
                 series=series, box=(box_lo, box_hi))
+
+
+def _step_counts(case: SphCase, dt: float) -> tuple[int, int, int]:
+    """(total steps, steps between saves, steps between series rows), each within LAMMPS's
+    integer limits and the frame and row limits (checked in floating point: nothing huge is
+    made before it is refused)."""
+    steps = case.end_time / dt
+    if not steps <= MAX_STEPS:
+        raise InputError(case.source, None, f"run.end_time {case.end_time:g} s at a time step of {dt:g} s is "
+                         f"{steps:.3g} steps; LAMMPS counts a run's steps in 32-bit integers (at most "
+                         f"{MAX_STEPS}): a shorter end time, a larger run.time_step or a lower "
+                         "fluid.sound_speed")
+    total = max(1, round(steps))
+
+    def steps_of(interval: float) -> int:      # whole steps, at least 1; beyond the run: the run
+        n = interval / dt
+        return total if n >= total else max(1, round(n))
+
+    every = steps_of(case.save_interval)
+    if total / every > MAX_FRAMES:
+        raise InputError(case.source, None, f"output.interval {case.save_interval:g} s gives {total // every + 1} "
+                         f"frames: at most {MAX_FRAMES}")
+    series = steps_of(case.series_interval) if case.series_interval else max(1, every // 10)
+    if total / series > MAX_SERIES_ROWS:
+        raise InputError(case.source, None, f"output.series_interval gives {total // series + 1} rows per "
+                         f"opening (one every {series} steps of {dt:g} s): at most {MAX_SERIES_ROWS}")
+    return total, every, series
 
 
 def _check_surface(case: SphCase, x: np.ndarray, tri4: np.ndarray) -> None:
@@ -297,7 +343,7 @@ def pressure_expression(table: np.ndarray) -> str:
     return expr
 
 
-def opening_context(o: OpeningGeometry) -> dict:
+def opening_context(o: OpeningGeometry, particle_volume: float) -> dict:
     """What the script says about an opening: its region, deletion and variable commands
     (rendered again, after the deletions, when a moving opening is put in its next place)."""
     f = float_text
@@ -335,8 +381,12 @@ def opening_context(o: OpeningGeometry) -> dict:
                  *(f"variable        f{a}_{name} atom v_F_{name}*({na})*v_w_{name}/v_wsum_{name}"
                    for a, na in zip("xyz", (nx, ny, nz))),
                  # the fluid's normal velocity relative to the opening's
-                 f"variable        vn_{name} atom vx*({nx})+vy*({ny})+vz*({nz})-({f(float(o.velocity @ n))})",
-                 f"variable        flux_{name} equal {area}*c_vn_{name}"]
+                 # times the particle's SPH volume m / rho: the near slab's volume flux is sum(V v_n) / d
+                 # (it counts the fluid that is there and its expansion; A x the mean v_n counted
+                 # particles, and read high when the slab was not full: near a wall's clearance)
+                 f"variable        vn_{name} atom (vx*({nx})+vy*({ny})+vz*({nz})-({f(float(o.velocity @ n))}))"
+                 "*mass/c_rho",
+                 f"variable        flux_{name} equal c_vn_{name}/{f(d)}"]
     return dict(name=name, nx=nx, ny=ny, nz=nz, area=area, d=f(d), pressure=pressure_expression(o.pressure),
                 regions=regions, deletes=deletes, variables=variables, series=o.series_name())
 
@@ -362,10 +412,11 @@ def write_job(case: SphCase, folder: str | Path, write_files: bool = True) -> tu
         frame = step // frame_steps if frames_matter and step % frame_steps == 0 and step // frame_steps < intervals \
             else None
         # a moving opening is put where the mesh is halfway through each motion interval
-        redefine = [opening_context(shapes[frame]) for shapes in moving_openings.values()] if frame else []
+        redefine = [opening_context(shapes[frame], p["particle_volume"]) for shapes in moving_openings.values()] \
+            if frame else []
         chunks.append(dict(step=step, frame=frame, save=step in p["saves"], redefine=redefine,
                            run=(events[k + 1] - step) if k + 1 < len(events) else 0))
-    openings = [opening_context(moving_openings[o.name][0] if o.name in moving_openings else o)
+    openings = [opening_context(moving_openings[o.name][0] if o.name in moving_openings else o, p["particle_volume"])
                 for o in p["openings"]]
     script = template_environment().get_template("sph.lammps.j2").render(
         case=case, fmt=float_text, data_name=DATA_NAME, frames_name=FRAMES_NAME, walls_name=WALLS_NAME,

@@ -9,8 +9,8 @@ CSV time series per opening.
   ``opening`` (-1 on walls, else the opening's index);
 * ``<name>_<opening>.csv``: ``time_s, pressure_Pa, force_x_N, force_y_N, force_z_N,
   force_normal_N, near_particles, flux_velocity_m3_s, crossed_particles, flux_crossing_m3_s``
-  every ``series_interval``: the outflow force LAMMPS applied, the flux as the opening's area
-  times the near particles' mean outward velocity, and from the particles that crossed the
+  every ``series_interval``: the outflow force LAMMPS applied, the flux as the near particles'
+  volume flux (the sum of m/rho times the outward velocity, over the search distance), and from the particles that crossed the
   opening's plane (cumulative count; the flux from its change since the previous row times
   the particle volume: the cavity's volume over the fluid particle count).
 """
@@ -84,6 +84,7 @@ class SphFrames:
         self.case, self.job = case, job
         self.frames = iter_frames(job.frames)
         self.clock = MeshClock(case)
+        self.beyond = BeyondWalls(case, job)
 
     def is_frame(self, words: list[str]) -> bool:
         return words[:3] == ["write_dump", "fluid", "custom"]
@@ -97,16 +98,72 @@ class SphFrames:
         c = f.columns
         rho = c["c_rho"]
         time = f.time if f.time is not None else step * self.job.dt
-        return SphFrame(step, time, c["id"].astype(np.int64), np.column_stack([c["x"], c["y"], c["z"]]),
-                        np.column_stack([c["vx"], c["vy"], c["vz"]]), rho,
-                        tait_pressure(rho, self.case.density, self.job.sound_speed),
-                        {o.name: c[f"v_share_{o.name}"] for o in self.job.openings},
-                        self.clock.at(time))
+        frame = SphFrame(step, time, c["id"].astype(np.int64), np.column_stack([c["x"], c["y"], c["z"]]),
+                         np.column_stack([c["vx"], c["vy"], c["vz"]]), rho,
+                         tait_pressure(rho, self.case.density, self.job.sound_speed),
+                         {o.name: c[f"v_share_{o.name}"] for o in self.job.openings},
+                         self.clock.at(time))
+        self.beyond.add(frame)
+        return frame
+
+    def tally(self) -> dict:
+        """The run summary's count of fluid beyond the walls (``fluid_beyond_walls``)."""
+        return self.beyond.summary()
 
     def close(self) -> None:
         close = getattr(self.frames, "close", None)
         if close is not None:
             close()
+        self.beyond.warn()
+
+
+class BeyondWalls:
+    """Counts, at every saved frame, the fluid particles that a moving wall let through: outside
+    the closed surface (the mesh at the frame's time), within the wall layers' depth of a wall
+    triangle and not where fluid leaves by an opening (within 2 search distances of one).  The
+    fill starts every particle geometry.CLEARANCE spacings inside, so any count is penetration
+    during the run; it is warned about with its figures (docs/cardioproof.md)."""
+
+    def __init__(self, case: SphCase, job: SphJob):
+        self.tri = job.surface
+        self.walls = job.surface[job.opening_of < 0]
+        self.openings = job.surface[job.opening_of >= 0]
+        self.depth = case.layers * case.spacing
+        self.reach = 2 * max((o.distance for o in job.openings), default=0.0)
+        self.spacing, self.warnings = case.spacing, case.warnings
+        self.counts: list[tuple[float, int, float]] = []          # (time, particles, deepest m)
+
+    def add(self, frame: SphFrame) -> None:
+        if frame.nodes is None or not len(frame.positions):
+            return
+        x, q = frame.nodes, frame.positions
+        outside = np.flatnonzero(~geometry.is_inside(x, self.tri, q))
+        depth = geometry.nearest_within(x, self.walls, q[outside], self.depth)
+        if len(self.openings) and self.reach > 0:
+            leaving = geometry.nearest_within(x, self.openings, q[outside], self.reach) < self.reach
+            depth[leaving] = np.inf
+        through = depth[np.isfinite(depth)]
+        self.counts.append((frame.time, len(through), float(through.max()) if len(through) else 0.0))
+
+    def summary(self) -> dict:
+        hit = [c for c in self.counts if c[1]]
+        return {"frames": len(self.counts), "frames_with": len(hit),
+                "most_particles": max((c[1] for c in hit), default=0),
+                "deepest_m": max((c[2] for c in hit), default=0.0),
+                "first_time": hit[0][0] if hit else None}
+
+    def warn(self) -> None:
+        s = self.summary()
+        if s["frames_with"] and self.warnings is not None:
+            from fibrelmp.runner import mpi_rank_size
+
+            if mpi_rank_size()[0] == 0:
+                self.warnings.append(("fluid in wall", f"fluid particles beyond a wall's surface in {s['frames_with']} "
+                                      f"of {s['frames']} frames (up to {s['most_particles']} per frame, up to "
+                                      f"{s['deepest_m'] / self.spacing:.2f} spacings deep, first at t = "
+                                      f"{s['first_time']:g} s): the flow pushed them through the wall particles; a "
+                                      "finer spacing, more wall.layers or a higher fluid.sound_speed keep "
+                                      "the fluid in"))
 
 
 class SphVtkWriter(Writer):

@@ -83,6 +83,8 @@ class DynptReader(Reader):
             self.inc_t = float(items.get("inc_t", 1.0))
         except ValueError:
             raise self.error(None, "org_t and inc_t must be numbers") from None
+        if not (np.isfinite(self.org_t) and np.isfinite(self.inc_t)):
+            raise self.error(None, "org_t and inc_t must be finite numbers")
 
     def __iter__(self) -> Iterator[PointsFrame]:
         with open(self.path, "rb") as fh:

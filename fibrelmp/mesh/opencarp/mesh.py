@@ -34,6 +34,9 @@ WRITE_TAGS = {"line": "Ln", "triangle": "Tr", "quad": "Qd", "tetra": "Tt", "pyra
 BINARY_TYPES = {0: "tetra", 1: "hexahedron", 3: "pyramid", 4: "wedge", 5: "quad", 6: "triangle",
                 7: "line"}
 BINARY_CODES = {kind: code for code, kind in BINARY_TYPES.items()}
+# region tags are C ints in openCARP and int32 in .belem files: larger ones are refused (a
+# text tag of 1e23 digits must not overflow the int64 arrays)
+TAG_RANGE = (-2 ** 31, 2 ** 31 - 1)
 
 
 def mesh_files(path: str | os.PathLike) -> tuple[Path, Path, bool]:
@@ -126,11 +129,15 @@ class OpenCarpMeshReader(Reader):
                 values = [int(t) for t in tok[1:]]
             except ValueError:
                 raise InputError(path, i, "node indices and the region must be integers") from None
-            kinds.append(kind)
-            nodes.append(values[:k])
-            tags.append(values[k] if len(values) > k else 0)
             if min(values[:k]) < 0 or max(values[:k]) >= npoints:
                 raise InputError(path, i, f"node index outside 0..{npoints - 1}")
+            tag = values[k] if len(values) > k else 0
+            if not TAG_RANGE[0] <= tag <= TAG_RANGE[1]:
+                raise InputError(path, i, f"region tag {tag} outside the 32-bit range openCARP stores "
+                                 f"({TAG_RANGE[0]}..{TAG_RANGE[1]})")
+            kinds.append(kind)
+            nodes.append(values[:k])
+            tags.append(tag)
         return kinds, nodes, tags
 
     # -- binary --------------------------------------------------------------------------
@@ -145,6 +152,8 @@ class OpenCarpMeshReader(Reader):
         except (IndexError, ValueError):
             raise InputError(path, None, "the 1024-byte header does not start with the entry "
                              "count") from None
+        if count < 0:
+            raise InputError(path, None, f"the header says {count} entries (negative)")
         if endian not in (0, 1) or (endian == 1) != (sys.byteorder == "big"):
             raise InputError(path, None, f"written with byte order flag {endian}, which this "
                              "machine cannot read (meshtool writes native order)")
@@ -157,7 +166,11 @@ class OpenCarpMeshReader(Reader):
         if len(data) != HEADER + 12 * n:
             raise InputError(path, None, f"the header says {n} points ({HEADER + 12 * n} bytes) "
                              f"but the file has {len(data)} bytes")
-        return np.frombuffer(data, np.float32, 3 * n, HEADER).reshape(n, 3).astype(np.float64)
+        points = np.frombuffer(data, np.float32, 3 * n, HEADER).reshape(n, 3).astype(np.float64)
+        if not np.isfinite(points).all():
+            bad = int(np.flatnonzero(~np.isfinite(points).all(axis=1))[0])
+            raise InputError(path, None, f"point {bad}: coordinates must be finite")
+        return points
 
     def _binary_elements(self, npoints: int):
         path = self.elements_file

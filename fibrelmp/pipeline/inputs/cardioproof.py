@@ -108,8 +108,40 @@ def case_outputs(case: "SphCase", out: str | Path | None = None,
     files += [folder / f"{case.name}_{o.name}.csv" for o in case.openings]
     inputs = [case.source, case.mesh_file] + (case.motion.files if case.motion else [])
     patterns = [(folder, re.compile(name + r"_\d{6}(_walls\.vtp|_walls\.vtu|\.vtp)"))]
-    return Outputs(case.source, work_folder(folder, case.source.stem, work), files=files,
-                   patterns=patterns, inputs=inputs), folder
+    job = work_folder(folder, case.source.stem, work)
+    _check_name_lengths(case, [*files, folder / f"{case.name}_000000_walls.vtp"], staged=True)
+    _check_name_lengths(case, [job, *(job / f"opening_{o.name}.txt" for o in case.openings)], staged=False)
+    return Outputs(case.source, job, files=files, patterns=patterns, inputs=inputs), folder
+
+
+# a staged file is ".<name>.tmp<pid>" (fibrelmp.textio.temp_name): 5 bytes and a pid of up to 7 digits
+TEMP_NAME_EXTRA = 12
+
+
+def _check_name_lengths(case: "SphCase", paths: list[Path], staged: bool) -> None:
+    """Every file name a run writes (and a ``staged`` file's temp name) fits its folder's file system
+    (``PC_NAME_MAX``, asked of the nearest existing folder): an output.name or an opening name
+    too long must fail here, not after the work folder was written."""
+    import os
+
+    limits: dict[Path, int] = {}
+    for path in paths:
+        folder = path.parent
+        if folder not in limits:
+            probe = folder
+            while not probe.exists() and probe != probe.parent:
+                probe = probe.parent
+            try:
+                limits[folder] = os.pathconf(probe, "PC_NAME_MAX")
+            except (OSError, ValueError):
+                limits[folder] = 255
+        size = len(os.fsencode(path.name))
+        extra = TEMP_NAME_EXTRA if staged else 0
+        if size + extra > limits[folder]:
+            raise InputError(case.source, None, f"the file name {path.name[:32]}... is {size} bytes"
+                             + (f" ({extra} more while it is written)" if extra else "")
+                             + f", over the {limits[folder]}-byte limit of its folder {folder}: a shorter "
+                             "output.name, opening name or case file name")
 
 
 class SphRecorder:
@@ -165,5 +197,7 @@ class SphRecorder:
             "particles": {"kind": "sph", "fluid_start": job.fluid_count, "wall": walls,
                           "fluid_end": self.final.get("fluid")},
             "openings": openings, "final_step": self.final.get("step"),
+            # fluid particles beyond a wall's surface at the saved frames (BeyondWalls)
+            "fluid_beyond_walls": tally,
             "warnings": warning_counts(warnings),
         }

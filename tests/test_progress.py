@@ -15,7 +15,6 @@ import os
 import pty
 import re
 import select
-import shutil
 import subprocess
 import sys
 import time
@@ -24,7 +23,7 @@ import pytest
 
 from fibrelmp.runner import LogEvery, Progress, parse_log_every
 
-from .conftest import REPO
+from .conftest import REPO, copy_example
 
 CLI = [sys.executable, "-m", "fibrelmp.cli"]
 EXAMPLE = REPO / "examples" / "fibre_network"
@@ -45,7 +44,7 @@ main()
 
 
 def _example(tmp_path):
-    shutil.copytree(EXAMPLE, tmp_path / "in")
+    copy_example(EXAMPLE.relative_to(REPO), tmp_path / "in")
     return tmp_path / "in" / "input.txt"
 
 

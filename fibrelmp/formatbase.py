@@ -44,6 +44,8 @@ class Replacement:
     def place(self, tmp: Path, final: Path) -> None:
         """Rename ``tmp`` to ``final`` (an OSError leaves ``final`` as it was)."""
         final = Path(final)
+        if _same_file(tmp, final):       # already in place (a FibreNet job writing its results there)
+            return
         first = final not in self._placed
         backup = None
         if first and os.path.lexists(final) and not os.path.isdir(final):
@@ -79,6 +81,13 @@ class Replacement:
                 except OSError:
                     pass
         self._placed.clear()
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return False
 
 
 # the replacements of the runs under way, by the folders they write (a run locks its

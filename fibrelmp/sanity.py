@@ -187,7 +187,9 @@ def rank_check(model: Model | GranularModel, ranks: int) -> None:
     limit = MIN_PER_RANK[what]
     if ranks > 1 and count < limit * ranks:
         best = max(1, count // limit)
-        model.warn("ranks", f"{ranks} MPI ranks for {count} {what} ({count // ranks} per rank): below "
+        named = what if count != 1 else what[:-1]          # 1 sphere, 2 spheres
+        share = f"{count // ranks} per rank" if count >= ranks else "fewer than one per rank"
+        model.warn("ranks", f"{ranks} MPI ranks for {count} {named} ({share}): below "
                    f"~{limit} {what} per rank more ranks make the run slower; use "
                    f"{'1 (no mpiexec)' if best == 1 else f'mpiexec -n {best}'} (docs/performance.md)")
 

@@ -113,7 +113,7 @@ def test_lines_without_a_terminal(tmp_path):
     # a line each time a quarter is passed (the steps advance 40 at a time)
     assert [int(pct // 25) for pct, *_ in lines] == [0, 1, 2, 3, 4]
     assert [n for _, n, *_ in lines] == sorted(n for _, n, *_ in lines)
-    assert proc.stderr.count("summary of") == 1
+    assert proc.stdout.count("summary of") == 1 and "summary of" not in proc.stderr
     quiet = subprocess.run(CLI + ["-q", "run", str(inp), "-o", str(tmp_path / "out"), "--force"],
                            cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert quiet.returncode == 0 and quiet.stderr == ""

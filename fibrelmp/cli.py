@@ -310,6 +310,9 @@ def run(input: Path = typer.Argument(..., help=f"{_TITLES[0].upper()}{_TITLES[1:
         log_every: Optional[str] = typer.Option(None, "--log-every", metavar="WHEN", help="Without a "
                                                 "terminal (batch jobs): a progress line on stderr every "
                                                 "10% of the steps, 60s/5m/1h, or both (default 10%,5m)."),
+        yes_i_mean_it: bool = typer.Option(False, "--yes-i-mean-it", help="Run even when the "
+                                           "estimated output exceeds the free disk space or the "
+                                           "run would take more than 30 days at any speed."),
         stock_styles: bool = _STOCK, quiet: bool = _QUIET, verbose: bool = _VERBOSE,
         ) -> None:
     import time
@@ -322,7 +325,7 @@ def run(input: Path = typer.Argument(..., help=f"{_TITLES[0].upper()}{_TITLES[1:
                      resume=resume, end_time=end_time, step=step, save_step=save_step, steps=steps,
                      precision=precision, progress=not _state["quiet"], stock_styles=stock_styles,
                      viewer_files=viewer_files, say=_say,
-                     warn=_report_warnings, log_every=log_every)
+                     warn=_report_warnings, log_every=log_every, allow_huge=yes_i_mean_it)
     for note in result.notes:
         _say(note)
     for line in _written(result.outputs):

@@ -347,11 +347,13 @@ def _free_space(folder) -> tuple[int, int]:
     return shutil.disk_usage(probe).free, os.stat(probe).st_dev
 
 
-def run_budget(jobs: list[tuple[object, object]], outputs, ranks: int, allow_huge: bool) -> None:
+def run_budget(jobs: list[tuple[object, object]], outputs, ranks: int, allow_huge: bool,
+               disk: bool = True) -> None:
     """Refuse, as an InputError before anything is written, a run that cannot finish: the
     estimated output (``jobs``: (model, rendered job) pairs) larger than the free space where
     it goes, or an optimistic wall time beyond ``LONGEST_RUN_SECONDS``.  ``allow_huge``
-    (run --yes-i-mean-it) skips both (step counts LAMMPS cannot hold are refused always)."""
+    (run --yes-i-mean-it) skips both (step counts LAMMPS cannot hold are refused always).
+    ``disk``: check the free space (MPI: rank 0, which writes every file)."""
     from fibrelmp.errors import InputError
 
     for _, rendered in jobs:
@@ -385,7 +387,7 @@ def run_budget(jobs: list[tuple[object, object]], outputs, ranks: int, allow_hug
                          f"{FASTEST_PARTICLE_STEPS_PER_SECOND:.0e} particle-steps/s per MPI rank "
                          f"(LAMMPS is slower): run fewer steps, or give --yes-i-mean-it")
     for size, folder, free in need.values():
-        if size > free:
+        if disk and size > free:
             raise InputError(outputs.source, None, f"the run would write about {_size(size)} "
                              f"({frames_total} saved frames) but {folder} has {_size(free)} free: "
                              "save fewer frames or run less, free space, or give --yes-i-mean-it")

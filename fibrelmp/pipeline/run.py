@@ -47,7 +47,7 @@ def run(plan: RunPlan, warn: Warn | None = None) -> Outcome:
             said = len(step.model.warnings)
             jobs.append((step.model, step.build(Path(step.work).resolve(), False)))
             del step.model.warnings[said:]      # said when the job is rendered for the run
-    run_budget(jobs, plan.outputs, size, options.allow_huge)
+    run_budget(jobs, plan.outputs, size, options.allow_huge, disk=rank == 0)
     outcome = Outcome()
     several = sum(isinstance(step, RunRequest) for step in plan.steps) > 1
     # resuming continues this run's own (locked) work: its partial results are not "earlier" ones

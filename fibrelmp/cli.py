@@ -394,7 +394,7 @@ def post(dump: Path = typer.Argument(..., help=" or ".join(f.title for f in form
 
 
 def _written(paths: list[Path]) -> list[str]:
-    """``wrote PATH`` lines; a numbered series (``<name>_<n><tail>``: DEMDF snapshots, VTK
+    """``wrote PATH`` lines; a numbered series (``<name>_<n><tail>``: snapshots, viewer
     frames) as one line per name and tail with its first and last file and their count, so
     a run with many frames does not list every file."""
     import re

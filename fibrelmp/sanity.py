@@ -305,6 +305,22 @@ def check_steps(model, where, allow_huge: bool) -> None:
                          f"(LAMMPS is slower): run fewer steps{override}")
 
 
+def needs_job(model, outputs) -> bool:
+    """Must the job be rendered to tell whether the run can finish?  Not when even a frame at
+    every step (``planned_steps`` + 1 frames) fits the estimate: every count then fits a
+    LAMMPS int, and the output and the time are within bounds (rendering a large model twice
+    costs a tenth of a second per 50,000 beads)."""
+    steps = planned_steps(model)
+    if steps is None or steps >= MAXSMALLINT - 1:
+        return True
+    n = particle_count(model)
+    frames = steps + 1
+    size = frames * (FRAME_HEADER_BYTES + n * ROW_BYTES + (FILE_BYTES if outputs.patterns else 0))
+    seconds = n * steps / FASTEST_PARTICLE_STEPS_PER_SECOND
+    folders = [outputs.work] + [f.parent for f in outputs.files[:1]]
+    return seconds > LONGEST_RUN_SECONDS or any(size > _free_space(f)[0] for f in folders)
+
+
 def particle_count(model) -> int:
     """Beads, spheres or SPH particles of a model (for the estimates; 0 when unknown)."""
     for name in ("particles", "spheres"):

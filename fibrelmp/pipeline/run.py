@@ -30,7 +30,8 @@ def run(plan: RunPlan, warn: Warn | None = None) -> Outcome:
     its model while it is translated and run."""
     from fibrelmp.outputs import finish, locked
     from fibrelmp.runner import mpi_rank_size
-    from fibrelmp.sanity import check_steps, rank_check, run_budget, time_step_check
+    from fibrelmp.sanity import (check_steps, needs_job, rank_check, run_budget,
+                                 time_step_check)
 
     rank, size = mpi_rank_size()
     options = plan.options
@@ -44,6 +45,8 @@ def run(plan: RunPlan, warn: Warn | None = None) -> Outcome:
     for step in plan.steps:
         if isinstance(step, RunRequest):
             check_steps(step.model, plan.outputs.source, options.allow_huge)
+            if not needs_job(step.model, plan.outputs):
+                continue
             said = len(step.model.warnings)
             jobs.append((step.model, step.build(Path(step.work).resolve(), False)))
             del step.model.warnings[said:]      # said when the job is rendered for the run

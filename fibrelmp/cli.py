@@ -76,8 +76,16 @@ def _rank0() -> bool:
 
 
 def _say(msg: str) -> None:
+    """Progress and notes: stderr (as Unix tools do; stdout carries the results)."""
     if not _state["quiet"] and _rank0():
         typer.echo(msg, err=True)
+
+
+def _result(msg: str) -> None:
+    """What a command produced (wrote lines, the run summary, check's report): stdout, so
+    ``fibrelmp run ... > log`` keeps it; --quiet leaves only warnings and errors."""
+    if not _state["quiet"] and _rank0():
+        typer.echo(msg)
 
 
 def _report_warnings(warnings: list[tuple[str, str]]) -> None:
@@ -258,7 +266,7 @@ def translate(input: Path = typer.Argument(..., help="Any supported input file."
 
     _set_flags(quiet, verbose)
     job = write_job(input, out, warn=_report_warnings, stock_styles=stock_styles)
-    _say(f"wrote {job.script} and {job.data}")
+    _result(f"wrote {job.script} and {job.data}")
 
 
 @app.command(cls=_Command, help=f"""Translate INPUT, run it on LAMMPS and write the results in the input's own
@@ -302,6 +310,9 @@ def run(input: Path = typer.Argument(..., help=f"{_TITLES[0].upper()}{_TITLES[1:
         log_every: Optional[str] = typer.Option(None, "--log-every", metavar="WHEN", help="Without a "
                                                 "terminal (batch jobs): a progress line on stderr every "
                                                 "10% of the steps, 60s/5m/1h, or both (default 10%,5m)."),
+        yes_i_mean_it: bool = typer.Option(False, "--yes-i-mean-it", help="Run even when the "
+                                           "estimated output exceeds the free disk space or the "
+                                           "run would take more than 30 days at any speed."),
         stock_styles: bool = _STOCK, quiet: bool = _QUIET, verbose: bool = _VERBOSE,
         ) -> None:
     import time
@@ -314,17 +325,22 @@ def run(input: Path = typer.Argument(..., help=f"{_TITLES[0].upper()}{_TITLES[1:
                      resume=resume, end_time=end_time, step=step, save_step=save_step, steps=steps,
                      precision=precision, progress=not _state["quiet"], stock_styles=stock_styles,
                      viewer_files=viewer_files, say=_say,
-                     warn=_report_warnings, log_every=log_every)
+                     warn=_report_warnings, log_every=log_every, allow_huge=yes_i_mean_it)
     for note in result.notes:
         _say(note)
     for line in _written(result.outputs):
-        _say(line)
+        _result(line)
     from fibrelmp.record import summary_lines
 
     for summary in result.summaries:
-        _say("\n".join(summary_lines(summary)))
+        _result("\n".join(summary_lines(summary)))
+    if _state["verbose"] and result.warnings:
+        # the summaries count warnings by kind: -v lists every one of them
+        _result("every warning:")
+        for kind, text in result.warnings:
+            _result(f"  [{kind}] {text}")
     script = result.scripts[-1] if result.scripts else None
-    _say(f"done in {time.monotonic() - start:.1f} s (LAMMPS job: {script})")
+    _result(f"done in {time.monotonic() - start:.1f} s (LAMMPS job: {script})")
 
 
 @app.command("post", cls=_Command, help=f"""Convert an existing dump into another code's files ({", ".join(
@@ -373,22 +389,30 @@ def post(dump: Path = typer.Argument(..., help=" or ".join(f.title for f in form
     written = convert(dump, to, out, frames=frames, types=types, data=data, local=local,
                       gravity=gravity, force=force, topology=topology, say=_say,
                       warn=_report_warnings, precision=precision)
-    for path in written:
-        _say(f"wrote {path}")
+    for line in _written(written):
+        _result(line)
 
 
 def _written(paths: list[Path]) -> list[str]:
-    """``wrote PATH`` lines; numbered frame files (``<name>_NNNNNN<tail>``) as one line per
-    name and tail, so a run with many frames does not list every file."""
+    """``wrote PATH`` lines; a numbered series (``<name>_<n><tail>``: snapshots, viewer
+    frames) as one line per name and tail with its first and last file and their count, so
+    a run with many frames does not list every file."""
     import re
 
-    lines: dict[str, list[Path]] = {}
+    series: dict[tuple[Path, str, str], list[tuple[int, Path]]] = {}
     for path in paths:
-        m = re.fullmatch(r"(.*_)\d{6}(\D.*)", path.name)
-        key = str(path.with_name(f"{m[1]}NNNNNN{m[2]}")) if m else str(path)
-        lines.setdefault(key, []).append(path)
-    return [f"wrote {key}" if len(group) == 1 and group[0] == Path(key) else
-            f"wrote {key} ({len(group)} files)" for key, group in lines.items()]
+        m = re.fullmatch(r"(.*_)(\d+)(\D.*)?", path.name)
+        key = (path.parent, m[1], m[3] or "") if m else (path, "", "")
+        series.setdefault(key, []).append((int(m[2]) if m else 0, path))
+    lines = []
+    for group in series.values():
+        if len(group) == 1:
+            lines.append(f"wrote {group[0][1]}")
+            continue
+        group.sort()
+        first, last = group[0][1], group[-1][1]
+        lines.append(f"wrote {first} .. {last.name} ({len(group)} files)")
+    return lines
 
 
 def _convert_examples() -> str:
@@ -429,7 +453,7 @@ def convert_command(source: Path = typer.Argument(..., help="The file to convert
 
     _set_flags(quiet, verbose)
     for path in convert_file(source, out, to=to, precision=precision, force=force):
-        _say(f"wrote {path}")
+        _result(f"wrote {path}")
 
 
 _RESULT_HELP = ("A run's work folder, its log.lammps, or a result file ("
@@ -473,10 +497,10 @@ def plot_command(result: Path = typer.Argument(..., help=_RESULT_HELP, readable=
 
     _set_flags(quiet, verbose)
     drawn = plot(result, out, source=source, size=size, force=force)
-    _say(f"plotted {', '.join(drawn.lines)} over {drawn.x_name}, from {drawn.source}")
+    _result(f"plotted {', '.join(drawn.lines)} over {drawn.x_name}, from {drawn.source}")
     for note in drawn.notes:
-        _say(f"  {note}")
-    _say(f"wrote {drawn.path}")
+        _result(f"  {note}")
+    _result(f"wrote {drawn.path}")
 
 
 @app.command("snapshot", cls=_Command, help="""Draw one frame of a result into a PNG: spheres at their radii,
@@ -503,11 +527,11 @@ def snapshot_command(result: Path = typer.Argument(..., help=_RESULT_HELP, reada
 
     _set_flags(quiet, verbose)
     drawn = snapshot(result, out, frame=frame, size=size, force=force)
-    _say(f"frame {drawn.frame} of {drawn.frames}: {drawn.points} particles, {drawn.bonds} bond "
-         f"lines, {drawn.walls} wall faces")
+    _result(f"frame {drawn.frame} of {drawn.frames}: {drawn.points} particles, {drawn.bonds} bond "
+            f"lines, {drawn.walls} wall faces")
     for note in drawn.notes:
-        _say(f"  {note}")
-    _say(f"wrote {drawn.path}")
+        _result(f"  {note}")
+    _result(f"wrote {drawn.path}")
 
 
 def main() -> None:

@@ -22,13 +22,122 @@ frame), and may ``adopt`` other writers whose files belong to the same output.
 from __future__ import annotations
 
 import os
+import threading
 from abc import ABC, abstractmethod
 from contextlib import contextmanager
 from pathlib import Path
-from typing import IO, Any, ClassVar, Iterator
+from typing import IO, Any, ClassVar, Iterable, Iterator
 
 from .errors import InputError
 from .textio import discard, temp_name, write_failure
+
+
+class Replacement:
+    """Files renamed into place, each earlier file of the same name kept aside (a hidden
+    ``.<name>.tmp<pid>.old`` beside it) until ``keep``; ``undo`` removes the new files and
+    puts the earlier ones back.  So a set of outputs is replaced completely or not at all:
+    a writer's own files (``Writer.close``), or every output of a run (``replacing``)."""
+
+    def __init__(self) -> None:
+        self._placed: dict[Path, Path | None] = {}      # final -> the earlier file, kept aside
+
+    def place(self, tmp: Path, final: Path) -> None:
+        """Rename ``tmp`` to ``final`` (an OSError leaves ``final`` as it was)."""
+        final = Path(final)
+        if _same_file(tmp, final):       # already in place (a FibreNet job writing its results there)
+            return
+        first = final not in self._placed
+        backup = None
+        if first and os.path.lexists(final) and not os.path.isdir(final):
+            backup = final.with_name(f".{final.name}.tmp{os.getpid()}.old")
+            os.replace(final, backup)
+        try:
+            os.replace(tmp, final)
+        except OSError:
+            if backup is not None:
+                os.replace(backup, final)
+            raise
+        if first:
+            self._placed[final] = backup
+
+    def undo(self) -> None:
+        """Remove the files placed, put the earlier ones back; never raises."""
+        for final, backup in reversed(list(self._placed.items())):
+            try:
+                if backup is not None:
+                    os.replace(backup, final)
+                else:
+                    os.unlink(final)
+            except OSError:
+                pass
+        self._placed.clear()
+
+    def keep(self) -> None:
+        """The new files stay: drop the earlier ones."""
+        for backup in self._placed.values():
+            if backup is not None:
+                try:
+                    os.unlink(backup)
+                except OSError:
+                    pass
+        self._placed.clear()
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return False
+
+
+# the replacements of the runs under way, by the folders they write (a run locks its
+# folders, so each folder belongs to one run at a time; runs may be in other threads)
+_replacing: dict[Path, Replacement] = {}
+_replacing_lock = threading.Lock()
+
+
+@contextmanager
+def replacing(folders: Iterable[Path]) -> Iterator[Replacement]:
+    """Every file a ``Writer`` renames into ``folders`` meanwhile is placed through one
+    ``Replacement``: kept when the block succeeds, undone (the earlier outputs back, the new
+    ones removed) when it raises."""
+    journal = Replacement()
+    keys = {Path(f).resolve() for f in folders}
+    with _replacing_lock:
+        taken = keys & _replacing.keys()
+        if taken:
+            raise RuntimeError(f"{sorted(taken)[0]}: already written by another run")
+        for key in keys:
+            _replacing[key] = journal
+    try:
+        yield journal
+    except BaseException:
+        journal.undo()
+        raise
+    else:
+        journal.keep()
+    finally:
+        with _replacing_lock:
+            for key in keys:
+                _replacing.pop(key, None)
+
+
+def replacement_for(final: Path) -> Replacement | None:
+    """The run replacement that ``final``'s folder belongs to, if any."""
+    with _replacing_lock:
+        if not _replacing:
+            return None
+        return _replacing.get(Path(final).parent.resolve())
+
+
+def place(tmp: Path, final: Path) -> None:
+    """Rename ``tmp`` to ``final``: through the run's replacement when a run writes there
+    (undone if the run fails later), else at once."""
+    journal = replacement_for(final)
+    if journal is not None:
+        journal.place(tmp, final)
+    else:
+        os.replace(tmp, final)
 
 
 class Reader(ABC):
@@ -222,17 +331,31 @@ class Writer(ABC):
                 raise write_failure(final, exc) from None
             del self._handles[final]
 
-    def _commit(self) -> list[Path]:
-        done = []
+    def _pending(self) -> list[tuple[Path, Path]]:
+        """(final, temp) of every staged file, the parts' first."""
+        pairs = [pair for part in self._parts for pair in part._pending()]
+        return pairs + list(self._staged.items())
+
+    def _forget_staged(self) -> None:
         for part in self._parts:
-            done += part._commit()
-        for final, tmp in list(self._staged.items()):
+            part._forget_staged()
+        self._staged.clear()
+
+    def _commit(self) -> list[Path]:
+        """Rename every staged file into place, all or none: a failing rename puts back
+        the files this writer had replaced already (inside a run, the run's replacement
+        does that when the run fails: ``replacing``)."""
+        own = Replacement()
+        done = []
+        for final, tmp in self._pending():
             try:
-                os.replace(tmp, final)
+                (replacement_for(final) or own).place(tmp, final)
             except OSError as exc:
+                own.undo()
                 raise write_failure(final, exc) from None
             done.append(final)
-            del self._staged[final]
+        own.keep()
+        self._forget_staged()
         return done
 
     def _closed(self) -> None:

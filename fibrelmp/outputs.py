@@ -7,8 +7,11 @@ overwritten) and its work folder.  ``prepare`` refuses, as an InputError before 
 written, an output that is an input, a location under a regular file or not writable, and
 existing results unless ``force``; then it creates the folders and takes an exclusive lock on
 each (``flock`` on the folder itself: nothing is left behind, and a killed run releases it).
-``finish`` removes what an earlier run wrote that this run did not (``--force`` replaces
-results completely).
+While the run holds the lock, every result renamed into place keeps the file it replaced
+aside (``formatbase.replacing``): a run that fails at any point, even after some of its
+writers finished, leaves the earlier results as they were and none of its own.  ``finish``
+removes what an earlier run wrote that this run did not (``--force`` replaces results
+completely).
 """
 
 from __future__ import annotations
@@ -24,6 +27,7 @@ from pathlib import Path
 from typing import Iterator
 
 from fibrelmp.errors import InputError
+from fibrelmp.formatbase import replacing
 
 
 # what a run writes into its work folder (translate.lammps_job / granular_job, checkpoint)
@@ -140,7 +144,10 @@ def locked(outputs: Outputs, force: bool, rank: int = 0) -> Iterator[Outputs]:
                 raise InputError(folder, None, f"cannot write here: {exc.strerror or exc}") from None
         _remove_stale_temps(outputs)
         ready = True
-        yield outputs
+        # every result this run renames into place replaces its earlier file only for good
+        # when the whole run succeeds: a failure puts the earlier set back (formatbase)
+        with replacing(outputs.folders()):
+            yield outputs
     finally:
         for fd in fds:
             os.close(fd)          # closing releases the lock

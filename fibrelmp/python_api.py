@@ -95,7 +95,8 @@ def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | N
         end_time: float | None = None, step: float | None = None, save_step: float | None = None,
         steps: int | None = None, precision: int | None = None, progress: bool = False,
         stock_styles: bool = False, viewer_files: bool = False, say: Say = _quiet,
-        warn: Warn | None = None, log_every: str | None = None) -> RunResult:
+        warn: Warn | None = None, log_every: str | None = None,
+        allow_huge: bool = False) -> RunResult:
     """Run any supported input on LAMMPS and write its results in the input's own format.
 
     ``out``: the results' folder, or the result file of an input with a single result;
@@ -109,7 +110,12 @@ def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | N
     ``(kind, text)`` warnings as they are found (they are also in the result).  ``progress``:
     a bar on a terminal, else a line on stderr every ``log_every`` (``"10%"``, ``"60s"``,
     ``"10%,5m"``: the default).  Each simulation's summary (``summary.json``) is in
-    ``summaries``."""
+    ``summaries``.
+
+    A run that cannot finish is refused before anything is written (``InputError``): step
+    counts LAMMPS cannot hold, an estimated output larger than the free disk space, or an
+    optimistic run time beyond 30 days (``fibrelmp.sanity.run_budget``); ``allow_huge``
+    (``run --yes-i-mean-it``) lifts the last two."""
     from fibrelmp.checkpoint import check_every
     from fibrelmp.pipeline import RunOptions, run as run_plan
     from fibrelmp.pipeline.inputs import RunSettings
@@ -142,7 +148,8 @@ def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | N
     from fibrelmp import lammps_styles
 
     with lammps_styles.stock(stock_styles):
-        plan = hook.plan(path, settings, RunOptions(progress, force, checkpoint_every, resume, every), say, warned)
+        plan = hook.plan(path, settings, RunOptions(progress, force, checkpoint_every, resume, every,
+                                              allow_huge), say, warned)
         outcome = run_plan(plan, warn=warned)
     result.outputs, result.notes = outcome.outputs, list(plan.notes)
     result.scripts = [job.script for job in outcome.jobs]

@@ -367,7 +367,7 @@ def _lines(path: Path) -> int:
 # ---------------------------------------------------------------------------------------
 # the block ``fibrelmp run`` prints
 def summary_lines(s: dict) -> list[str]:
-    """The summary as a short text block (stderr at the end of ``fibrelmp run``)."""
+    """The summary as a short text block (stdout at the end of ``fibrelmp run``)."""
     def g(v, fmt: str = ".4g") -> str:
         return "?" if v is None else format(v, fmt)
 

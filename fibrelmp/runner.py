@@ -14,7 +14,9 @@ from __future__ import annotations
 
 import os
 import sys
+import threading
 import time
+from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable, Iterator
@@ -28,6 +30,49 @@ if TYPE_CHECKING:
     from fibrelmp.record import Recorder  # noqa: F401
 
 LOG_NAME = "log.lammps"          # LAMMPS's own log with the thermo output (fibrelmp.record)
+
+_CLONE_FS = 0x00000200           # linux/sched.h: the working directory, root and umask
+_own_folder = threading.local()  # has this thread a working directory of its own?
+_folder_lock = threading.Lock()  # where it cannot have one: one run at a time in the process
+
+
+def _thread_own_folder() -> bool:
+    """Give the calling thread a working directory of its own (Linux ``unshare(CLONE_FS)``:
+    a ``chdir`` in it no longer moves the process's other threads; threads it starts later
+    share its directory).  False where that is not possible (not Linux)."""
+    if getattr(_own_folder, "done", None) is None:
+        done = False
+        if sys.platform.startswith("linux"):
+            import ctypes
+
+            try:
+                libc = ctypes.CDLL(None, use_errno=True)
+                done = libc.unshare(_CLONE_FS) == 0
+            except (OSError, AttributeError):
+                done = False
+        _own_folder.done = done
+    return _own_folder.done
+
+
+@contextmanager
+def in_folder(folder: Path) -> Iterator[None]:
+    """Run the block with ``folder`` as the calling thread's working directory (the job's
+    relative file names are LAMMPS's own: ``cd WORK && lmp -in in.lammps`` replays it).  The
+    caller's other threads keep their directory; where a thread cannot have its own
+    directory, runs in this process are serialised instead (docs/python.md)."""
+    own = _thread_own_folder()
+    if not own:
+        _folder_lock.acquire()
+    try:
+        cwd = os.getcwd()
+        os.chdir(folder)
+        try:
+            yield
+        finally:
+            os.chdir(cwd)
+    finally:
+        if not own:
+            _folder_lock.release()
 
 
 def mpi_rank_size() -> tuple[int, int]:
@@ -242,7 +287,7 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
             "-screen", "none"]
     script_text = text if text is not None else read_script(script)
     commands, labels = parse_commands(script_text, str(script))
-    cwd = os.getcwd()
+    folder = ExitStack()             # the job folder as this thread's working directory
     skip_to = resume["commands"] if resume else 0     # commands done before the checkpoint
     steps = resume["steps"] if resume else 0
     resumed_steps = steps
@@ -266,7 +311,7 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
             from fibrelmp._lammps import mpi_barrier
             mpi_barrier()
         try:
-            os.chdir(script.parent)
+            folder.enter_context(in_folder(script.parent))
         except OSError as exc:
             raise RunError(f"{script.parent}: job folder not visible on MPI rank {rank} ({exc.strerror}): "
                            "the work folder must be on a file system shared by all ranks") from None
@@ -358,7 +403,7 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
             checkpoints.clear(rank)
     finally:
         bar.close()
-        os.chdir(cwd)
+        folder.close()
         if checkpoints is not None:
             checkpoints.uninstall()
         if lmp is not None:
@@ -417,6 +462,22 @@ def restore_step_state(lmp, state: dict) -> None:
 
 
 
+_switch = {"runs": 0, "saved": 0.0}
+_switch_lock = threading.Lock()
+
+
+def _short_switch(change: int) -> None:
+    """A short GIL switch interval while any overlapped run is under way (runs in several
+    threads: the interval the first one found comes back when the last one ends)."""
+    with _switch_lock:
+        if _switch["runs"] == 0 and change > 0:
+            _switch["saved"] = sys.getswitchinterval()
+            sys.setswitchinterval(min(_switch["saved"], 2e-4))
+        _switch["runs"] += change
+        if _switch["runs"] == 0:
+            sys.setswitchinterval(_switch["saved"])
+
+
 class RunAborted(Exception):
     """Raised inside the consumer when LAMMPS failed: writers discard partial outputs."""
 
@@ -467,8 +528,7 @@ def run_overlapped(script: Path, total_steps: int, frame_token: Callable[[list[s
     worker = threading.Thread(target=work, daemon=True)
     # LAMMPS runs without the GIL, but between two commands the main thread needs it back:
     # while the converter holds it, that takes up to the switch interval (5 ms by default)
-    switch = sys.getswitchinterval()
-    sys.setswitchinterval(min(switch, 2e-4))
+    _short_switch(+1)
     worker.start()
     try:
         with cores_taken(1):        # LAMMPS's core: the converter then uses one thread only
@@ -479,7 +539,7 @@ def run_overlapped(script: Path, total_steps: int, frame_token: Callable[[list[s
         worker.join()
         raise
     finally:
-        sys.setswitchinterval(switch)
+        _short_switch(-1)
     ready.put(done)
     worker.join()
     if "error" in result:

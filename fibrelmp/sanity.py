@@ -231,7 +231,9 @@ def rank_check(model: Model | GranularModel, ranks: int) -> None:
     limit = MIN_PER_RANK[what]
     if ranks > 1 and count < limit * ranks:
         best = max(1, count // limit)
-        model.warn("ranks", f"{ranks} MPI ranks for {count} {what} ({count // ranks} per rank): below "
+        named = what if count != 1 else what[:-1]          # 1 sphere, 2 spheres
+        share = f"{count // ranks} per rank" if count >= ranks else "fewer than one per rank"
+        model.warn("ranks", f"{ranks} MPI ranks for {count} {named} ({share}): below "
                    f"~{limit} {what} per rank more ranks make the run slower; use "
                    f"{'1 (no mpiexec)' if best == 1 else f'mpiexec -n {best}'} (docs/performance.md)")
 
@@ -278,3 +280,174 @@ def blow_up_hint(model: Model | GranularModel, message: str) -> str | None:
     return (f"hint: atoms moved too far in one step: the run became unstable. `fibrelmp check` "
             f"shows the time step against the {what}; a smaller step, stiffer walls or less "
             "overlap at the start usually help")
+
+
+# ---------------------------------------------------------------------------------------
+# runs that cannot finish: steps LAMMPS cannot count, output no disk holds, years of CPU
+MAXSMALLINT = 2 ** 31 - 1         # LAMMPS: the steps of one 'run', a 'variable loop' count
+MAXBIGINT = 2 ** 63 - 1           # LAMMPS: the time step counter
+# the estimate (docs/python.md "Refused before LAMMPS starts"): the work dump alone holds a
+# header per frame and a row of at least id, type and three %.17g coordinates per particle;
+# a result written as one file per frame (DEMDF snapshots, VTK frames) takes a disk block each
+FRAME_HEADER_BYTES = 150
+ROW_BYTES = 64
+FILE_BYTES = 4096
+# optimistic LAMMPS speeds: no run goes faster, so a run refused by them cannot finish
+FASTEST_STEPS_PER_SECOND = 1e6            # LAMMPS's own overhead per step, tiny systems
+FASTEST_PARTICLE_STEPS_PER_SECOND = 1e9   # per MPI rank
+LONGEST_RUN_SECONDS = 30 * 86400
+
+
+def _size(n: float) -> str:
+    for unit in ("B", "kB", "MB", "GB", "TB", "PB", "EB"):
+        if n < 1000 or unit == "EB":
+            return f"{n:.3g} {unit}" if unit != "B" else f"{n:.0f} B"
+        n /= 1000
+    return f"{n:.3g} EB"
+
+
+def _duration(seconds: float) -> str:
+    days = seconds / 86400
+    return f"{days / 365.25:.3g} years" if days > 730 else f"{days:.3g} days"
+
+
+# a run beyond this many steps is refused even with --yes-i-mean-it: 31 years at the fastest
+# LAMMPS speed, and its job could not even be rendered (millions of 'run' pieces)
+MOST_STEPS = 10 ** 15
+
+
+def planned_steps(model) -> int | None:
+    """The time steps a model's run takes, known before its job is rendered (None: only the
+    rendered job says)."""
+    plan = getattr(model, "plan", None)
+    stages = getattr(plan, "stages", None)
+    if stages is not None:                                  # FibreNet: relaxation + production
+        return int(sum(st.steps for st in stages))
+    if isinstance(model, GranularModel):
+        span = (plan.t_end - plan.t_start) / plan.dt
+        return int(math.ceil(span)) if math.isfinite(span) else MAXBIGINT + 1
+    return None
+
+
+def check_steps(model, where, allow_huge: bool) -> None:
+    """Refuse (InputError at ``where``) before the job is rendered a run of more steps than
+    LAMMPS counts, than ``MOST_STEPS``, or (unless ``allow_huge``) than it can make in
+    ``LONGEST_RUN_SECONDS`` at ``FASTEST_STEPS_PER_SECOND``."""
+    from fibrelmp.errors import InputError
+
+    steps = planned_steps(model)
+    if steps is None:
+        return
+    if steps > MAXBIGINT:
+        raise InputError(where, None, f"the run has {steps} time steps; LAMMPS counts at most "
+                         f"{MAXBIGINT} (2^63-1)")
+    seconds = steps / FASTEST_STEPS_PER_SECOND
+    if steps > MOST_STEPS or (seconds > LONGEST_RUN_SECONDS and not allow_huge):
+        override = "" if steps > MOST_STEPS else ", or give --yes-i-mean-it"
+        raise InputError(where, None, f"the run has {steps} time steps: at least "
+                         f"{_duration(seconds)} even at {FASTEST_STEPS_PER_SECOND:.0e} steps/s "
+                         f"(LAMMPS is slower): run fewer steps{override}")
+
+
+def needs_job(model, outputs) -> bool:
+    """Must the job be rendered to tell whether the run can finish?  Not when even a frame at
+    every step (``planned_steps`` + 1 frames) fits the estimate: every count then fits a
+    LAMMPS int, and the output and the time are within bounds (rendering a large model twice
+    costs a tenth of a second per 50,000 beads)."""
+    steps = planned_steps(model)
+    if steps is None or steps >= MAXSMALLINT - 1:
+        return True
+    n = particle_count(model)
+    frames = steps + 1
+    size = frames * (FRAME_HEADER_BYTES + n * ROW_BYTES + (FILE_BYTES if outputs.patterns else 0))
+    seconds = n * steps / FASTEST_PARTICLE_STEPS_PER_SECOND
+    folders = [outputs.work] + [f.parent for f in outputs.files[:1]]
+    return seconds > LONGEST_RUN_SECONDS or any(size > _free_space(f)[0] for f in folders)
+
+
+def particle_count(model) -> int:
+    """Beads, spheres or SPH particles of a model (for the estimates; 0 when unknown)."""
+    for name in ("particles", "spheres"):
+        group = getattr(model, name, None)
+        if group is not None and hasattr(group, "count"):
+            return int(group.count)
+    return 0
+
+
+def representable(rendered, where) -> None:
+    """Refuse a job whose step counts LAMMPS cannot hold (an InputError at ``where``): a
+    'run' or loop count above 2^31-1, a total above 2^63-1."""
+    from fibrelmp.errors import InputError
+
+    if rendered.total_steps > MAXBIGINT:
+        raise InputError(where, None, f"the run has {rendered.total_steps} time steps; LAMMPS "
+                         f"counts at most {MAXBIGINT} (2^63-1)")
+    for number, line in enumerate(rendered.text.splitlines(), 1):
+        words = line.split()
+        count = None
+        if words[:1] == ["run"] and len(words) > 1:
+            count = words[1]
+        elif words[:1] == ["variable"] and len(words) > 3 and words[2] == "loop":
+            count = words[-1] if len(words) > 4 and words[4].isdigit() else words[3]
+        if count is not None and count.isdigit() and int(count) > MAXSMALLINT:
+            raise InputError(where, None, f"the job needs '{line.strip()}' ({rendered.script.name}"
+                             f" line {number}): more than the {MAXSMALLINT} (2^31-1) LAMMPS takes "
+                             "there; run fewer steps or save fewer frames")
+
+
+def _free_space(folder) -> tuple[int, int]:
+    """(free bytes, device) of the file system ``folder`` is (or will be) on."""
+    import os
+    import shutil
+    from pathlib import Path
+
+    probe = Path(folder)
+    while not probe.exists() and probe != probe.parent:
+        probe = probe.parent
+    return shutil.disk_usage(probe).free, os.stat(probe).st_dev
+
+
+def run_budget(jobs: list[tuple[object, object]], outputs, ranks: int, allow_huge: bool,
+               disk: bool = True) -> None:
+    """Refuse, as an InputError before anything is written, a run that cannot finish: the
+    estimated output (``jobs``: (model, rendered job) pairs) larger than the free space where
+    it goes, or an optimistic wall time beyond ``LONGEST_RUN_SECONDS``.  ``allow_huge``
+    (run --yes-i-mean-it) skips both (step counts LAMMPS cannot hold are refused always).
+    ``disk``: check the free space (MPI: rank 0, which writes every file)."""
+    from fibrelmp.errors import InputError
+
+    for _, rendered in jobs:
+        representable(rendered, outputs.source)
+    if allow_huge:
+        return
+    per_file = bool(outputs.patterns)                 # numbered files: one per frame
+    results_folder = (outputs.files[0].parent if outputs.files else
+                      outputs.patterns[0][0] if outputs.patterns else outputs.work)
+    need: dict[int, list] = {}                        # device -> [bytes, folder, what]
+    seconds = 0.0
+    frames_total = 0
+    for model, rendered in jobs:
+        n = particle_count(model)
+        try:
+            frames = len(rendered.schedule)
+        except TypeError:
+            frames = 0
+        frames_total += frames
+        steps = rendered.total_steps
+        seconds += max(steps / FASTEST_STEPS_PER_SECOND,
+                       n * steps / (FASTEST_PARTICLE_STEPS_PER_SECOND * max(ranks, 1)))
+        for folder, size in ((rendered.folder, frames * (FRAME_HEADER_BYTES + n * ROW_BYTES)),
+                             (results_folder, frames * FILE_BYTES if per_file else 0)):
+            free, device = _free_space(folder)
+            entry = need.setdefault(device, [0, folder, free])
+            entry[0] += size
+    if seconds > LONGEST_RUN_SECONDS:
+        raise InputError(outputs.source, None, f"the run would take at least {_duration(seconds)} "
+                         f"even at {FASTEST_STEPS_PER_SECOND:.0e} steps/s and "
+                         f"{FASTEST_PARTICLE_STEPS_PER_SECOND:.0e} particle-steps/s per MPI rank "
+                         f"(LAMMPS is slower): run fewer steps, or give --yes-i-mean-it")
+    for size, folder, free in need.values():
+        if disk and size > free:
+            raise InputError(outputs.source, None, f"the run would write about {_size(size)} "
+                             f"({frames_total} saved frames) but {folder} has {_size(free)} free: "
+                             "save fewer frames or run less, free space, or give --yes-i-mean-it")

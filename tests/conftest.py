@@ -1,4 +1,6 @@
 import os
+import shutil
+import subprocess
 from pathlib import Path
 
 import pytest
@@ -33,3 +35,25 @@ def shared_path(*parts: str) -> Path:
                     f"does not have it: {path}; set FIBRELMP_SHARED to a folder holding "
                     f"{Path(*parts)}")
     return path
+
+
+def copy_example(folder: str | Path, dest: Path) -> Path:
+    """Copy the example inputs of ``folder`` (relative to the repository, e.g.
+    ``examples/fibre_network``) to ``dest``: only the files git tracks there, so results that
+    running the examples left in the clone (README's main job) never reach a test."""
+    source = REPO / folder
+    try:
+        listed = subprocess.run(["git", "-C", str(REPO), "ls-files", "-z", "--", str(source)],
+                                capture_output=True, check=True, timeout=30).stdout
+    except (OSError, subprocess.SubprocessError):
+        listed = b""
+    tracked = [REPO / name for name in listed.decode().split("\0") if name]
+    if not tracked:
+        # not a git checkout (an unpacked sdist holds the inputs only)
+        shutil.copytree(source, dest)
+        return dest
+    for path in tracked:
+        target = dest / path.relative_to(source)
+        target.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(path, target)
+    return dest

@@ -6,7 +6,6 @@ One small example per format: the registry's ``example`` (a file in examples/)."
 
 from __future__ import annotations
 
-import shutil
 from pathlib import Path
 
 import pytest
@@ -19,7 +18,7 @@ from fibrelmp.model import Model
 from fibrelmp.pipeline.inputs import InputFormat
 from fibrelmp.registry import INPUT, detect, formats
 
-from .conftest import REPO
+from .conftest import REPO, copy_example
 
 FORMATS = formats(INPUT)
 
@@ -29,7 +28,7 @@ def example(request, tmp_path):
     """(format, a copy of its example: the example's folder, so the files it names come along)."""
     fmt = request.param
     source = REPO / fmt.example
-    shutil.copytree(source.parent, tmp_path / "in")
+    copy_example(source.parent.relative_to(REPO), tmp_path / "in")
     return fmt, tmp_path / "in" / source.name
 
 

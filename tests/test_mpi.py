@@ -211,9 +211,10 @@ def test_messages_are_printed_by_rank_0_only(demdf_runs, musen_runs):
     for runs in (demdf_runs, musen_runs):
         assert_ran(runs)
         mpi, serial = runs["mpi"][1].err, runs["serial"][1].err
-        assert mpi.count("done in") == 1, mpi
-        assert mpi.count("wrote ") == serial.count("wrote ") > 0
-        assert mpi.count("warning [ranks]: 2 MPI ranks for ") == mpi.count("summary of") > 0, mpi
+        results, serial_results = runs["mpi"][1].out, runs["serial"][1].out    # stdout
+        assert results.count("done in") == 1, results
+        assert results.count("wrote ") == serial_results.count("wrote ") > 0
+        assert mpi.count("warning [ranks]: 2 MPI ranks for ") == results.count("summary of") > 0, mpi
         assert "ranks" not in serial
         assert mpi.count("warning") - mpi.count("warning [ranks]") == serial.count("warning"), mpi
         assert runs["mpi"][1].err.count("job 2:") == runs["serial"][1].err.count("job 2:")

@@ -236,7 +236,7 @@ def test_plot_says_which_source_it_used_on_the_command_line(runs, tmp_path):
     folder, _ = runs["musen"]
     result = invoke("plot", folder / "single_particle_result.mdem", "-o", tmp_path / "c.png")
     assert result.exit_code == 0, result.output
-    assert "from LAMMPS thermo of" in result.stderr              # every run keeps log.lammps
+    assert "from LAMMPS thermo of" in result.stdout              # every run keeps log.lammps
     again = invoke("plot", folder / "single_particle_result.mdem", "-o", tmp_path / "c.png")
     assert again.exit_code == 2 and "use --force" in again.stderr
     # a copy of the run without its log: the result files are plotted, and --source log refuses
@@ -246,7 +246,7 @@ def test_plot_says_which_source_it_used_on_the_command_line(runs, tmp_path):
         log.unlink()
     frames = invoke("plot", copy / "single_particle_result.mdem", "-o", tmp_path / "e.png")
     assert frames.exit_code == 0, frames.output
-    assert "from the frames of" in frames.stderr and "no LAMMPS log" in frames.stderr
+    assert "from the frames of" in frames.stdout and "no LAMMPS log" in frames.stdout
     log_only = invoke("plot", copy / "single_particle_result.mdem", "--source", "log", "-o",
                       tmp_path / "d.png")
     assert log_only.exit_code == 2 and "no LAMMPS log for this result" in log_only.stderr

@@ -15,7 +15,6 @@ import os
 import pty
 import re
 import select
-import shutil
 import subprocess
 import sys
 import time
@@ -24,7 +23,7 @@ import pytest
 
 from fibrelmp.runner import LogEvery, Progress, parse_log_every
 
-from .conftest import REPO
+from .conftest import REPO, copy_example
 
 CLI = [sys.executable, "-m", "fibrelmp.cli"]
 EXAMPLE = REPO / "examples" / "fibre_network"
@@ -45,7 +44,7 @@ main()
 
 
 def _example(tmp_path):
-    shutil.copytree(EXAMPLE, tmp_path / "in")
+    copy_example(EXAMPLE.relative_to(REPO), tmp_path / "in")
     return tmp_path / "in" / "input.txt"
 
 
@@ -114,7 +113,7 @@ def test_lines_without_a_terminal(tmp_path):
     # a line each time a quarter is passed (the steps advance 40 at a time)
     assert [int(pct // 25) for pct, *_ in lines] == [0, 1, 2, 3, 4]
     assert [n for _, n, *_ in lines] == sorted(n for _, n, *_ in lines)
-    assert proc.stderr.count("summary of") == 1
+    assert proc.stdout.count("summary of") == 1 and "summary of" not in proc.stderr
     quiet = subprocess.run(CLI + ["-q", "run", str(inp), "-o", str(tmp_path / "out"), "--force"],
                            cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert quiet.returncode == 0 and quiet.stderr == ""

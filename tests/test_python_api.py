@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import os
 import re
-import shutil
 import signal
 import subprocess
 import sys
@@ -13,14 +12,14 @@ import sys
 import numpy as np
 import pytest
 
-from .conftest import REPO
+from .conftest import REPO, copy_example
 
 
 def test_documented_example_runs(tmp_path):
     text = (REPO / "docs" / "python.md").read_text()
     code = re.search(r"```python\n(.*?)```", text, re.S).group(1)
     for folder in ("examples/fibre_network", "examples/demdf"):
-        shutil.copytree(REPO / folder, tmp_path / folder)
+        copy_example(folder, tmp_path / folder)
     res = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True,
                          timeout=300)
     assert res.returncode == 0, res.stderr

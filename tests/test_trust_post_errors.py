@@ -8,7 +8,6 @@ from __future__ import annotations
 import builtins
 import errno
 import os
-import shutil
 from pathlib import Path
 
 import pytest
@@ -21,6 +20,7 @@ from fibrelmp.translate.fibrenet.writer import XyzWriter, read_xyz
 from fibrelmp.post.lammps_dump.reader import iter_frames, iter_headers
 
 from .test_post_robust import ROWS, frame, write
+from .conftest import copy_example
 
 REPO = Path(__file__).resolve().parents[1]
 ENOSPC = os.strerror(errno.ENOSPC)          # "No space left on device"
@@ -160,7 +160,7 @@ def test_read_text_says_a_directory_is_a_directory(tmp_path):
 def test_directories_named_by_inputs_are_reported_as_directories(tmp_path):
     # FibreNet: model_file names a directory
     fn = tmp_path / "fn"
-    shutil.copytree(REPO / "examples" / "fibre_network", fn)
+    copy_example("examples/fibre_network", fn)
     (fn / "model.txt").unlink()
     (fn / "model.txt").mkdir()
     result = invoke("check", fn / "input.txt")

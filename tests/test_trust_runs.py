@@ -445,7 +445,7 @@ def test_quiet_and_verbose_after_the_subcommand(tmp_path):
     res = cli(["translate", inp, "-o", tmp_path / "job", "-q"], tmp_path)
     assert res.returncode == 0 and res.stderr == ""
     res = cli(["run", inp, "--quiet"], tmp_path)
-    assert res.returncode == 0 and "wrote" not in res.stderr
+    assert res.returncode == 0 and "wrote" not in res.stdout + res.stderr
 
 
 def test_python_users_get_a_working_lammps_instance(tmp_path):

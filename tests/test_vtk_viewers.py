@@ -275,7 +275,8 @@ def test_run_vtk_needs_force_for_earlier_frames_and_removes_them(tmp_path):
     done = runner.invoke(app, [*args, "--force"])
     assert done.exit_code == 0, done.output
     assert not stale.exists()
-    assert re.search(r"wrote .*fibre_network_NNNNNN_bonds\.vtp \(6 files\)", done.output)
+    assert re.search(r"wrote .*fibre_network_000000_bonds\.vtp \.\. fibre_network_000005_bonds\.vtp "
+                     r"\(6 files\)", done.stdout)
     assert len(list(tmp_path.glob("fibre_network_*.vtp"))) == 12
 
 

@@ -33,7 +33,7 @@ from fibrelmp.lammps_styles import build as _build
 ENV_STOCK = "FIBRELMP_STOCK_STYLES"
 _lock = threading.Lock()
 _found: "Plugin | None" = None
-_stock_requested = False
+_stock = threading.local()      # stock styles requested, per thread (runs in several threads)
 
 
 @dataclass(frozen=True)
@@ -82,7 +82,7 @@ def plugin() -> Plugin:
     """The plugin jobs load (looked up, and built if needed, once per process); a Plugin
     without path when stock styles were requested (:func:`request_stock`) or it is missing."""
     global _found
-    if _stock_requested:
+    if getattr(_stock, "requested", False):
         return Plugin(None, "stock styles requested (--stock-styles)")
     with _lock:
         if _found is None:
@@ -98,16 +98,17 @@ def forget() -> None:
 
 
 def request_stock(flag: bool = True) -> bool:
-    """Render jobs with stock styles (``--stock-styles``); returns the previous setting."""
-    global _stock_requested
-    previous, _stock_requested = _stock_requested, bool(flag)
+    """Render jobs with stock styles (``--stock-styles``) in the calling thread; returns the
+    previous setting."""
+    previous = getattr(_stock, "requested", False)
+    _stock.requested = bool(flag)
     return previous
 
 
 @contextmanager
 def stock(flag: bool = True) -> Iterator[None]:
     """Within the block, render jobs with stock styles if ``flag`` (restored afterwards)."""
-    previous = request_stock(flag or _stock_requested)
+    previous = request_stock(flag or getattr(_stock, "requested", False))
     try:
         yield
     finally:

@@ -3,7 +3,6 @@ force laws): the translated set-up, then ``run 0``."""
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -34,21 +33,20 @@ def evaluate(model: "Model", folder: str | Path) -> Evaluation:
 
     from fibrelmp._lammps import new_lammps
     from fibrelmp.errors import RunError
-    from fibrelmp.runner import parse_commands
+    from fibrelmp.runner import in_folder, parse_commands
     from fibrelmp.translate.lammps_job import write_job
 
     job = write_job(model, folder)
     commands, _ = parse_commands(job.text, str(job.script))
     stop = next(i for i, cmd in enumerate(commands) if cmd.words[0] in _DYNAMICS)
-    cwd = os.getcwd()
     lmp = new_lammps(["-nocite", "-log", "none", "-screen", "none"])
     try:
-        os.chdir(job.folder)
-        for cmd in commands[:stop]:
-            lmp.command(cmd.text)
-        lmp.command("thermo_style custom step pe")
-        lmp.command("thermo_modify norm no")
-        lmp.command("run 0 post no")
+        with in_folder(job.folder):       # this thread's directory only (runner.in_folder)
+            for cmd in commands[:stop]:
+                lmp.command(cmd.text)
+            lmp.command("thermo_style custom step pe")
+            lmp.command("thermo_modify norm no")
+            lmp.command("run 0 post no")
         n = model.particles.count
         f = np.array(lmp.numpy.extract_atom("f")[:n], dtype=float)
         ids = np.array(lmp.numpy.extract_atom("id")[:n], dtype=np.int64)
@@ -58,5 +56,4 @@ def evaluate(model: "Model", folder: str | Path) -> Evaluation:
     except Exception as exc:
         raise RunError(f"LAMMPS error: {exc}") from None
     finally:
-        os.chdir(cwd)
         lmp.close()

@@ -183,13 +183,13 @@ def move_file(src: Path, dst: Path) -> None:
     """Rename ``src`` to ``dst`` (replacing it); across file systems through a temp file
     beside ``dst``, so ``dst`` is never half written."""
     import errno
-    import os
     import shutil
 
+    from fibrelmp.formatbase import place
     from fibrelmp.textio import discard, temp_name, write_failure
 
     try:
-        os.replace(src, dst)
+        place(src, dst)          # undone with the run's other results if the run fails
         return
     except OSError as exc:
         if exc.errno != errno.EXDEV:
@@ -197,7 +197,7 @@ def move_file(src: Path, dst: Path) -> None:
     tmp = temp_name(dst)
     try:
         shutil.copyfile(src, tmp)
-        os.replace(tmp, dst)
+        place(tmp, dst)
     except OSError as exc:
         discard(tmp)
         raise write_failure(dst, exc) from None

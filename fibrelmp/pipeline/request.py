@@ -28,6 +28,7 @@ class RunOptions:
     checkpoint_every: int | None = None   # steps between checkpoints (None: on signals only)
     resume: bool = False               # continue from the checkpoint in the work folder
     log_every: "LogEvery | None" = None   # progress lines without a terminal (None: the default)
+    allow_huge: bool = False           # run --yes-i-mean-it: no disk-space or run-time refusal
 
 
 @dataclass

@@ -30,7 +30,8 @@ def run(plan: RunPlan, warn: Warn | None = None) -> Outcome:
     its model while it is translated and run."""
     from fibrelmp.outputs import finish, locked
     from fibrelmp.runner import mpi_rank_size
-    from fibrelmp.sanity import rank_check, time_step_check
+    from fibrelmp.sanity import (check_steps, needs_job, rank_check, run_budget,
+                                 time_step_check)
 
     rank, size = mpi_rank_size()
     options = plan.options
@@ -38,6 +39,18 @@ def run(plan: RunPlan, warn: Warn | None = None) -> Outcome:
         from fibrelmp.checkpoint import NO_CHECKPOINT
 
         raise InputError(plan.outputs.source, None, NO_CHECKPOINT)
+    # runs that cannot finish (steps LAMMPS cannot count, output beyond the free disk space,
+    # years of CPU) are refused before anything is written: each job rendered in memory
+    jobs = []
+    for step in plan.steps:
+        if isinstance(step, RunRequest):
+            check_steps(step.model, plan.outputs.source, options.allow_huge)
+            if not needs_job(step.model, plan.outputs):
+                continue
+            said = len(step.model.warnings)
+            jobs.append((step.model, step.build(Path(step.work).resolve(), False)))
+            del step.model.warnings[said:]      # said when the job is rendered for the run
+    run_budget(jobs, plan.outputs, size, options.allow_huge, disk=rank == 0)
     outcome = Outcome()
     several = sum(isinstance(step, RunRequest) for step in plan.steps) > 1
     # resuming continues this run's own (locked) work: its partial results are not "earlier" ones

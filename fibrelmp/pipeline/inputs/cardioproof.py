@@ -114,8 +114,9 @@ def case_outputs(case: "SphCase", out: str | Path | None = None,
     return Outputs(case.source, job, files=files, patterns=patterns, inputs=inputs), folder
 
 
-# a staged file is ".<name>.tmp<pid>" (fibrelmp.textio.temp_name): 5 bytes and a pid of up to 7 digits
-TEMP_NAME_EXTRA = 12
+# a staged file is ".<name>.tmp<pid>" (fibrelmp.textio.temp_name) and the earlier file a --force run
+# keeps aside ".<name>.tmp<pid>.old" (formatbase.replacing): 9 bytes and a pid of up to 7 digits
+TEMP_NAME_EXTRA = 16
 
 
 def _check_name_lengths(case: "SphCase", paths: list[Path], staged: bool) -> None:

@@ -366,7 +366,7 @@ def test_musen_results_get_their_usual_suffix(tmp_path, to, out, written):
     p = write(tmp_path, frame(0, rows, cols=VEL_FORCE, time=0.0) + frame(10, rows, cols=VEL_FORCE, time=0.1))
     proc = cli(["post", p.name, "--to", to, "-o", out], tmp_path)
     assert proc.returncode == 0, proc.stderr
-    assert f"wrote {written}" in proc.stderr
+    assert f"wrote {written}" in proc.stdout
     assert listing(tmp_path) == sorted(["d.dump", written])
     again = cli(["post", p.name, "--to", to, "-o", out], tmp_path)     # --force guards that name
     assert again.returncode == 2 and f"error: {written}: output exists" in again.stderr
@@ -412,7 +412,7 @@ def test_post_under_mpi_writes_once_on_rank_0(tmp_path):
     assert listing(tmp_path / "out") == sorted(f.name for f in serial)
     for f in serial:
         assert (tmp_path / "out" / f.name).read_bytes() == f.read_bytes()
-    assert done.stderr.count("wrote out/net_coord.xyz") == 1
+    assert done.stdout.count("wrote out/net_coord.xyz") == 1
     info = mpi_post([p.name, "--info"], tmp_path)
     assert info.returncode == 0 and info.stdout.count("frames     3") == 1, info.stdout
 

@@ -37,8 +37,10 @@ _KNOWN_KEYS = ("fileFormat", "fileFormatVersion", "name", "dimensionality", "tim
                "timeStep", "timeStepCount", "timeStepCountEnd", "eventCount", "eventCountEnd",
                "output", "domain", "bodyForce", "objectTypes", "objects", "interactions",
                "particleRadius", "fibrelmp")
-_PARTICLE_TYPE_KEYS = ("type", "id", "radius", "mass", "restitutionCoefficient")
-_WALL_TYPE_KEYS = ("type", "id", "restitutionCoefficient")
+# "name": a label only (the schema allows any key; fibrelmp's own DEMDF target names each
+# type by its MUSEN material), read for nothing
+_PARTICLE_TYPE_KEYS = ("type", "id", "name", "radius", "mass", "restitutionCoefficient")
+_WALL_TYPE_KEYS = ("type", "id", "name", "restitutionCoefficient")
 _INTERACTION_KEYS = ("name", "objectTypes")
 _OBJECT_KEYS = ("particles", "walls")
 _WALL_KEYS = ("normal", "point", "objectType", "typename")

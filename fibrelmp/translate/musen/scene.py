@@ -483,7 +483,9 @@ def check_patch(err: InputError, line: str | None, attempt: int) -> str | None:
         if key is not None and otype == str(WALL):
             candidates.append(f"0 {tok[1]} 1 14 5 23 {key} 24 0 1e+300 2 0 44 0 0 0 1 0 0 0 1 0")
         elif key is not None and otype not in (str(SOLID_BOND), str(LIQUID_BOND)):
-            candidates.append(f"0 {tok[1]} 1 1 5 1 1 23 {key} 24 0 1e+300 2 0 12 0 0 0")
+            # at a position its id makes unique (two stand-ins at one point would be a bond's
+            # "same position" error that the file does not have)
+            candidates.append(f"0 {tok[1]} 1 1 5 1 1 23 {key} 24 0 1e+300 2 0 12 {tok[1]}e-100 0 0")
     elif len(tok) >= 3 and tok[0] == "32":
         candidates.append(f"32 {tok[1]} {tok[2]}")
     candidates.append("")

@@ -1,7 +1,7 @@
 """A toy ``post --to csv`` target: one CSV file with every frame's atoms.
 
 The whole of what adding an output format takes (docs/architecture.md): this module and
-one ``register_format`` call (tests/test_conformance.py makes it).
+one ``register_format`` call (tests/conformance/test_registry.py makes it).
 """
 
 from __future__ import annotations

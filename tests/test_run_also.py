@@ -138,3 +138,15 @@ def test_python_api_viewer_files_is_a_deprecated_also(tmp_path):
     with pytest.warns(DeprecationWarning, match=r"run\(viewer_files=True\) is deprecated: use also=\[.vtk.\]"):
         done = python_api.run(tmp_path / "head_on.json", viewer_files=True)
     assert tmp_path / "head_on.pvd" in done.outputs and (tmp_path / "head_on_000008.vtp").is_file()
+
+
+def test_also_choices_complete_and_help_come_from_the_registry(times_format):
+    line = "fibrelmp run scene.txt --also "
+    env = {"_FIBRELMP_COMPLETE": "complete_bash", "COMP_WORDS": line,
+           "COMP_CWORD": str(len(line.split(" ")) - 1), "_TYPER_COMPLETE_ARGS": line}
+    done = CliRunner().invoke(app, [], prog_name="fibrelmp", env=env)
+    assert done.exit_code == 0 and done.stdout.split() == registry.names(ALSO)
+    assert "times" in registry.names(ALSO)          # registered after the CLI was imported
+    helped = CliRunner().invoke(app, ["run", "--help"], terminal_width=400)
+    assert all(f"{f.name}: {f.title}" in " ".join(helped.stdout.split())
+               for f in registry.formats(ALSO) if f.name != "times")

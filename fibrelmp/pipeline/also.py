@@ -57,7 +57,7 @@ def chosen(names: Iterable[str]) -> tuple[str, ...]:
 
 
 def hooks(names: Iterable[str]) -> list[RunOutput]:
-    return [registry.get(name).load(ALSO)() for name in names]
+    return [registry.choose(ALSO, name, OPTION).load(ALSO)() for name in names]
 
 
 def granular_writers(names: Iterable[str], model: "GranularModel", outputs: "Outputs",

@@ -13,7 +13,7 @@ import typer
 
 from fibrelmp import __version__
 
-from fibrelmp.registry import DOCUMENT, FRAMES, INPUT, RESULT, TARGET, formats, names
+from fibrelmp.registry import ALSO, DOCUMENT, FRAMES, INPUT, RESULT, TARGET, formats, names
 
 _INPUTS = formats(INPUT)
 _TITLES = ", ".join(f.title for f in _INPUTS[:-1]) + " or " + _INPUTS[-1].title
@@ -38,6 +38,29 @@ class _Command(typer.core.TyperCommand):
                     n if required else f"[{n}]")
             elif not getattr(param, "is_flag", False) and param.metavar is None:
                 param.metavar = param.name.upper()
+
+    def parse_args(self, ctx, args: list[str]) -> list[str]:
+        return super().parse_args(ctx, _also_aliases(self, args))
+
+
+def _also_aliases(command: typer.core.TyperCommand, args: list[str]) -> list[str]:
+    """A bare ``--NAME`` of a format ``run --also`` takes is ``--also NAME``, with a note on
+    stderr: the form of the one such flag before ``--also`` existed, kept for users' scripts."""
+    options = {opt for param in command.params for opt in param.opts}
+    if "--also" not in options:
+        return args
+    out: list[str] = []
+    for k, arg in enumerate(args):
+        if arg == "--":                        # what follows is no option
+            return out + args[k:]
+        name = arg[2:] if arg.startswith("--") and arg not in options else None
+        if name in names(ALSO):
+            if _rank0():
+                typer.echo(f"note: --{name} is deprecated, use --also {name}", err=True)
+            out += ["--also", name]
+        else:
+            out.append(arg)
+    return out
 
 
 app = typer.Typer(add_completion=True, no_args_is_help=True, rich_markup_mode=None,
@@ -304,9 +327,10 @@ def run(input: Path = typer.Argument(..., help=f"{_TITLES[0].upper()}{_TITLES[1:
                                     "checkpoint in its work folder."),
         force: bool = typer.Option(False, "--force", help="Replace the results of an earlier run "
                                    "(all of them: stale files are removed)."),
-        viewer_files: bool = typer.Option(False, "--vtk", help="Also write every saved frame "
-                                          "as files 3D viewers open (OVITO and others; "
-                                          "docs/post.md), next to the results."),
+        also: Optional[list[str]] = typer.Option(
+            None, "--also", metavar="NAME", autocompletion=lambda: names(ALSO),
+            help="Also write every saved frame next to the results as NAME, one of: " + "; ".join(
+                f"{f.name}: {f.title}" for f in formats(ALSO)) + ". Repeat or comma-separate."),
         log_every: Optional[str] = typer.Option(None, "--log-every", metavar="WHEN", help="Without a "
                                                 "terminal (batch jobs): a progress line on stderr every "
                                                 "10% of the steps, 60s/5m/1h, or both (default 10%,5m)."),
@@ -324,7 +348,7 @@ def run(input: Path = typer.Argument(..., help=f"{_TITLES[0].upper()}{_TITLES[1:
     result = run_any(input, out, work=work, force=force, checkpoint_every=checkpoint_every,
                      resume=resume, end_time=end_time, step=step, save_step=save_step, steps=steps,
                      precision=precision, progress=not _state["quiet"], stock_styles=stock_styles,
-                     viewer_files=viewer_files, say=_say,
+                     also=also or (), say=_say,
                      warn=_report_warnings, log_every=log_every, allow_huge=yes_i_mean_it)
     for note in result.notes:
         _say(note)

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Iterator
+from typing import Callable, Iterable, Iterator
 
 from fibrelmp.errors import InputError
 
@@ -94,9 +94,9 @@ def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | N
         force: bool = False, checkpoint_every: int | None = None, resume: bool = False,
         end_time: float | None = None, step: float | None = None, save_step: float | None = None,
         steps: int | None = None, precision: int | None = None, progress: bool = False,
-        stock_styles: bool = False, viewer_files: bool = False, say: Say = _quiet,
+        stock_styles: bool = False, also: Iterable[str] = (), say: Say = _quiet,
         warn: Warn | None = None, log_every: str | None = None,
-        allow_huge: bool = False) -> RunResult:
+        allow_huge: bool = False, viewer_files: bool = False) -> RunResult:
     """Run any supported input on LAMMPS and write its results in the input's own format.
 
     ``out``: the results' folder, or the result file of an input with a single result;
@@ -104,9 +104,10 @@ def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | N
     ``force``.  ``end_time``/``step``/``save_step`` and ``steps`` override the
     input's (an input that sets them itself refuses them).  ``precision``: significant
     digits of text results that take it (default 6; refused for the others).  ``stock_styles``: stock LAMMPS
-    styles instead of fibrelmp's own (see ``translate_job``).  ``viewer_files`` (``run --vtk``):
-    also write every saved frame as files 3D viewers open, beside the results
-    (``fibrelmp.pipeline.viewer``; they are in ``outputs``).  ``say`` receives progress notes, ``warn`` lists of
+    styles instead of fibrelmp's own (see ``translate_job``).  ``also`` (``run --also``):
+    formats also written from every saved frame beside the results, any of
+    ``fibrelmp.registry.names("also")`` (``fibrelmp.pipeline.also``; the files are in
+    ``outputs``); ``viewer_files=True`` is deprecated: every one of them.  ``say`` receives progress notes, ``warn`` lists of
     ``(kind, text)`` warnings as they are found (they are also in the result).  ``progress``:
     a bar on a terminal, else a line on stderr every ``log_every`` (``"10%"``, ``"60s"``,
     ``"10%,5m"``: the default).  Each simulation's summary (``summary.json``) is in
@@ -118,11 +119,22 @@ def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | N
     (``run --yes-i-mean-it``) lifts the last two."""
     from fibrelmp.checkpoint import check_every
     from fibrelmp.pipeline import RunOptions, run as run_plan
+    from fibrelmp.pipeline.also import chosen
     from fibrelmp.pipeline.inputs import RunSettings
 
     path = Path(path)
     hook = _input(path)
     check_every(checkpoint_every)         # before any folder is made
+    also = [also] if isinstance(also, str) else list(also)
+    if viewer_files:
+        import warnings
+
+        from fibrelmp.registry import ALSO, names
+
+        warnings.warn(f"run(viewer_files=True) is deprecated: use also={names(ALSO)!r}",
+                      DeprecationWarning, stacklevel=2)
+        also += names(ALSO)
+    also = chosen(also)                   # an unknown name: an InputError listing the choices
     if precision is not None:
         _check_precision(precision)
         unused = hook.precision_unused(path, None if out is None else Path(out))
@@ -140,7 +152,7 @@ def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | N
 
     settings = RunSettings(None if out is None else Path(out), None if work is None else Path(work),
                            end_time, step, save_step, steps, 6 if precision is None else precision,
-                           viewer_files=viewer_files)
+                           also=also)
     if resume and not hook.has_checkpoint(path, settings.out, settings.work):    # before reading
         from .checkpoint import NO_CHECKPOINT
 

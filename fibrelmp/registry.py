@@ -21,6 +21,9 @@ Roles
               has ``open(path)`` (a document) and ``writer(target, precision, force=)``.
   ``mesh``    a finite-element mesh; its hook is a ``mesh.model.MeshFormat`` (reader, writer).
   ``motion``  mesh node positions over time; its hook is a frame ``Reader``.
+  ``also``    written from a run's own frames beside the input's results (``run --also
+              NAME``, any input); its hook is a ``pipeline.also.RunOutput`` (it declares the
+              files among the run's outputs and makes the writer the frames are fed to).
 
 Adding a format: one module with its Reader/Writer subclass, one ``register_format`` call
 below (docs/architecture.md shows an example).  Like meshio's ``register_format`` and ASE's
@@ -38,8 +41,8 @@ from typing import Any
 from .errors import InputError
 
 INPUT, RESULT, TARGET, FRAMES, DOCUMENT = "input", "result", "target", "frames", "document"
-MESH, MOTION = "mesh", "motion"
-ROLES = (INPUT, RESULT, TARGET, FRAMES, DOCUMENT, MESH, MOTION)
+MESH, MOTION, ALSO = "mesh", "motion", "also"
+ROLES = (INPUT, RESULT, TARGET, FRAMES, DOCUMENT, MESH, MOTION, ALSO)
 
 
 @dataclass(frozen=True)
@@ -210,9 +213,9 @@ register_format(Format(
     {TARGET: "fibrelmp.post.mercury:MercuryTarget"},
     extensions=(".data", ".ene", ".fstat", ".restart"), home="fibrelmp.post.mercury"))
 register_format(Format(
-    # also written by ``run --vtk`` beside the results (fibrelmp.pipeline.viewer)
+    # also written by ``run --also vtk`` beside the results (fibrelmp.pipeline.viewer)
     "vtk", "VTK .vtp/.vtm frames with a .pvd index (ParaView, OVITO)", "any",
-    {TARGET: "fibrelmp.post.vtk:VtkTarget"},
+    {TARGET: "fibrelmp.post.vtk:VtkTarget", ALSO: "fibrelmp.pipeline.viewer:ViewerOutput"},
     extensions=(".pvd", ".vtp", ".vtm"), home="fibrelmp.post.vtk"))
 register_format(Format(
     "lammps-dump", "a LAMMPS text dump (plain or .gz)", "any",

@@ -1,6 +1,7 @@
 """The architecture's rules (docs/architecture.md), checked on the source:
 
-- the CLI and the Python API name no format: every format choice comes from the registry;
+- the CLI and the Python API name no format, not even as an option (``--vtk``): every format
+  choice comes from the registry;
 - ``fibrelmp.translate`` (the formats' homes and the job renderers) imports neither
   ``fibrelmp.post`` nor ``fibrelmp.pipeline``, ``post`` does not import the pipeline and
   ``pictures`` (which reads results through both) neither the pipeline nor the API, so the
@@ -18,7 +19,7 @@ from pathlib import Path
 import pytest
 
 from fibrelmp import registry
-from fibrelmp.registry import DOCUMENT, FRAMES, INPUT, MESH, MOTION, RESULT, TARGET
+from fibrelmp.registry import ALSO, DOCUMENT, FRAMES, INPUT, MESH, MOTION, RESULT, TARGET
 
 REPO = Path(__file__).resolve().parents[1]
 PACKAGE = REPO / "fibrelmp"
@@ -32,10 +33,10 @@ FORMAT_WORDS = sorted({f.name for f in registry.formats()} |
 @pytest.mark.parametrize("module", ["cli.py", "python_api.py"])
 def test_cli_and_python_api_name_no_format(module):
     text = (PACKAGE / module).read_text()
-    # words, not substrings: "results" is not "res", "fibrelmp" is not a format
-    # (the MDAnalysis library, which RunResult.universe uses, is not the "mdanalysis" format)
+    # words, not substrings: "results" is not "res", "fibrelmp" is not a format; "--vtk" is
+    # (grep -w); the MDAnalysis library, which RunResult.universe uses, is not the format
     found = sorted({w for w in FORMAT_WORDS
-                    if re.search(rf"(?<![\w-]){re.escape(w)}(?![\w-])", text,
+                    if re.search(rf"(?<!\w){re.escape(w)}(?!\w)", text,
                                  0 if w == "mdanalysis" else re.I)})
     assert not found, f"{module} names formats: {found}"
 
@@ -83,6 +84,7 @@ BASES = {
     DOCUMENT: ("fibrelmp.formatbase", "DocumentFormat"),
     MESH: ("fibrelmp.mesh.model", "MeshFormat"),
     MOTION: ("fibrelmp.formatbase", "Reader"),
+    ALSO: ("fibrelmp.pipeline.also", "RunOutput"),
 }
 
 
@@ -101,3 +103,13 @@ def test_architecture_doc_lists_every_format():
     doc = (REPO / "docs" / "architecture.md").read_text()
     for fmt in registry.formats():
         assert f"`{fmt.name}`" in doc, fmt.name
+
+
+def test_input_hooks_pick_no_run_output_writer():
+    """``run --also``'s writers come from the registry (``pipeline.also``): no input hook
+    imports the module of a format's ALSO hook."""
+    homes = {f.hooks[ALSO].partition(":")[0] for f in registry.formats(ALSO)}
+    bad = [f"{path.relative_to(REPO)} imports {name}"
+           for path in sorted((PACKAGE / "pipeline" / "inputs").rglob("*.py"))
+           for name in _imports(path) if name in homes]
+    assert homes and not bad, "\n".join(bad)

@@ -310,7 +310,7 @@ def test_fibrenet_output_file_that_needs_escaping_with_vtk(tmp_path):
     parse.  A short run of the example network (3 frames, bonds: .vtm frames)."""
     name = 'net&a"b<c'
     fibrenet_case(tmp_path, name)
-    proc = cli(["-q", "run", "input.txt", "--vtk"], tmp_path, timeout=120)
+    proc = cli(["-q", "run", "input.txt", "--also", "vtk"], tmp_path, timeout=120)
     assert proc.returncode == 0, proc.stderr
     pvd = tmp_path / f"{name}.pvd"
     assert [t for t, _ in pvd_entries(pvd)] == ["0.0", "0.025", "0.05"]       # 50 x 0.0005 per frame
@@ -334,7 +334,7 @@ def test_names_xml_cannot_hold_are_refused_before_writing(tmp_path, where):
 def test_run_vtk_output_name_xml_cannot_hold_is_refused_before_the_run(tmp_path):
     """Was refused only when the writer was made, after the work folder was written."""
     fibrenet_case(tmp_path, "net\x01x")
-    proc = cli(["-q", "run", "input.txt", "--vtk"], tmp_path)
+    proc = cli(["-q", "run", "input.txt", "--also", "vtk"], tmp_path)
     assert proc.returncode == 2, proc.stderr
     assert "output name 'net\\x01x' has a character a VTK XML file cannot hold" in proc.stderr
     assert listing(tmp_path) == ["input.txt", "model.txt"]

@@ -19,7 +19,7 @@ from fibrelmp.post.vtk.writer import VtkWriter
 
 from .conftest import REPO
 
-RUN = dict(step=1e-6, save_step=1e-3, viewer_files=True)
+RUN = dict(step=1e-6, save_step=1e-3, also=["vtk"])
 
 
 def _contents(folder: Path) -> dict[str, bytes]:
@@ -27,7 +27,7 @@ def _contents(folder: Path) -> dict[str, bytes]:
 
 
 def test_force_rerun_failing_at_the_end_keeps_the_earlier_results(tmp_path):
-    """A MUSEN scene run with --vtk (res.mdem, res.pvd, frames), then a --force rerun with
+    """A MUSEN scene run with --also vtk (res.mdem, res.pvd, frames), then a --force rerun with
     one more frame whose VTK frame path is a directory: the rerun fails when its files are
     renamed into place; the earlier .mdem, .pvd and frames are byte for byte as before."""
     scene = tmp_path / "SingelParticle.mdem"
@@ -38,7 +38,7 @@ def test_force_rerun_failing_at_the_end_keeps_the_earlier_results(tmp_path):
     before = _contents(tmp_path)
     (tmp_path / "SingelParticle_result_000003.vtp").mkdir()      # the rerun's 4th frame
     proc = subprocess.run([sys.executable, "-m", "fibrelmp.cli", "run", str(scene), "--force",
-                           "--vtk", "--end-time", "3e-3", "--step", "1e-6", "--save-step", "1e-3"],
+                           "--also", "vtk", "--end-time", "3e-3", "--step", "1e-6", "--save-step", "1e-3"],
                           cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert proc.returncode != 0, proc.stderr
     assert "SingelParticle_result_000003.vtp" in proc.stderr and "Traceback" not in proc.stderr

@@ -1,4 +1,4 @@
-"""``fibrelmp run --vtk`` and ``post --to vtk``: files ParaView and OVITO open.
+"""``fibrelmp run --also vtk`` and ``post --to vtk``: files ParaView and OVITO open.
 
 Checked three ways: fibrelmp's own reader (always), VTK's XML readers (the library ParaView
 is built on; the ``vtk`` wheel of the ``test`` extra) and OVITO's Python module (``ovito``,
@@ -121,7 +121,7 @@ def fibre_run(tmp_path_factory):
     import fibrelmp
 
     out = tmp_path_factory.mktemp("fibre")
-    result = fibrelmp.run(FIBRE / "input.txt", out=out, viewer_files=True)
+    result = fibrelmp.run(FIBRE / "input.txt", out=out, also=["vtk"])
     return out, result
 
 
@@ -268,7 +268,7 @@ def test_run_vtk_needs_force_for_earlier_frames_and_removes_them(tmp_path):
     stale = tmp_path / "fibre_network_000009.vtp"
     stale.write_text("earlier run")
     runner = CliRunner()
-    args = ["run", str(FIBRE / "input.txt"), "-o", str(tmp_path), "--vtk"]
+    args = ["run", str(FIBRE / "input.txt"), "-o", str(tmp_path), "--also", "vtk"]
     refused = runner.invoke(app, args)
     assert refused.exit_code == 2 and "fibre_network_000009.vtp: exists already" in refused.output
     assert sorted(p.name for p in tmp_path.iterdir()) == ["fibre_network_000009.vtp"]
@@ -297,7 +297,7 @@ def test_demdf_run_frames_equal_the_snapshots(tmp_path):
 
     spec = json.loads((REPO / "examples" / "demdf" / "head_on.json").read_text())
     shutil.copy(REPO / "examples" / "demdf" / "head_on.json", tmp_path)
-    fibrelmp.run(tmp_path / "head_on.json", viewer_files=True)
+    fibrelmp.run(tmp_path / "head_on.json", also=["vtk"])
     entries = read_pvd(tmp_path / "head_on.pvd")
     period = spec["output"]["snapshot"]["savePeriodInTime"]
     assert [t for t, _ in entries] == pytest.approx([k * period for k in range(9)])
@@ -328,7 +328,7 @@ def agglomerate_run(tmp_path_factory):
     folder = tmp_path_factory.mktemp("agglo")
     for name in ("agglomerate_short_job.txt", "SphericalAgglomerate_text.txt"):
         shutil.copy(REPO / "examples" / "musen" / name, folder)
-    result = fibrelmp.run(folder / "agglomerate_short_job.txt", viewer_files=True)
+    result = fibrelmp.run(folder / "agglomerate_short_job.txt", also=["vtk"])
     alive = [f.count for f in iter_frames(result.dumps[-1].parent / "bonds.dump")]
     return folder, read_pvd(folder / "agglomerate_short_result.pvd"), alive
 
@@ -447,7 +447,7 @@ def test_musen_walls_are_a_polydata_series_vtk_and_ovito_open(tmp_path):
 
     scene = tmp_path / "SingelParticle.mdem"
     shutil.copy(REPO / "examples" / "musen" / "SingelParticle.mdem", scene)
-    python_api.run(scene, end_time=2e-3, step=1e-7, save_step=1e-3, viewer_files=True)
+    python_api.run(scene, end_time=2e-3, step=1e-7, save_step=1e-3, also=["vtk"])
     series = read_pvd(tmp_path / "SingelParticle_result_walls.pvd")
     frames = list(MdemReader(tmp_path / "SingelParticle_result.mdem"))
     assert [t for t, _ in series] == [f.time for f in frames]

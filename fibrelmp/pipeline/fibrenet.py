@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Iterator
+from typing import TYPE_CHECKING, Callable, Iterator
 
 from fibrelmp.errors import InputError, RunError
 from fibrelmp.pipeline.request import Consumer, Rendered, RunOptions, RunPlan, RunRequest
@@ -121,9 +121,10 @@ class WrittenFrames:
         pass
 
 
-def results(model: "Model", folder: Path, prefix: str, viewer_files: bool = False):
-    """The FibreNet writers of a rendered job: a consumer of its frames (and, with
-    ``viewer_files``, of the dump frames the viewer files are made of)."""
+def results(model: "Model", folder: Path, prefix: str,
+            also: Callable[[], list] = lambda: []):
+    """The FibreNet writers of a rendered job: a consumer of its frames (and, with ``also``'s
+    writers, of the dump frames their files are made of: ``pipeline.also``)."""
     spec = model.plan.output
 
     def make(rendered: Rendered) -> Consumer:
@@ -135,11 +136,9 @@ def results(model: "Model", folder: Path, prefix: str, viewer_files: bool = Fals
                 from fibrelmp.pipeline.finite import guarded
 
                 return convert_frames(model, job, guarded(frames), folder, prefix)
-        if viewer_files:
-            from fibrelmp.pipeline import viewer
+        from fibrelmp.pipeline.also import also_to
 
-            return viewer.also_to(consume, viewer.fibrenet_writer(model, folder / prefix))
-        return consume
+        return also_to(consume, also())
     return make
 
 
@@ -205,22 +204,21 @@ def move_file(src: Path, dst: Path) -> None:
 
 
 def fibrenet_plan(model: "Model", out: str | Path | None = None, work: str | Path | None = None,
-                  options: RunOptions = RunOptions(), viewer_files: bool = False) -> RunPlan:
+                  options: RunOptions = RunOptions(), also: tuple[str, ...] = ()) -> RunPlan:
     """The run of a FibreNet model: one simulation, its results next to the input (or in
     ``out``), its job in ``work`` (default ``<prefix>_work`` beside the results);
-    ``viewer_files``: also ``<prefix>.pvd`` and its frames (``pipeline.viewer``)."""
-    outputs, folder, prefix = fibrenet_outputs(model, out, work)
-    if viewer_files:
-        from fibrelmp.pipeline.viewer import declare
+    ``also``: the formats also written from the frames, named ``<prefix>`` (``pipeline.also``)."""
+    from fibrelmp.pipeline.also import fibrenet_writers
 
-        declare(outputs, folder / prefix)
+    outputs, folder, prefix = fibrenet_outputs(model, out, work)
+    extra = fibrenet_writers(also, model, outputs, folder / prefix)
 
     def frames(rendered: Rendered):
-        if rendered.job.native is not None and not viewer_files:
+        if rendered.job.native is not None and not also:
             return WrittenFrames()
         return DumpFrames(rendered.job.frames)
 
-    request = RunRequest(model, render(model), frames, results(model, folder, prefix, viewer_files),
+    request = RunRequest(model, render(model), frames, results(model, folder, prefix, extra),
                          outputs.work)
     return RunPlan(outputs, [request], options)
 

@@ -1,4 +1,4 @@
-"""``fibrelmp run --vtk``: the run's frames as files ParaView and OVITO open, written with
+"""``fibrelmp run --also vtk``: the run's frames as files ParaView and OVITO open, written with
 ``post.vtk``'s writer while the frames are converted, beside the run's results.
 
 Where: ``<base>.pvd`` and ``<base>_NNNNNN.vtp`` (with bonds also ``_bonds.vtp`` and ``.vtm``),
@@ -14,16 +14,19 @@ where they are at each frame, with their velocity and force).
 What: every saved frame; ids, types, ``Radius``, ``Mass``, ``Velocity``, ``Force``,
 ``Angular Velocity`` and ``Orientation`` where the run has them (post/vtk/frame.py); the
 time is the simulation time.
+
+``ViewerOutput`` is the registry's ALSO hook of ``vtk`` (``pipeline.also``).
 """
 
 from __future__ import annotations
 
 from dataclasses import replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, Iterator
+from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
+from fibrelmp.pipeline.also import RunOutput
 from fibrelmp.post.vtk.frame import ViewerFrame, box_of, from_dump, wrap
 from fibrelmp.post.vtk.target import frame_pattern
 from fibrelmp.post.vtk.writer import VtkWriter, check_output_name
@@ -32,17 +35,11 @@ if TYPE_CHECKING:
     from fibrelmp.granmodel import GranularFrame, GranularModel
     from fibrelmp.model import Model
     from fibrelmp.outputs import Outputs
-    from fibrelmp.pipeline.request import Consumer
     from fibrelmp.post.lammps_dump.reader import Frame
 
 # FibreNet work dumps name FibreNet's velocity and force after the variables that hold them
 FIBRENET_COLUMNS = {"v_fn_vx": "vx", "v_fn_vy": "vy", "v_fn_vz": "vz",
                     "v_fn_fx": "fx", "v_fn_fy": "fy", "v_fn_fz": "fz"}
-
-
-def viewer_base(result: str | Path) -> Path:
-    """The viewer files' base name for a result file: its path without the suffix."""
-    return Path(result).with_suffix("")
 
 
 def declare(outputs: "Outputs", base: Path) -> None:
@@ -106,17 +103,6 @@ def granular_frame(model: "GranularModel", frame: "GranularFrame") -> ViewerFram
                        data, bonds, bond_data, walls, wall_data)
 
 
-def viewer_writers(model: "GranularModel", outputs: "Outputs", base: Path,
-                   wanted: bool) -> Callable[[], list]:
-    """For a granular run's writer list: declares the viewer files of ``base`` in
-    ``outputs`` when ``wanted``; the returned function makes their writer (rank 0, once the
-    outputs are locked), or none."""
-    if not wanted:
-        return lambda: []
-    declare(outputs, base)
-    return lambda: [granular_writer(model, base)]
-
-
 # -- FibreNet runs ---------------------------------------------------------------------------
 def fibrenet_writer(model: "Model", base: Path) -> ViewerWriter:
     return ViewerWriter(base, lambda frame: fibrenet_frame(model, frame), model.bonds.count > 0)
@@ -141,18 +127,14 @@ def fibrenet_frame(model: "Model", frame: "Frame") -> ViewerFrame:
     return view
 
 
-def also_to(consume: "Consumer", writer: VtkWriter) -> "Consumer":
-    """A consumer that hands every frame to ``writer`` too, before ``consume`` sees it;
-    the writer is closed after ``consume`` succeeded, aborted if anything fails."""
-    def run(frames: Iterator[Any]) -> list[Path]:
-        def each() -> Iterator[Any]:
-            for frame in frames:
-                writer.add(frame)
-                yield frame
-        try:
-            written = consume(each())
-        except BaseException:
-            writer.abort()
-            raise
-        return list(written) + writer.close()
-    return run
+class ViewerOutput(RunOutput):
+    """``run --also vtk``: the frames through ``ViewerWriter``, named after ``base``."""
+
+    def declare(self, outputs: "Outputs", base: Path) -> None:
+        declare(outputs, base)
+
+    def granular_writer(self, model: "GranularModel", base: Path) -> ViewerWriter:
+        return granular_writer(model, base)
+
+    def fibrenet_writer(self, model: "Model", base: Path) -> ViewerWriter:
+        return fibrenet_writer(model, base)

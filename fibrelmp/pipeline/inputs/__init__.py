@@ -33,7 +33,7 @@ class RunSettings:
     save_step: float | None = None     # --save-step
     steps: int | None = None           # --steps
     precision: int = 6                 # significant digits of text results that take it
-    viewer_files: bool = False         # --vtk: also the frames for ParaView/OVITO (pipeline.viewer)
+    also: tuple[str, ...] = ()         # --also: formats also written from the frames (pipeline.also)
 
     def overrides(self) -> tuple:
         return (self.end_time, self.step, self.save_step, self.steps)

@@ -72,6 +72,13 @@ class CaseInput(InputFormat):
                              "(the wall velocity files are read as the run goes): run it again")
         from fibrelmp.cardioproof.job import plan_job
 
+        from fibrelmp.cardioproof.results import SphVtkWriter
+
+        for name in settings.also:     # its frames are VTK already; nothing else is written from them
+            if name != SphVtkWriter.format:
+                raise InputError(path, None, f"--also {name}: a CardioProof run writes its frames only "
+                                 f"as its own results ({SphVtkWriter.format} frames and CSV series)")
+            say(f"--also {name}: a CardioProof run's results are {name} frames already")
         model = self.read(path)
         plan_job(model)            # the geometry's input errors before anything is locked
         outputs, folder = case_outputs(model, settings.out, settings.work)

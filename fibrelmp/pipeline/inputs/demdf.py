@@ -47,14 +47,14 @@ class DemdfInput(InputFormat):
         earlier snapshots of the same name are replaced, all of them, only with ``force``."""
         from fibrelmp.pipeline.granular import granular_request
         from fibrelmp.pipeline.request import RunPlan
-        from fibrelmp.pipeline.viewer import viewer_writers
+        from fibrelmp.pipeline.also import granular_writers
         from fibrelmp.translate.demdf.writer import DemdfSnapshotWriter
 
         model = self.read(path, settings)
         warn(model.warnings)
         outputs, folder = demdf_outputs(model, settings.out, settings.work)
-        extra = viewer_writers(model, outputs, folder / str(model.passthrough["demdf"]["filename"]),
-                               settings.viewer_files)
+        extra = granular_writers(settings.also, model, outputs,
+                                 folder / str(model.passthrough["demdf"]["filename"]))
         request = granular_request(model, outputs.work,
                                    lambda: [DemdfSnapshotWriter(model, folder)] + extra())
         return RunPlan(outputs, [request], options)

@@ -69,7 +69,7 @@ class FibreNetInput(InputFormat):
                      "--save-step/--steps are for MUSEN and DEMDF inputs")
         model = self.read(path)
         warn(model.warnings)
-        return fibrenet_plan(model, settings.out, settings.work, options, settings.viewer_files)
+        return fibrenet_plan(model, settings.out, settings.work, options, settings.also)
 
     def work_folder(self, path: Path, out: Path | None, work: Path | None) -> Path:
         from fibrelmp.pipeline.fibrenet import fibrenet_outputs

@@ -64,7 +64,7 @@ class SceneInput(InputFormat):
             say(f"override: {text}")
         warn(model.warnings)
         return scene_plan(model, scene_result_path(path, settings.out), settings.work,
-                          settings.precision, options, settings.viewer_files)
+                          settings.precision, options, settings.also)
 
     def work_folder(self, path: Path, out: Path | None, work: Path | None) -> Path:
         return _work_folder(scene_result_path(path, out), work)
@@ -79,20 +79,20 @@ class SceneInput(InputFormat):
 
 def scene_plan(model: "GranularModel", result: str | Path, work: str | Path | None = None,
                precision: int = 6, options: "RunOptions | None" = None,
-               viewer_files: bool = False) -> "RunPlan":
+               also: tuple[str, ...] = ()) -> "RunPlan":
     """The run of a MUSEN scene whose plan (step, end, saves) is set: one simulation, its
-    result at ``result`` (MUSEN text, or ``.mdem`` by its name); ``viewer_files``: also the
-    frames for ParaView/OVITO beside it (``pipeline.viewer``)."""
+    result at ``result`` (MUSEN text, or ``.mdem`` by its name); ``also``: the formats also
+    written from the frames beside it (``pipeline.also``)."""
     from fibrelmp.outputs import Outputs
     from fibrelmp.pipeline.granular import granular_request
     from fibrelmp.pipeline.request import RunOptions, RunPlan
-    from fibrelmp.pipeline.viewer import viewer_base, viewer_writers
+    from fibrelmp.pipeline.also import granular_writers
 
     check_musen_runnable(model)
     target = Path(result).resolve()
     outputs = Outputs(Path(model.source), _work_folder(target, work), [target],
                       inputs=[Path(model.source)])
-    extra = viewer_writers(model, outputs, viewer_base(target), viewer_files)
+    extra = granular_writers(also, model, outputs, target.with_suffix(""))
     request = granular_request(model, outputs.work,
                                lambda: [musen_result_writer(model, target, precision=precision)] + extra())
     return RunPlan(outputs, [request], options or RunOptions())

@@ -82,7 +82,7 @@ class ScriptInput(InputFormat):
             if st.kind == "simulate":
                 steps.append(Action(partial(_announce, st, say, warn)))
                 steps.append(_simulation(st, work / f"job{st.job.index}", spools,
-                                         outputs, settings.viewer_files))
+                                         outputs, settings.also))
             else:
                 steps.append(Action(partial(_import if st.kind == "import" else _export, st, spools, say)))
 
@@ -105,14 +105,14 @@ def _announce(step: "ScriptStep", say: Say, warn: Warn, rank0: bool) -> list[Pat
 
 
 def _simulation(step: "ScriptStep", work: Path, spools: dict, outputs: "Outputs",
-                viewer_files: bool):
+                also: tuple[str, ...]):
     """A SIMULATOR job: its frames go to a spool (exported later) and/or its MUSEN result
-    (and with ``viewer_files`` to ParaView/OVITO files named after its RESULT_FILE)."""
+    (and to the ``--also`` formats, named after its RESULT_FILE: ``pipeline.also``)."""
     from fibrelmp.pipeline.granular import granular_request
     from fibrelmp.pipeline.spool import FrameSpool
-    from fibrelmp.pipeline.viewer import viewer_base, viewer_writers
+    from fibrelmp.pipeline.also import granular_writers
 
-    extra = viewer_writers(step.model, outputs, viewer_base(step.written or step.handle), viewer_files)
+    extra = granular_writers(also, step.model, outputs, Path(step.written or step.handle).with_suffix(""))
 
     def writers() -> list:
         made: list = []

@@ -5,7 +5,7 @@ A target is one class (registered with ``registry.register_format(..., {TARGET: 
 ``files(base)`` names what a conversion to ``base`` writes, ``write_frame`` writes one frame
 (``start`` first sees the first ``lookahead`` frames, e.g. to find the time step), ``end``
 writes what comes last, and ``read_back(files)`` reads the output back (the conformance
-tests, tests/test_conformance.py).  Class attributes tell the conversion (post/convert.py)
+tests, tests/conformance/).  Class attributes tell the conversion (post/convert.py)
 what it needs: ``units`` (for the unit-mismatch warning), ``last_frame_by_default``,
 ``uses_local``.  Files are staged and renamed into place by ``close`` (formatbase.Writer).
 """
@@ -161,7 +161,7 @@ class DumpTarget(Writer):
 
     @classmethod
     def read_back(cls, files: list[Path]) -> list[ReadBack]:
-        """The frames of a written output (tests/test_conformance.py)."""
+        """The frames of a written output (tests/conformance/)."""
         raise NotImplementedError
 
     # -- shared ------------------------------------------------------------------------------

@@ -15,6 +15,9 @@ start with ``Test``, so pytest collects only the subclasses.
   point through every document format; existing outputs kept; bad files write nothing.
 * ``MotionConformance``   (``motion``): the frames a hand-made file holds, one at a time;
   bad files.
+* ``AlsoConformance``     (``also``, ``run --also``): from a granular run's frames, every file
+  written is one the format declared beforehand, atomically; abort and a full disk leave
+  nothing.
 """
 
 from __future__ import annotations
@@ -30,7 +33,7 @@ import pytest
 from fibrelmp import python_api, registry
 from fibrelmp.errors import InputError, RunError
 from fibrelmp.python_api import convert
-from fibrelmp.registry import DOCUMENT, FRAMES, INPUT, MESH, MOTION, RESULT, TARGET
+from fibrelmp.registry import ALSO, DOCUMENT, FRAMES, INPUT, MESH, MOTION, RESULT, TARGET
 
 from ..conftest import REPO, copy_example
 
@@ -567,6 +570,68 @@ class MotionConformance(Conformance):
             assert err.value.path == str(bad), str(err.value)
 
 
+# -- ALSO ---------------------------------------------------------------------------------------
+class AlsoConformance(Conformance):
+    """A ``run --also`` format: its ``RunOutput`` declares the files of a result base before
+    anything is written, and its writer of a granular run's frames writes only declared files
+    (named or matching a declared family), through temp files; abort or a full disk leaves
+    the folder as it was."""
+
+    role = ALSO
+
+    def _declared(self, tmp_path: Path):
+        from fibrelmp.outputs import Outputs
+
+        out = tmp_path / "res"
+        out.mkdir()
+        outputs = Outputs(source=tmp_path / "in.txt", work=tmp_path / "work")
+        self.hook()().declare(outputs, out / "run")
+        return outputs, out
+
+    @staticmethod
+    def _is_declared(outputs, path: Path) -> bool:
+        return path in outputs.files or any(
+            folder == path.parent and pattern.fullmatch(path.name) for folder, pattern in outputs.patterns)
+
+    def test_writes_only_declared_files_atomically(self, tmp_path):
+        outputs, out = self._declared(tmp_path)
+        assert outputs.files or outputs.patterns
+        model = two_glass_spheres()
+        writer = self.hook()().granular_writer(model, out / "run")
+        for frame in granular_frames(model, 3):
+            writer.add(frame)
+        written = writer.close()
+        assert written and all(p.is_file() and p.stat().st_size for p in written)
+        assert all(self._is_declared(outputs, p) for p in written), written
+        assert not [p for p in listing(out) if p.startswith(".")]          # no temp file left
+
+    def test_abort_and_full_disk_leave_nothing(self, tmp_path, monkeypatch):
+        _, out = self._declared(tmp_path)
+        model = two_glass_spheres()
+        frames = granular_frames(model, 3)
+        writer = self.hook()().granular_writer(model, out / "run")
+        for frame in frames:
+            writer.add(frame)
+        writer.abort()
+        assert listing(out) == {}
+        writer = self.hook()().granular_writer(model, out / "run")
+        kind, calls = type(writer), []
+        real = kind.write
+
+        def failing(self, frame):          # a full disk at the 2nd frame
+            calls.append(1)
+            if len(calls) == 2:
+                raise OSError(errno.ENOSPC, ENOSPC)
+            real(self, frame)
+        monkeypatch.setattr(kind, "write", failing)
+        with pytest.raises(RunError, match=f"cannot write output: {ENOSPC}"):
+            for frame in frames:
+                writer.add(frame)
+        writer.abort()
+        assert listing(out) == {}
+
+
 BASES = {INPUT: InputConformance, RESULT: ResultConformance, TARGET: TargetConformance,
          FRAMES: FramesConformance, MESH: MeshConformance, DOCUMENT: DocumentConformance,
-         MOTION: MotionConformance}
+         MOTION: MotionConformance, ALSO: AlsoConformance}
+

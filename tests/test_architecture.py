@@ -41,77 +41,13 @@ def test_cli_and_python_api_name_no_format(module):
     assert not found, f"{module} names formats: {found}"
 
 
-def _modules() -> dict[str, Path]:
-    """Every module of fibrelmp by dotted name (a package is its ``__init__.py``)."""
-    out = {}
-    for path in sorted(PACKAGE.rglob("*.py")):
-        parts = path.relative_to(REPO).with_suffix("").parts
-        out[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = path
-    return out
-
-
-MODULES = _modules()
-
-
 def _type_checking_only(tree: ast.Module) -> set[int]:
-    """Ids of the import nodes under ``if TYPE_CHECKING:``: they never run."""
+    """Ids of the nodes under ``if TYPE_CHECKING:``: those imports never run."""
     skip = set()
     for node in ast.walk(tree):
         if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test):
             skip.update(id(n) for stmt in node.body for n in ast.walk(stmt))
     return skip
-
-
-def _module_of(name: str) -> str | None:
-    """The fibrelmp module ``name`` executes: itself, else its nearest existing parent."""
-    while name and name not in MODULES:
-        name = name.rpartition(".")[0]
-    return name or None
-
-
-def _imports(module: str) -> dict[str, int]:
-    """The fibrelmp modules ``module`` imports at run time (function-level imports too), with
-    the line of the first such import.  Importing ``a.b.c`` also runs the packages ``a.b``
-    and ``a`` (not the root ``fibrelmp``, whose lazy exports import nothing when loaded)."""
-    path = MODULES[module]
-    tree = ast.parse(path.read_text())
-    package = module if path.name == "__init__.py" else module.rpartition(".")[0]
-    skip = _type_checking_only(tree)
-    out: dict[str, int] = {}
-    for node in ast.walk(tree):
-        if id(node) in skip:
-            continue
-        if isinstance(node, ast.Import):
-            names = [alias.name for alias in node.names]
-        elif isinstance(node, ast.ImportFrom):
-            base = node.module or ""
-            if node.level:
-                parts = package.split(".")[: len(package.split(".")) - node.level + 1]
-                base = ".".join(parts + ([node.module] if node.module else []))
-            # ``from pkg import sub`` imports the submodule ``pkg.sub``
-            names = [f"{base}.{a.name}" if f"{base}.{a.name}" in MODULES else base
-                     for a in node.names]
-        else:
-            continue
-        for name in names:
-            target = _module_of(name) if name.startswith("fibrelmp.") or name == "fibrelmp" else None
-            while target and target != "fibrelmp":
-                if target != module:
-                    out[target] = min(out.get(target, node.lineno), node.lineno)
-                target = target.rpartition(".")[0]
-    return out
-
-
-# The one upward import: ``fibrelmp.translate`` is callable as the API's
-# ``translate(path, folder)`` and imports ``python_api`` only when called.
-UPWARD_EXCEPTIONS = {("fibrelmp.translate", "fibrelmp.python_api")}
-
-IMPORTS = {m: {t: line for t, line in _imports(m).items() if (m, t) not in UPWARD_EXCEPTIONS}
-           for m in MODULES}
-
-
-def _where(module: str, target: str) -> str:
-    return f"{MODULES[module].relative_to(REPO)}:{IMPORTS[module][target]} imports {target}"
 
 
 def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
@@ -156,55 +92,137 @@ def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
     return found
 
 
-PACKAGES = sorted(m for m, p in MODULES.items() if p.name == "__init__.py")
+class ImportGraph:
+    """Which modules of a package tree import which, read with ``ast`` (nothing is imported)."""
+
+    def __init__(self, root: Path, exceptions: set[tuple[str, str]] = frozenset()):
+        self.top = root.name
+        self.modules: dict[str, Path] = {}
+        for path in sorted(root.rglob("*.py")):
+            parts = path.relative_to(root.parent).with_suffix("").parts
+            self.modules[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = path
+        self.base = root.parent
+        self.imports = {m: {t: line for t, line in self._imports(m).items()
+                            if (m, t) not in exceptions} for m in self.modules}
+
+    def _module_of(self, name: str) -> str | None:
+        """The module ``name`` executes: itself, else its nearest existing parent."""
+        while name and name not in self.modules:
+            name = name.rpartition(".")[0]
+        return name or None
+
+    def _imports(self, module: str) -> dict[str, int]:
+        """The modules ``module`` imports at run time (function-level imports too), with the
+        line of the first such import.  Importing ``a.b.c`` also runs the packages ``a.b`` and
+        ``a`` (not the root, whose lazy exports import nothing when it loads)."""
+        path = self.modules[module]
+        tree = ast.parse(path.read_text())
+        package = module if path.name == "__init__.py" else module.rpartition(".")[0]
+        skip = _type_checking_only(tree)
+        out: dict[str, int] = {}
+        for node in ast.walk(tree):
+            if id(node) in skip:
+                continue
+            if isinstance(node, ast.Import):
+                names = [alias.name for alias in node.names]
+            elif isinstance(node, ast.ImportFrom):
+                base = node.module or ""
+                if node.level:
+                    parts = package.split(".")[: len(package.split(".")) - node.level + 1]
+                    base = ".".join(parts + ([node.module] if node.module else []))
+                # ``from pkg import sub`` imports the submodule ``pkg.sub``
+                names = [f"{base}.{a.name}" if f"{base}.{a.name}" in self.modules else base
+                         for a in node.names]
+            else:
+                continue
+            for name in names:
+                ours = name == self.top or name.startswith(self.top + ".")
+                target = self._module_of(name) if ours else None
+                while target and target != self.top:
+                    if target != module:
+                        out[target] = min(out.get(target, node.lineno), node.lineno)
+                    target = target.rpartition(".")[0]
+        return out
+
+    def where(self, module: str, target: str) -> str:
+        line = self.imports[module][target]
+        return f"{self.modules[module].relative_to(self.base)}:{line} imports {target}"
+
+    def part_of(self, package: str, module: str) -> str | None:
+        """Which part of ``package`` holds ``module``: one of its plain modules (the package's
+        own ``__init__`` included) or the whole of one of its subpackages (``name/``)."""
+        if module == package:
+            return module
+        if not module.startswith(package + "."):
+            return None
+        child = package + "." + module[len(package) + 1:].split(".")[0]
+        return child + "/" if self.modules[child].name == "__init__.py" else child
+
+    def packages(self) -> list[str]:
+        return sorted(m for m, p in self.modules.items() if p.name == "__init__.py")
+
+    def subpackage_cycles(self, package: str) -> list[str]:
+        """Inside ``package``: the import cycles that run through one of its subpackages (each
+        taken whole), with the imports that make them.  Plain modules of one package may need
+        each other; two subpackages, or a subpackage and a module beside it, may not."""
+        graph: dict[str, set[str]] = {}
+        edges: dict[tuple[str, str], list[str]] = {}
+        for module, targets in self.imports.items():
+            a = self.part_of(package, module)
+            if a is None:
+                continue
+            graph.setdefault(a, set())
+            for target in targets:
+                b = self.part_of(package, target)
+                if b is not None and b != a:
+                    graph[a].add(b)
+                    graph.setdefault(b, set())
+                    edges.setdefault((a, b), []).append(self.where(module, target))
+        found = []
+        for component in _cycles(graph):
+            if any(part.endswith("/") for part in component):
+                members = set(component)
+                found.append("cycle " + " <-> ".join(component) + ":\n  " + "\n  ".join(
+                    w for (a, b), where in sorted(edges.items()) if a in members and b in members
+                    for w in where))
+        return found
 
 
-def _part_of(package: str, module: str) -> str | None:
-    """Which part of ``package`` holds ``module``: one of its plain modules (the package's own
-    ``__init__`` included) or the whole of one of its subpackages (``name/``)."""
-    if module == package:
-        return module
-    if not module.startswith(package + "."):
-        return None
-    child = package + "." + module[len(package) + 1:].split(".")[0]
-    return child + "/" if MODULES[child].name == "__init__.py" else child
+# The one upward import: ``fibrelmp.translate`` is callable as the API's
+# ``translate(path, folder)`` and imports ``python_api`` only when called.
+GRAPH = ImportGraph(PACKAGE, {("fibrelmp.translate", "fibrelmp.python_api")})
+MODULES, IMPORTS = GRAPH.modules, GRAPH.imports
 
 
-@pytest.mark.parametrize("package", PACKAGES)
+@pytest.mark.parametrize("package", GRAPH.packages())
 def test_no_import_cycle_between_subpackages(package):
-    """Inside ``package``, its subpackages (each taken whole) and its plain modules import each
-    other without a cycle through a subpackage: modules of one package may need each other,
-    two subpackages (or a subpackage and a module beside it) may not."""
-    graph: dict[str, set[str]] = {}
-    edges: dict[tuple[str, str], list[str]] = {}
-    for module, targets in IMPORTS.items():
-        a = _part_of(package, module)
-        if a is None:
-            continue
-        graph.setdefault(a, set())
-        for target in targets:
-            b = _part_of(package, target)
-            if b is not None and b != a:
-                graph[a].add(b)
-                graph.setdefault(b, set())
-                edges.setdefault((a, b), []).append(_where(module, target))
-    bad = []
-    for component in _cycles(graph):
-        if any(part.endswith("/") for part in component):
-            members = set(component)
-            bad.append("cycle " + " <-> ".join(component) + ":\n  " + "\n  ".join(
-                w for (a, b), where in sorted(edges.items()) if a in members and b in members
-                for w in where))
+    bad = GRAPH.subpackage_cycles(package)
     assert not bad, "\n".join(bad)
 
 
-def test_the_cycle_check_sees_a_cycle_through_a_function_level_import():
-    """The check itself: two subpackages that import each other, one of them inside a function."""
-    graph = {"a/": {"b/"}, "b/": {"a/"}, "c": {"a/"}}
-    assert _cycles(graph) == [["a/", "b/"]]
-    tree = ast.parse("def f():\n    from fibrelmp.pipeline.run import wrong_frame\n")
-    assert [n.module for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)] == \
-        ["fibrelmp.pipeline.run"]
+def _toy_tree(root: Path, files: dict[str, str]) -> Path:
+    for name, text in files.items():
+        (root / name).parent.mkdir(parents=True, exist_ok=True)
+        (root / name).write_text(text)
+    return root / "pkg"
+
+
+def test_the_cycle_check_sees_function_level_imports_and_skips_type_checking_ones(tmp_path):
+    """The check itself, on a toy package: ``pkg.a`` and ``pkg.b`` import each other, one of
+    them inside a function (a cycle), or under ``if TYPE_CHECKING:`` (none)."""
+    files = {"pkg/__init__.py": "", "pkg/a/__init__.py": "", "pkg/b/__init__.py": "",
+             "pkg/a/x.py": "from pkg.b.y import g\n",
+             "pkg/b/y.py": "def g():\n    from ..a import x\n    return x\n",
+             "pkg/b/z.py": "import pkg.b.y\n", "pkg/m.py": "from pkg.a import x\n"}
+    cyclic = ImportGraph(_toy_tree(tmp_path / "one", files))
+    assert cyclic.imports["pkg.b.y"] == {"pkg.a.x": 2, "pkg.a": 2}
+    [found] = cyclic.subpackage_cycles("pkg")
+    assert found.startswith("cycle pkg.a/ <-> pkg.b/:") and "pkg/b/y.py:2 imports pkg.a.x" in found
+    assert cyclic.subpackage_cycles("pkg.b") == []          # y and z inside b: no cycle there
+
+    files["pkg/b/y.py"] = ("from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n"
+                           "    from pkg.a import x\n")
+    assert ImportGraph(_toy_tree(tmp_path / "two", files)).subpackage_cycles("pkg") == []
 
 
 # The layers, lowest first (docs/architecture.md draws them).  A module imports its own layer
@@ -226,7 +244,7 @@ LAYER_OF = {unit: rank for rank, (_, units) in enumerate(LAYERS) for unit in uni
 
 def _unit(module: str) -> str:
     """The top-level part of fibrelmp that holds ``module`` (as LAYERS names it)."""
-    part = _part_of("fibrelmp", module)
+    part = GRAPH.part_of("fibrelmp", module)
     return "__init__" if part == "fibrelmp" else part[len("fibrelmp."):]
 
 
@@ -241,7 +259,7 @@ def test_imports_point_down_the_layers():
         for target in targets:
             a, b = _unit(module), _unit(target)
             if LAYER_OF.get(b, -1) > LAYER_OF.get(a, len(LAYERS)):
-                bad.append(f"{_where(module, target)} ({LAYERS[LAYER_OF[a]][0]} -> "
+                bad.append(f"{GRAPH.where(module, target)} ({LAYERS[LAYER_OF[a]][0]} -> "
                            f"{LAYERS[LAYER_OF[b]][0]})")
     assert not bad, "\n".join(bad)
 
@@ -249,7 +267,7 @@ def test_imports_point_down_the_layers():
 @pytest.mark.parametrize("unit", ["numtext/", "lammps_styles/"])
 def test_built_parts_import_nothing_of_fibrelmp(unit):
     """The C fast path and the LAMMPS plugin build on their own."""
-    bad = [_where(m, t) for m, targets in IMPORTS.items() if _unit(m) == unit
+    bad = [GRAPH.where(m, t) for m, targets in IMPORTS.items() if _unit(m) == unit
            for t in targets if _unit(t) != unit]
     assert not bad, "\n".join(bad)
 
@@ -266,7 +284,7 @@ def test_shared_layers_reach_formats_only_through_the_registry():
     a format through the registry (``Format.load``), which imports its hook when used."""
     code = _format_code()
     shared = {u for name, units in LAYERS if name in ("base", "core", "api") for u in units}
-    bad = [_where(m, t) for m, targets in IMPORTS.items() if _unit(m) in shared
+    bad = [GRAPH.where(m, t) for m, targets in IMPORTS.items() if _unit(m) in shared
            for t in targets if any(t == c or t.startswith(c + ".") for c in code)]
     assert not bad, "\n".join(bad)
 

@@ -315,3 +315,17 @@ def test_architecture_doc_lists_every_format():
     doc = (REPO / "docs" / "architecture.md").read_text()
     for fmt in registry.formats():
         assert f"`{fmt.name}`" in doc, fmt.name
+
+
+def test_architecture_doc_draws_every_layer():
+    """The picture of the layers in docs/architecture.md names each layer and what it holds."""
+    doc = (REPO / "docs" / "architecture.md").read_text()
+    picture = doc[doc.index("### The layers"):].split("```")[1]
+    rows = {line.split()[0]: line for line in picture.splitlines() if line[:1] == " " and line.split()
+            and line.split()[0].isalpha()}
+    assert list(rows) == [name for name, _ in reversed(LAYERS)]
+    for name, units in LAYERS:
+        text = rows[name] + "".join(ln for ln in picture.splitlines() if ln.startswith("            "))
+        for unit in units:
+            shown = "fibrelmp/__init__.py" if unit == "__init__" else unit.rstrip("/")
+            assert shown in text, f"docs/architecture.md: layer {name} does not show {unit}"

@@ -79,3 +79,10 @@ class InputErrors(InputError):
         more = " (the limit: fix these and check again)" if self.at_limit else ""
         return ("\nerror: ".join(InputError.__str__(e) for e in self.errors)
                 + f"\n{len(self.errors)} errors{more}")
+
+
+def wrong_frame(path: str | PathLike, step: int, found: int | None) -> RunError:
+    """The error of a frame source that found another frame (or none) than the scheduled one
+    (here, below every frame source: the pipeline's and CardioProof's)."""
+    what = "no more frames" if found is None else f"step {found}"
+    return RunError(f"{path}: expected the frame of step {step}, found {what}")

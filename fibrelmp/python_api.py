@@ -79,15 +79,15 @@ class RunResult:
     def frames(self, simulation: int = -1) -> Iterator:
         """The saved frames of one simulation (default: the last), one at a time, as
         ``fibrelmp.post.lammps_dump.reader.Frame`` (``.step``, ``.column('x')``, ``.vector('x','y','z')``)."""
-        from fibrelmp.post.lammps_dump.reader import iter_frames
+        from fibrelmp.post.convert import open_frames       # the registered reader that claims it
 
-        return iter_frames(self.dumps[simulation])
+        return iter(open_frames(self.dumps[simulation], None, []))
 
     def universe(self, simulation: int = -1):
         """The frames as an MDAnalysis ``Universe`` (``ts.time`` is the dump's ITEM: TIME)."""
-        from fibrelmp.post.lammps_dump.universe import dump_universe
+        from fibrelmp.post.convert import open_frames
 
-        return dump_universe(self.dumps[simulation])
+        return open_frames(self.dumps[simulation], None, []).universe()
 
 
 def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | None = None,

@@ -2,10 +2,11 @@
 
 - the CLI and the Python API name no format, not even as an option (``--vtk``): every format
   choice comes from the registry;
-- ``fibrelmp.translate`` (the formats' homes and the job renderers) imports neither
-  ``fibrelmp.post`` nor ``fibrelmp.pipeline``, ``post`` does not import the pipeline and
-  ``pictures`` (which reads results through both) neither the pipeline nor the API, so the
-  packages form no cycle;
+- every module of fibrelmp sits in one layer (``LAYERS``) and imports only its own layer and
+  those below (function-level imports count; ``if TYPE_CHECKING:`` ones never run);
+- no import cycle runs through two subpackages, or a subpackage and a module beside it, at
+  any depth of the package tree;
+- the API and the shared layers below the formats reach a format only through the registry;
 - every registry hook loads and derives from its role's base class;
 - docs/architecture.md lists every registered format.
 """
@@ -41,38 +42,251 @@ def test_cli_and_python_api_name_no_format(module):
     assert not found, f"{module} names formats: {found}"
 
 
-def _imports(path: Path) -> set[str]:
-    """Every module ``path`` imports, at any level (function-level imports too)."""
-    tree = ast.parse(path.read_text())
-    package = ".".join(path.relative_to(REPO).with_suffix("").parts[:-1])
-    out = set()
+def _type_checking_only(tree: ast.Module) -> set[int]:
+    """Ids of the nodes under ``if TYPE_CHECKING:``: those imports never run."""
+    skip = set()
     for node in ast.walk(tree):
-        if isinstance(node, ast.Import):
-            out.update(alias.name for alias in node.names)
-        elif isinstance(node, ast.ImportFrom):
-            if node.level:
-                base = package.split(".")[: len(package.split(".")) - node.level + 1]
-                out.add(".".join(base + ([node.module] if node.module else [])))
+        if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test):
+            skip.update(id(n) for stmt in node.body for n in ast.walk(stmt))
+    return skip
+
+
+def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The strongly connected components of more than one node (Tarjan, iterative)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on_stack: set[str] = set()
+    found = []
+    for root in sorted(graph):
+        if root in index:
+            continue
+        work = [(root, iter(sorted(graph[root])))]
+        index[root] = low[root] = len(index)
+        stack.append(root)
+        on_stack.add(root)
+        while work:
+            node, edges = work[-1]
+            for nxt in edges:
+                if nxt not in index:
+                    index[nxt] = low[nxt] = len(index)
+                    stack.append(nxt)
+                    on_stack.add(nxt)
+                    work.append((nxt, iter(sorted(graph[nxt]))))
+                    break
+                if nxt in on_stack:
+                    low[node] = min(low[node], index[nxt])
             else:
-                out.add(node.module or "")
-    return out
+                work.pop()
+                if work:
+                    low[work[-1][0]] = min(low[work[-1][0]], low[node])
+                if low[node] == index[node]:
+                    component = []
+                    while True:
+                        member = stack.pop()
+                        on_stack.discard(member)
+                        component.append(member)
+                        if member == node:
+                            break
+                    if len(component) > 1:
+                        found.append(sorted(component))
+    return found
 
 
-@pytest.mark.parametrize("package, forbidden", [
-    ("translate", ("fibrelmp.post", "fibrelmp.pipeline", "fibrelmp.python_api", "fibrelmp.cli")),
-    ("post", ("fibrelmp.pipeline", "fibrelmp.cli")),
-    ("pictures", ("fibrelmp.pipeline", "fibrelmp.cli", "fibrelmp.python_api")),
-    ("numtext", ("fibrelmp.",)),
-])
-def test_packages_form_no_cycle(package, forbidden):
+class ImportGraph:
+    """Which modules of a package tree import which, read with ``ast`` (nothing is imported)."""
+
+    def __init__(self, root: Path, exceptions: set[tuple[str, str]] = frozenset()):
+        self.top = root.name
+        self.modules: dict[str, Path] = {}
+        for path in sorted(root.rglob("*.py")):
+            parts = path.relative_to(root.parent).with_suffix("").parts
+            self.modules[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = path
+        self.base = root.parent
+        self.imports = {m: {t: line for t, line in self._imports(m).items()
+                            if (m, t) not in exceptions} for m in self.modules}
+
+    def _module_of(self, name: str) -> str | None:
+        """The module ``name`` executes: itself, else its nearest existing parent."""
+        while name and name not in self.modules:
+            name = name.rpartition(".")[0]
+        return name or None
+
+    def _imports(self, module: str) -> dict[str, int]:
+        """The modules ``module`` imports at run time (function-level imports too), with the
+        line of the first such import.  Importing ``a.b.c`` also runs the packages ``a.b`` and
+        ``a`` (not the root, whose lazy exports import nothing when it loads)."""
+        path = self.modules[module]
+        tree = ast.parse(path.read_text())
+        package = module if path.name == "__init__.py" else module.rpartition(".")[0]
+        skip = _type_checking_only(tree)
+        out: dict[str, int] = {}
+        for node in ast.walk(tree):
+            if id(node) in skip:
+                continue
+            if isinstance(node, ast.Import):
+                names = [alias.name for alias in node.names]
+            elif isinstance(node, ast.ImportFrom):
+                base = node.module or ""
+                if node.level:
+                    parts = package.split(".")[: len(package.split(".")) - node.level + 1]
+                    base = ".".join(parts + ([node.module] if node.module else []))
+                # ``from pkg import sub`` imports the submodule ``pkg.sub``
+                names = [f"{base}.{a.name}" if f"{base}.{a.name}" in self.modules else base
+                         for a in node.names]
+            else:
+                continue
+            for name in names:
+                ours = name == self.top or name.startswith(self.top + ".")
+                target = self._module_of(name) if ours else None
+                while target and target != self.top:
+                    if target != module:
+                        out[target] = min(out.get(target, node.lineno), node.lineno)
+                    target = target.rpartition(".")[0]
+        return out
+
+    def where(self, module: str, target: str) -> str:
+        line = self.imports[module][target]
+        return f"{self.modules[module].relative_to(self.base)}:{line} imports {target}"
+
+    def part_of(self, package: str, module: str) -> str | None:
+        """Which part of ``package`` holds ``module``: one of its plain modules (the package's
+        own ``__init__`` included) or the whole of one of its subpackages (``name/``)."""
+        if module == package:
+            return module
+        if not module.startswith(package + "."):
+            return None
+        child = package + "." + module[len(package) + 1:].split(".")[0]
+        return child + "/" if self.modules[child].name == "__init__.py" else child
+
+    def packages(self) -> list[str]:
+        return sorted(m for m, p in self.modules.items() if p.name == "__init__.py")
+
+    def subpackage_cycles(self, package: str) -> list[str]:
+        """Inside ``package``: the import cycles that run through one of its subpackages (each
+        taken whole), with the imports that make them.  Plain modules of one package may need
+        each other; two subpackages, or a subpackage and a module beside it, may not."""
+        graph: dict[str, set[str]] = {}
+        edges: dict[tuple[str, str], list[str]] = {}
+        for module, targets in self.imports.items():
+            a = self.part_of(package, module)
+            if a is None:
+                continue
+            graph.setdefault(a, set())
+            for target in targets:
+                b = self.part_of(package, target)
+                if b is not None and b != a:
+                    graph[a].add(b)
+                    graph.setdefault(b, set())
+                    edges.setdefault((a, b), []).append(self.where(module, target))
+        found = []
+        for component in _cycles(graph):
+            if any(part.endswith("/") for part in component):
+                members = set(component)
+                found.append("cycle " + " <-> ".join(component) + ":\n  " + "\n  ".join(
+                    w for (a, b), where in sorted(edges.items()) if a in members and b in members
+                    for w in where))
+        return found
+
+
+# The one upward import: ``fibrelmp.translate`` is callable as the API's
+# ``translate(path, folder)`` and imports ``python_api`` only when called.
+GRAPH = ImportGraph(PACKAGE, {("fibrelmp.translate", "fibrelmp.python_api")})
+MODULES, IMPORTS = GRAPH.modules, GRAPH.imports
+
+
+@pytest.mark.parametrize("package", GRAPH.packages())
+def test_no_import_cycle_between_subpackages(package):
+    bad = GRAPH.subpackage_cycles(package)
+    assert not bad, "\n".join(bad)
+
+
+def _toy_tree(root: Path, files: dict[str, str]) -> Path:
+    for name, text in files.items():
+        (root / name).parent.mkdir(parents=True, exist_ok=True)
+        (root / name).write_text(text)
+    return root / "pkg"
+
+
+def test_the_cycle_check_sees_function_level_imports_and_skips_type_checking_ones(tmp_path):
+    """The check itself, on a toy package: ``pkg.a`` and ``pkg.b`` import each other, one of
+    them inside a function (a cycle), or under ``if TYPE_CHECKING:`` (none)."""
+    files = {"pkg/__init__.py": "", "pkg/a/__init__.py": "", "pkg/b/__init__.py": "",
+             "pkg/a/x.py": "from pkg.b.y import g\n",
+             "pkg/b/y.py": "def g():\n    from ..a import x\n    return x\n",
+             "pkg/b/z.py": "import pkg.b.y\n", "pkg/m.py": "from pkg.a import x\n"}
+    cyclic = ImportGraph(_toy_tree(tmp_path / "one", files))
+    assert cyclic.imports["pkg.b.y"] == {"pkg.a.x": 2, "pkg.a": 2}
+    [found] = cyclic.subpackage_cycles("pkg")
+    assert found.startswith("cycle pkg.a/ <-> pkg.b/:") and "pkg/b/y.py:2 imports pkg.a.x" in found
+    assert cyclic.subpackage_cycles("pkg.b") == []          # y and z inside b: no cycle there
+
+    files["pkg/b/y.py"] = ("from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n"
+                           "    from pkg.a import x\n")
+    assert ImportGraph(_toy_tree(tmp_path / "two", files)).subpackage_cycles("pkg") == []
+
+
+# The layers, lowest first (docs/architecture.md draws them).  A module imports its own layer
+# and the layers below; an import upwards fails, and so does a module no layer names.
+LAYERS = [
+    ("base", ["errors", "textio", "units", "registry", "formatbase", "lammps_text", "_lammps",
+              "numtext/", "lammps_styles/"]),
+    ("core", ["model", "granmodel", "sanity", "record", "runner", "checkpoint", "outputs"]),
+    ("mesh", ["mesh/"]),
+    ("translate", ["translate/"]),
+    ("post", ["post/"]),
+    ("cases", ["cardioproof/", "granular_check"]),
+    ("pictures", ["pictures/"]),
+    ("pipeline", ["pipeline/"]),
+    ("api", ["__init__", "python_api", "cli"]),
+]
+LAYER_OF = {unit: rank for rank, (_, units) in enumerate(LAYERS) for unit in units}
+
+
+def _unit(module: str) -> str:
+    """The top-level part of fibrelmp that holds ``module`` (as LAYERS names it)."""
+    part = GRAPH.part_of("fibrelmp", module)
+    return "__init__" if part == "fibrelmp" else part[len("fibrelmp."):]
+
+
+def test_every_module_has_a_layer():
+    missing = sorted({_unit(m) for m in MODULES} - set(LAYER_OF))
+    assert not missing, f"not in test_architecture.LAYERS (and the picture in docs/architecture.md): {missing}"
+
+
+def test_imports_point_down_the_layers():
     bad = []
-    for path in sorted((PACKAGE / package).rglob("*.py")):
-        for name in _imports(path):
-            own = name == f"fibrelmp.{package}" or name.startswith(f"fibrelmp.{package}.")
-            if name.startswith(forbidden) and not own:       # its own modules are fine
-                bad.append(f"{path.relative_to(REPO)} imports {name}")
-    # the callable-module shim of fibrelmp.translate defers to the API only when called
-    bad = [b for b in bad if not b.startswith("fibrelmp/translate/__init__.py imports fibrelmp.python_api")]
+    for module, targets in IMPORTS.items():
+        for target in targets:
+            a, b = _unit(module), _unit(target)
+            if LAYER_OF.get(b, -1) > LAYER_OF.get(a, len(LAYERS)):
+                bad.append(f"{GRAPH.where(module, target)} ({LAYERS[LAYER_OF[a]][0]} -> "
+                           f"{LAYERS[LAYER_OF[b]][0]})")
+    assert not bad, "\n".join(bad)
+
+
+@pytest.mark.parametrize("unit", ["numtext/", "lammps_styles/"])
+def test_built_parts_import_nothing_of_fibrelmp(unit):
+    """The C fast path and the LAMMPS plugin build on their own."""
+    bad = [GRAPH.where(m, t) for m, targets in IMPORTS.items() if _unit(m) == unit
+           for t in targets if _unit(t) != unit]
+    assert not bad, "\n".join(bad)
+
+
+def _format_code() -> list[str]:
+    """The packages and modules that are a registered format's code: each home and hook module."""
+    code = {f.home for f in registry.formats() if f.home}
+    code |= {hook.partition(":")[0] for f in registry.formats() for hook in f.hooks.values()}
+    return sorted(code)
+
+
+def test_shared_layers_reach_formats_only_through_the_registry():
+    """The API and the layers below the formats (base, core) import no format's code: they find
+    a format through the registry (``Format.load``), which imports its hook when used."""
+    code = _format_code()
+    shared = {u for name, units in LAYERS if name in ("base", "core", "api") for u in units}
+    bad = [GRAPH.where(m, t) for m, targets in IMPORTS.items() if _unit(m) in shared
+           for t in targets if any(t == c or t.startswith(c + ".") for c in code)]
     assert not bad, "\n".join(bad)
 
 
@@ -109,7 +323,20 @@ def test_input_hooks_pick_no_run_output_writer():
     """``run --also``'s writers come from the registry (``pipeline.also``): no input hook
     imports the module of a format's ALSO hook."""
     homes = {f.hooks[ALSO].partition(":")[0] for f in registry.formats(ALSO)}
-    bad = [f"{path.relative_to(REPO)} imports {name}"
-           for path in sorted((PACKAGE / "pipeline" / "inputs").rglob("*.py"))
-           for name in _imports(path) if name in homes]
+    bad = [f"{module} imports {name}" for module, imports in sorted(GRAPH.imports.items())
+           if module.startswith("fibrelmp.pipeline.inputs") for name in imports if name in homes]
     assert homes and not bad, "\n".join(bad)
+
+
+def test_architecture_doc_draws_every_layer():
+    """The picture of the layers in docs/architecture.md names each layer and what it holds."""
+    doc = (REPO / "docs" / "architecture.md").read_text()
+    picture = doc[doc.index("### The layers"):].split("```")[1]
+    rows = {line.split()[0]: line for line in picture.splitlines() if line[:1] == " " and line.split()
+            and line.split()[0].isalpha()}
+    assert list(rows) == [name for name, _ in reversed(LAYERS)]
+    for name, units in LAYERS:
+        text = rows[name] + "".join(ln for ln in picture.splitlines() if ln.startswith("            "))
+        for unit in units:
+            shown = "fibrelmp/__init__.py" if unit == "__init__" else unit.rstrip("/")
+            assert shown in text, f"docs/architecture.md: layer {name} does not show {unit}"

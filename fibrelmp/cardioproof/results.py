@@ -26,7 +26,7 @@ import numpy as np
 from fibrelmp.cardioproof import geometry
 from fibrelmp.cardioproof.case import SphCase
 from fibrelmp.cardioproof.job import SphJob
-from fibrelmp.errors import RunError
+from fibrelmp.errors import RunError, wrong_frame
 from fibrelmp.formatbase import Writer
 
 SERIES_COLUMNS = ("time_s", "pressure_Pa", "force_x_N", "force_y_N", "force_z_N", "force_normal_N",
@@ -90,8 +90,6 @@ class SphFrames:
         return words[:3] == ["write_dump", "fluid", "custom"]
 
     def read(self, step: int) -> SphFrame:
-        from fibrelmp.pipeline.run import wrong_frame
-
         f = next(self.frames, None)
         if f is None or f.step != step:
             raise wrong_frame(self.job.frames, step, None if f is None else f.step)

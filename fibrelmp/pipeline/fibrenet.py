@@ -9,9 +9,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable, Iterator
 
-from fibrelmp.errors import InputError, RunError
+from fibrelmp.errors import InputError, RunError, wrong_frame
 from fibrelmp.pipeline.request import Consumer, Rendered, RunOptions, RunPlan, RunRequest
-from fibrelmp.pipeline.run import run, wrong_frame
+from fibrelmp.pipeline.run import run
 
 if TYPE_CHECKING:
     from fibrelmp.model import Model

@@ -14,8 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
+from fibrelmp.errors import wrong_frame
 from fibrelmp.granmodel import GranularFrame, GranularModel, quat_multiply
-from fibrelmp.pipeline.run import wrong_frame
 from fibrelmp.post.lammps_dump.reader import iter_frames
 from fibrelmp.translate.granular_job import GranularJob
 from fibrelmp.translate.granular.geometry import nearest_triangle

@@ -240,12 +240,6 @@ def _count(schedule) -> str:
         return "frames"
 
 
-def wrong_frame(path: Path, step: int, found: int | None) -> RunError:
-    """The error of a frame source that found another frame (or none) than the scheduled one."""
-    what = "no more frames" if found is None else f"step {found}"
-    return RunError(f"{path}: expected the frame of step {step}, found {what}")
-
-
 def prepare_checkpoints(folder: Path, text: str, every: int | None, resume: bool,
                         appended: list[str], rank: int, inputs: list[Path] = ()):
     """Checkpointing for a job (always on: a SIGTERM/Ctrl-C leaves a checkpoint behind);

@@ -73,6 +73,12 @@ class DumpReader(Reader):
     def __iter__(self) -> Iterator[Frame]:
         return self.frames()
 
+    def universe(self):
+        """The frames as an MDAnalysis ``Universe`` (``ts.time`` is the dump's ITEM: TIME)."""
+        from fibrelmp.post.lammps_dump.universe import dump_universe
+
+        return dump_universe(self.path)
+
     def describe(self) -> list[str]:
         from fibrelmp.post.lammps_dump.info import describe_dump
 

@@ -67,23 +67,6 @@ def describe_dump(path: Path, warnings: list[tuple[str, str]]) -> list[str]:
     return out
 
 
-def describe_universe(path: Path, topology: Path | None) -> list[str]:
-    from fibrelmp.post.mdanalysis.reader import open_universe
-
-    u = open_universe(path, topology)
-    ts = u.trajectory.ts
-    fmt = type(u.trajectory).__name__
-    out = [f"file       {path} (MDAnalysis {fmt}{', topology ' + str(topology) if topology else ''})",
-           f"frames     {len(u.trajectory)}",
-           f"atoms      {len(u.atoms)}",
-           "fields     positions" + (", velocities" if ts.has_velocities else "") +
-           (", forces" if ts.has_forces else "")]
-    if ts.dimensions is not None:
-        out.append("box        " + " ".join(f"{v:g}" for v in ts.dimensions) + " (a b c alpha beta gamma)")
-    out.append(f"time       {u.trajectory[0].time:g} .. {u.trajectory[-1].time:g} ps")
-    return out
-
-
 def _gz(path: Path) -> bool:
     with open(path, "rb") as fh:
         return fh.read(2) == b"\x1f\x8b"

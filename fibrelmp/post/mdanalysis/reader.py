@@ -152,6 +152,20 @@ class UniverseReader(Reader):
         return self.frames()
 
     def describe(self) -> list[str]:
-        from fibrelmp.post.lammps_dump.info import describe_universe
-
         return describe_universe(self.path, self.topology)
+
+
+def describe_universe(path: Path, topology: Path | None) -> list[str]:
+    """``fibrelmp post --info`` of a trajectory MDAnalysis reads."""
+    u = open_universe(path, topology)
+    ts = u.trajectory.ts
+    fmt = type(u.trajectory).__name__
+    out = [f"file       {path} (MDAnalysis {fmt}{', topology ' + str(topology) if topology else ''})",
+           f"frames     {len(u.trajectory)}",
+           f"atoms      {len(u.atoms)}",
+           "fields     positions" + (", velocities" if ts.has_velocities else "") +
+           (", forces" if ts.has_forces else "")]
+    if ts.dimensions is not None:
+        out.append("box        " + " ".join(f"{v:g}" for v in ts.dimensions) + " (a b c alpha beta gamma)")
+    out.append(f"time       {u.trajectory[0].time:g} .. {u.trajectory[-1].time:g} ps")
+    return out

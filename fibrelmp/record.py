@@ -44,32 +44,15 @@ ENERGY_COLUMNS = {"KinEng": "kinetic", "RotEng": "rotational", "PotEng": "potent
 # ---------------------------------------------------------------------------------------
 # log.lammps
 def thermo_blocks(log: str | Path) -> Iterator[list[dict[str, float]]]:
-    """The thermo output of a LAMMPS log, one list of rows per ``run`` (LAMMPS prints a
-    header and the run's first step at every ``run``, its last step, and every ``thermo N``
-    steps in between), streamed: one block in memory."""
-    header: list[str] | None = None
-    rows: list[dict[str, float]] = []
-    with open(log, errors="replace") as fh:
-        for line in fh:
-            words = line.split()
-            if not words:
-                continue
-            if header is None:
-                if words[0] == "Step" and len(words) > 1:
-                    header, rows = words, []
-                continue
-            if len(words) == len(header):
-                try:
-                    rows.append(dict(zip(header, map(float, words))))
-                    continue
-                except ValueError:
-                    pass
-            # "Loop time of ...", a warning, or an error: the block ends
-            if rows:
-                yield rows
-            header, rows = (words, []) if words[0] == "Step" else (None, [])
-    if rows:
-        yield rows
+    """The thermo output of a LAMMPS log, one list of rows per ``run`` that printed any (LAMMPS
+    prints a header and the run's first step at every ``run``, its last step, and every
+    ``thermo N`` steps in between), streamed: one block in memory (``lammps_log.ThermoLog``:
+    warnings between rows are skipped, a log cut short keeps its last rows)."""
+    from fibrelmp.lammps_log import ThermoLog
+
+    for block in ThermoLog(log).blocks():
+        if block.rows:
+            yield [dict(zip(block.header, values)) for values in block.rows]
 
 
 def thermo(log: str | Path) -> Iterator[dict[str, float]]:

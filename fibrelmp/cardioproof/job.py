@@ -449,20 +449,18 @@ def write_job(case: SphCase, folder: str | Path, write_files: bool = True) -> tu
 
 def _data_text(case: SphCase, x: np.ndarray, types: np.ndarray, box, particle_volume: float) -> str:
     from fibrelmp.lammps_text import comment_text
-    from fibrelmp.translate.lammps_format import data_rows
+    from fibrelmp.translate.lammps_data import DataSection, data_file_text
 
     lo, hi = box
-    mass = case.density * particle_volume
+    mass = float_text(case.density * particle_volume)
     n = len(x)
-    head = [f"LAMMPS data file written by fibrelmp from {comment_text(case.source.name)} (CardioProof SPH)", "",
-            f"{n} atoms", "3 atom types",
-            *(f"{float_text(lo[a])} {float_text(hi[a])} {c}lo {c}hi" for a, c in enumerate("xyz")), "",
-            "Masses", "", *(f"{t} {float_text(mass)}" for t in (FLUID, WALL, MOVING)), "",
-            "Atoms # sph", "", ""]
-    ids = np.arange(1, n + 1)
-    rows = data_rows("%d %d %.17g 0 1 %.17g %.17g %.17g\n",
-                     [ids, types, np.full(n, case.density), x[:, 0], x[:, 1], x[:, 2]])
-    return "\n".join(head) + rows
+    kinds = (FLUID, WALL, MOVING)
+    sections = [DataSection("Masses", "%d %s\n", [np.array(kinds), [mass] * len(kinds)]),
+                DataSection("Atoms # sph", "%d %d %.17g 0 1 %.17g %.17g %.17g\n",
+                            [np.arange(1, n + 1), types, np.full(n, case.density), x[:, 0], x[:, 1], x[:, 2]])]
+    return data_file_text(f"LAMMPS data file written by fibrelmp from {comment_text(case.source.name)} "
+                          "(CardioProof SPH)", [(n, "atoms"), (len(kinds), "atom types")],
+                          list(zip(lo, hi)), sections, blank_before_box=False)
 
 
 def _write_velocities(case: SphCase, job: SphJob, walls, moving_rows: np.ndarray, wall_tri: np.ndarray,

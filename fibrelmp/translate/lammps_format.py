@@ -1,4 +1,4 @@
-"""Numbers and data-file rows as the LAMMPS jobs write them (bead-spring and granular).
+"""Numbers and data-file rows as the LAMMPS jobs write them (lammps_data writes the data files).
 
 ``float_text`` is how every float enters an input script (shortest text that reads back to the
 same double); ``data_rows`` formats the columns of a data-file section; ``atomfile_blocks``
@@ -23,9 +23,11 @@ def data_rows(fmt_row: str, columns: list[np.ndarray]) -> str:
     n = len(columns[0])
     if n == 0:
         return ""
-    # fast path: "%d"/"%.17g" columns and literal tokens, formatted digit-column-wise
+    # fast path: "%d"/"%.17g" columns and literal tokens, single-spaced, formatted
+    # digit-column-wise; anything else (%s, %g, two spaces) takes the % operation
     tokens, it = fmt_row.split(), iter(columns)
-    if fmt_row.endswith("\n") and fmt_row.count("%") == len(columns):
+    if fmt_row == " ".join(tokens) + "\n" and fmt_row.count("%") == len(columns) \
+            and all(tok in ("%d", "%.17g") for tok in tokens if "%" in tok):
         text = rows_text([next(it) if tok.startswith("%") else tok for tok in tokens])
         if text is not None:
             return text.decode("ascii")

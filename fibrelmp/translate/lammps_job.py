@@ -20,7 +20,8 @@ from fibrelmp.errors import InputError, RunError
 from fibrelmp.lammps_text import comment_text, lammps_path, lammps_token, template_environment
 from fibrelmp.model import Model
 from fibrelmp.textio import atomic_write
-from fibrelmp.translate.lammps_format import atomfile_blocks, data_rows, float_text
+from fibrelmp.translate.lammps_data import DataSection, write_data_file
+from fibrelmp.translate.lammps_format import atomfile_blocks, float_text
 from fibrelmp.translate.steps import MIN_PIECE_STEPS, SaveSteps, run_piece
 from fibrelmp.translate.work_facts import WorkFacts, write_facts
 
@@ -450,41 +451,40 @@ def _write_data(model: Model, bonds, path: Path, ltypes, atype, btypes, btype, a
     p, box = model.particles, model.box
     n = p.count
     ids = np.arange(1, n + 1)
-    parts = [f"LAMMPS data file written by fibrelmp from {comment_text(model.source.name)}\n\n",
-             f"{n} atoms\n{bonds.count} bonds\n{model.angles.count} angles\n",
-             f"{len(ltypes)} atom types\n{len(btypes) if bonds.count else 0} bond types\n",
-             f"{len(atypes) if model.angles.count else 0} angle types\n\n"]
+    counts = [(n, "atoms"), (bonds.count, "bonds"), (model.angles.count, "angles"),
+              (len(ltypes), "atom types"), (len(btypes) if bonds.count else 0, "bond types"),
+              (len(atypes) if model.angles.count else 0, "angle types")]
     # finite axes: the data-file box must hold beads already pushed into a wall (restarts);
     # the walls themselves sit at box.lo / box.hi in the script
     x = p.unwrapped if any(box.periodic) else p.positions
-    for axis, name in enumerate("xyz"):
+    bounds = []
+    for axis in range(3):
         lo, hi = box.lo[axis], box.hi[axis]
         if not box.periodic[axis] and n:
             margin = 1e-6 * (hi - lo)
             lo = min(lo, float(x[:, axis].min()) - margin)
             hi = max(hi, float(x[:, axis].max()) + margin)
-        parts.append(f"{float_text(lo)} {float_text(hi)} {name}lo {name}hi\n")
-    parts.append("\nMasses\n\n")
-    for i, row in enumerate(ltypes):
-        mass = row[1] if row[1] > 0 else 1.0      # mass-0 beads are not integrated: placeholder
-        parts.append(f"{i + 1} {float_text(mass)}  # {comment_text(p.type_names[int(row[0])])} m={row[1]:g} R={row[2]:g}\n")
+        bounds.append((lo, hi))
+    # mass-0 beads are not integrated: 1.0 is a placeholder
+    masses = [float_text(row[1] if row[1] > 0 else 1.0) for row in ltypes]
+    notes = [f"{comment_text(p.type_names[int(row[0])])} m={row[1]:g} R={row[2]:g}" for row in ltypes]
+    sections = [DataSection("Masses", "%d %s  # %s\n", [np.arange(1, len(ltypes) + 1), masses, notes])]
     # unwrapped coordinates: read_data wraps them into periodic boxes and sets image flags
-    cols = [ids, p.molecules, atype + 1, x[:, 0], x[:, 1], x[:, 2]]
     if use_mvv:
-        parts.append("\nAtoms # hybrid angle mdpd\n\n")
-        parts.append(data_rows("%d %d %.17g %.17g %.17g %d 0\n", [ids, atype + 1, x[:, 0], x[:, 1], x[:, 2], p.molecules]))
+        sections.append(DataSection("Atoms # hybrid angle mdpd", "%d %d %.17g %.17g %.17g %d 0\n",
+                                    [ids, atype + 1, x[:, 0], x[:, 1], x[:, 2], p.molecules]))
     else:
-        parts.append("\nAtoms # angle\n\n")
-        parts.append(data_rows("%d %d %d %.17g %.17g %.17g\n", cols))
+        sections.append(DataSection("Atoms # angle", "%d %d %d %.17g %.17g %.17g\n",
+                                    [ids, p.molecules, atype + 1, x[:, 0], x[:, 1], x[:, 2]]))
     v = p.velocities
-    parts.append("\nVelocities\n\n")
-    parts.append(data_rows("%d %.17g %.17g %.17g\n", [ids, v[:, 0], v[:, 1], v[:, 2]]))
+    sections.append(DataSection("Velocities", "%d %.17g %.17g %.17g\n", [ids, v[:, 0], v[:, 1], v[:, 2]]))
     if bonds.count:
         b = bonds.atoms + 1
-        parts.append("\nBonds\n\n")
-        parts.append(data_rows("%d %d %d %d\n", [np.arange(1, len(b) + 1), btype + 1, b[:, 0], b[:, 1]]))
+        sections.append(DataSection("Bonds", "%d %d %d %d\n",
+                                    [np.arange(1, len(b) + 1), btype + 1, b[:, 0], b[:, 1]]))
     if model.angles.count:
         a = model.angles.atoms + 1
-        parts.append("\nAngles\n\n")
-        parts.append(data_rows("%d %d %d %d %d\n", [np.arange(1, len(a) + 1), antype + 1, a[:, 0], a[:, 1], a[:, 2]]))
-    atomic_write(path, "".join(parts))
+        sections.append(DataSection("Angles", "%d %d %d %d %d\n",
+                                    [np.arange(1, len(a) + 1), antype + 1, a[:, 0], a[:, 1], a[:, 2]]))
+    write_data_file(path, f"LAMMPS data file written by fibrelmp from {comment_text(model.source.name)}",
+                    counts, bounds, sections)

@@ -13,7 +13,8 @@ import numpy as np
 from fibrelmp.lammps_text import comment_text
 from fibrelmp.textio import atomic_write
 from fibrelmp.translate.granular.bonds import GEOMETRY_NAME, PARTNERS, VALUES
-from fibrelmp.translate.lammps_format import atomfile_blocks, data_rows, float_text
+from fibrelmp.translate.lammps_data import DataSection, write_data_file
+from fibrelmp.translate.lammps_format import atomfile_blocks
 
 
 def write_data(model, path: Path, rows, type_of_mat, smat, crad, lo, hi, ntypes,
@@ -24,13 +25,9 @@ def write_data(model, path: Path, rows, type_of_mat, smat, crad, lo, hi, ntypes,
     (i_fl_bpk), then each column c of d2_fl_bvk[c], in the order the script sets them."""
     sp = model.spheres
     n = len(rows) + len(tx)
-    parts = [f"LAMMPS data file written by fibrelmp from {comment_text(model.source.name)}\n\n",
-             f"{n} atoms\n{ntypes} atom types\n"]
+    counts = [(n, "atoms"), (ntypes, "atom types")]
     if len(bond_rows):
-        parts.append(f"{len(bond_rows)} bonds\n{nbtypes} bond types\n")
-    parts.append("\n")
-    for a, name in enumerate("xyz"):
-        parts.append(f"{float_text(lo[a])} {float_text(hi[a])} {name}lo {name}hi\n")
+        counts += [(len(bond_rows), "bonds"), (nbtypes, "bond types")]
     r = crad[rows]
     # LAMMPS sets rmass = 4/3 pi r^3 density (also in 2D): density chosen to give the mass
     dens = sp.mass[rows] / (4.0 * math.pi / 3.0 * r * r * r)
@@ -48,22 +45,21 @@ def write_data(model, path: Path, rows, type_of_mat, smat, crad, lo, hi, ntypes,
         x = np.vstack([x, tx])
     else:
         diam = 2.0 * r
-    parts.append("\nAtoms # bpm/sphere\n\n")
-    parts.append(data_rows("%d 0 %d %.17g %.17g %.17g %.17g %.17g\n",
-                        [ids, types, diam, dens, x[:, 0], x[:, 1], x[:, 2]]))
     v = sp.velocity[rows]
     w = sp.omega[rows]
     if len(tx):
         v = np.vstack([v, tv])
         w = np.vstack([w, np.zeros_like(tv)])
-    parts.append("\nVelocities\n\n")
-    parts.append(data_rows("%d %.17g %.17g %.17g %.17g %.17g %.17g\n",
-                        [ids, v[:, 0], v[:, 1], v[:, 2], w[:, 0], w[:, 1], w[:, 2]]))
+    sections = [DataSection("Atoms # bpm/sphere", "%d 0 %d %.17g %.17g %.17g %.17g %.17g\n",
+                            [ids, types, diam, dens, x[:, 0], x[:, 1], x[:, 2]]),
+                DataSection("Velocities", "%d %.17g %.17g %.17g %.17g %.17g %.17g\n",
+                            [ids, v[:, 0], v[:, 1], v[:, 2], w[:, 0], w[:, 1], w[:, 2]])]
     if len(bond_rows):
         b = model.bonds.pair[bond_rows].astype(np.int64) + 1
-        parts.append("\nBonds\n\n")
-        parts.append(data_rows("%d %d %d %d\n", [np.arange(1, len(b) + 1), btype + 1, b[:, 0], b[:, 1]]))
-    atomic_write(path, "".join(parts))
+        sections.append(DataSection("Bonds", "%d %d %d %d\n",
+                                    [np.arange(1, len(b) + 1), btype + 1, b[:, 0], b[:, 1]]))
+    write_data_file(path, f"LAMMPS data file written by fibrelmp from {comment_text(model.source.name)}",
+                    counts, list(zip(lo, hi)), sections)
     if len(bond_rows) and geometry is not None:
         columns = []
         for k in range(geometry.slots):

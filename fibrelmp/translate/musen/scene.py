@@ -4,7 +4,7 @@ Semantics follow MUSEN's code (github.com/msolids/musen e0ff360: ``ImportFromTex
 ``ExportAsText.cpp``, ``DefinesMDB.h``), not its PDF, where the two disagree.  docs/musen.md
 lists every deviation.  One object per line: ``0 ID 1 TYPE 5 GEOM [23 KEY] [24 T0 T1]`` then
 any number of time points ``2 T <tag values>...``; the LAST time point is the start state.
-Tokenising lives in ``musen_text``; this module turns the tokens into the model.
+Tokenising lives in ``text.py`` (``scan_text``); this module turns the tokens into the model.
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from fibrelmp.units import SI
 from fibrelmp.granmodel import (ContactLaw, Geometry, GranularModel, GranularPlan, Material,
                          MotionInterval, SolidBonds, Spheres, Triangles, hertz_effective)
 from fibrelmp.translate.musen.text import (LIQUID_BOND, SOLID_BOND, SPHERE, TD_SIZE, TYPE_NAMES, WALL,  # noqa: F401
-                         TimePoints, _bool, _check_duplicate_ids, _fill, _int, _num, _scan, _Scan,
+                         TimePoints, _bool, check_duplicate_ids, _fill, _int, _num, scan_text, TextScan,
                          _state, read_time_points)
 
 DEFAULT_ACTIVITY_END = 1e300            # MUSENDefinitions.h; read as inf, written back as 1e+300
@@ -39,11 +39,11 @@ NOT_USED_TAGS = {38: "analysis volume", 39: "package generator", 41: "bonds gene
 def read(path: str | Path) -> GranularModel:
     """Read a MUSEN text scene (or text result: its last time point is the start state)."""
     path = Path(path)
-    scan = _scan(path)
+    scan = scan_text(path)
     model_warn: list[tuple[str, str]] = []
     ids = np.array(scan.ids, np.int64)
     types = np.array(scan.types, np.int64)
-    _check_duplicate_ids(scan, ids, path)
+    check_duplicate_ids(scan, ids, path)
     all_times = [scan.vals[r][lay.time_idx] for r, lay in enumerate(scan.layouts) if lay]
     t_start = float(max(float(t.max()) for t in all_times)) if all_times else 0.0
 
@@ -83,7 +83,7 @@ def read(path: str | Path) -> GranularModel:
     return model
 
 
-def _materials(scan: _Scan, path: Path, warn: list) -> tuple[list[Material], dict[str, int]]:
+def _materials(scan: TextScan, path: Path, warn: list) -> tuple[list[Material], dict[str, int]]:
     materials: list[Material] = []
     key_index: dict[str, int] = {}
     for ln, tag, tok in scan.scene:
@@ -129,7 +129,7 @@ def _check_material(key: str, name: str, props: dict, path: Path | None, ln: int
             raise InputError(path, ln, f"material {key} ({name}): {text}")
 
 
-def _keys(scan: _Scan, rows: np.ndarray, key_index: dict[str, int], path: Path,
+def _keys(scan: TextScan, rows: np.ndarray, key_index: dict[str, int], path: Path,
           what: str) -> np.ndarray:
     out = np.empty(len(rows), np.int64)
     for j, r in enumerate(rows):
@@ -143,14 +143,14 @@ def _keys(scan: _Scan, rows: np.ndarray, key_index: dict[str, int], path: Path,
     return out
 
 
-def _activity(scan: _Scan, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _activity(scan: TextScan, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     act = np.array([scan.acts[r] or (0.0, math.inf) for r in rows], np.float64).reshape(-1, 2)
     end = act[:, 1].copy()
     end[end >= DEFAULT_ACTIVITY_END] = np.inf
     return act[:, 0].copy(), end
 
 
-def _require_time_point(scan: _Scan, rows: np.ndarray, what: str, path: Path) -> None:
+def _require_time_point(scan: TextScan, rows: np.ndarray, what: str, path: Path) -> None:
     for r in rows:
         if scan.layouts[r] is None:
             raise InputError(path, scan.lines[r], f"{what} {scan.ids[r]} has no time point "

@@ -20,7 +20,7 @@ import numpy as np
 
 from fibrelmp.errors import InputError
 from fibrelmp.granmodel import MotionInterval
-from fibrelmp.translate.musen.writer import EXPORT_FLAGS, all_on
+from fibrelmp.translate.musen.text_writer import EXPORT_FLAGS, all_on
 from fibrelmp.textio import read_text
 
 COMPONENTS = {"SIMULATOR": "SIMULATOR", "IMPORT_FROM_TEXT": "IMPORT_FROM_TEXT",

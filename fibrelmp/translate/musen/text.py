@@ -1,5 +1,7 @@
-"""Tokenising MUSEN text files (``ImportFromText.cpp`` syntax): object lines, scene lines
-and the per-time-point sections, plus ``read_time_points`` for whole result files.
+"""The one MUSEN text reader: tokenising MUSEN text files (``ImportFromText.cpp`` syntax),
+object lines, scene lines and the per-time-point sections (``scan_text``, used by the scene
+reader ``scene.py`` and ``mdem/text_import.py``), plus ``read_time_points`` for whole result
+files.
 
 Speed: a line is split once and its time-point part converted to floats in one numpy call;
 the tag layout of a line is worked out once and then only verified for lines of the same
@@ -51,7 +53,10 @@ class _Layout:
 
 
 @dataclass
-class _Scan:
+class TextScan:
+    """A MUSEN text file as ``scan_text`` tokenised it: per object line (in file order) its line
+    number, id, type, geometry numbers, material key, activity interval, time-point values and
+    their tag layout; the scene lines as (line number, tag, tokens)."""
     path: Path
     lines: list[int] = field(default_factory=list)
     ids: list[int] = field(default_factory=list)
@@ -228,12 +233,15 @@ def _check_binary(path: Path) -> None:
                          "export it as text with cmusen COMPONENT EXPORT_TO_TEXT")
 
 
-def _scan(path: Path, objects_only: bool = False) -> _Scan:
+def scan_text(path: Path, objects_only: bool = False) -> TextScan:
+    """The one MUSEN text reader (scenes, results, ``.mdem`` text import): every line of
+    ``path`` tokenised, malformed lines an InputError at their line; ``objects_only`` skips the
+    scene lines."""
     _check_binary(path)
     text = read_text(path, "MUSEN text file")
     if "\r" in text:                       # MUSEN's safeGetLine accepts \n, \r\n and \r
         text = text.replace("\r\n", "\n").replace("\r", "\n")
-    scan = _Scan(path)
+    scan = TextScan(path)
     cache: dict[int, list[_Layout]] = {}
     any_line = False
     for ln, line in enumerate(text.split("\n"), 1):
@@ -279,7 +287,7 @@ def _scan(path: Path, objects_only: bool = False) -> _Scan:
     return scan
 
 
-def _scene_line(tok: list[str], path: Path, ln: int, scan: _Scan) -> None:
+def _scene_line(tok: list[str], path: Path, ln: int, scan: TextScan) -> None:
     """Scene lines (22..41).  Lines 32/33/34/38..41 take the rest of the line."""
     i = 0
     while i < len(tok):
@@ -329,7 +337,7 @@ def _musen_interp(times: np.ndarray, y: np.ndarray, t: float) -> np.ndarray:
     return y[il] + (t - times[il]) * (y[ir] - y[il]) / (times[ir] - times[il])
 
 
-def _state(scan: _Scan, rows: np.ndarray, tags: tuple[int, ...], t: float,
+def _state(scan: TextScan, rows: np.ndarray, tags: tuple[int, ...], t: float,
            warn: list[str]) -> dict[int, np.ndarray]:
     """Values of ``tags`` at time ``t`` for object ``rows`` (nan where an object's time point
     lacks the tag); rows sharing a layout are handled as one stacked array."""
@@ -367,7 +375,8 @@ def _fill(a: np.ndarray, default) -> np.ndarray:
     return a
 
 
-def _check_duplicate_ids(scan: _Scan, ids: np.ndarray, path: Path) -> None:
+def check_duplicate_ids(scan: TextScan, ids: np.ndarray, path: Path) -> None:
+    """An InputError at the second line of an id used twice."""
     order = np.argsort(ids, kind="stable")
     dup = np.flatnonzero(np.diff(ids[order]) == 0)
     if len(dup):
@@ -383,16 +392,16 @@ def read_time_points(path: str | Path, types: tuple[int, ...] | None = None,
 
     ``types``/``tags`` limit what is returned (memory: T x n x k floats per tag)."""
     path = Path(path)
-    return time_points_of(_scan(path, objects_only=True), types, tags)
+    return time_points_of(scan_text(path, objects_only=True), types, tags)
 
 
-def time_points_of(scan: _Scan, types: tuple[int, ...] | None = None,
+def time_points_of(scan: TextScan, types: tuple[int, ...] | None = None,
                    tags: tuple[int, ...] | None = None) -> TimePoints:
     """``read_time_points`` of a scanned file."""
     path = scan.path
     ids = np.array(scan.ids, np.int64)
     otypes = np.array(scan.types, np.int64)
-    _check_duplicate_ids(scan, ids, path)
+    check_duplicate_ids(scan, ids, path)
     keep = np.ones(len(ids), bool) if types is None else np.isin(otypes, types)
     rows = np.flatnonzero(keep)
     rows = rows[np.argsort(ids[rows], kind="stable")]

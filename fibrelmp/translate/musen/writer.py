@@ -4,7 +4,8 @@ Layout (``ExportAsText.cpp``): one line per object in ascending id with ALL save
 on it, then the scene lines 22/28/29/30, geometries 25/26/27, 38, materials 32/33/34 and
 generators 39/40/41.  Time-point values get ``precision`` significant digits like a C++
 ostream (``%g``); activity intervals and scene lines always get 6, sphere radii 16 and bond
-diameters/lengths 25, as in MUSEN.
+diameters/lengths 25, as in MUSEN.  The lines are formatted by ``text_writer`` (shared with
+the ``.mdem`` text export); this module supplies the values from the frames and the model.
 
 Memory stays bounded: ``add`` appends each frame's per-type value block to one raw float64
 file per object type in a temporary folder beside the output (laid out saves x objects x
@@ -27,21 +28,9 @@ from fibrelmp.granmodel import GranularFrame, GranularModel
 from fibrelmp.textio import temp_name, write_failure
 from fibrelmp.translate.musen.scene import (ACTIVE_INTERACTIONS, ACTIVE_PROPERTIES, DEFAULT_ACTIVITY_END,
                                PROPERTY_DEFAULTS)
+from fibrelmp.translate.musen.text_writer import (export_selectors, gather_spool, object_header, scene_line,
+                                                  time_point_lines)
 
-# MUSEN's export selector groups and flags, in ExportAsText.h order (cmusen TEXT_EXPORT_*).
-EXPORT_FLAGS: dict[str, tuple[str, ...]] = {
-    "objectTypes": ("particles", "bonds", "walls"),
-    "constProps": ("id", "type", "geometry", "material", "activityInterval"),
-    "tdPropsPart": ("angVel", "coord", "force", "forceAmpl", "orient", "princStress",
-                    "stressTensor", "temperature", "velocity"),
-    "tdPropsBond": ("coord", "force", "forceAmpl", "tangOverlap", "temperature", "totTorque",
-                    "velocity"),
-    "tdPropsWall": ("coord", "force", "forceAmpl", "velocity"),
-    "sceneInfo": ("domain", "pbc", "anisotropy", "contactRadius"),
-    "geometries": ("baseInfo", "tdProperties", "wallsList", "analysisVolumes"),
-    "materials": ("compounds", "interactions", "mixtures"),
-    "generators": ("packageGenerator", "bondsGenerator"),
-}
 # per type: (flag, tag, width) in the exporter's order, and the spooled column block.
 # Spheres: principal stresses (42) and the stress tensor (36) are never written (fibrelmp
 # does not compute them); temperature (37) is 0, as MUSEN writes without a thermal model.
@@ -52,23 +41,6 @@ _BOND = (("coord", 12, 3), ("force", 20, 3), ("forceAmpl", 18, 1), ("tangOverlap
 _WALL = (("coord", 44, 9), ("force", 20, 3), ("forceAmpl", 18, 1), ("velocity", 15, 3))
 _CHUNK = 4096
 _VALUES_PER_CHUNK = 1_000_000         # ~8 MB of floats (+ their text) per formatting chunk
-
-
-def _gather(path: Path, count: int, width: int, nt: int, rows: np.ndarray) -> np.ndarray:
-    """(len(rows), nt, width) from the spool file laid out (nt, count, width): one read of
-    the row span per save (rows of one type come in id order, so the span is tight)."""
-    lo, hi = int(rows.min()), int(rows.max()) + 1
-    out = np.empty((len(rows), nt, width))
-    with open(path, "rb") as fh:
-        for k in range(nt):
-            fh.seek(((k * count) + lo) * width * 8)
-            block = np.fromfile(fh, np.float64, (hi - lo) * width).reshape(hi - lo, width)
-            out[:, k] = block[rows - lo]
-    return out
-
-
-def all_on() -> dict[str, dict[str, bool]]:
-    return {g: {f: True for f in flags} for g, flags in EXPORT_FLAGS.items()}
 
 
 def _property(mat, pid: int) -> float:
@@ -97,9 +69,7 @@ class MusenResultWriter(Writer):
         self.path = self.target
         self.precision = int(precision)
         self.time_interval = time_interval
-        self.sel = all_on()
-        for group, flags in (selectors or {}).items():
-            self.sel[group].update(flags)
+        self.sel = export_selectors(selectors)
         self.times: list[float] = []
         sp = model.spheres
         self.sphere_end = sp.active_end.copy()
@@ -275,30 +245,20 @@ class MusenResultWriter(Writer):
             out.write("".join(lines.tolist()))
 
     def _lines(self, otype: int, ids: np.ndarray, rows: np.ndarray, maps) -> list[str]:
-        heads = self._headers(otype, ids, rows)
-        nt = len(self.times)
-        p = self.precision
         spec, group, name = {1: (_SPHERE, "tdPropsPart", "s"), 9: (_BOND, "tdPropsBond", "b"),
                              14: (_WALL, "tdPropsWall", "w"), 13: ((), "", "")}[otype]
-        cols, tpl = [], f"2 %.{p}g "
-        start = 0
-        for flag, tag, width in spec:
-            if self.sel[group][flag]:
-                cols.extend(range(start, start + width))
-                tpl += f"{tag} " + f"%.{p}g " * width
-            start += width
-        if nt == 0:
-            return [h + "\n" for h in heads]
-        values = np.empty((len(rows), nt, 1 + len(cols)))
-        values[:, :, 0] = self.times
-        if cols:
-            values[:, :, 1:] = _gather(*maps[name], nt, rows)[:, :, cols]
-        text = ((tpl * nt + "\n") * len(rows)) % tuple(values.ravel().tolist())
-        return [h + body + "\n" for h, body in zip(heads, text.split("\n"))]
+        nt = len(self.times)
+
+        def values_of(cols: list[int]) -> np.ndarray:
+            path, count, width = maps[name]
+            with open(path, "rb") as fh:
+                return gather_spool(fh, count, width, nt, rows)[:, :, cols]
+
+        return time_point_lines(self._headers(otype, ids, rows), spec, self.sel.get(group, {}),
+                                self.times, self.precision, values_of)
 
     def _headers(self, otype: int, ids: np.ndarray, rows: np.ndarray) -> list[str]:
         m = self.model
-        c = self.sel["constProps"]
         if otype == 1:
             obj = m.spheres
             geom = ["%.16g %.16g" % (obj.radius[r], obj.contact_radius[r]) for r in rows]
@@ -317,21 +277,10 @@ class MusenResultWriter(Writer):
                                           liquid[r]["diameter"], liquid[r]["length0"])
                     for r in rows]
         start, end = self._activity(np.full(len(rows), otype), rows)
-        heads = []
-        for j, r in enumerate(rows):
-            h = []
-            if c["id"]:
-                h.append(f"0 {ids[j]} ")
-            if c["type"]:
-                h.append(f"1 {otype} ")
-            if c["geometry"]:
-                h.append(f"5 {geom[j]} ")
-            if c["material"]:
-                h.append(f"23 {self._key(obj, otype, r)} ")
-            if c["activityInterval"]:
-                h.append(f"24 {_g(start[j])} {_g(end[j])} ")
-            heads.append("".join(h))
-        return heads
+        const = self.sel["constProps"]
+        return [object_header(const, ids[j], otype, geom[j], self._key(obj, otype, r) if const["material"] else "",
+                              _g(start[j]), _g(end[j]))
+                for j, r in enumerate(rows)]
 
     def _key(self, obj, otype: int, r: int) -> str:
         if otype == 13:
@@ -348,8 +297,8 @@ class MusenResultWriter(Writer):
         raw = pt.get("raw", {})
         lines: list[str] = []
 
-        def line(*values) -> None:
-            lines.append("".join(f"{v} " for v in values) + "\n")
+        def line(tag: int, *values) -> None:
+            lines.append(scene_line(tag, *values))
 
         sc = self.sel["sceneInfo"]
         if sc["domain"] and m.plan.domain is not None:

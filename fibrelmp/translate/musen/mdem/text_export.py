@@ -6,6 +6,9 @@ One line per object, ascending id, holding every saved time point; then the scen
 39/40/41.  Time-point values get ``precision`` significant digits (C++ ostream ``%g``), every
 other number 6; sphere radii 16 digits and bond diameters/lengths 25, as MUSEN formats them.
 
+The lines are formatted by ``translate/musen/text_writer.py`` (shared with the result writer
+from frames); this module supplies the values from the ``.mdem`` file.
+
 Memory stays bounded: time points are read one at a time and their per-type values appended
 to a spool file (saves x objects x columns, as MUSEN's own exporter does with its temporary
 binary file); lines are then formatted for chunks of objects at a time.
@@ -24,6 +27,9 @@ from fibrelmp.translate.musen.mdem import timepoints as tp
 from fibrelmp.translate.musen.mdem.document import MdemFile
 from fibrelmp.translate.musen.mdem.objects import (LIQUID_BOND, SOLID_BOND, SPHERE, WALL, Objects,
                                                    read_objects)
+from fibrelmp.translate.musen.text_writer import (export_selectors, gather_spool, object_header, scene_line,
+                                                  time_point_lines)
+from fibrelmp.translate.musen.text_writer import number_text as g
 
 # material property ids MUSEN exports (DefinesMDB.h _MUSEN_ACTIVE_PROPERTIES/_INTERACTIONS)
 # and the defaults a compound/interaction is created with
@@ -55,9 +61,6 @@ _TEMPLATES = {
 _WIDTH = {SPHERE: _SPHERE_COLS, SOLID_BOND: _BOND_COLS, WALL: _WALL_COLS, LIQUID_BOND: 0}
 
 
-def g(x: float) -> str:
-    """A number as a C++ ostream writes it with the default precision 6."""
-    return "%g" % x
 
 
 def _length(v: np.ndarray) -> np.ndarray:
@@ -175,11 +178,7 @@ def export(mdem: MdemFile, out: IO[str], precision: int = 6,
     ``time_interval`` (cmusen's TIME_INTERVAL) and ``times_limit`` (the first k time points)
     restrict the time points; ``selectors`` (cmusen's TEXT_EXPORT_* groups and flags, all on
     by default) what is written, as ``CExportAsText`` filters."""
-    from fibrelmp.translate.musen.writer import all_on
-
-    sel = all_on()
-    for group, flags in (selectors or {}).items():
-        sel[group].update(flags)
+    sel = export_selectors(selectors)
     obj = read_objects(mdem.info, mdem.version, mdem.path)
     compounds = {c.uniqueKey for c in mdem.storage.modules_data.materials_database.compound}
     saved = np.array(mdem.info.savedTimePoints, float)
@@ -229,7 +228,6 @@ def _filter(obj: Objects, sel: dict, times: list[float]) -> np.ndarray:
 def _write_objects(out, obj: Objects, index, keep, spools, times, precision: int, compounds,
                    sel) -> None:
     nt = len(times)
-    p = int(precision)
     kinds = obj.types
     width_all = max(1, nt * 31)
     chunk = max(16, min(4096, _CHUNK_VALUES // width_all))
@@ -245,54 +243,25 @@ def _write_objects(out, obj: Objects, index, keep, spools, times, precision: int
             sel_rows = sl[kinds[sl] == t]
             if not len(sel_rows):
                 continue
-            heads = _headers(obj, sel_rows, t, compounds, sel["constProps"])
             group, fields = _TEMPLATES[t]
-            tpl, cols, start = f"2 %.{p}g ", [], 0
-            for flag, tag, k in fields:
-                if sel[group][flag]:
-                    tpl += f"{tag} " + f"%.{p}g " * k
-                    cols.extend(range(start, start + k))
-                start += k
-            values = np.empty((len(sel_rows), nt, 1 + len(cols)))
-            values[:, :, 0] = times
-            if cols and nt:
-                values[:, :, 1:] = _gather(spools[t], len(index[t]), _WIDTH[t], nt,
-                                           where[sel_rows])[:, :, cols]
-            text = ((tpl * nt + "\n") * len(sel_rows)) % tuple(values.ravel().tolist())
-            lines[np.searchsorted(sl, sel_rows)] = [h + body + "\n" for h, body in
-                                                    zip(heads, text.split("\n"))]
+
+            def values_of(cols: list[int], t: int = t, sel_rows: np.ndarray = sel_rows) -> np.ndarray:
+                return gather_spool(spools[t], len(index[t]), _WIDTH[t], nt, where[sel_rows])[:, :, cols]
+
+            lines[np.searchsorted(sl, sel_rows)] = time_point_lines(
+                _headers(obj, sel_rows, t, compounds, sel["constProps"]), fields, sel.get(group, {}),
+                times, int(precision), values_of)
         out.write("".join(lines.tolist()))
 
 
 def _headers(obj: Objects, rows: np.ndarray, kind: int, compounds, const: dict) -> list[str]:
     geom = geometry_text(obj, rows, compounds)
-    out = []
-    for j, r in enumerate(rows.tolist()):
-        h = f"0 {obj.ids[r]} " if const["id"] else ""
-        h += f"1 {kind} " if const["type"] else ""
-        h += f"5 {geom[j]} " if const["geometry"] else ""
-        h += f"23 {obj.compound[r] or 'Undefined'} " if const["material"] else ""
-        h += f"24 {g(obj.start[r])} {g(obj.end[r])} " if const["activityInterval"] else ""
-        out.append(h)
-    return out
-
-
-def _gather(fh, count: int, width: int, nt: int, rows: np.ndarray) -> np.ndarray:
-    """(len(rows), nt, width) from a spool laid out (nt, count, width)."""
-    lo, hi = int(rows.min()), int(rows.max()) + 1
-    out = np.empty((len(rows), nt, width))
-    for k in range(nt):
-        fh.seek(((k * count) + lo) * width * 8)
-        block = np.fromfile(fh, np.float64, (hi - lo) * width).reshape(hi - lo, width)
-        out[:, k] = block[rows - lo]
-    return out
+    return [object_header(const, obj.ids[r], kind, geom[j], obj.compound[r] or "Undefined",
+                          g(obj.start[r]), g(obj.end[r]))
+            for j, r in enumerate(rows.tolist())]
 
 
 # ------------------------------------------------------------------------- scene lines
-def _line(tag: int, *values: Any) -> str:
-    return f"{tag} " + "".join(f"{v} " for v in values) + "\n"
-
-
 def _vec(v: Any) -> str:
     return f"{g(v.x)} {g(v.y)} {g(v.z)}"
 
@@ -300,45 +269,43 @@ def _vec(v: Any) -> str:
 def scene_lines(storage: Any, sel: dict[str, dict[str, bool]] | None = None) -> list[str]:
     """Lines 22, 28, 29, 30, 25/26/27, 38, 32/33/34, 39/40/41 of ``storage`` (those the
     selectors ask for; all by default)."""
-    from fibrelmp.translate.musen.writer import all_on
-
-    sel = sel or all_on()
+    sel = sel or export_selectors()
     info, mods = storage.info, storage.modules_data
     sc, ge, ma, gn = sel["sceneInfo"], sel["geometries"], sel["materials"], sel["generators"]
     lines = []
     if sc["domain"]:
-        lines.append(_line(22, _vec(info.simulation_volume_min), _vec(info.simulation_volume_max)))
+        lines.append(scene_line(22, _vec(info.simulation_volume_min), _vec(info.simulation_volume_max)))
     if sc["pbc"]:
-        lines.append(_line(28, int(info.periodic_conditions_enabled), int(info.periodic_conditions_x),
+        lines.append(scene_line(28, int(info.periodic_conditions_enabled), int(info.periodic_conditions_x),
                            int(info.periodic_conditions_y), int(info.periodic_conditions_z),
                            _vec(info.periodic_conditions_min) + " " + _vec(info.periodic_conditions_max)))
     if sc["anisotropy"]:
-        lines.append(_line(29, int(info.anisotripy)))
+        lines.append(scene_line(29, int(info.anisotripy)))
     if sc["contactRadius"]:
-        lines.append(_line(30, int(info.contact_radius)))
+        lines.append(scene_line(30, int(info.contact_radius)))
     for geo in geometries(info):
         if ge["baseInfo"]:
-            lines.append(_line(25, geo["name"], geo["key"], g(geo["mass"]), *geo["free"],
+            lines.append(scene_line(25, geo["name"], geo["key"], g(geo["mass"]), *geo["free"],
                                int(geo["rotate"])))
         if ge["tdProperties"]:
-            lines.append(_line(26, motion_text(geo["motion_type"], geo["intervals"])))
+            lines.append(scene_line(26, motion_text(geo["motion_type"], geo["intervals"])))
         if ge["wallsList"]:
-            lines.append(_line(27, len(geo["planes"]), " ".join(str(i) for i in geo["planes"])))
+            lines.append(scene_line(27, len(geo["planes"]), " ".join(str(i) for i in geo["planes"])))
     if ge["analysisVolumes"]:
         for vol in volumes(info):
-            lines.append(_line(38, volume_text(vol)))
+            lines.append(scene_line(38, volume_text(vol)))
     lines += material_lines(mods.materials_database, ma)
     pg = mods.package_generator
     for gen in pg.generators if gn["packageGenerator"] else ():
-        lines.append(_line(39, f"{_single(gen.volume_name)} {int(gen.volume_active)} {gen.volume_key} "
+        lines.append(scene_line(39, f"{_single(gen.volume_name)} {int(gen.volume_active)} {gen.volume_key} "
                            f"{gen.mixture_key} {g(gen.porosity)} {g(gen.max_overlap)} "
                            f"{gen.max_iterations} {_vec(gen.init_velocity)} {int(gen.inside_geometry)}"))
     if gn["packageGenerator"]:
-        lines.append(_line(40, f"{pg.simulator_type} {g(pg.verlet_coeff or 2.0)}"))
+        lines.append(scene_line(40, f"{pg.simulator_type} {g(pg.verlet_coeff or 2.0)}"))
     for gen in mods.bonds_generator.generators if gn["bondsGenerator"] else ():
         first = "".join(f"{k} " for k in gen.partner_compounds1)
         second = "".join(f"{k} " for k in gen.partner_compounds2)
-        lines.append(_line(41, f"{_single(gen.name)} {int(gen.activity)} {gen.material_key} "
+        lines.append(scene_line(41, f"{_single(gen.name)} {int(gen.activity)} {gen.material_key} "
                            f"{g(gen.min_length)} {g(gen.max_length)} {g(gen.property1)} "
                            f"{int(gen.allow_overlap)} {int(gen.compound_specific)} / {first}/ "
                            f"{second}/ "))

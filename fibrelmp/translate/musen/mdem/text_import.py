@@ -44,12 +44,12 @@ _TAGS = {12: ("coord", 0, 3), 15: ("vel", 0, 3), 16: ("angle_vel", 0, 3), 20: ("
 
 def import_text(path: str | Path) -> tuple[Any, Iterator[tuple[float, np.ndarray, np.ndarray]]]:
     """(scene message, time points) of a MUSEN text file."""
-    from fibrelmp.translate.musen.text import _check_duplicate_ids, _scan, time_points_of
+    from fibrelmp.translate.musen.text import check_duplicate_ids, scan_text, time_points_of
 
     path = Path(path)
-    scan = _scan(path)
+    scan = scan_text(path)
     ids = np.array(scan.ids, np.int64)
-    _check_duplicate_ids(scan, ids, path)
+    check_duplicate_ids(scan, ids, path)
     storage = new("ProtoSimulationStorage")
     info = storage.info
     info.version = 1

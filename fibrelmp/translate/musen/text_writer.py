@@ -1,0 +1,107 @@
+"""The one MUSEN text writer's formatting (what cmusen's EXPORT_TO_TEXT writes,
+``ExportAsText.cpp``), shared by the result writer from frames (``writer.py``) and the
+``.mdem`` text export (``mdem/text_export.py``), which differ only in where the values come
+from.
+
+An object line is its constant part (``object_header``: 0 id, 1 type, 5 geometry, 23 material,
+24 activity interval) followed by every saved time point (``time_point_lines``: ``2 t`` and the
+selected tags with ``precision`` significant digits, C++ ostream ``%g``); a scene line is
+``scene_line``.  Time-point values come from a spool file laid out (saves, objects, columns)
+(``gather_spool``), so memory holds a chunk of objects, not the whole result.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from typing import IO, Any
+
+import numpy as np
+
+# MUSEN's export selector groups and flags, in ExportAsText.h order (cmusen TEXT_EXPORT_*).
+EXPORT_FLAGS: dict[str, tuple[str, ...]] = {
+    "objectTypes": ("particles", "bonds", "walls"),
+    "constProps": ("id", "type", "geometry", "material", "activityInterval"),
+    "tdPropsPart": ("angVel", "coord", "force", "forceAmpl", "orient", "princStress",
+                    "stressTensor", "temperature", "velocity"),
+    "tdPropsBond": ("coord", "force", "forceAmpl", "tangOverlap", "temperature", "totTorque",
+                    "velocity"),
+    "tdPropsWall": ("coord", "force", "forceAmpl", "velocity"),
+    "sceneInfo": ("domain", "pbc", "anisotropy", "contactRadius"),
+    "geometries": ("baseInfo", "tdProperties", "wallsList", "analysisVolumes"),
+    "materials": ("compounds", "interactions", "mixtures"),
+    "generators": ("packageGenerator", "bondsGenerator"),
+}
+# (flag, tag, number of values) of a time-point field
+Field = tuple[str, int, int]
+
+
+def all_on() -> dict[str, dict[str, bool]]:
+    """Every export selector on (cmusen's default)."""
+    return {g: {f: True for f in flags} for g, flags in EXPORT_FLAGS.items()}
+
+
+def export_selectors(overrides: dict[str, dict[str, bool]] | None = None) -> dict[str, dict[str, bool]]:
+    """All selectors on, then ``overrides`` (group -> flag -> on) applied."""
+    sel = all_on()
+    for group, flags in (overrides or {}).items():
+        sel[group].update(flags)
+    return sel
+
+
+def number_text(x: float) -> str:
+    """A number as a C++ ostream writes it with the default precision 6."""
+    return "%g" % x
+
+
+def scene_line(tag: int, *values: Any) -> str:
+    """``tag v1 v2 ... `` and a newline: every value followed by a space, as MUSEN writes."""
+    return f"{tag} " + "".join(f"{v} " for v in values) + "\n"
+
+
+def object_header(const: dict[str, bool], oid: int, otype: int, geometry: str, key: str,
+                  start: str, end: str) -> str:
+    """The constant part of an object line, the parts ``const`` (constProps) selects;
+    ``start``/``end``: the activity interval already as text."""
+    h = f"0 {oid} " if const["id"] else ""
+    h += f"1 {otype} " if const["type"] else ""
+    h += f"5 {geometry} " if const["geometry"] else ""
+    h += f"23 {key} " if const["material"] else ""
+    h += f"24 {start} {end} " if const["activityInterval"] else ""
+    return h
+
+
+def gather_spool(fh: IO[bytes], count: int, width: int, nt: int, rows: np.ndarray) -> np.ndarray:
+    """(len(rows), nt, width) from a float64 spool laid out (nt, count, width): one read of
+    the row span per save (rows of one type come in id order, so the span is tight)."""
+    lo, hi = int(rows.min()), int(rows.max()) + 1
+    out = np.empty((len(rows), nt, width))
+    for k in range(nt):
+        fh.seek(((k * count) + lo) * width * 8)
+        block = np.fromfile(fh, np.float64, (hi - lo) * width).reshape(hi - lo, width)
+        out[:, k] = block[rows - lo]
+    return out
+
+
+def time_point_lines(heads: Sequence[str], fields: Sequence[Field], flags: dict[str, bool],
+                     times: Sequence[float], precision: int,
+                     values_of: Callable[[list[int]], np.ndarray]) -> list[str]:
+    """Whole object lines: each head followed by its time points.  ``fields`` in spool column
+    order, ``flags`` the selector group that picks them; ``values_of(columns)`` gives the
+    selected spool columns as (len(heads), len(times), len(columns))."""
+    nt = len(times)
+    if nt == 0:
+        return [h + "\n" for h in heads]
+    cols: list[int] = []
+    tpl, start = f"2 %.{precision}g ", 0
+    for flag, tag, width in fields:
+        if flags[flag]:
+            cols.extend(range(start, start + width))
+            tpl += f"{tag} " + f"%.{precision}g " * width
+        start += width
+    values = np.empty((len(heads), nt, 1 + len(cols)))
+    values[:, :, 0] = times
+    if cols:
+        values[:, :, 1:] = values_of(cols)
+    # one C-level % for the whole chunk of objects
+    text = ((tpl * nt + "\n") * len(heads)) % tuple(values.ravel().tolist())
+    return [h + body + "\n" for h, body in zip(heads, text.split("\n"))]

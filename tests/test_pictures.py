@@ -397,3 +397,19 @@ def test_snapshot_of_a_fibrenet_work_folder_has_the_springs_and_radii(runs, tmp_
     # the dump keeps 17 digits, the xyz file 5 decimals
     np.testing.assert_allclose(via_work.positions, via_xyz.positions, atol=5.1e-6)
     np.testing.assert_allclose(via_work.sizes, via_xyz.sizes, rtol=1e-6)      # same radii, same view
+
+
+@pytest.mark.parametrize("bad", ["nan", "inf"])
+def test_snapshot_of_a_blown_up_dump_is_an_input_error(tmp_path, bad):
+    """Was: a dump with a nan/inf position gave matplotlib's ``ValueError: data must be finite``
+    (a traceback and exit 1 from the CLI, ValueError from the API)."""
+    rows = ["1 1 0 0 0", f"2 1 1 {bad} 0", "3 1 2 0 0"]
+    dump = tmp_path / "blown.dump"
+    dump.write_text("ITEM: TIMESTEP\n0\nITEM: NUMBER OF ATOMS\n3\nITEM: BOX BOUNDS pp pp pp\n"
+                    "0 3\n0 3\n0 3\nITEM: ATOMS id type x y z\n" + "\n".join(rows) + "\n")
+    with pytest.raises(InputError, match="frame 0: 1 of 3 particle positions are nan or inf"):
+        python_api.snapshot(dump)
+    result = CliRunner().invoke(app, ["snapshot", str(dump)])
+    assert result.exit_code == 2 and "Traceback" not in result.output
+    assert "nothing to draw" in result.output
+    assert not list(tmp_path.glob("*.png"))

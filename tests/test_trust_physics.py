@@ -60,19 +60,41 @@ def test_bond_between_coincident_spheres_is_an_input_error(tmp_path, styles):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["scene.txt"]      # not even a work folder
 
 
-def test_non_finite_frame_is_a_run_error_and_keeps_the_old_result(tmp_path):
-    """Two unbonded spheres at one position under stock pair granular: LAMMPS divides by their
-    zero distance and writes nan forces.  Was: exit 0 with nan in the result; now exit 1
-    naming the sphere, the quantity and the time, and the earlier result is untouched."""
+UNBONDED_COINCIDENT = "".join(ln + "\n" for ln in COINCIDENT.splitlines()    # no bond, no wall
+                              if ln.split()[:2] not in (["0", "3"], ["0", "0"])
+                              and ln[:3] not in ("25 ", "26 ", "27 "))
+
+
+def test_unbonded_spheres_at_one_position_are_an_input_error(tmp_path):
+    """Was: exit 0, the two spheres overlapping for ever with no force (musen/hm skips a pair at
+    zero distance), where MUSEN gives nan."""
     scene = tmp_path / "scene.txt"
-    scene.write_text("".join(ln + "\n" for ln in COINCIDENT.splitlines()    # no bond, no wall
-                             if ln.split()[:2] not in (["0", "3"], ["0", "0"]) and ln[:3] not in ("25 ", "26 ", "27 ")))
+    scene.write_text(UNBONDED_COINCIDENT)
+    for command in (["check", scene], ["run", scene, "-o", tmp_path / "result.txt", *SHORT]):
+        res = cli(command, tmp_path)
+        assert res.returncode == 2, res.stderr
+        assert f"error: {scene}: spheres 1 and 2 are at the same position (0, 0, 0.01)" \
+            in res.stderr and "Traceback" not in res.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["scene.txt"]
+
+
+def test_non_finite_frame_is_a_run_error_and_keeps_the_old_result(tmp_path, monkeypatch):
+    """Two unbonded spheres at one position (let through here: the input check refuses them)
+    under stock pair granular: LAMMPS divides by their zero distance and writes nan forces.
+    Was: exit 0 with nan in the result; now a RunError naming the sphere, the quantity and the
+    time, and the earlier result is untouched."""
+    import fibrelmp
+    from fibrelmp.translate.granular import spheres
+
+    monkeypatch.setattr(spheres, "check_distinct_positions", lambda model: None)
+    scene = tmp_path / "scene.txt"
+    scene.write_text(UNBONDED_COINCIDENT)
     result = tmp_path / "result.txt"
     result.write_text("an earlier result\n")
-    res = cli(["-q", "run", scene, "-o", result, *SHORT, "--stock-styles", "--force"], tmp_path)
-    assert res.returncode == 1, res.stderr
-    assert "the simulation produced nan in the force of sphere 1 at t = 0 (step 0)" in res.stderr
-    assert "Traceback" not in res.stderr
+    with pytest.raises(RunError, match=r"the simulation produced nan in the force of sphere 1 at "
+                       r"t = 0 \(step 0\)"):
+        fibrelmp.run(scene, result, force=True, stock_styles=True, end_time=1e-5, step=1e-7,
+                     save_step=1e-6)
     assert result.read_text() == "an earlier result\n"
     assert not [p.name for p in tmp_path.iterdir() if ".tmp" in p.name]
 

@@ -136,10 +136,21 @@ def snapshot(result: str | Path, out: str | Path | None = None, *, frame: int | 
     src = open_source(located)
     total = src.count()
     scene = src.frame(frame)
+    _check_finite(located.path, scene)
     fig, drawn = draw_frame(scene, width, height, _title(located.path, scene, total, src.time_unit))
     _save(fig, target, force)
     return Snapshot(target, scene.index, total, scene.time, drawn.positions, drawn.sizes,
                     drawn.bonds, drawn.triangles, (width, height), src.notes + drawn.notes)
+
+
+def _check_finite(path: Path, scene) -> None:
+    """A frame with nan/inf positions (a run that blew up) has no picture: an input error that
+    says which frame and how many particles, not matplotlib's ValueError."""
+    bad = ~np.isfinite(np.asarray(scene.position, float)).all(axis=1)
+    if bad.any():
+        raise InputError(path, None, f"frame {scene.index}: {int(bad.sum())} of {scene.count} "
+                         "particle positions are nan or inf (the run blew up?): nothing to draw; "
+                         "choose an earlier --frame")
 
 
 def _title(path: Path, scene, total: int, unit: str) -> str:

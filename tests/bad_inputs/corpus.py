@@ -15,6 +15,8 @@ table and ``tests/test_bad_inputs_corpus.py`` checks the two agree.
 
 from __future__ import annotations
 
+import dataclasses
+
 import os
 import re
 from contextlib import contextmanager
@@ -54,6 +56,13 @@ def _c(fmt: str, folder: str, rows: list[tuple], ext: str = ".txt") -> list[Case
         out.append(Case(f"{folder}/{name}", fmt, f"{folder}/{name}{ext}", what, accept,
                         "post" if folder == "dump" else "check"))
     return out
+
+
+def _command(cases: list[Case], name: str, command: str) -> list[Case]:
+    """``cases`` with case ``name`` run by ``command``: ``check`` lists every error, and some
+    inputs have two that share one cause (a bond between coincident spheres: the spheres are
+    at one position too), while ``run`` stops at the first."""
+    return [dataclasses.replace(case, command=command) if case.name == name else case for case in cases]
 
 
 FIBRENET = _c("FibreNet input", "fibrenet", [
@@ -102,7 +111,7 @@ FIBRENET_MODEL = _c("FibreNet model", "fibrenet_model", [
     ("duplicate_spring", "two springs between the same beads (FibreNet adds them)", "accept"),
     ("crlf", "Windows line ends (CRLF)", "accept"),
 ])
-MUSEN = _c("MUSEN scene", "musen", [
+MUSEN = _command(_c("MUSEN scene", "musen", [
     ("good", "a valid scene (reference)", "accept"),
     ("unknown_tag", "unknown scene tag 99"),
     ("bad_time_point_tag", "unknown per-time-point tag 19"),
@@ -129,7 +138,7 @@ MUSEN = _c("MUSEN scene", "musen", [
     ("crlf", "Windows line ends (CRLF)", "accept"),
     ("tabs", "tabs between values", "accept"),
     ("bom", "UTF-8 byte-order mark", "accept"),
-])
+]), "musen/coincident_bond", "run")
 MUSEN_SCRIPT = _c("cmusen script", "musen_script", [
     ("good", "a valid job script (reference)", "accept"),
     ("unknown_keyword", "misspelt keyword SIMULATION_STEPP"),

@@ -31,9 +31,11 @@ class SceneInput(InputFormat):
         if settings.steps is not None:
             raise InputError(path, None, "--steps is for DEMDF inputs; a MUSEN scene takes --end-time")
         from fibrelmp.translate.granular.bonds import check_bond_directions
+        from fibrelmp.translate.granular.spheres import check_distinct_positions
 
         model = self.read_scene(path)
-        check_bond_directions(model)          # `check` finds it too, not only `run`
+        check_bond_directions(model)          # `check` finds these too, not only `run`
+        check_distinct_positions(model)       # (a bond's spheres: the bond's line is named)
         return model, bare_scene_settings(model, settings.end_time, settings.step, settings.save_step)
 
     def read_scene(self, path: Path) -> "GranularModel":
@@ -142,8 +144,10 @@ def check_musen_runnable(model: GranularModel) -> None:
         raise InputError(model.source, None, "no saving step: give SAVING_STEP in the job script "
                          "or --save-step")
     from fibrelmp.translate.granular.bonds import check_bond_directions
+    from fibrelmp.translate.granular.spheres import check_distinct_positions
 
     check_bond_directions(model)          # before the outputs are locked (nothing written)
+    check_distinct_positions(model)
 
 
 def bare_scene_settings(model: GranularModel, end_time: float | None, step: float | None,

@@ -90,3 +90,27 @@ def select_spheres(model: GranularModel, run: RunTime, periodic: np.ndarray, dom
         rolling_spring(max(m_min.values()), dt, model.source)
     return SimulatedSpheres(keep, rows, outside_rows, late_rows, deletions, x, crad, smat, mats,
                             type_of_mat, mass, m_min, r_mean, r_min, r_max)
+
+
+def check_distinct_positions(model: GranularModel) -> None:
+    """Refuse two spheres alive at the start at exactly one position: their contact has no
+    normal (MUSEN's law divides by the zero distance and gives nan; LAMMPS's pair styles skip
+    the pair, so the two would overlap for ever with no force)."""
+    sp = model.spheres
+    if sp is None or sp.count < 2:
+        return
+    t = model.plan.t_start
+    rows = np.flatnonzero((sp.active_start <= t) & (sp.active_end > t))
+    if len(rows) < 2:
+        return
+    pos = np.ascontiguousarray(np.asarray(sp.position, float)[rows])
+    order = np.lexsort(pos.T[::-1])
+    same = np.flatnonzero((pos[order[1:]] == pos[order[:-1]]).all(axis=1))
+    if not len(same):
+        return
+    a, b = (int(sp.ids[rows[order[k]]]) for k in (same[0], same[0] + 1))
+    more = f" (and {len(same) - 1} more pair(s))" if len(same) > 1 else ""
+    x = ", ".join(f"{v:.17g}" for v in pos[order[same[0]]])
+    raise InputError(model.source, None, f"spheres {min(a, b)} and {max(a, b)} are at the same "
+                     f"position ({x}){more}: their contact has no direction (MUSEN gives nan, "
+                     "LAMMPS no force); move one sphere")

@@ -296,6 +296,10 @@ FILE_BYTES = 4096
 FASTEST_STEPS_PER_SECOND = 1e6            # LAMMPS's own overhead per step, tiny systems
 FASTEST_PARTICLE_STEPS_PER_SECOND = 1e9   # per MPI rank
 LONGEST_RUN_SECONDS = 30 * 86400
+# a LAMMPS 'run' command sets up again (neighbour lists, forces): 0.44 ms measured for one-step
+# FibreNet relaxation chunks of the example network on this machine; 1e-4 s is optimistic
+FASTEST_RUNS_PER_SECOND = 1e4
+LONG_RUN_SECONDS = 86400                   # beyond: warned (kind 'long run'), still run
 
 
 def _size(n: float) -> str:
@@ -341,12 +345,34 @@ def check_steps(model, where, allow_huge: bool) -> None:
     if steps > MAXBIGINT:
         raise InputError(where, None, f"the run has {steps} time steps; LAMMPS counts at most "
                          f"{MAXBIGINT} (2^63-1)")
-    seconds = steps / FASTEST_STEPS_PER_SECOND
+    seconds = steps / FASTEST_STEPS_PER_SECOND + planned_runs(model) / FASTEST_RUNS_PER_SECOND
     if steps > MOST_STEPS or (seconds > LONGEST_RUN_SECONDS and not allow_huge):
         override = "" if steps > MOST_STEPS else ", or give --yes-i-mean-it"
         raise InputError(where, None, f"the run has {steps} time steps: at least "
                          f"{_duration(seconds)} even at {FASTEST_STEPS_PER_SECOND:.0e} steps/s "
+                         f"and {FASTEST_RUNS_PER_SECOND:.0e} LAMMPS runs (chunks) per second "
                          f"(LAMMPS is slower): run fewer steps{override}")
+
+
+def long_run_check(model) -> None:
+    """Warn (kind 'long run') before a run that takes more than a day even at the optimistic
+    speeds ``check_steps`` refuses beyond a month with."""
+    steps = planned_steps(model)
+    if steps is None or not hasattr(model, "warn"):
+        return
+    runs = planned_runs(model)
+    seconds = steps / FASTEST_STEPS_PER_SECOND + runs / FASTEST_RUNS_PER_SECOND
+    if seconds > LONG_RUN_SECONDS:
+        model.warn("long run", f"the run has {steps} time steps in {runs} LAMMPS runs (chunks): "
+                   f"at least {_duration(seconds)} even at {FASTEST_STEPS_PER_SECOND:.0e} steps/s "
+                   f"and {FASTEST_RUNS_PER_SECOND:.0e} runs/s (the progress line gives the ETA)")
+
+
+def planned_runs(model) -> int:
+    """The separate LAMMPS 'run' commands a FibreNet model's stages make (one per chunk; each
+    sets the system up again: neighbour lists, forces), known before rendering; 0 otherwise."""
+    stages = getattr(getattr(model, "plan", None), "stages", None) or []
+    return int(sum(-(-st.steps // max(st.chunk, 1)) for st in stages if st.steps > 0))
 
 
 def needs_job(model, outputs) -> bool:

@@ -10,6 +10,8 @@ import shutil
 import subprocess
 import sys
 
+import pytest
+
 from fibrelmp.sanity import LONGEST_RUN_SECONDS, run_budget
 
 from .conftest import REPO, copy_example
@@ -101,3 +103,28 @@ def test_the_override_skips_the_estimates_only(tmp_path):
         raise AssertionError("not refused")
     assert LONGEST_RUN_SECONDS == 30 * 86400
     assert shutil.disk_usage(tmp_path).free < 16.7e12        # the refusal above is real
+
+
+def test_one_step_minimisation_chunks_are_warned_or_refused_by_their_run_count(tmp_path):
+    """2e9 minimisation chunks of one step each: every chunk is a LAMMPS 'run' that sets the
+    system up again (0.44 ms measured here), so 2e9 of them take days however few steps they
+    hold.  Was: accepted silently (a progress ETA of 10 days).  Now warned ('long run') above a
+    day at 1e4 runs/s, refused above 30 days unless --yes-i-mean-it."""
+    import fibrelmp
+    from fibrelmp.errors import InputError
+    from fibrelmp.sanity import check_steps, long_run_check, planned_runs
+
+    folder = _fibrenet(tmp_path, minimize_steps="2000000000", minimize_substeps="1",
+                       minimize_reset="yes")
+    model = fibrelmp.read(folder / "input.txt")
+    assert planned_runs(model) == 2_000_000_000 + -(-model.plan.stages[-1].steps // model.plan.stages[-1].chunk)
+    check_steps(model, folder / "input.txt", allow_huge=False)          # 2.3 days: runs
+    long_run_check(model)
+    assert [k for k, _ in model.warnings].count("long run") == 1
+    said = dict(model.warnings)["long run"]
+    assert f"in {planned_runs(model)} LAMMPS runs (chunks): at least 2.34 days" in said
+    folder = _fibrenet(tmp_path / "b", minimize_steps="40000000000", minimize_substeps="1")
+    model = fibrelmp.read(folder / "input.txt")
+    with pytest.raises(InputError, match="46.8 days even at 1e\\+06 steps/s and 1e\\+04 LAMMPS runs"):
+        check_steps(model, folder / "input.txt", allow_huge=False)
+    check_steps(model, folder / "input.txt", allow_huge=True)

@@ -31,7 +31,7 @@ def run(plan: RunPlan, warn: Warn | None = None) -> Outcome:
     from fibrelmp.outputs import finish, locked
     from fibrelmp.runner import mpi_rank_size
     from fibrelmp.sanity import (check_steps, needs_job, rank_check, run_budget,
-                                 time_step_check)
+                                 long_run_check, time_step_check)
 
     rank, size = mpi_rank_size()
     options = plan.options
@@ -66,6 +66,7 @@ def run(plan: RunPlan, warn: Warn | None = None) -> Outcome:
                     continue
                 said = len(step.model.warnings)
                 time_step_check(step.model)     # check's warning, said before the run starts
+                long_run_check(step.model)      # over a day even at optimistic speeds
                 rank_check(step.model, size)    # too many MPI ranks for this system
                 if warn is not None and step.model.warnings[said:]:
                     warn(step.model.warnings[said:])

@@ -355,3 +355,21 @@ def test_demdf_run_plane_wall_contacts_reach_fstat(tmp_path):
     np.testing.assert_allclose(walls[0, 6], 0.5 - 0.45, rtol=1e-9)
     np.testing.assert_allclose(walls[0, 10:13], [0, 0, -1], atol=1e-15)
     np.testing.assert_allclose(walls[0, 8], fz, rtol=1e-9)
+
+
+def test_post_of_a_musen_run_with_triangle_walls_says_they_are_not_in_fstat(tmp_path):
+    """Was: a MUSEN run's triangle walls silently missing from .fstat (fix musen/wall/mesh
+    keeps the force per triangle, not per contact): now a 'no wall contacts' warning."""
+    import shutil
+
+    from fibrelmp import python_api
+
+    scene = tmp_path / "scene.txt"
+    shutil.copyfile(REPO / "examples" / "musen" / "SingelParticle_text.txt", scene)
+    python_api.run(scene, tmp_path / "res.mdem", end_time=2e-5, step=1e-6, save_step=1e-5)
+    work = tmp_path / "res_work"
+    warnings: list[tuple[str, str]] = []
+    post(work / "frames.dump", tmp_path / "m", data=work / "data.lammps", local=work / "contacts.dump",
+         report=warnings.extend)
+    assert [k for k, _ in warnings].count("no wall contacts") == 1, warnings
+    assert (tmp_path / "m.fstat").exists()

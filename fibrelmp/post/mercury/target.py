@@ -51,6 +51,16 @@ class MercuryTarget(DumpTarget):
         self.out = self.adopt(MercuryWriter(self.target, g, fstat=ctx.local is not None or walls, bonds=bonds,
                                             time_step=ctx.facts.time_step if ctx.facts is not None else None,
                                             warn=ctx.warn))
+        facts = ctx.facts
+        if facts is not None and facts.path is not None and not walls:
+            from fibrelmp.translate.granular.mesh import MESH_NAME
+            from fibrelmp.translate.granular_job import TILES_NAME
+
+            work = facts.path.parent
+            if (work / MESH_NAME).exists() or (work / TILES_NAME).exists():
+                ctx.warn("no wall contacts", "the run's MUSEN walls are not in the .fstat: their "
+                         "fix keeps the force on each wall triangle, not each sphere's contact "
+                         "(docs/post.md); sphere-sphere contacts come from --local")
         self.local = iter_frames(ctx.local, ctx.warnings) if ctx.local is not None else None
         self.pending: list[Frame] = []
 

@@ -529,8 +529,8 @@ def _lying_vtu(tmp: Path) -> None:
     (lambda tmp: _edit_dynpt(_bad(tmp, lambda d: None), b"x:266 ", b"x:266000000000000 "),
      "the header says 21 frames of 266000000000000 nodes (67032000000001024 bytes) but the file has"),
     (lambda tmp: (_cube(tmp), (tmp / "cube.vtu").write_bytes(np.random.default_rng(1).bytes(4000)))[0],
-     "cube.vtu: cannot read as a VTK mesh"),
-    (lambda tmp: (_cube(tmp), _lying_vtu(tmp))[0], "cube.vtu: cannot read as a VTK mesh"),
+     "cube.vtu: cannot read as a VTK XML unstructured grid"),
+    (lambda tmp: (_cube(tmp), _lying_vtu(tmp))[0], "cube.vtu: cannot read as a VTK XML unstructured grid"),
 ])
 def test_hostile_mesh_and_path_keys_are_input_errors(tmp_path, make, message):
     """An .elem region tag of 1e23 (was OverflowError), a NUL in motion.file (was ValueError:

@@ -197,7 +197,7 @@ def _vtu_text(tmp: Path, binary: bool) -> str:
 
 
 @pytest.mark.parametrize("make, message", [
-    (lambda tmp: bytes(np.random.default_rng(3).integers(0, 256, 3000, np.uint8)), "cannot read as a VTK mesh"),
+    (lambda tmp: bytes(np.random.default_rng(3).integers(0, 256, 3000, np.uint8)), "cannot read as a VTK XML unstructured grid"),
     (lambda tmp: _vtu_text(tmp, True).replace('NumberOfCells="', 'NumberOfCells="99999').encode(), "cannot read"),
     (lambda tmp: _vtu_text(tmp, False).replace('NumberOfPoints="', 'NumberOfPoints="99999').encode(), "cannot read"),
 ])

@@ -54,8 +54,10 @@ class VtkMeshReader(Reader):
             # the format's own reader: meshio.read() prints a failure and calls sys.exit(1)
             m = (meshio.vtk.read if legacy else meshio.vtu.read)(self.path)
         except (Exception, SystemExit) as exc:      # meshio raises many kinds for bad files
-            raise self.error(None, f"cannot read as a VTK mesh: {type(exc).__name__}"
-                             + (f": {exc}" if str(exc) else "")) from None
+            what = "legacy VTK unstructured grid" if legacy else "VTK XML unstructured grid (.vtu)"
+            raise self.error(None, f"cannot read as a {what}: meshio's {type(exc).__name__}"
+                             + (f": {exc}" if str(exc).strip() else " (the file is not one, is cut "
+                                "short, or its NumberOfPoints/NumberOfCells do not match its data)")) from None
         blocks = []
         tags = m.cell_data.get(TAGS)
         for i, block in enumerate(m.cells):

@@ -372,6 +372,20 @@ def test_musen_results_get_their_usual_suffix(tmp_path, to, out, written):
     assert again.returncode == 2 and f"error: {written}: output exists" in again.stderr
 
 
+@pytest.mark.parametrize("to,out,written", [
+    ("xyz", "m1", ["m1_coord.xyz", "m1_force.xyz", "m1_vel.xyz"]),
+    ("xyz", "m1.xyz", ["m1_coord.xyz", "m1_force.xyz", "m1_vel.xyz"]),
+    ("xyz", "m1_coord.xyz", ["m1_coord.xyz", "m1_force.xyz", "m1_vel.xyz"]),
+    ("res", "m1.res", ["m1_restart.res"]), ("res", "m1_restart.res", ["m1_restart.res"])])
+def test_fibrenet_names_given_with_their_own_suffix_are_the_base(tmp_path, to, out, written):
+    """Was: ``-o m1.xyz`` wrote ``m1.xyz_coord.xyz``."""
+    rows = [r + (0.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.1, 1.0) for r in ROWS]
+    p = write(tmp_path, frame(0, rows, cols=VEL_FORCE, time=0.0) + frame(10, rows, cols=VEL_FORCE, time=0.1))
+    proc = cli(["post", p.name, "--to", to, "-o", out], tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert listing(tmp_path) == sorted(["d.dump", *written])
+
+
 @pytest.mark.parametrize("args,message", [
     (["--to", "pdb", "-o", "x"], "--to 'pdb': unknown format (choose from "),
     (["-o", "x"], "choose an output with --to"),

@@ -178,6 +178,19 @@ class _FibreNetTarget(DumpTarget):
     lookahead = 2                  # the time step comes from the first two frames
     finite_columns = frozenset({"vx", "vy", "vz", "fx", "fy", "fz", *VEL_COLUMNS, *FORCE_COLUMNS})
     restart: ClassVar[bool]
+    own_suffixes: ClassVar[tuple[str, ...]]     # what -o may end with: the base is before it
+
+    def __init__(self, base: str | Path, context=None, *, force: bool = True):
+        super().__init__(self.named(Path(base)), context, force=force)
+
+    @classmethod
+    def named(cls, base: Path) -> Path:
+        """The base of ``-o``: ``out/net`` as given; ``out/net.xyz`` or ``out/net_coord.xyz``
+        mean ``out/net`` too (was: ``out/net.xyz_coord.xyz``)."""
+        for suffix in cls.own_suffixes:
+            if base.name.endswith(suffix) and len(base.name) > len(suffix):
+                return base.with_name(base.name[:-len(suffix)])
+        return base
 
     def fields(self, first: Frame) -> tuple[str, ...]:
         return ()
@@ -206,9 +219,11 @@ class XyzTarget(_FibreNetTarget):
     """``<base>_coord.xyz`` and, when dumped, ``_vel.xyz`` / ``_force.xyz``: every frame."""
 
     restart = False
+    own_suffixes = (*XYZ_SUFFIX.values(), ".xyz")
 
     @classmethod
     def files(cls, base: Path) -> list[Path]:
+        base = cls.named(base)
         return [base.with_name(base.name + s) for s in XYZ_SUFFIX.values()]
 
     def fields(self, first: Frame) -> tuple[str, ...]:
@@ -240,10 +255,11 @@ class RestartTarget(_FibreNetTarget):
 
     restart = True
     last_frame_by_default = True
+    own_suffixes = (RESTART_SUFFIX, ".res")
 
     @classmethod
     def files(cls, base: Path) -> list[Path]:
-        return [base.with_name(base.name + RESTART_SUFFIX)]
+        return [cls.named(base).with_name(cls.named(base).name + RESTART_SUFFIX)]
 
     def start(self, first: list[Frame]) -> None:
         for need, cols in (("velocity", ("vx", "vy", "vz")), ("force", ("fx", "fy", "fz"))):

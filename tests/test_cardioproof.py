@@ -661,3 +661,13 @@ def test_fluid_beyond_a_wall_is_counted_and_warned(tmp_path):
     counter.warn()
     [(kind, text)] = case.warnings
     assert kind == "fluid in wall" and "in 1 of 2 frames (up to 3 per frame, up to 0.30 spacings deep" in text
+
+
+def test_an_output_interval_below_the_time_step_is_warned(tmp_path):
+    """Was: output.interval 1e-9 s (below the time step) saved every step without a word."""
+    path = _cube(tmp_path, output={"interval": 1e-12, "series_interval": 1e-12})
+    result, text = _cli("-v", "check", path)
+    assert result.exit_code == 0, text
+    assert "warning [output interval] (2): " in text
+    assert "output.interval 1e-12 s is below the time step" in text
+    assert "output.series_interval 1e-12 s is below the time step" in text

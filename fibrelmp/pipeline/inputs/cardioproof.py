@@ -19,7 +19,7 @@ if TYPE_CHECKING:
 
 class CaseInput(InputFormat):
     name = "cardioproof"
-    styles = "stock LAMMPS only (packages SPH and EXTRA-FIX)"
+    styles = "stock LAMMPS only (packages SPH and MISC)"
 
     def read(self, path: Path) -> "SphCase":
         from fibrelmp.cardioproof.case import read_case

@@ -457,3 +457,22 @@ def test_the_mdanalysis_view_of_a_dump_bounds_its_lines_too(tmp_path):
     line = len((good + third).splitlines()) + 1
     with pytest.raises(InputError, match=rf"long\.dump:{line}: line longer than 1 MiB"):
         dump_universe(p).trajectory.n_frames
+
+
+def test_data_may_name_the_work_folder(tmp_path):
+    """README: 'a run's frames.dump with --data of its work folder'.  Was: a folder given to
+    --data was refused ('is a directory'); now its data.lammps is read."""
+    work = tmp_path / "w"
+    work.mkdir()
+    (work / "data.lammps").write_text(
+        "LAMMPS data\n\n5 atoms\n2 atom types\n\n0 10 xlo xhi\n0 10 ylo yhi\n0 10 zlo zhi\n\n"
+        "Masses\n\n1 1.5\n2 2.5\n\nAtoms # atomic\n\n"
+        + "".join(f"{i} {1 + i % 2} 0 0 0\n" for i in range(1, 6)))
+    rows = [r + (0.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.1, 1.0) for r in ROWS]
+    p = write(tmp_path, frame(0, rows, cols=VEL_FORCE, time=0.0) + frame(10, rows, cols=VEL_FORCE, time=0.1))
+    by_file = cli(["post", p.name, "--to", "xyz", "-o", "a/n", "--data", "w/data.lammps"], tmp_path)
+    by_folder = cli(["post", p.name, "--to", "xyz", "-o", "b/n", "--data", "w"], tmp_path)
+    assert by_file.returncode == 0 == by_folder.returncode, by_folder.stderr
+    assert listing(tmp_path / "a") == listing(tmp_path / "b")
+    for name in listing(tmp_path / "a"):
+        assert (tmp_path / "a" / name).read_bytes() == (tmp_path / "b" / name).read_bytes()

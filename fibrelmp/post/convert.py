@@ -129,6 +129,8 @@ def _convert(reader, target: DumpTarget, dump: Path, data: Path | None, types: l
     context = target.context
     if data is not None:
         from fibrelmp.post.lammps_data.reader import read_data
+        if data.is_dir() and (data / "data.lammps").is_file():
+            data = data / "data.lammps"           # --data of a fibrelmp work folder: its data file
         context.datafile = read_data(data)
     else:
         from fibrelmp.translate.work_facts import facts_path

@@ -1,0 +1,105 @@
+"""MUSEN physics models as plug-ins: one module per model in this package, registering itself
+by its MUSEN name (``@register``); nothing else lists them.  A model says its kind (PP, PW, SB,
+LB, EF), its parameters with MUSEN's names and defaults, whether it needs fibrelmp's own LAMMPS
+styles, checks its parameters (``path:line`` errors) and applies them to a ``GranularPlan``.
+``find``/``of_kind`` import every module of the package on first use (docs/architecture.md,
+"Adding a physics model")."""
+
+from __future__ import annotations
+
+import importlib
+import pkgutil
+from pathlib import Path
+from typing import ClassVar
+
+from fibrelmp.errors import InputError
+from fibrelmp.granmodel import GranularModel, GranularPlan
+
+KIND_WORDS = {"PP": "particle-particle", "PW": "particle-wall", "SB": "solid-bond",
+              "LB": "liquid-bond", "EF": "external-force"}
+
+_REGISTRY: dict[str, type[PhysicsModel]] = {}
+_loaded = False
+
+
+class PhysicsModel:
+    """One MUSEN model fibrelmp translates.  Subclasses set the class attributes and, where the
+    model changes the run, override ``apply``."""
+
+    name: ClassVar[str]                        # MUSEN's name, e.g. "ModelPPHertzMindlin"
+    kind: ClassVar[str]                        # "PP" | "PW" | "SB" | "LB" | "EF"
+    mdem_key: ClassVar[str] = ""               # MUSEN's unique key (a .mdem's model manager)
+    parameters: ClassVar[dict[str, float]] = {}   # MUSEN's AddParameter(...) names and defaults
+    # why the model needs fibrelmp's LAMMPS styles (None: stock LAMMPS expresses it)
+    needs_styles: ClassVar[str | None] = None
+    # the only model of its kind fibrelmp translates with stock LAMMPS (bare scenes use it)
+    default: ClassVar[bool] = False
+
+    @classmethod
+    def read_parameters(cls, text: str, path: Path | str | None, line: int | None,
+                        model: GranularModel) -> dict[str, float]:
+        """MUSEN's defaults updated by ``NAME value`` pairs of ``text`` (a MODEL_*_PARAMS line
+        or a .mdem's stored parameters); an unknown name is ignored with a warning, as MUSEN
+        does; a value that is not a number is an InputError at ``path``:``line``."""
+        params = dict(cls.parameters)
+        tok = text.split()
+        for j in range(0, len(tok), 2):
+            key = tok[j]
+            if key not in params:
+                at = f"{path}:{line}" if line is not None else f"{path} (its model manager)"
+                model.warn("musen-unknown-model-parameter", f"{at}: {cls.name} has no parameter "
+                           f"{key}; ignored as MUSEN does")
+                continue
+            try:
+                params[key] = float(tok[j + 1])
+            except (IndexError, ValueError):
+                raise InputError(path, line, f"{cls.name} parameter {key}: expected "
+                                 "a number") from None
+        return params
+
+    @classmethod
+    def apply(cls, plan: GranularPlan, params: dict[str, float], path: Path | str | None,
+              line: int | None) -> None:
+        """Check ``params`` and set what the model changes in ``plan`` (nothing by default)."""
+
+
+def register(model: type[PhysicsModel]) -> type[PhysicsModel]:
+    """Class decorator: add ``model`` to the registry under its MUSEN name."""
+    if model.kind not in KIND_WORDS:
+        raise ValueError(f"{model.__name__}: kind {model.kind!r} is not one of {list(KIND_WORDS)}")
+    if model.name in _REGISTRY and _REGISTRY[model.name] is not model:
+        raise ValueError(f"two modules register the MUSEN model {model.name}")
+    _REGISTRY[model.name] = model
+    return model
+
+
+def _load() -> None:
+    global _loaded
+    if not _loaded:
+        for info in pkgutil.iter_modules(__path__):
+            importlib.import_module(f"{__name__}.{info.name}")
+        _loaded = True
+
+
+def find(name: str) -> type[PhysicsModel] | None:
+    """The registered model called ``name`` (MUSEN's name), or None."""
+    _load()
+    return _REGISTRY.get(name)
+
+
+def of_kind(kind: str) -> list[type[PhysicsModel]]:
+    """The registered models of ``kind``: the stock default first, then by name."""
+    _load()
+    return sorted((m for m in _REGISTRY.values() if m.kind == kind),
+                  key=lambda m: (not m.default, m.needs_styles is not None, m.name))
+
+
+def default_model(kind: str) -> type[PhysicsModel] | None:
+    """The model fibrelmp uses for ``kind`` when a scene names none (MUSEN's for a bare scene)."""
+    return next((m for m in of_kind(kind) if m.default), None)
+
+
+def mdem_key(name: str) -> str:
+    """MUSEN's key of the model called ``name`` ("" for a model fibrelmp does not translate)."""
+    model = find(name)
+    return model.mdem_key if model is not None else ""

@@ -34,6 +34,8 @@ class PhysicsModel:
     needs_styles: ClassVar[str | None] = None
     # the only model of its kind fibrelmp translates with stock LAMMPS (bare scenes use it)
     default: ClassVar[bool] = False
+    # SB models: their GranularPlan.bond_model (what granular.bonds renders)
+    plan_bond_model: ClassVar[str | None] = None
 
     @classmethod
     def read_parameters(cls, text: str, path: Path | str | None, line: int | None,
@@ -56,6 +58,19 @@ class PhysicsModel:
                 raise InputError(path, line, f"{cls.name} parameter {key}: expected "
                                  "a number") from None
         return params
+
+    @classmethod
+    def pair_style_lines(cls, params: dict[str, float], own_styles: bool) -> list[str]:
+        """PP models: the ``pair_style`` line (and its comment) of the LAMMPS script;
+        ``own_styles``: fibrelmp's LAMMPS styles are in use.  Every pair_coeff line gives
+        E* G* e mu mu_r (musen styles) or the stock granular law (``granular.contacts``)."""
+        raise NotImplementedError(f"{cls.name} is not a particle-particle model")
+
+    @classmethod
+    def bond_law(cls, plan: GranularPlan) -> tuple[str, str]:
+        """SB models with fibrelmp's ``bond_style musen/elastic``: (the law's name in the
+        script's comment, the style's law arguments)."""
+        raise NotImplementedError(f"{cls.name} is not a solid-bond model of musen/elastic")
 
     @classmethod
     def apply(cls, plan: GranularPlan, params: dict[str, float], path: Path | str | None,
@@ -97,6 +112,21 @@ def of_kind(kind: str) -> list[type[PhysicsModel]]:
 def default_model(kind: str) -> type[PhysicsModel] | None:
     """The model fibrelmp uses for ``kind`` when a scene names none (MUSEN's for a bare scene)."""
     return next((m for m in of_kind(kind) if m.default), None)
+
+
+def chosen(model: GranularModel, kind: str) -> tuple[type[PhysicsModel], dict[str, float]]:
+    """The model of ``kind`` a scene runs and its parameters: the one its settings chose
+    (``script_settings``), else the stock default with MUSEN's defaults (a DEMDF scene)."""
+    picked = model.passthrough.get("musen_models", {}).get(kind)
+    if picked is not None:
+        return find(picked[0]), picked[1]
+    stock = default_model(kind)
+    return stock, dict(stock.parameters)
+
+
+def solid_bond_model(plan: GranularPlan) -> type[PhysicsModel]:
+    """The SB model of ``plan.bond_model``."""
+    return next(m for m in of_kind("SB") if m.plan_bond_model == plan.bond_model)
 
 
 def mdem_key(name: str) -> str:

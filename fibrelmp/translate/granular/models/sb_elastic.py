@@ -23,6 +23,7 @@ def apply_breakage(plan: GranularPlan, params: dict[str, float], path: Path | st
 class SBElastic(PhysicsModel):
     name = "ModelSBElastic"
     kind = "SB"
+    plan_bond_model = "elastic"
     mdem_key = "4CE31CB89C784476AC1971DFC5C39C10"
     parameters = {"CONSIDER_BREAKAGE": 1.0}
     default = True
@@ -31,4 +32,8 @@ class SBElastic(PhysicsModel):
     def apply(cls, plan: GranularPlan, params: dict[str, float], path: Path | str | None,
               line: int | None) -> None:
         apply_breakage(plan, params, path, line)
-        plan.bond_model = "elastic"
+        plan.bond_model = cls.plan_bond_model
+
+    @classmethod
+    def bond_law(cls, plan: GranularPlan) -> tuple[str, str]:
+        return "elastic", f"breakage {int(plan.bond_breakage)}"

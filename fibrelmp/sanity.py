@@ -109,7 +109,7 @@ def granular_extent(model: GranularModel) -> np.ndarray:
 
 
 def granular_contact_time(model: GranularModel) -> tuple[float, str] | None:
-    """The shortest Hertz contact duration of the contacts the input can have, at the fastest
+    """The shortest contact duration (Hertz's, or the PP model's ``plan.pp_contact_time``) of the contacts the input can have, at the fastest
     approach: for each material pair with a contact law, the smallest spheres of each
     (m* = m1 m2 / (m1 + m2), R* = r1 r2 / (r1 + r2); a sphere-sphere pair of one material
     needs two spheres of it) approaching at the sum of the two fastest speed bounds, and
@@ -130,7 +130,8 @@ def granular_contact_time(model: GranularModel) -> tuple[float, str] | None:
         # the contact time grows as (m^2 / r)^(1/5): the smallest sphere of a material
         k = rows[int(np.argmin(s.mass[rows] ** 2 / s.contact_radius[rows]))]
         smallest[mat] = (float(s.mass[k]), float(s.contact_radius[k]), bounds[rows])
-    partners = []                      # (m*, R*, E*, approach speed, name)
+    partners = []                      # (m*, R*, E*, approach speed, name, duration law)
+    pp_time = model.plan.pp_contact_time or hertz_contact_time
     for (a, b), law in model.contacts.items():
         if not law.youngs_eff > 0:
             continue
@@ -138,15 +139,15 @@ def granular_contact_time(model: GranularModel) -> tuple[float, str] | None:
         if a in smallest and b in smallest:
             (ma, ra, va), (mb, rb, vb) = smallest[a], smallest[b]
             partners.append((ma * mb / (ma + mb), ra * rb / (ra + rb), law.youngs_eff,
-                             pair_speed(va, va if a == b else vb), name))
+                             pair_speed(va, va if a == b else vb), name, pp_time))
         for sphere, wall in ((a, b), (b, a)):
             if sphere in smallest and wall in walls:
                 m, r, v = smallest[sphere]
-                partners.append((m, r, law.youngs_eff, pair_speed(v, None), name))
+                partners.append((m, r, law.youngs_eff, pair_speed(v, None), name, hertz_contact_time))
     possible = [p for p in partners if p[3] > 0] or [p[:3] + (1.0,) + p[4:] for p in partners]
     best = None
-    for m_eff, r_eff, e_star, speed, name in possible:
-        tc = hertz_contact_time(m_eff, r_eff, e_star, speed)
+    for m_eff, r_eff, e_star, speed, name, contact_time in possible:
+        tc = contact_time(m_eff, r_eff, e_star, speed)
         if best is None or tc < best[0]:
             best = (tc, name)
     return best

@@ -168,6 +168,7 @@ class GranularPlan:
     # the particle-particle law's contact duration (m*, R*, E*, approach speed) when it is not
     # Hertz's (set by its model in translate/granular/models; None: Hertz)
     pp_contact_time: Callable[[float, float, float, float], float] | None = None
+    pp_contact_law: str = "Hertz"           # its name in check's contact-time line
     dimension: int = 3
 
 

@@ -169,6 +169,8 @@ class GranularPlan:
     # Hertz's (set by its model in translate/granular/models; None: Hertz)
     pp_contact_time: Callable[[float, float, float, float], float] | None = None
     pp_contact_law: str = "Hertz"           # its name in check's contact-time line
+    pw_contact_time: Callable[[float, float, float, float], float] | None = None   # the same for
+    pw_contact_law: str = "Hertz"                                                 # sphere-wall
     dimension: int = 3
 
 

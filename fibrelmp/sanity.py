@@ -109,7 +109,8 @@ def granular_extent(model: GranularModel) -> np.ndarray:
 
 
 def granular_contact_time(model: GranularModel) -> tuple[float, str, str] | None:
-    """The shortest contact duration (Hertz's, or the PP model's ``plan.pp_contact_time``) of the contacts the input can have, at the fastest
+    """The shortest contact duration (Hertz's, or the PP / PW model's ``plan.pp_contact_time``,
+    ``plan.pw_contact_time``) of the contacts the input can have, at the fastest
     approach: for each material pair with a contact law, the smallest spheres of each
     (m* = m1 m2 / (m1 + m2), R* = r1 r2 / (r1 + r2); a sphere-sphere pair of one material
     needs two spheres of it) approaching at the sum of the two fastest speed bounds, and
@@ -133,6 +134,8 @@ def granular_contact_time(model: GranularModel) -> tuple[float, str, str] | None
     partners = []                      # (m*, R*, E*, approach speed, name, duration law)
     pp_time = model.plan.pp_contact_time or hertz_contact_time
     pp_law = model.plan.pp_contact_law if model.plan.pp_contact_time else "Hertz"
+    pw_time = model.plan.pw_contact_time or hertz_contact_time
+    pw_law = model.plan.pw_contact_law if model.plan.pw_contact_time else "Hertz"
     for (a, b), law in model.contacts.items():
         if not law.youngs_eff > 0:
             continue
@@ -144,8 +147,7 @@ def granular_contact_time(model: GranularModel) -> tuple[float, str, str] | None
         for sphere, wall in ((a, b), (b, a)):
             if sphere in smallest and wall in walls:
                 m, r, v = smallest[sphere]
-                partners.append((m, r, law.youngs_eff, pair_speed(v, None), name, hertz_contact_time,
-                                 "Hertz"))
+                partners.append((m, r, law.youngs_eff, pair_speed(v, None), name, pw_time, pw_law))
     possible = [p for p in partners if p[3] > 0] or [p[:3] + (1.0,) + p[4:] for p in partners]
     best = None
     for m_eff, r_eff, e_star, speed, name, contact_time, law in possible:

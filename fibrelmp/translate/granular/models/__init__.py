@@ -67,6 +67,12 @@ class PhysicsModel:
         raise NotImplementedError(f"{cls.name} is not a particle-particle model")
 
     @classmethod
+    def mesh_law_args(cls, params: dict[str, float]) -> str:
+        """PW models: what follows the file name of ``fix musen/wall/mesh`` ("" for its
+        default law, hertz/mindlin; else " law NAME parameters", musen_pw_law.h)."""
+        raise NotImplementedError(f"{cls.name} is not a particle-wall model")
+
+    @classmethod
     def bond_law(cls, plan: GranularPlan) -> tuple[str, str]:
         """SB models with fibrelmp's ``bond_style musen/elastic``: (the law's name in the
         script's comment, the style's law arguments)."""

@@ -11,3 +11,7 @@ class PWHertzMindlin(PhysicsModel):
     kind = "PW"
     mdem_key = "906949ACFFAE4B8C8B1B65509930EA6D"
     default = True
+
+    @classmethod
+    def mesh_law_args(cls, params: dict[str, float]) -> str:
+        return ""                   # the fix's default law

@@ -89,3 +89,13 @@ def test_reference_is_cmusens_output(tmp_path):
     assert done.returncode == 0 and "Error:" not in done.stdout, done.stdout + done.stderr
     assert (tmp_path / "le_result_prec17.txt").read_bytes() == \
         (DATA / "cmusen_le_result_prec17.txt").read_bytes()
+
+
+def test_refused_without_fibrelmps_styles(tmp_path):
+    """Stock LAMMPS has no such law: an InputError at the model line, nothing written."""
+    job = _job(tmp_path)
+    with lammps_styles.stock(True), pytest.raises(InputError, match="ModelPPLinearElastic needs "
+                                                  "fibrelmp's LAMMPS styles") as err:
+        python_api.run(job)
+    assert str(err.value).startswith(f"{job}:10: ")
+    assert not (tmp_path / "le_init.mdem").exists()

@@ -63,7 +63,7 @@ def _model_choice(model: GranularModel, spec, path, line: int | None) -> tuple[s
             raise InputError(path, line, f"{where}{spec.name} needs fibrelmp's LAMMPS styles "
                              f"({found.needs_styles}), which are not available here "
                              f"({styles.how}); stock LAMMPS has no such "
-                             f"{physics.KIND_WORDS[kind].replace('-', ' ')}"
+                             f"{physics.KIND_NOUNS[kind]}"
                              + (f", so fibrelmp translates {stock.name} only without them"
                                 if stock is not None else ""))
     elif found is None:

@@ -17,6 +17,9 @@ from fibrelmp.granmodel import GranularModel, GranularPlan
 
 KIND_WORDS = {"PP": "particle-particle", "PW": "particle-wall", "SB": "solid-bond",
               "LB": "liquid-bond", "EF": "external-force"}
+# what a model of each kind is, in messages ("stock LAMMPS has no such ...")
+KIND_NOUNS = {"PP": "particle-particle law", "PW": "particle-wall law", "SB": "solid bond",
+              "LB": "liquid bond", "EF": "external force"}
 
 _REGISTRY: dict[str, type[PhysicsModel]] = {}
 _loaded = False

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -165,6 +165,12 @@ class GranularPlan:
     bond_model: str = "elastic"             # MUSEN solid bond: "elastic" (ModelSBElastic), "kelvin"
     bond_max_damp_ratio: float = 1.0        # ModelSBKelvin MAX_DAMP_RATIO (0: no cap)
     contacts_between_bonded: bool = True    # MUSEN default
+    # the particle-particle law's contact duration (m*, R*, E*, approach speed) when it is not
+    # Hertz's (set by its model in translate/granular/models; None: Hertz)
+    pp_contact_time: Callable[[float, float, float, float], float] | None = None
+    pp_contact_law: str = "Hertz"           # its name in check's contact-time line
+    pw_contact_time: Callable[[float, float, float, float], float] | None = None   # the same for
+    pw_contact_law: str = "Hertz"                                                 # sphere-wall
     dimension: int = 3
 
 

@@ -108,14 +108,15 @@ def granular_extent(model: GranularModel) -> np.ndarray:
     return points.max(axis=0) - points.min(axis=0) + 2 * float(s.contact_radius.max(initial=0))
 
 
-def granular_contact_time(model: GranularModel) -> tuple[float, str] | None:
-    """The shortest Hertz contact duration of the contacts the input can have, at the fastest
+def granular_contact_time(model: GranularModel) -> tuple[float, str, str] | None:
+    """The shortest contact duration (Hertz's, or the PP / PW model's ``plan.pp_contact_time``,
+    ``plan.pw_contact_time``) of the contacts the input can have, at the fastest
     approach: for each material pair with a contact law, the smallest spheres of each
     (m* = m1 m2 / (m1 + m2), R* = r1 r2 / (r1 + r2); a sphere-sphere pair of one material
     needs two spheres of it) approaching at the sum of the two fastest speed bounds, and
     for a wall material, the smallest sphere (m* = m, R* = r) at its material's fastest
     bound (``speed_bounds``).  Where nothing can move (no speed, no gravity), at an
-    approach speed of 1.  (time, "material-material"); None when there are no spheres.
+    approach speed of 1.  (time, "material-material", law); None when there are no spheres.
     DEMDF's reader sizes its contact stiffness and time step by this same figure."""
     s = model.spheres
     if s.count == 0:
@@ -130,7 +131,11 @@ def granular_contact_time(model: GranularModel) -> tuple[float, str] | None:
         # the contact time grows as (m^2 / r)^(1/5): the smallest sphere of a material
         k = rows[int(np.argmin(s.mass[rows] ** 2 / s.contact_radius[rows]))]
         smallest[mat] = (float(s.mass[k]), float(s.contact_radius[k]), bounds[rows])
-    partners = []                      # (m*, R*, E*, approach speed, name)
+    partners = []                      # (m*, R*, E*, approach speed, name, duration law)
+    pp_time = model.plan.pp_contact_time or hertz_contact_time
+    pp_law = model.plan.pp_contact_law if model.plan.pp_contact_time else "Hertz"
+    pw_time = model.plan.pw_contact_time or hertz_contact_time
+    pw_law = model.plan.pw_contact_law if model.plan.pw_contact_time else "Hertz"
     for (a, b), law in model.contacts.items():
         if not law.youngs_eff > 0:
             continue
@@ -138,17 +143,17 @@ def granular_contact_time(model: GranularModel) -> tuple[float, str] | None:
         if a in smallest and b in smallest:
             (ma, ra, va), (mb, rb, vb) = smallest[a], smallest[b]
             partners.append((ma * mb / (ma + mb), ra * rb / (ra + rb), law.youngs_eff,
-                             pair_speed(va, va if a == b else vb), name))
+                             pair_speed(va, va if a == b else vb), name, pp_time, pp_law))
         for sphere, wall in ((a, b), (b, a)):
             if sphere in smallest and wall in walls:
                 m, r, v = smallest[sphere]
-                partners.append((m, r, law.youngs_eff, pair_speed(v, None), name))
+                partners.append((m, r, law.youngs_eff, pair_speed(v, None), name, pw_time, pw_law))
     possible = [p for p in partners if p[3] > 0] or [p[:3] + (1.0,) + p[4:] for p in partners]
     best = None
-    for m_eff, r_eff, e_star, speed, name in possible:
-        tc = hertz_contact_time(m_eff, r_eff, e_star, speed)
+    for m_eff, r_eff, e_star, speed, name, contact_time, law in possible:
+        tc = contact_time(m_eff, r_eff, e_star, speed)
         if best is None or tc < best[0]:
-            best = (tc, name)
+            best = (tc, name, law)
     return best
 
 
@@ -196,10 +201,10 @@ def contact_check(model: GranularModel) -> list[str]:
     with np.errstate(all="ignore"):
         tc = granular_contact_time(model)
     if tc is not None and math.isfinite(plan.dt) and plan.dt > 0 and math.isfinite(tc[0]):
-        lines.append(f"contact time {tc[0]:.3g} (Hertz, {tc[1]}, fastest approach in the input) "
+        lines.append(f"contact time {tc[0]:.3g} ({tc[2]}, {tc[1]}, fastest approach in the input) "
                      f"= {tc[0] / plan.dt:.1f} time steps")
         if plan.dt > STEP_FRACTION * tc[0]:
-            model.warn("time step", f"the time step {plan.dt:g} exceeds 1/10 of the Hertz "
+            model.warn("time step", f"the time step {plan.dt:g} exceeds 1/10 of the {tc[2]} "
                        f"contact time {tc[0]:.3g}: contacts will be poorly resolved")
     return lines
 
@@ -247,7 +252,7 @@ def time_step_scale(model: Model | GranularModel) -> dict | None:
         if found is None or not math.isfinite(found[0]):
             return None
         return {"name": "contact time", "value": found[0],
-                "where": f"Hertz, {found[1]}, fastest approach in the input"}
+                "where": f"{found[2]}, {found[1]}, fastest approach in the input"}
     found = spring_period(model)
     if found is None:
         return None

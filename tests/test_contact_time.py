@@ -51,7 +51,8 @@ def test_musen_example_contact_time_is_the_sphere_on_plate_impact():
 
     model = read(EXAMPLES / "musen" / "SingelParticle_text.txt")
     model.plan.gravity[:] = (0.0, 0.0, -9.81)              # the job's EXT_ACCEL
-    assert sanity.granular_contact_time(model) == (pytest.approx(expected, rel=1e-9), "Steel-Glass")
+    assert sanity.granular_contact_time(model) == (pytest.approx(expected, rel=1e-9), "Steel-Glass",
+                                                   "Hertz")
     readme = (EXAMPLES / "musen" / "README.md").read_text()
     assert f"{expected * 1e6:.2f} µs" in readme and "3.6 µs" not in readme
 

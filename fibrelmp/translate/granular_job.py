@@ -31,6 +31,7 @@ from fibrelmp.translate.granular.reach import Travel, speed_bound
 from fibrelmp.translate.granular.schedule import compress_ids, run_time, save_steps, schedule
 from fibrelmp.translate.granular.spheres import select_spheres
 from fibrelmp.translate.granular.tiles import TILE_MASS_FACTOR, place_tiles, tile_estimate, tile_types
+from fibrelmp.translate.granular import models as physics
 from fibrelmp.translate.granular.mesh import MESH_FIX, MESH_FORCES_NAME, MESH_NAME, mesh_rows, write_mesh
 from fibrelmp.translate.granular.walls import (WallPlan, describe_walls, plan_walls, wall_commands,
                                                wall_warnings)
@@ -168,6 +169,8 @@ def build_granular_job(model: GranularModel, folder: str | Path):
     # style, which is exact for it
     musen_hm = styles.available and model.kind == "musen"
     pair_lines = pair_coeff_lines(model, spheres, tiles.materials, tiles.radius, dt, musen_hm)
+    pp_model, pp_params = physics.chosen(model, "PP")
+    sb_model = physics.solid_bond_model(plan)
     wall_cmds, var_cmds, frame_columns = wall_commands(model, wall_plans, spheres, dt)
     wall_cmds = box_cmds + wall_cmds
 
@@ -212,8 +215,9 @@ def build_granular_job(model: GranularModel, folder: str | Path):
         overlay=bool(plan.contacts_between_bonded), breakage=breakage, bond_types=bonds.types,
         musen_bonds=geometry is not None, bond_geometry=geometry, bond_partners=PARTNERS,
         bond_values=VALUES, geometry_fix=GEOMETRY_FIX, geometry_name=GEOMETRY_NAME,
-        bond_criterion=int(plan.bond_breakage), bond_model=plan.bond_model,
-        bond_max_damp_ratio=plan.bond_max_damp_ratio,
+        bond_criterion=int(plan.bond_breakage),
+        bond_law=sb_model.bond_law(plan) if geometry is not None else None,
+        pair_style_lines=pp_model.pair_style_lines(pp_params, musen_hm),
         sphere_types=[spheres.type_of_mat[m] for m in mats],
         sphere_type_names=[model.materials[m].name for m in mats],
         tile_types=[tiles.type_of_mat[m] for m in tile_mats],

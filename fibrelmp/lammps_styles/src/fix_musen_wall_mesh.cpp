@@ -35,7 +35,6 @@ using namespace FixConst;
 namespace {
 
 constexpr double MUSEN_PI = 3.14159265358979323846;            // MUSENDefinitions.h PI
-constexpr double TWO_SQRT_5_6 = 1.825741858350553711523232609336;    // _2_SQRT_5_6
 constexpr double MIN_SIGNIFICANT = 1e-100;     // Vector3.h MinValueHelper<double>
 constexpr int NSHIFT = 27;
 constexpr int GRID_CELL_CAP_MIN = 4096;
@@ -76,11 +75,6 @@ inline double sqlen(const double *a)
 inline bool is_zero(const double *a)
 {
   return a[0] == 0 && a[1] == 0 && a[2] == 0;
-}
-inline bool is_significant(const double *a)
-{
-  return std::fabs(a[0]) > MIN_SIGNIFICANT || std::fabs(a[1]) > MIN_SIGNIFICANT ||
-      std::fabs(a[2]) > MIN_SIGNIFICANT;
 }
 
 /* The contact of a sphere (centre p, radius r) with a triangle v (3 vertices, 9 values) of
@@ -245,8 +239,17 @@ FixMusenWallMesh::FixMusenWallMesh(LAMMPS *lmp, int narg, char **arg) :
     placed(false), reduced_step(-1), reduced_valid(false), history(nullptr), grid_valid(false),
     grid_cell(0.0), grid_rmax(0.0), grid_margin(0.0)
 {
-  if (narg != 4) error->all(FLERR, "Illegal fix musen/wall/mesh command: fix ID group musen/wall/mesh FILE");
+  const char *usage = "fix ID group musen/wall/mesh FILE [law NAME [parameters]]";
+  if (narg < 4 || narg == 5 || (narg > 5 && strcmp(arg[4], "law") != 0))
+    error->all(FLERR, "Illegal fix musen/wall/mesh command: {}", usage);
   file = arg[3];
+  // the particle-wall law (MUSEN's ModelPWHertzMindlin unless named)
+  const std::string law_name = narg > 5 ? arg[5] : "hertz/mindlin";
+  std::vector<double> law_params;
+  for (int a = 6; a < narg; a++) law_params.push_back(utils::numeric(FLERR, arg[a], false, lmp));
+  std::string why;
+  pw_law = musen_pw::create(law_name, law_params, why);
+  if (!pw_law) error->all(FLERR, "Fix musen/wall/mesh: {}", why);
   if (domain->dimension != 3) error->all(FLERR, "Fix musen/wall/mesh needs a 3d simulation");
   if (domain->triclinic) error->all(FLERR, "Fix musen/wall/mesh needs an orthogonal box");
   read_file();
@@ -922,8 +925,9 @@ void FixMusenWallMesh::post_force(int /*vflag*/)
   }
 }
 
-/* MUSEN's CModelPWHertzMindlin::CalculatePW for sphere i and one contact: force fo and
-   torque to on the sphere; hist: the contact's tangential overlap, updated. */
+/* MUSEN's CalculatePW for sphere i and one contact, up to the law (musen_pw_law.h): the
+   contact's geometry and relative velocity; the chosen law gives force fo and torque to on
+   the sphere and updates hist, the contact's history (tangential overlap). */
 void FixMusenWallMesh::wall_force(int i, const Candidate &cd, double *hist, double dt, double *fo,
                                   double *to)
 {
@@ -971,58 +975,17 @@ void FixMusenWallMesh::wall_force(int i, const Candidate &cd, double *hist, doub
     for (int k = 0; k < 3; k++) arm[k] = cp[k] - G.rotcentre[k];
     cross(arm, G.rotvel, rot_vel);
   }
-  double spin[3];
-  cross(rc_n, w_p, spin);
-  double rel[3];
-  for (int k = 0; k < 3; k++) rel[k] = atom->v[i][k] - G.vel[k] + rot_vel[k] + spin[k] * R;
-  const double vn = dot(n, rel);
-  double vt[3];
-  for (int k = 0; k < 3; k++) vt[k] = rel[k] - vn * n[k];
-
-  const double a = std::sqrt(R * overlap);
-  const double kn = 2 * L.estar * a;
-  const double fn_el = 2. / 3. * overlap * kn * std::fabs(dot(rc_n, n));
-  const double fn_damp = TWO_SQRT_5_6 * L.alpha * vn * std::sqrt(kn * m);
-  double fn[3];
-  for (int k = 0; k < 3; k++) fn[k] = n[k] * (fn_el + fn_damp);
-
-  // old overlap turned into the tangent plane, its length kept
-  double xi_rot[3];
-  const double on = dot(n, hist);
-  for (int k = 0; k < 3; k++) xi_rot[k] = hist[k] - n[k] * on;
-  if (is_significant(xi_rot)) {
-    const double scale = std::sqrt(sqlen(hist)) / std::sqrt(sqlen(xi_rot));
-    for (int k = 0; k < 3; k++) xi_rot[k] *= scale;
-  }
-  double xi_new[3];
-  for (int k = 0; k < 3; k++) xi_new[k] = xi_rot[k] + vt[k] * dt;
-
-  const double kt = 8 * L.gstar * a;
-  double ft_shear[3], ft_damp[3], ft[3];
-  for (int k = 0; k < 3; k++) ft_shear[k] = xi_new[k] * -kt;
-  const double damp_t = TWO_SQRT_5_6 * L.alpha * std::sqrt(kt * m);
-  for (int k = 0; k < 3; k++) ft_damp[k] = vt[k] * damp_t;
-  const double shear_len = std::sqrt(sqlen(ft_shear));
-  const double friction = L.mu * std::fabs(fn_el + fn_damp);
-  if (shear_len > friction) {
-    for (int k = 0; k < 3; k++) ft[k] = ft_shear[k] * friction / shear_len;
-    for (int k = 0; k < 3; k++) xi_new[k] = ft[k] / -kt;
-  } else {
-    for (int k = 0; k < 3; k++) ft[k] = ft_shear[k] + ft_damp[k];
-  }
-
-  double roll[3] = {0, 0, 0};
-  if (is_significant(w_p)) {
-    const double s = -L.mur * std::fabs(fn_el) * R / std::sqrt(sqlen(w_p));
-    for (int k = 0; k < 3; k++) roll[k] = w_p[k] * s;
-  }
-  double nxft[3];
-  cross(n, ft, nxft);
-  for (int k = 0; k < 3; k++) {
-    fo[k] = fn[k] + ft[k];
-    to[k] = nxft[k] * -R + roll[k];
-    hist[k] = xi_new[k];
-  }
+  musen_pw::Contact c;
+  c.radius = R;
+  c.mass = m;
+  c.overlap = overlap;
+  c.normal = n;
+  c.rc_n = rc_n;
+  c.omega = w_p;
+  for (int k = 0; k < 3; k++) c.vel[k] = atom->v[i][k] - G.vel[k] + rot_vel[k];
+  c.dt = dt;
+  const musen_pw::Materials mats{L.estar, L.gstar, L.alpha, L.mu, L.mur};
+  pw_law->force(c, mats, hist, fo, to);
 }
 
 /* ---------------------------------------------------------------------- */

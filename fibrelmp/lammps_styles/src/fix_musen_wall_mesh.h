@@ -4,7 +4,7 @@
    FixMusenWallMesh (fix style musen/wall/mesh): MUSEN's particle-wall contact against walls
    made of triangles, moving rigidly by time-dependent motion intervals.
 
-     fix ID group musen/wall/mesh FILE
+     fix ID group musen/wall/mesh FILE [law NAME [parameters]]   (default law hertz/mindlin)
 
    What it reproduces (MUSEN 1.74.2, github.com/msolids/musen e0ff360; file/function named
    where each part is implemented below):
@@ -76,7 +76,9 @@ FixStyle(musen/wall/mesh,FixMusenWallMesh);
 #define FIBRELMP_FIX_MUSEN_WALL_MESH_H
 
 #include "fix.h"
+#include "musen_pw_law.h"
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -122,6 +124,7 @@ class FixMusenWallMesh : public Fix {
     // the wall motion MUSEN's contact law sees now
     double vel[3], rotvel[3], rotcentre[3];
   };
+  std::unique_ptr<musen_pw::Law> pw_law;    // the particle-wall law (musen_pw_law.h)
   struct Law {
     bool set;
     double estar, gstar, alpha, mu, mur;

@@ -72,6 +72,16 @@ inline void cross(const double *a, const double *b, double *c)
 
 /* ---------------------------------------------------------------------- */
 
+void PairMusenHM::stiffness(int itype, int jtype, double overlap, double equiv_radius,
+                            double &kn, double &kt, double &fn_el) const
+{
+  // Hertz: both stiffnesses grow with the contact area radius
+  const double contact_area_radius = std::sqrt(equiv_radius * overlap);
+  kn = 2 * estar[itype][jtype] * contact_area_radius;
+  fn_el = -overlap * kn * 2. / 3.;
+  kt = 8 * gstar[itype][jtype] * contact_area_radius;
+}
+
 PairMusenHM::PairMusenHM(LAMMPS *lmp) :
     Pair(lmp), estar(nullptr), gstar(nullptr), restitution(nullptr), alpha(nullptr),
     mu(nullptr), mu_roll(nullptr), maxrad(nullptr), history(nullptr)
@@ -193,11 +203,9 @@ void PairMusenHM::compute(int eflag, int vflag)
       double vt[3];
       for (int k = 0; k < 3; k++) vt[k] = rel[k] - vn * n[k];
 
-      const double contact_area_radius = std::sqrt(equiv_radius * overlap);
-
       // normal force with damping (negative: pushes src away from dst)
-      const double kn = 2 * estar[itype][jtype] * contact_area_radius;
-      const double fn_el = -overlap * kn * 2. / 3.;
+      double kn, kt, fn_el;
+      stiffness(itype, jtype, overlap, equiv_radius, kn, kt, fn_el);
       const double fn_damp =
           -MUSEN_2_SQRT_5_6 * alpha[itype][jtype] * vn * std::sqrt(kn * equiv_mass);
 
@@ -213,7 +221,6 @@ void PairMusenHM::compute(int eflag, int vflag)
       for (int k = 0; k < 3; k++) xi[k] = xi_rot[k] + vt[k] * dt;
 
       // tangential force with damping
-      const double kt = 8 * gstar[itype][jtype] * contact_area_radius;
       double ft_spring[3];
       for (int k = 0; k < 3; k++) ft_spring[k] = xi[k] * kt;
       const double damp_t = -MUSEN_2_SQRT_5_6 * alpha[itype][jtype] * std::sqrt(kt * equiv_mass);
@@ -472,11 +479,9 @@ double PairMusenHM::single(int i, int j, int itype, int jtype, double rsq, doubl
   double xi[3];
   for (int k = 0; k < 3; k++) xi[k] = 0.0 + vt[k] * update->dt;    // a new contact's first xi
 
-  const double contact_area_radius = std::sqrt(equiv_radius * overlap);
-  const double kn = 2 * estar[itype][jtype] * contact_area_radius;
-  const double fn_el = -overlap * kn * 2. / 3.;
+  double kn, kt, fn_el;
+  stiffness(itype, jtype, overlap, equiv_radius, kn, kt, fn_el);
   const double fn_damp = -MUSEN_2_SQRT_5_6 * alpha[itype][jtype] * vn * std::sqrt(kn * equiv_mass);
-  const double kt = 8 * gstar[itype][jtype] * contact_area_radius;
   double ft_spring[3];
   for (int k = 0; k < 3; k++) ft_spring[k] = xi[k] * kt;
   const double damp_t = -MUSEN_2_SQRT_5_6 * alpha[itype][jtype] * std::sqrt(kt * equiv_mass);

@@ -62,6 +62,12 @@ class PairMusenHM : public Pair {
   double *maxrad;             // largest radius per type (neighbor cutoff)
   FixMusenHistory *history;
 
+  // the law's normal and tangential stiffness and elastic normal force (<= 0) of a contact
+  // of types itype, jtype at this overlap: MUSEN's Hertz-Mindlin here; a style whose law
+  // differs from it only there (musen/linear) overrides this alone
+  virtual void stiffness(int itype, int jtype, double overlap, double equiv_radius,
+                         double &kn, double &kt, double &fn_el) const;
+
   void allocate();
 };
 

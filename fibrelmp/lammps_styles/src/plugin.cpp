@@ -23,6 +23,10 @@
 #include "pair_musen_hm.h"
 #define HAVE_PAIR_MUSEN_HM
 #endif
+#if __has_include("pair_musen_linear.h")
+#include "pair_musen_linear.h"
+#define HAVE_PAIR_MUSEN_LINEAR
+#endif
 #if __has_include("bond_musen_elastic.h")
 #include "bond_musen_elastic.h"
 #define HAVE_BOND_MUSEN_ELASTIC
@@ -59,6 +63,9 @@ Fix *fix_musen_history_creator(LAMMPS *lmp, int narg, char **arg)
 }
 #ifdef HAVE_PAIR_MUSEN_HM
 Pair *pair_musen_hm_creator(LAMMPS *lmp) { return new PairMusenHM(lmp); }
+#endif
+#ifdef HAVE_PAIR_MUSEN_LINEAR
+Pair *pair_musen_linear_creator(LAMMPS *lmp) { return new PairMusenLinear(lmp); }
 #endif
 #ifdef HAVE_BOND_MUSEN_ELASTIC
 Bond *bond_musen_elastic_creator(LAMMPS *lmp) { return new BondMusenElastic(lmp); }
@@ -119,6 +126,10 @@ extern "C" void lammpsplugin_init(void *ptr, void *handle, void *regfunc)
 #ifdef HAVE_PAIR_MUSEN_HM
   add(reg, lmp, handle, "pair", "musen/hm", "MUSEN Hertz-Mindlin particle-particle contact",
       (lammpsplugin_factory1 *) &pair_musen_hm_creator, nullptr);
+#endif
+#ifdef HAVE_PAIR_MUSEN_LINEAR
+  add(reg, lmp, handle, "pair", "musen/linear", "MUSEN linear elastic particle-particle contact",
+      (lammpsplugin_factory1 *) &pair_musen_linear_creator, nullptr);
 #endif
 #ifdef HAVE_BOND_MUSEN_ELASTIC
   add(reg, lmp, handle, "bond", "musen/elastic", "MUSEN elastic/Kelvin solid bond with breakage",

@@ -157,8 +157,9 @@ def bare_scene_settings(model: GranularModel, end_time: float | None, step: floa
     gravity (0, 0, -9.81); step, saving step and end time from the command line (MUSEN's
     defaults 1e-6 s, 1e-3 s and 1 s, with a warning, when not given).  A ``.mdem`` scene's own
     models, steps and gravity (what MUSEN loads with the file) take the defaults' place."""
-    from fibrelmp.translate.musen.script import (MUSEN_DEFAULTS, SUPPORTED_MODELS, MusenJob,
-                                         MusenModelSpec, apply_simulator_settings)
+    from fibrelmp.translate.granular.models import default_model
+    from fibrelmp.translate.musen.script import (MUSEN_DEFAULTS, MusenJob, MusenModelSpec,
+                                         apply_simulator_settings)
 
     for name, value in (("end-time", end_time), ("step", step), ("save-step", save_step)):
         if value is not None and not value > 0:
@@ -169,7 +170,7 @@ def bare_scene_settings(model: GranularModel, end_time: float | None, step: floa
                    end_time=end_time or 0.0,
                    ext_accel=None if file_set else tuple(MUSEN_DEFAULTS["gravity"]))
     stored = {spec.kind for spec in model.passthrough.get("mdem_models", [])}
-    job.models = [MusenModelSpec(name=SUPPORTED_MODELS[kind], params="", kind=kind, line=0)
+    job.models = [MusenModelSpec(name=default_model(kind).name, params="", kind=kind, line=0)
                   for kind, wanted in (("PP", True),
                                        ("PW", model.triangles is not None and model.triangles.count),
                                        ("SB", model.bonds is not None and model.bonds.count))

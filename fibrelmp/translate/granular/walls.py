@@ -23,6 +23,7 @@ from fibrelmp.translate.granular.geometry import (BoxShape, CylinderShape, Kinem
                                                   detect_cylinder,
                                                   detect_oriented_box, geometry_kinematics,
                                                   geometry_triangle_rows, piecewise_expression)
+from fibrelmp.translate.granular import models as physics
 from fibrelmp.translate.granular.mesh import MESH_FIX, MESH_NAME
 from fibrelmp.translate.lammps_format import float_text
 
@@ -252,7 +253,9 @@ def wall_commands(model: GranularModel, wall_plans: list[WallPlan], spheres, dt:
     if any(wp.kind == "mesh" for wp in wall_plans):
         wall_cmds.append(LammpsText("# " + comment_text(f"the exact triangles of every wall geometry "
                                                          f"({MESH_NAME}), MUSEN's particle-wall contact")))
-        wall_cmds.append(f"fix             {MESH_FIX} spheres musen/wall/mesh {MESH_NAME}")
+        pw_model, pw_params = physics.chosen(model, "PW")
+        wall_cmds.append(f"fix             {MESH_FIX} spheres musen/wall/mesh {MESH_NAME}"
+                         f"{pw_model.mesh_law_args(pw_params)}")
     for gi, wp in enumerate(wall_plans):
         tag = f"w{gi + 1}"
         if wp.kind == "mesh":

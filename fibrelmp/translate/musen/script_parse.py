@@ -20,6 +20,7 @@ import numpy as np
 
 from fibrelmp.errors import InputError
 from fibrelmp.granmodel import MotionInterval
+from fibrelmp.translate.granular import models as physics
 from fibrelmp.translate.musen.text_writer import EXPORT_FLAGS, all_on
 from fibrelmp.textio import read_text
 
@@ -36,7 +37,6 @@ MATERIAL_PROPERTIES = {"DENSITY": 0, "HEAT_CAPACITY": 1, "DYNAMIC_VISCOSITY": 2,
                        "YIELD_STRENGTH": 15}
 INTERACTION_PROPERTIES = {"RESTITUTION_COEFFICIENT": 200, "SLIDING_FRICTION": 201,
                           "ROLLING_FRICTION": 202}
-SUPPORTED_MODELS = {"PP": "ModelPPHertzMindlin", "PW": "ModelPWHertzMindlin", "SB": "ModelSBElastic"}
 # what ``fibrelmp check`` puts in place of a model line of a kind fibrelmp translates none of
 # (LB, EF) after reporting it: the job keeps a model of that kind, so the kind's PARAMS lines
 # below it read as cmusen reads them (not as "no MODEL_EF line"), and the settings skip it
@@ -456,8 +456,9 @@ def check_patch(err: InputError, line: str | None, attempt: int) -> str | None:
     candidates: list[str] = []
     kind = key[len("MODEL_"):] if key.startswith("MODEL_") else ""
     kind = {"EXT_FORCE": "EF", "PPHT": "PP"}.get(kind, kind)
-    if kind in SUPPORTED_MODELS:
-        candidates.append(f"{key} {SUPPORTED_MODELS[kind]}")
+    stock = physics.default_model(kind) if kind in physics.KIND_WORDS else None
+    if stock is not None:
+        candidates.append(f"{key} {stock.name}")
     elif kind in ("LB", "EF"):
         candidates.append(f"{key} {REFUSED_MODEL}{kind}")
     elif key in _NEUTRAL_TIMES:

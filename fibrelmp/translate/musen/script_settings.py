@@ -15,13 +15,9 @@ from fibrelmp.errors import InputError
 from fibrelmp.granmodel import GranularModel
 from fibrelmp.translate.musen.scene import (INTERACTION_DEFAULTS, _check_material, check_simulable, contact_law,
                     domain_warning)
-from fibrelmp.translate.musen.script_parse import (MUSEN_MODELS, REFUSED_MODEL, SUPPORTED_MODELS,
-                                                   MusenJob, model_kind)
+from fibrelmp.translate.granular import models as physics
+from fibrelmp.translate.musen.script_parse import MUSEN_MODELS, REFUSED_MODEL, MusenJob, model_kind
 
-MODEL_PARAMETERS = {"ModelSBElastic": {"CONSIDER_BREAKAGE": 1.0},    # AddParameter(...) defaults
-                    "ModelSBKelvin": {"CONSIDER_BREAKAGE": 1.0, "MAX_DAMP_RATIO": 1.0}}
-# models translated only with fibrelmp's own LAMMPS styles (stock LAMMPS has no equivalent)
-STYLE_MODELS = {"SB": {"ModelSBKelvin": "bond_style musen/elastic with MUSEN's Kelvin damping"}}
 MUSEN_DEFAULTS = {"dt": 1e-6, "save": 1e-3, "t_end": 1.0, "gravity": (0.0, 0.0, -9.81)}
 
 
@@ -44,7 +40,7 @@ def _resolve_models(model: GranularModel, job: MusenJob) -> dict[str, tuple[str,
 
 def accepted_models(kind: str) -> list[str]:
     """The MUSEN models of ``kind`` fibrelmp translates (with its LAMMPS styles, if any)."""
-    return ([SUPPORTED_MODELS[kind]] if kind in SUPPORTED_MODELS else []) + list(STYLE_MODELS.get(kind, {}))
+    return [m.name for m in physics.of_kind(kind)]
 
 
 def _model_choice(model: GranularModel, spec, path, line: int | None) -> tuple[str, tuple[str, dict]]:
@@ -59,36 +55,26 @@ def _model_choice(model: GranularModel, spec, path, line: int | None) -> tuple[s
     if spec.kind and spec.kind != kind:
         raise InputError(path, line, f"{spec.name} is a {kind} model, given as "
                          f"MODEL_{spec.kind}")
-    if spec.name in STYLE_MODELS.get(kind, {}):
+    found = physics.find(spec.name)
+    if found is not None and found.needs_styles:
         styles = lammps_styles.plugin()
         if not styles.available:
+            stock = physics.default_model(kind)
             raise InputError(path, line, f"{where}{spec.name} needs fibrelmp's LAMMPS styles "
-                             f"({STYLE_MODELS[kind][spec.name]}), which are not available here "
-                             f"({styles.how}); stock LAMMPS has no such solid bond, so fibrelmp "
-                             "translates ModelSBElastic only without them")
-    elif SUPPORTED_MODELS.get(kind) != spec.name:
-        what = {"PP": "particle-particle", "PW": "particle-wall", "SB": "solid-bond",
-                "LB": "liquid-bond", "EF": "external-force"}[kind]
-        ok = [f"{name} (with fibrelmp's LAMMPS styles)" if name in STYLE_MODELS.get(kind, {})
-              else name for name in accepted_models(kind)]
+                             f"({found.needs_styles}), which are not available here "
+                             f"({styles.how}); stock LAMMPS has no such "
+                             f"{physics.KIND_NOUNS[kind]}"
+                             + (f", so fibrelmp translates {stock.name} only without them"
+                                if stock is not None else ""))
+    elif found is None:
+        what = physics.KIND_WORDS[kind]
+        ok = [f"{m.name} (with fibrelmp's LAMMPS styles)" if m.needs_styles else m.name
+              for m in physics.of_kind(kind)]
         raise InputError(path, line, f"{where}{spec.name}: this {what} model is not supported"
                          + (f"; fibrelmp translates {' and '.join(ok)}" if ok
                             else f"; fibrelmp translates no {what} model")
                          + ("; name another in the job script (MODEL_" + kind + ")" if line is None else ""))
-    params = dict(MODEL_PARAMETERS.get(spec.name, {}))
-    tok = spec.params.split()
-    for j in range(0, len(tok), 2):
-        name = tok[j]
-        if name not in params:
-            at = f"{path}:{line}" if line is not None else f"{path} (its model manager)"
-            model.warn("musen-unknown-model-parameter", f"{at}: {spec.name} has no parameter "
-                       f"{name}; ignored as MUSEN does")
-            continue
-        try:
-            params[name] = float(tok[j + 1])
-        except (IndexError, ValueError):
-            raise InputError(path, line, f"{spec.name} parameter {name}: expected "
-                             "a number") from None
+    params = found.read_parameters(spec.params, path, line, model)
     return kind, (spec.name, params)
 
 
@@ -130,20 +116,9 @@ def apply_simulator_settings(model: GranularModel, job: MusenJob) -> None:
     models = _resolve_models(model, job)
     model.passthrough["musen_models"] = models
     _check_models(model, job, models)
-    if "SB" in models:
-        name, params = models["SB"]
-        plan.bond_breakage = int(params["CONSIDER_BREAKAGE"])
-        if plan.bond_breakage not in (0, 1, 2) or plan.bond_breakage != params["CONSIDER_BREAKAGE"]:
-            raise InputError(job.path, job.where("MODEL_SB_PARAMS"), "CONSIDER_BREAKAGE must be "
-                             f"0, 1 or 2 (got {params['CONSIDER_BREAKAGE']:g})")
-        plan.bond_model = "kelvin" if name == "ModelSBKelvin" else "elastic"
-        if plan.bond_model == "kelvin":
-            # ModelSBKelvin: any non-zero CONSIDER_BREAKAGE is its one criterion (MUSEN's 1)
-            plan.bond_breakage = 1 if plan.bond_breakage else 0
-            plan.bond_max_damp_ratio = float(params["MAX_DAMP_RATIO"])
-            if not (plan.bond_max_damp_ratio >= 0 and math.isfinite(plan.bond_max_damp_ratio)):
-                raise InputError(job.path, job.where("MODEL_SB_PARAMS"), "MAX_DAMP_RATIO must be "
-                                 f">= 0 (0: no cap; got {plan.bond_max_damp_ratio:g})")
+    for kind, (name, params) in models.items():
+        # a kind's parameter errors point at its PARAMS line (cmusen reads them there)
+        physics.find(name).apply(plan, params, job.path, job.where(f"MODEL_{kind}_PARAMS"))
     if job.connected_pp_contact is not None:
         plan.contacts_between_bonded = job.connected_pp_contact
     _apply_times(model, job)

@@ -22,14 +22,11 @@ from typing import Any
 import numpy as np
 
 from fibrelmp.granmodel import GranularFrame, GranularModel
+from fibrelmp.translate.granular.models import mdem_key
 from fibrelmp.translate.musen.mdem import timepoints as tp
 from fibrelmp.translate.musen.mdem.document import MdemFile, MdemWriter
 from fibrelmp.translate.musen.writer import MusenResultWriter
 
-MODEL_KEYS = {"ModelPPHertzMindlin": "B18A46C2786D4D44B925A8A04D0D1008",
-              "ModelPWHertzMindlin": "906949ACFFAE4B8C8B1B65509930EA6D",
-              "ModelSBElastic": "4CE31CB89C784476AC1971DFC5C39C10",
-              "ModelSBKelvin": "09405654485642A686561E1FC646DF1E"}
 SPHERE_FIELDS = tp.bit("coord", "vel", "angle_vel", "force", "quaternion")
 BOND_FIELDS = tp.bit("force", "angle_vel", "total_torque")
 WALL_FIELDS = tp.bit("coord", "vel", "angle_vel", "force", "quaternion")
@@ -220,7 +217,7 @@ class MdemResultWriter(MusenResultWriter):
                     continue
                 name, params = models[kind]
                 entry = manager.models.add()
-                entry.key = MODEL_KEYS.get(name, "")
+                entry.key = mdem_key(name)
                 entry.path = name
                 entry.params = "".join(f"{k} {v:g} " for k, v in params.items())
             manager.connected_pp_contact = bool(plan.contacts_between_bonded)

@@ -1,0 +1,144 @@
+"""MUSEN physics models as plug-ins: one module per model in this package, registering itself
+by its MUSEN name (``@register``); nothing else lists them.  A model says its kind (PP, PW, SB,
+LB, EF), its parameters with MUSEN's names and defaults, whether it needs fibrelmp's own LAMMPS
+styles, checks its parameters (``path:line`` errors) and applies them to a ``GranularPlan``.
+``find``/``of_kind`` import every module of the package on first use (docs/architecture.md,
+"Adding a physics model")."""
+
+from __future__ import annotations
+
+import importlib
+import pkgutil
+from pathlib import Path
+from typing import ClassVar
+
+from fibrelmp.errors import InputError
+from fibrelmp.granmodel import GranularModel, GranularPlan
+
+KIND_WORDS = {"PP": "particle-particle", "PW": "particle-wall", "SB": "solid-bond",
+              "LB": "liquid-bond", "EF": "external-force"}
+# what a model of each kind is, in messages ("stock LAMMPS has no such ...")
+KIND_NOUNS = {"PP": "particle-particle law", "PW": "particle-wall law", "SB": "solid bond",
+              "LB": "liquid bond", "EF": "external force"}
+
+_REGISTRY: dict[str, type[PhysicsModel]] = {}
+_loaded = False
+
+
+class PhysicsModel:
+    """One MUSEN model fibrelmp translates.  Subclasses set the class attributes and, where the
+    model changes the run, override ``apply``."""
+
+    name: ClassVar[str]                        # MUSEN's name, e.g. "ModelPPHertzMindlin"
+    kind: ClassVar[str]                        # "PP" | "PW" | "SB" | "LB" | "EF"
+    mdem_key: ClassVar[str] = ""               # MUSEN's unique key (a .mdem's model manager)
+    parameters: ClassVar[dict[str, float]] = {}   # MUSEN's AddParameter(...) names and defaults
+    # why the model needs fibrelmp's LAMMPS styles (None: stock LAMMPS expresses it)
+    needs_styles: ClassVar[str | None] = None
+    # the only model of its kind fibrelmp translates with stock LAMMPS (bare scenes use it)
+    default: ClassVar[bool] = False
+    # SB models: their GranularPlan.bond_model (what granular.bonds renders)
+    plan_bond_model: ClassVar[str | None] = None
+
+    @classmethod
+    def read_parameters(cls, text: str, path: Path | str | None, line: int | None,
+                        model: GranularModel) -> dict[str, float]:
+        """MUSEN's defaults updated by ``NAME value`` pairs of ``text`` (a MODEL_*_PARAMS line
+        or a .mdem's stored parameters); an unknown name is ignored with a warning, as MUSEN
+        does; a value that is not a number is an InputError at ``path``:``line``."""
+        params = dict(cls.parameters)
+        tok = text.split()
+        for j in range(0, len(tok), 2):
+            key = tok[j]
+            if key not in params:
+                at = f"{path}:{line}" if line is not None else f"{path} (its model manager)"
+                model.warn("musen-unknown-model-parameter", f"{at}: {cls.name} has no parameter "
+                           f"{key}; ignored as MUSEN does")
+                continue
+            try:
+                params[key] = float(tok[j + 1])
+            except (IndexError, ValueError):
+                raise InputError(path, line, f"{cls.name} parameter {key}: expected "
+                                 "a number") from None
+        return params
+
+    @classmethod
+    def pair_style_lines(cls, params: dict[str, float], own_styles: bool) -> list[str]:
+        """PP models: the ``pair_style`` line (and its comment) of the LAMMPS script;
+        ``own_styles``: fibrelmp's LAMMPS styles are in use.  Every pair_coeff line gives
+        E* G* e mu mu_r (musen styles) or the stock granular law (``granular.contacts``)."""
+        raise NotImplementedError(f"{cls.name} is not a particle-particle model")
+
+    @classmethod
+    def mesh_law_args(cls, params: dict[str, float]) -> str:
+        """PW models: what follows the file name of ``fix musen/wall/mesh`` ("" for its
+        default law, hertz/mindlin; else " law NAME parameters", musen_pw_law.h)."""
+        raise NotImplementedError(f"{cls.name} is not a particle-wall model")
+
+    @classmethod
+    def bond_law(cls, plan: GranularPlan) -> tuple[str, str]:
+        """SB models with fibrelmp's ``bond_style musen/elastic``: (the law's name in the
+        script's comment, the style's law arguments)."""
+        raise NotImplementedError(f"{cls.name} is not a solid-bond model of musen/elastic")
+
+    @classmethod
+    def apply(cls, plan: GranularPlan, params: dict[str, float], path: Path | str | None,
+              line: int | None) -> None:
+        """Check ``params`` and set what the model changes in ``plan`` (nothing by default)."""
+
+
+def register(model: type[PhysicsModel]) -> type[PhysicsModel]:
+    """Class decorator: add ``model`` to the registry under its MUSEN name."""
+    if model.kind not in KIND_WORDS:
+        raise ValueError(f"{model.__name__}: kind {model.kind!r} is not one of {list(KIND_WORDS)}")
+    if model.name in _REGISTRY and _REGISTRY[model.name] is not model:
+        raise ValueError(f"two modules register the MUSEN model {model.name}")
+    _REGISTRY[model.name] = model
+    return model
+
+
+def _load() -> None:
+    global _loaded
+    if not _loaded:
+        for info in pkgutil.iter_modules(__path__):
+            importlib.import_module(f"{__name__}.{info.name}")
+        _loaded = True
+
+
+def find(name: str) -> type[PhysicsModel] | None:
+    """The registered model called ``name`` (MUSEN's name), or None."""
+    _load()
+    return _REGISTRY.get(name)
+
+
+def of_kind(kind: str) -> list[type[PhysicsModel]]:
+    """The registered models of ``kind``: the stock default first, then by name."""
+    _load()
+    return sorted((m for m in _REGISTRY.values() if m.kind == kind),
+                  key=lambda m: (not m.default, m.needs_styles is not None, m.name))
+
+
+def default_model(kind: str) -> type[PhysicsModel] | None:
+    """The model fibrelmp uses for ``kind`` when a scene names none (MUSEN's for a bare scene)."""
+    return next((m for m in of_kind(kind) if m.default), None)
+
+
+def chosen(model: GranularModel, kind: str) -> tuple[type[PhysicsModel], dict[str, float]]:
+    """The model of ``kind`` a scene runs and its parameters: the one its settings chose
+    (``script_settings``), else the stock default with MUSEN's defaults (a DEMDF scene)."""
+    picked = model.passthrough.get("musen_models", {}).get(kind)
+    if picked is not None:
+        return find(picked[0]), picked[1]
+    stock = default_model(kind)
+    return stock, dict(stock.parameters)
+
+
+def solid_bond_model(plan: GranularPlan) -> type[PhysicsModel]:
+    """The SB model of ``plan.bond_model``."""
+    return next(m for m in of_kind("SB") if m.plan_bond_model == plan.bond_model)
+
+
+def mdem_key(name: str) -> str:
+    """MUSEN's key of the model called ``name`` ("" for a model fibrelmp does not translate)."""
+    model = find(name)
+    return model.mdem_key if model is not None else ""

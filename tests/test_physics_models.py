@@ -1,0 +1,59 @@
+"""The registry of MUSEN physics models (fibrelmp/translate/granular/models/): every module of
+the package registers one model, found by its MUSEN name; kinds, parameter names and defaults
+are MUSEN's (checked against the real cmusen's own model list when it is here)."""
+
+from __future__ import annotations
+
+import pkgutil
+import re
+from pathlib import Path
+
+import pytest
+
+from fibrelmp.translate.granular import models as physics
+from fibrelmp.translate.musen.script_parse import MUSEN_MODELS
+
+CMUSEN_MODELS = Path("/work/shared/oracles/cmusen_models.txt")   # cmusen's printed model list
+
+
+def _registered():
+    return [m for kind in physics.KIND_WORDS for m in physics.of_kind(kind)]
+
+
+def test_every_module_registers_a_model():
+    modules = [i.name for i in pkgutil.iter_modules(physics.__path__)]
+    owners = sorted(m.__module__.rsplit(".", 1)[1] for m in _registered())
+    assert owners == sorted(modules)
+
+
+def test_names_and_kinds_are_musens():
+    for m in _registered():
+        assert m.name in MUSEN_MODELS[m.kind], m.name
+        assert m.name.startswith(f"Model{m.kind}")
+        assert physics.find(m.name) is m
+        assert re.fullmatch(r"[0-9A-F]{32}", m.mdem_key), m.name
+
+
+def test_one_stock_default_per_translated_kind():
+    for kind in ("PP", "PW", "SB"):
+        stock = physics.default_model(kind)
+        assert stock is not None and stock.needs_styles is None
+        assert physics.of_kind(kind)[0] is stock
+    assert physics.default_model("LB") is None and physics.find("ModelLBCapilarViscous") is None
+
+
+@pytest.mark.skipif(not CMUSEN_MODELS.exists(), reason="the cmusen oracle is not on this machine")
+def test_parameters_are_cmusens():
+    listed = {}
+    for line in CMUSEN_MODELS.read_text().splitlines():
+        m = re.match(r"\s+(Model\w+) \([^)]*\)\s*(.*)$", line)
+        if m:
+            tok = m.group(2).split()
+            listed[m.group(1)] = {tok[j]: float(tok[j + 1]) for j in range(0, len(tok), 2)}
+    for m in _registered():
+        assert m.parameters == listed[m.name], m.name
+
+
+def test_mdem_key_of_unknown_model_is_empty():
+    assert physics.mdem_key("ModelPPJKR") == ""
+    assert physics.mdem_key("ModelSBKelvin") == "09405654485642A686561E1FC646DF1E"

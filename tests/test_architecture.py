@@ -96,8 +96,10 @@ def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
 class ImportGraph:
     """Which modules of a package tree import which, read with ``ast`` (nothing is imported)."""
 
-    def __init__(self, root: Path, exceptions: set[tuple[str, str]] = frozenset()):
+    def __init__(self, root: Path, exceptions: set[tuple[str, str]] = frozenset(),
+                 units: tuple[str, ...] = ()):
         self.top = root.name
+        self.units = units          # deeper packages that are parts of the root of their own
         self.modules: dict[str, Path] = {}
         for path in sorted(root.rglob("*.py")):
             parts = path.relative_to(root.parent).with_suffix("").parts
@@ -156,6 +158,10 @@ class ImportGraph:
             return module
         if not module.startswith(package + "."):
             return None
+        if package == self.top:
+            for unit in self.units:
+                if module == unit or module.startswith(unit + "."):
+                    return unit + "/"
         child = package + "." + module[len(package) + 1:].split(".")[0]
         return child + "/" if self.modules[child].name == "__init__.py" else child
 
@@ -191,7 +197,10 @@ class ImportGraph:
 
 # The one upward import: ``fibrelmp.translate`` is callable as the API's
 # ``translate(path, folder)`` and imports ``python_api`` only when called.
-GRAPH = ImportGraph(PACKAGE, {("fibrelmp.translate", "fibrelmp.python_api")})
+# The format homes under translate/ are parts of fibrelmp of their own (a layer above post and
+# pictures, LAYERS): translate/ (the shared job code) and each home are taken whole apart.
+HOMES = ("fibrelmp.translate.fibrenet", "fibrelmp.translate.demdf")
+GRAPH = ImportGraph(PACKAGE, {("fibrelmp.translate", "fibrelmp.python_api")}, HOMES)
 MODULES, IMPORTS = GRAPH.modules, GRAPH.imports
 
 
@@ -231,12 +240,16 @@ def test_the_cycle_check_sees_function_level_imports_and_skips_type_checking_one
 LAYERS = [
     ("base", ["errors", "textio", "units", "registry", "formatbase", "lammps_text", "_lammps",
               "lammps_log", "numtext/", "lammps_styles/"]),
-    ("core", ["model", "granmodel", "sanity", "record", "runner", "checkpoint", "outputs"]),
+    ("core", ["model", "granmodel", "sanity", "record", "runner", "checkpoint", "outputs",
+              "inputformat"]),
     ("mesh", ["mesh/"]),
     ("translate", ["translate/"]),
     ("post", ["post/"]),
     ("cases", ["cardioproof/", "granular_check"]),
     ("pictures", ["pictures/"]),
+    # a format's home: reader, writers, input hook, post target, picture source; it uses the
+    # shared translate code, post's and pictures' bases, never the pipeline
+    ("homes", [h[len("fibrelmp."):].replace(".", "/") + "/" for h in HOMES]),
     ("pipeline", ["pipeline/"]),
     ("api", ["__init__", "python_api", "cli"]),
 ]
@@ -244,9 +257,10 @@ LAYER_OF = {unit: rank for rank, (_, units) in enumerate(LAYERS) for unit in uni
 
 
 def _unit(module: str) -> str:
-    """The top-level part of fibrelmp that holds ``module`` (as LAYERS names it)."""
+    """The part of fibrelmp that holds ``module`` (as LAYERS names it: a format home,
+    ``translate/fibrenet/``, or a top-level module or package)."""
     part = GRAPH.part_of("fibrelmp", module)
-    return "__init__" if part == "fibrelmp" else part[len("fibrelmp."):]
+    return "__init__" if part == "fibrelmp" else part[len("fibrelmp."):].replace(".", "/")
 
 
 def test_every_module_has_a_layer():
@@ -291,7 +305,7 @@ def test_shared_layers_reach_formats_only_through_the_registry():
 
 
 BASES = {
-    INPUT: ("fibrelmp.pipeline.inputs", "InputFormat"),
+    INPUT: ("fibrelmp.inputformat", "InputFormat"),
     RESULT: ("fibrelmp.formatbase", "Writer"),
     TARGET: ("fibrelmp.post.target", "DumpTarget"),
     FRAMES: ("fibrelmp.formatbase", "Reader"),
@@ -323,8 +337,10 @@ def test_input_hooks_pick_no_run_output_writer():
     """``run --also``'s writers come from the registry (``pipeline.also``): no input hook
     imports the module of a format's ALSO hook."""
     homes = {f.hooks[ALSO].partition(":")[0] for f in registry.formats(ALSO)}
+    hooks = {f.hooks[INPUT].partition(":")[0] for f in registry.formats(INPUT)}
     bad = [f"{module} imports {name}" for module, imports in sorted(GRAPH.imports.items())
-           if module.startswith("fibrelmp.pipeline.inputs") for name in imports if name in homes]
+           if module.startswith("fibrelmp.pipeline.inputs") or module in hooks
+           for name in imports if name in homes]
     assert homes and not bad, "\n".join(bad)
 
 

@@ -2,7 +2,7 @@
 fibrelmp's Python converter writes them from the same frames.
 
 The reference is always the converter (``pipeline.fibrenet.convert_frames`` /
-``post.to_fibrenet.write_fibrenet``) run on the %.17g dump the job writes next to the fix's
+``translate.fibrenet.target.write_fibrenet``) run on the %.17g dump the job writes next to the fix's
 files: the same frames, so any byte that differs is the fix's, whatever the physics styles.
 Covered: the five real FibreNet cases (and the restart case's first run), synthetic models
 (beads crossing periodic faces between neighbour-list rebuilds, several LAMMPS types per
@@ -28,7 +28,7 @@ from fibrelmp import lammps_styles
 from fibrelmp._lammps import new_lammps
 from fibrelmp.pipeline.fibrenet import convert_frames, run_fibrenet
 from fibrelmp.post.lammps_dump.reader import iter_frames
-from fibrelmp.post.to_fibrenet import OUTSIDE_KIND, write_fibrenet
+from fibrelmp.translate.fibrenet.target import OUTSIDE_KIND, write_fibrenet
 from fibrelmp.translate.fibrenet.reader import read as read_fibrenet
 from fibrelmp.translate.fibrenet.writer import RESTART_SUFFIX, XYZ_SUFFIX
 

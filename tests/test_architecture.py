@@ -14,6 +14,7 @@
 from __future__ import annotations
 
 import ast
+import importlib
 import re
 from pathlib import Path
 
@@ -319,12 +320,24 @@ BASES = {
 @pytest.mark.parametrize("fmt, role", [(f, r) for f in registry.formats() for r in f.roles],
                          ids=lambda v: v.name if isinstance(v, registry.Format) else v)
 def test_every_hook_loads_and_derives_from_its_role_base(fmt, role):
-    import importlib
-
     module, name = BASES[role]
     base = getattr(importlib.import_module(module), name)
     hook = fmt.load(role)
     assert isinstance(hook, type) and issubclass(hook, base), f"{fmt.name} {role}: {hook}"
+
+
+def test_every_result_format_names_a_picture_source():
+    """``plot``/``snapshot`` draw a result through the source its registry record names (no
+    second table of formats in ``pictures``): each result format names one, and it loads."""
+    from fibrelmp.pictures.sources import Source
+
+    for fmt in registry.formats(RESULT):
+        assert fmt.pictures, f"{fmt.name}: no picture source"
+    for fmt in registry.formats():
+        if fmt.pictures:
+            source = fmt.load_pictures()
+            assert isinstance(source, type) and issubclass(source, Source), f"{fmt.name}: {source}"
+    assert not hasattr(importlib.import_module("fibrelmp.pictures.sources"), "_SOURCES")
 
 
 def test_architecture_doc_lists_every_format():

@@ -15,6 +15,7 @@ from fibrelmp.errors import RunError, wrong_frame
 from fibrelmp.pipeline.request import Consumer, Rendered, RunOptions, RunPlan, RunRequest
 from fibrelmp.pipeline.run import run
 from fibrelmp.translate.fibrenet.input import fibrenet_outputs
+from fibrelmp.translate.fibrenet.target import convert_frames, report_outside
 
 if TYPE_CHECKING:
     from fibrelmp.model import Model
@@ -33,21 +34,8 @@ def render(model: "Model"):
         if job.native is None:
             return Rendered(job, job.text, job.output_steps, [job.frames])
         return Rendered(job, job.text, job.output_steps, [job.frames, *job.native.xyz],
-                        finished=_report_outside(model))
+                        finished=report_outside(model))
     return build
-
-
-def _report_outside(model: "Model"):
-    """After the run: the fix's wall check (``target.outside_message``, the warning the
-    converter gives when it reads the frames itself)."""
-    def finished(lmp) -> None:
-        from fibrelmp.translate.fibrenet.target import OUTSIDE_KIND, outside_message
-        from fibrelmp.translate.lammps_job import OUTPUT_FIX
-
-        step, count = (int(lmp.extract_fix(OUTPUT_FIX, 0, 1, k)) for k in (0, 1))   # global vector
-        if step >= 0:
-            model.warn(OUTSIDE_KIND, outside_message(step, count, model.box.lengths))
-    return finished
 
 
 class DumpFrames:
@@ -108,19 +96,6 @@ def results(model: "Model", folder: Path, prefix: str,
 
         return also_to(consume, also())
     return make
-
-
-def convert_frames(model: "Model", job: "Job", frames: Iterator["Frame"], folder: Path,
-                   prefix: str) -> list[Path]:
-    """FibreNet's files from the job's dump frames (``translate.fibrenet.target``): the path without
-    fibrelmp's plugin, and the reference its ``fix fibrenet/output`` matches byte for byte."""
-    from fibrelmp.translate.fibrenet import target as to_fibrenet
-
-    spec = model.plan.output
-    names = {lt: model.particles.type_names[t] for lt, t in enumerate(job.type_of_ltype) if lt > 0}
-    types = None if spec.types is None else {model.particles.type_names[t] for t in spec.types}
-    return to_fibrenet.write_fibrenet(frames, prefix, folder, spec.fields, names, model.dynamics.dt,
-                                      model.box.lengths, types, warn=model.warn)
 
 
 def _move_native(native, folder: Path, prefix: str, fields) -> Consumer:

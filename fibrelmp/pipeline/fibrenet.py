@@ -11,9 +11,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable, Iterator
 
-from fibrelmp.errors import RunError, wrong_frame
+from fibrelmp.errors import RunError
 from fibrelmp.pipeline.request import Consumer, Rendered, RunOptions, RunPlan, RunRequest
 from fibrelmp.pipeline.run import run
+from fibrelmp.translate.fibrenet.frames import DumpFrames, WrittenFrames, move_file
 from fibrelmp.translate.fibrenet.input import fibrenet_outputs
 from fibrelmp.translate.fibrenet.target import convert_frames, report_outside
 
@@ -36,45 +37,6 @@ def render(model: "Model"):
         return Rendered(job, job.text, job.output_steps, [job.frames, *job.native.xyz],
                         finished=report_outside(model))
     return build
-
-
-class DumpFrames:
-    """The frames of the job's dump (``write_dump`` commands), read as LAMMPS writes them."""
-
-    def __init__(self, path: Path):
-        self.path = path
-        self.frames: Iterator["Frame"] | None = None
-
-    def is_frame(self, words: list[str]) -> bool:
-        return words[0] == "write_dump"
-
-    def read(self, step: int) -> "Frame":
-        from fibrelmp.post.lammps_dump.reader import iter_frames
-
-        if self.frames is None:
-            self.frames = iter_frames(self.path)
-        frame = next(self.frames, None)
-        if frame is None or frame.step != step:
-            raise wrong_frame(self.path, step, None if frame is None else frame.step)
-        return frame
-
-    def close(self) -> None:
-        if self.frames is not None:
-            self.frames.close()
-
-
-class WrittenFrames:
-    """The frames of a job that writes FibreNet's files itself: every ``write_dump`` is
-    followed by ``fibrenet/frame``, so nothing is read back (the schedule is still checked)."""
-
-    def is_frame(self, words: list[str]) -> bool:
-        return words[0] == "write_dump"
-
-    def read(self, step: int) -> int:
-        return step
-
-    def close(self) -> None:
-        pass
 
 
 def results(model: "Model", folder: Path, prefix: str,
@@ -119,31 +81,6 @@ def _move_native(native, folder: Path, prefix: str, fields) -> Consumer:
             move_file(src, dst)
         return [dst for _, dst in moves]
     return consume
-
-
-def move_file(src: Path, dst: Path) -> None:
-    """Rename ``src`` to ``dst`` (replacing it); across file systems through a temp file
-    beside ``dst``, so ``dst`` is never half written."""
-    import errno
-    import shutil
-
-    from fibrelmp.formatbase import place
-    from fibrelmp.textio import discard, temp_name, write_failure
-
-    try:
-        place(src, dst)          # undone with the run's other results if the run fails
-        return
-    except OSError as exc:
-        if exc.errno != errno.EXDEV:
-            raise write_failure(dst, exc) from None
-    tmp = temp_name(dst)
-    try:
-        shutil.copyfile(src, tmp)
-        place(tmp, dst)
-    except OSError as exc:
-        discard(tmp)
-        raise write_failure(dst, exc) from None
-    src.unlink(missing_ok=True)
 
 
 def fibrenet_plan(model: "Model", out: str | Path | None = None, work: str | Path | None = None,

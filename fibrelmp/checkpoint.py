@@ -135,6 +135,12 @@ class Checkpointing:
                 path.unlink(missing_ok=True)
 
 
+def has_checkpoint(work: Path) -> bool:
+    """Is there a checkpoint in the work folder (a cmusen script's: in a job's sub-folder)?"""
+    work = Path(work)
+    return work.is_dir() and next(work.rglob(STATE), None) is not None
+
+
 def check_every(every: int | None) -> None:
     """``--checkpoint-every`` must be a positive number of steps (None: only on signals)."""
     if every is not None and every <= 0:

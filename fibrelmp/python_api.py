@@ -23,7 +23,7 @@ def _quiet(_: object) -> None:
 
 
 def _input(path: Path):
-    """The INPUT hook of the input's format (``fibrelmp.pipeline.inputs.InputFormat``)."""
+    """The INPUT hook of the input's format (``fibrelmp.inputformat.InputFormat``)."""
     from fibrelmp.registry import INPUT, detect
 
     return detect(path).load(INPUT)()
@@ -120,7 +120,7 @@ def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | N
     from fibrelmp.checkpoint import check_every
     from fibrelmp.pipeline import RunOptions, run as run_plan
     from fibrelmp.pipeline.also import chosen
-    from fibrelmp.pipeline.inputs import RunSettings
+    from fibrelmp.inputformat import RunSettings
 
     path = Path(path)
     hook = _input(path)

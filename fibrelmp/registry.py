@@ -8,11 +8,11 @@ targets, help texts list names); no other module names formats.  Code is importe
 
 Roles
   ``input``   a simulation input ``run``/``check``/``translate`` accept; its hook is an
-              ``InputFormat`` (``fibrelmp.pipeline.inputs``): read, check, translate, and
-              the ``RunPlan`` of a run.  The hooks live in the pipeline, not in the
-              format's ``translate`` home, because a run plan joins translate (job),
-              post (frame conversion) and pipeline objects, and translate never imports
-              post or the pipeline.
+              ``InputFormat`` (``fibrelmp.inputformat``): read, check, translate, and
+              the ``RunPlan`` of a run.  A format home holds its hook (FibreNet, DEMDF;
+              the MUSEN and CardioProof hooks are still in ``pipeline.inputs``); a home
+              lies below the pipeline and names the pipeline's run-plan parts it uses
+              (``inputformat.pipeline_part``).
   ``result``  written by ``run`` as the input's native results (its hook is a ``Writer``).
   ``target``  a ``post --to`` output; its hook is a ``post.target.DumpTarget`` (a ``Writer``
               of LAMMPS dump frames).
@@ -24,6 +24,9 @@ Roles
   ``also``    written from a run's own frames beside the input's results (``run --also
               NAME``, any input); its hook is a ``pipeline.also.RunOutput`` (it declares the
               files among the run's outputs and makes the writer the frames are fed to).
+
+A record's ``pictures`` names the source ``fibrelmp plot``/``snapshot`` read its results with
+(a ``pictures.sources.Source``).
 
 Adding a format: one module with its Reader/Writer subclass, one ``register_format`` call
 below (docs/architecture.md shows an example).  Like meshio's ``register_format`` and ASE's
@@ -56,6 +59,7 @@ class Format:
     example: str = ""                      # a command line for help texts
     home: str = ""                         # the format's package (docs)
     binary: bool = False                   # detected first (text magics could match its bytes)
+    pictures: str = ""                     # "module:Class": its results' frames for plot/snapshot
     roles: tuple[str, ...] = field(init=False)
 
     def __post_init__(self) -> None:
@@ -66,8 +70,16 @@ class Format:
 
     def load(self, role: str) -> Any:
         """The class/object implementing ``role`` (imported now, not before)."""
-        module, _, attribute = self.hooks[role].partition(":")
-        return getattr(importlib.import_module(module), attribute)
+        return _load(self.hooks[role])
+
+    def load_pictures(self) -> Any:
+        """The picture source (``pictures.sources.Source``) of this format's results."""
+        return _load(self.pictures)
+
+
+def _load(spec: str) -> Any:
+    module, _, attribute = spec.partition(":")
+    return getattr(importlib.import_module(module), attribute)
 
 
 _FORMATS: dict[str, Format] = {}
@@ -86,6 +98,10 @@ def unregister_format(name: str) -> None:
 
 def get(name: str) -> Format:
     return _FORMATS[name]
+
+
+def formats_by_name() -> dict[str, Format]:
+    return dict(_FORMATS)
 
 
 def formats(role: str | None = None) -> list[Format]:
@@ -157,7 +173,7 @@ def detect(path: str | Path) -> Format:
 # -- the formats ---------------------------------------------------------------------------
 register_format(Format(
     "fibrenet", "a FibreNet input (with a 'model_file' line)", "lj",
-    {INPUT: "fibrelmp.pipeline.inputs.fibrenet:FibreNetInput"},
+    {INPUT: "fibrelmp.translate.fibrenet.input:FibreNetInput"},
     magic=re.compile(rb"^[ \t]*model_file\s", re.M),
     example="examples/fibre_network/input.txt", home="fibrelmp.translate.fibrenet"))
 register_format(Format(
@@ -173,6 +189,7 @@ register_format(Format(
      RESULT: "fibrelmp.translate.musen.mdem.result:MdemResultWriter",
      TARGET: "fibrelmp.post.to_granular:MdemTarget",
      DOCUMENT: "fibrelmp.translate.musen.mdem.convert:MdemDocument"},
+    pictures="fibrelmp.pictures.sources:MdemSource",
     extensions=(".mdem",), magic=re.compile(rb"\Ax\x56\x34\x12", re.S), binary=True,
     example="examples/musen/SingelParticle.mdem", home="fibrelmp.translate.musen.mdem"))
 register_format(Format(
@@ -183,6 +200,7 @@ register_format(Format(
      RESULT: "fibrelmp.translate.musen.writer:MusenResultWriter",
      TARGET: "fibrelmp.post.to_granular:MusenTarget",
      DOCUMENT: "fibrelmp.translate.musen.mdem.convert:MusenTextDocument"},
+    pictures="fibrelmp.pictures.sources:MusenTextSource",
     magic=re.compile(rb"\A\s*(0\s+\d+\s+1\s+\d+\s+5\b|(22|32)\s+\S)"),
     example="examples/musen/SingelParticle_text.txt", home="fibrelmp.translate.musen"))
 register_format(Format(
@@ -193,21 +211,22 @@ register_format(Format(
     example="examples/cardioproof/piston_tube.json", home="fibrelmp.cardioproof"))
 register_format(Format(
     "demdf", "a DEMDF JSON file (input or snapshot)", "dimensionless",
-    {INPUT: "fibrelmp.pipeline.inputs.demdf:DemdfInput",
+    {INPUT: "fibrelmp.translate.demdf.input:DemdfInput",
      RESULT: "fibrelmp.translate.demdf.writer:DemdfSnapshotWriter",
-     TARGET: "fibrelmp.post.to_granular:DemdfTarget"},
+     TARGET: "fibrelmp.translate.demdf.target:DemdfTarget"},
+    pictures="fibrelmp.translate.demdf.pictures:DemdfSource",
     extensions=(".json",), magic=re.compile(rb"\A\s*\{"),
     example="examples/demdf/head_on.json", home="fibrelmp.translate.demdf"))
 register_format(Format(
     "xyz", "FibreNet trajectories (_coord/_vel/_force.xyz)", "lj",
     {RESULT: "fibrelmp.translate.fibrenet.writer:XyzWriter",
-     TARGET: "fibrelmp.post.to_fibrenet:XyzTarget"},
-    extensions=(".xyz",), home="fibrelmp.translate.fibrenet"))
+     TARGET: "fibrelmp.translate.fibrenet.target:XyzTarget"},
+    pictures="fibrelmp.translate.fibrenet.pictures:FibreNetSource", extensions=(".xyz",), home="fibrelmp.translate.fibrenet"))
 register_format(Format(
     "res", "a FibreNet restart (_restart.res)", "lj",
     {RESULT: "fibrelmp.translate.fibrenet.writer:RestartWriter",
-     TARGET: "fibrelmp.post.to_fibrenet:RestartTarget"},
-    extensions=(".res",), home="fibrelmp.translate.fibrenet"))
+     TARGET: "fibrelmp.translate.fibrenet.target:RestartTarget"},
+    pictures="fibrelmp.translate.fibrenet.pictures:FibreNetSource", extensions=(".res",), home="fibrelmp.translate.fibrenet"))
 register_format(Format(
     "mercury", "MercuryDPM .data/.ene/.fstat/.restart", "any",
     {TARGET: "fibrelmp.post.mercury:MercuryTarget"},
@@ -219,7 +238,7 @@ register_format(Format(
     extensions=(".pvd", ".vtp", ".vtm"), home="fibrelmp.post.vtk"))
 register_format(Format(
     "lammps-dump", "a LAMMPS text dump (plain or .gz)", "any",
-    {FRAMES: "fibrelmp.post.lammps_dump:DumpReader"},
+    {FRAMES: "fibrelmp.post.lammps_dump:DumpReader"}, pictures="fibrelmp.pictures.sources:DumpSource",
     extensions=(".dump", ".lammpstrj", ".gz"), magic=re.compile(rb"\A\s*ITEM:"),
     home="fibrelmp.post.lammps_dump"))
 register_format(Format(

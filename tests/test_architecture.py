@@ -14,6 +14,7 @@
 from __future__ import annotations
 
 import ast
+import importlib
 import re
 from pathlib import Path
 
@@ -96,8 +97,10 @@ def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
 class ImportGraph:
     """Which modules of a package tree import which, read with ``ast`` (nothing is imported)."""
 
-    def __init__(self, root: Path, exceptions: set[tuple[str, str]] = frozenset()):
+    def __init__(self, root: Path, exceptions: set[tuple[str, str]] = frozenset(),
+                 units: tuple[str, ...] = ()):
         self.top = root.name
+        self.units = units          # deeper packages that are parts of the root of their own
         self.modules: dict[str, Path] = {}
         for path in sorted(root.rglob("*.py")):
             parts = path.relative_to(root.parent).with_suffix("").parts
@@ -156,6 +159,10 @@ class ImportGraph:
             return module
         if not module.startswith(package + "."):
             return None
+        if package == self.top:
+            for unit in self.units:
+                if module == unit or module.startswith(unit + "."):
+                    return unit + "/"
         child = package + "." + module[len(package) + 1:].split(".")[0]
         return child + "/" if self.modules[child].name == "__init__.py" else child
 
@@ -191,7 +198,10 @@ class ImportGraph:
 
 # The one upward import: ``fibrelmp.translate`` is callable as the API's
 # ``translate(path, folder)`` and imports ``python_api`` only when called.
-GRAPH = ImportGraph(PACKAGE, {("fibrelmp.translate", "fibrelmp.python_api")})
+# The format homes under translate/ are parts of fibrelmp of their own (a layer above post and
+# pictures, LAYERS): translate/ (the shared job code) and each home are taken whole apart.
+HOMES = ("fibrelmp.translate.fibrenet", "fibrelmp.translate.demdf")
+GRAPH = ImportGraph(PACKAGE, {("fibrelmp.translate", "fibrelmp.python_api")}, HOMES)
 MODULES, IMPORTS = GRAPH.modules, GRAPH.imports
 
 
@@ -231,12 +241,16 @@ def test_the_cycle_check_sees_function_level_imports_and_skips_type_checking_one
 LAYERS = [
     ("base", ["errors", "textio", "units", "registry", "formatbase", "lammps_text", "_lammps",
               "lammps_log", "numtext/", "lammps_styles/"]),
-    ("core", ["model", "granmodel", "sanity", "record", "runner", "checkpoint", "outputs"]),
+    ("core", ["model", "granmodel", "sanity", "record", "runner", "checkpoint", "outputs",
+              "inputformat"]),
     ("mesh", ["mesh/"]),
     ("translate", ["translate/"]),
     ("post", ["post/"]),
     ("cases", ["cardioproof/", "granular_check"]),
     ("pictures", ["pictures/"]),
+    # a format's home: reader, writers, input hook, post target, picture source; it uses the
+    # shared translate code, post's and pictures' bases, never the pipeline
+    ("homes", [h[len("fibrelmp."):].replace(".", "/") + "/" for h in HOMES]),
     ("pipeline", ["pipeline/"]),
     ("api", ["__init__", "python_api", "cli"]),
 ]
@@ -244,9 +258,10 @@ LAYER_OF = {unit: rank for rank, (_, units) in enumerate(LAYERS) for unit in uni
 
 
 def _unit(module: str) -> str:
-    """The top-level part of fibrelmp that holds ``module`` (as LAYERS names it)."""
+    """The part of fibrelmp that holds ``module`` (as LAYERS names it: a format home,
+    ``translate/fibrenet/``, or a top-level module or package)."""
     part = GRAPH.part_of("fibrelmp", module)
-    return "__init__" if part == "fibrelmp" else part[len("fibrelmp."):]
+    return "__init__" if part == "fibrelmp" else part[len("fibrelmp."):].replace(".", "/")
 
 
 def test_every_module_has_a_layer():
@@ -291,7 +306,7 @@ def test_shared_layers_reach_formats_only_through_the_registry():
 
 
 BASES = {
-    INPUT: ("fibrelmp.pipeline.inputs", "InputFormat"),
+    INPUT: ("fibrelmp.inputformat", "InputFormat"),
     RESULT: ("fibrelmp.formatbase", "Writer"),
     TARGET: ("fibrelmp.post.target", "DumpTarget"),
     FRAMES: ("fibrelmp.formatbase", "Reader"),
@@ -305,12 +320,24 @@ BASES = {
 @pytest.mark.parametrize("fmt, role", [(f, r) for f in registry.formats() for r in f.roles],
                          ids=lambda v: v.name if isinstance(v, registry.Format) else v)
 def test_every_hook_loads_and_derives_from_its_role_base(fmt, role):
-    import importlib
-
     module, name = BASES[role]
     base = getattr(importlib.import_module(module), name)
     hook = fmt.load(role)
     assert isinstance(hook, type) and issubclass(hook, base), f"{fmt.name} {role}: {hook}"
+
+
+def test_every_result_format_names_a_picture_source():
+    """``plot``/``snapshot`` draw a result through the source its registry record names (no
+    second table of formats in ``pictures``): each result format names one, and it loads."""
+    from fibrelmp.pictures.sources import Source
+
+    for fmt in registry.formats(RESULT):
+        assert fmt.pictures, f"{fmt.name}: no picture source"
+    for fmt in registry.formats():
+        if fmt.pictures:
+            source = fmt.load_pictures()
+            assert isinstance(source, type) and issubclass(source, Source), f"{fmt.name}: {source}"
+    assert not hasattr(importlib.import_module("fibrelmp.pictures.sources"), "_SOURCES")
 
 
 def test_architecture_doc_lists_every_format():
@@ -323,8 +350,10 @@ def test_input_hooks_pick_no_run_output_writer():
     """``run --also``'s writers come from the registry (``pipeline.also``): no input hook
     imports the module of a format's ALSO hook."""
     homes = {f.hooks[ALSO].partition(":")[0] for f in registry.formats(ALSO)}
+    hooks = {f.hooks[INPUT].partition(":")[0] for f in registry.formats(INPUT)}
     bad = [f"{module} imports {name}" for module, imports in sorted(GRAPH.imports.items())
-           if module.startswith("fibrelmp.pipeline.inputs") for name in imports if name in homes]
+           if module.startswith("fibrelmp.pipeline.inputs") or module in hooks
+           for name in imports if name in homes]
     assert homes and not bad, "\n".join(bad)
 
 

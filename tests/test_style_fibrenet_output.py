@@ -1,8 +1,8 @@
 """``fix fibrenet/output`` (fibrelmp's plugin) writes FibreNet's files byte for byte as
 fibrelmp's Python converter writes them from the same frames.
 
-The reference is always the converter (``pipeline.fibrenet.convert_frames`` /
-``post.to_fibrenet.write_fibrenet``) run on the %.17g dump the job writes next to the fix's
+The reference is always the converter (``translate.fibrenet.target.convert_frames`` /
+``translate.fibrenet.target.write_fibrenet``) run on the %.17g dump the job writes next to the fix's
 files: the same frames, so any byte that differs is the fix's, whatever the physics styles.
 Covered: the five real FibreNet cases (and the restart case's first run), synthetic models
 (beads crossing periodic faces between neighbour-list rebuilds, several LAMMPS types per
@@ -26,9 +26,9 @@ import pytest
 
 from fibrelmp import lammps_styles
 from fibrelmp._lammps import new_lammps
-from fibrelmp.pipeline.fibrenet import convert_frames, run_fibrenet
+from fibrelmp.pipeline.fibrenet import run_fibrenet
 from fibrelmp.post.lammps_dump.reader import iter_frames
-from fibrelmp.post.to_fibrenet import OUTSIDE_KIND, write_fibrenet
+from fibrelmp.translate.fibrenet.target import OUTSIDE_KIND, convert_frames, write_fibrenet
 from fibrelmp.translate.fibrenet.reader import read as read_fibrenet
 from fibrelmp.translate.fibrenet.writer import RESTART_SUFFIX, XYZ_SUFFIX
 

@@ -17,9 +17,9 @@ import pytest
 from fibrelmp.pipeline.fibrenet import run_fibrenet
 from fibrelmp.translate.fibrenet.reader import read as read_fibrenet
 from fibrelmp.errors import InputError, RunError
-from fibrelmp.post import to_fibrenet
+from fibrelmp.translate.fibrenet import target as to_fibrenet
 from fibrelmp.post.lammps_dump.reader import Frame, iter_frames
-from fibrelmp.post.to_fibrenet import write_fibrenet
+from fibrelmp.translate.fibrenet.target import write_fibrenet
 from fibrelmp.translate import granular_job as gj
 from fibrelmp.translate.granular import reach, tiles
 from fibrelmp.translate.granular.geometry import tile_triangles, tile_triangles_within

@@ -29,7 +29,7 @@ import numpy as np
 from fibrelmp.errors import InputError
 from fibrelmp.lammps_text import lammps_word
 from fibrelmp.mesh.model import Mesh
-from fibrelmp.translate.demdf.json_doc import JsonDoc, load_json
+from fibrelmp.translate.json_doc import JsonDoc, load_json
 
 VERSION = 1
 ARTIFICIAL_VISCOSITY = 0.1   # Monaghan's alpha when the case gives no viscosity

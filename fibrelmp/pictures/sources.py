@@ -1,9 +1,10 @@
 """Frames of any result, as what a picture needs: ``SceneFrame``s.
 
-One source class per kind of result (``open_source`` picks it from ``locate``), each reading
-through the format's own reader: FibreNet xyz (``translate.fibrenet.writer.iter_xyz``), MUSEN
-``.mdem`` (``MdemReader``) and text results (``scene.read`` + ``read_time_points``), DEMDF
-snapshots (``read_snapshot``, one file per frame), LAMMPS dumps (``post.lammps_dump``, with the
+One source class per kind of result, named by its format's registry record (``pictures``;
+``open_source`` picks it from ``locate``), each reading through the format's own reader:
+FibreNet xyz (``translate.fibrenet.pictures``), DEMDF snapshots (``translate.demdf.pictures``,
+one file per frame), and here MUSEN ``.mdem`` (``MdemReader``) and text results
+(``scene.read`` + ``read_time_points``) and LAMMPS dumps (``post.lammps_dump``, with the
 run's ``data.lammps`` for radii, masses, type names and bonds).  Sources stream: one frame is
 in memory at a time (a MUSEN text result is read whole, as its reader does).
 """
@@ -19,7 +20,7 @@ from typing import Iterator
 import numpy as np
 
 from fibrelmp.errors import InputError
-from fibrelmp.pictures.locate import DATA_NAME, DUMP_NAME, LOG, WORK, Located, family_prefix, run_folder
+from fibrelmp.pictures.locate import DATA_NAME, DUMP_NAME, LOG, WORK, Located
 
 
 @dataclass
@@ -78,7 +79,7 @@ class Source:
         raise InputError(self.path, None, f"frame {i} could not be read")     # file changed
 
 
-def _names(names: list[str], kinds: np.ndarray) -> tuple[np.ndarray, list[str]]:
+def kind_indices(names: list[str], kinds: np.ndarray) -> tuple[np.ndarray, list[str]]:
     """Kind indices 0..k-1 of the kinds present, and their names (legend order)."""
     used = np.unique(kinds)
     lookup = {int(k): i for i, k in enumerate(used)}
@@ -98,69 +99,12 @@ def noted_radii(data: Path) -> dict[str, float]:
     return radii
 
 
-# -- FibreNet --------------------------------------------------------------------------------
-class FibreNetSource(Source):
-    """``<prefix>_coord.xyz`` (and ``_vel.xyz``); beads' radii, masses and the springs come
-    from the run's ``data.lammps`` when its work folder is found."""
-
-    what = "FibreNet xyz result"
-    time_unit, energy_unit = "τ", "ε"
-
-    def __init__(self, path: Path):
-        super().__init__(path)
-        prefix = family_prefix(path)
-        self.coord = path.with_name(f"{prefix}_coord.xyz")
-        if not self.coord.is_file():
-            raise InputError(path, None, f"the positions are in {self.coord.name}, which is not here")
-        if self.coord != path:
-            self.notes.append(f"frames from {self.coord.name}")
-        vel = path.with_name(f"{prefix}_vel.xyz")
-        self.vel = vel if vel.is_file() else None
-        self.radius_by_name: dict[str, float] = {}
-        self.mass_by_name: dict[str, float] = {}
-        self.bonds = np.zeros((0, 2), np.int64)
-        folder, how = run_folder(path)
-        data = folder / DATA_NAME if folder is not None else None
-        if data is not None and data.is_file():
-            self._read_data(data)
-            self.notes.append(f"springs, radii and masses from {data} ({how})")
-        else:
-            self.notes.append(f"no springs, radii or masses: {how}")
-
-    def _read_data(self, data: Path) -> None:
-        from fibrelmp.post.lammps_data.reader import read_data
-
-        facts = read_data(data)
-        for t, name in facts.type_names.items():
-            if t in facts.type_masses:
-                self.mass_by_name[name] = facts.type_masses[t]
-        self.radius_by_name = noted_radii(data)
-        self.bonds = facts.rows(facts.bonds.ravel(), "springs").reshape(-1, 2) if len(facts.bonds) else self.bonds
-
-    def frames(self) -> Iterator[SceneFrame]:
-        from fibrelmp.translate.fibrenet.writer import iter_xyz
-
-        velocities = iter_xyz(self.vel) if self.vel is not None else None
-        for i, frame in enumerate(iter_xyz(self.coord)):
-            v = next(velocities, None) if velocities is not None else None
-            names = sorted(set(frame.names))
-            kinds = np.array([names.index(n) for n in frame.names], np.int64)
-            radius = np.array([self.radius_by_name.get(n, math.nan) for n in frame.names])
-            mass = np.array([self.mass_by_name.get(n, math.nan) for n in frame.names])
-            bonds = self.bonds if len(self.bonds) and self.bonds.max() < len(frame.names) else self.bonds[:0]
-            yield SceneFrame(i, frame.step * frame.dt, frame.step, frame.values, radius
-                             if np.isfinite(radius).all() else None, kinds, names,
-                             velocity=None if v is None or v.step != frame.step else v.values,
-                             mass=mass if np.isfinite(mass).all() else None, bonds=bonds,
-                             box=(np.zeros(3), np.asarray(frame.lengths, float)))
-
-
 # -- MUSEN -----------------------------------------------------------------------------------
 def _musen_frame(model, index: int, time: float, rows: np.ndarray, position: np.ndarray,
                  velocity: np.ndarray | None, triangles: np.ndarray | None) -> SceneFrame:
     """A frame of the spheres at ``rows`` of the model (bonds between them, if intact)."""
     s = model.spheres
-    kinds, names = _names([m.name for m in model.materials], s.material[rows])
+    kinds, names = kind_indices([m.name for m in model.materials], s.material[rows])
     bonds, broken = np.zeros((0, 2), np.int64), None
     if model.bonds is not None and model.bonds.count:
         b = model.bonds
@@ -229,43 +173,6 @@ class MusenTextSource(Source):
                 tri = f[44][k, self.wall_cols].reshape(-1, 3, 3)
                 tri = tri[np.isfinite(tri).all(axis=(1, 2))]
             yield _musen_frame(self.model, k, float(time), rows, pos[rows], vel, tri)
-
-
-# -- DEMDF -----------------------------------------------------------------------------------
-class DemdfSource(Source):
-    """A DEMDF snapshot and the other snapshots of its family (``<name>_<n>.json``), in
-    ``n`` order; any other DEMDF document is one frame."""
-
-    what = "DEMDF snapshot series"
-
-    def __init__(self, path: Path):
-        super().__init__(path)
-        hit = re.fullmatch(r"(.*)_(\d+)", path.stem)
-        if hit:
-            same = [p for p in path.parent.glob(f"{hit.group(1)}_*.json")
-                    if re.fullmatch(rf"{re.escape(hit.group(1))}_\d+", p.stem)]
-            self.files = sorted(same, key=lambda p: int(p.stem.rsplit("_", 1)[1]))
-        else:
-            self.files = [path]
-        self.own = self.files.index(path) if path in self.files else 0
-
-    def count(self) -> int:
-        return len(self.files)
-
-    def frame(self, index: int | None) -> SceneFrame:
-        return super().frame(self.own if index is None else index)
-
-    def frames(self) -> Iterator[SceneFrame]:
-        from fibrelmp.translate.demdf.reader import read_snapshot
-
-        for i, file in enumerate(self.files):
-            m = read_snapshot(file)
-            s = m.spheres
-            kinds, names = _names([x.name for x in m.materials], s.material)
-            yield SceneFrame(i, m.plan.t_start, None, s.position, s.radius, kinds, names,
-                             velocity=s.velocity, mass=s.mass,
-                             planes=[(p.normal, p.point) for p in m.planes], box=m.plan.domain,
-                             dimension=m.plan.dimension)
 
 
 # -- LAMMPS dumps ----------------------------------------------------------------------------
@@ -342,7 +249,7 @@ class DumpSource(Source):
             names = ["", *labels]
         else:
             names = [d.name(t) if d is not None else str(t) for t in range(top + 1)]
-        kinds, kind_names = _names(names, types)
+        kinds, kind_names = kind_indices(names, types)
         bonds = np.zeros((0, 2), np.int64)
         if d is not None and len(d.bonds) and len(ids):
             order = np.argsort(ids, kind="stable")
@@ -364,16 +271,17 @@ class WorkFolderSource(DumpSource):
         super().__init__(dump)
 
 
-_SOURCES = {"xyz": FibreNetSource, "res": FibreNetSource, "mdem": MdemSource, "musen": MusenTextSource,
-            "demdf": DemdfSource, "lammps-dump": DumpSource, WORK: WorkFolderSource}
-
-
 def open_source(located: Located) -> Source:
-    """The frame source of a located result (a log has no frames: an InputError)."""
-    kind = _SOURCES.get(located.kind)
-    if kind is None:
+    """The frame source of a located result (a log has no frames: an InputError): a work
+    folder's dump, else the picture source its format's registry record names (its home's)."""
+    from fibrelmp import registry
+
+    if located.kind == WORK:
+        return WorkFolderSource(located.path)
+    fmt = registry.formats_by_name().get(located.kind)
+    if fmt is None or not fmt.pictures:
         if located.kind == LOG:
             raise InputError(located.path, None, "a LAMMPS log has no frames: give a result file "
                              "or the run's work folder")
         raise InputError(located.path, None, f"fibrelmp does not draw {located.kind} files")
-    return kind(located.path)
+    return fmt.load_pictures()(located.path)

@@ -1,7 +1,9 @@
-"""FibreNet runs: the bead-spring job, its dump frames and FibreNet's own result files
+"""FibreNet's run plan: the bead-spring job, its dump frames and FibreNet's own result files
 (``_coord/_vel/_force.xyz``, ``_restart.res``): written by LAMMPS itself with fibrelmp's
 plugin (``fix fibrenet/output``; moved into place after the run), else converted from the
-dump frames by ``post.to_fibrenet``."""
+dump frames by ``translate.fibrenet.target``.  The rest of FibreNet lives in its home,
+``fibrelmp/translate/fibrenet/``; this module joins it with the pipeline (``run``,
+``RunRequest``, ``pipeline.also``), which a home may not import."""
 
 from __future__ import annotations
 
@@ -9,49 +11,17 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable, Iterator
 
-from fibrelmp.errors import InputError, RunError, wrong_frame
+from fibrelmp.errors import RunError
 from fibrelmp.pipeline.request import Consumer, Rendered, RunOptions, RunPlan, RunRequest
 from fibrelmp.pipeline.run import run
+from fibrelmp.translate.fibrenet.frames import DumpFrames, WrittenFrames, move_file
+from fibrelmp.translate.fibrenet.input import fibrenet_outputs
+from fibrelmp.translate.fibrenet.target import convert_frames, report_outside
 
 if TYPE_CHECKING:
     from fibrelmp.model import Model
-    from fibrelmp.outputs import Outputs
     from fibrelmp.post.lammps_dump.reader import Frame
     from fibrelmp.translate.lammps_job import Job
-
-
-def fibrenet_outputs(model: "Model", out: str | Path | None = None,
-                     work: str | Path | None = None) -> tuple["Outputs", Path, str]:
-    """Where a FibreNet run writes: (outputs, output folder, file name prefix).
-
-    ``output_file`` is a name inside the output folder (``-o``, default the input's folder);
-    one that leaves it (``..``) is refused, and an absolute one is honoured only without
-    ``-o`` (as FibreNet would write it)."""
-    from fibrelmp.outputs import Outputs
-    from fibrelmp.translate.fibrenet.writer import RESTART_SUFFIX, XYZ_SUFFIX
-
-    spec = model.plan.output
-    name = Path(spec.basename)
-    if name.is_absolute():
-        if out is not None:
-            raise InputError(model.source, spec.line, f"output_file {spec.basename} is an absolute "
-                             "path, which -o cannot place: give a plain name, or leave out -o")
-        target = name
-    else:
-        folder = (Path(out) if out is not None else spec.folder).resolve()
-        if ".." in name.parts:
-            raise InputError(model.source, spec.line, f"output_file {spec.basename} leaves the "
-                             f"output folder {folder}: give a name inside it")
-        target = folder / name
-    if not target.name or target.name in (".", ".."):
-        raise InputError(model.source, spec.line, f"output_file {spec.basename!r} names no file")
-    folder, prefix = target.parent, target.name
-    from fibrelmp.outputs import work_folder as job_folder
-
-    work_folder = job_folder(folder, prefix, work)
-    files = [folder / f"{prefix}{XYZ_SUFFIX[f]}" for f in spec.fields] + [folder / f"{prefix}{RESTART_SUFFIX}"]
-    family = [folder / f"{prefix}{suffix}" for suffix in (*XYZ_SUFFIX.values(), RESTART_SUFFIX)]
-    return Outputs(model.source, work_folder, files, family, inputs=list(model.inputs)), folder, prefix
 
 
 def render(model: "Model"):
@@ -65,60 +35,8 @@ def render(model: "Model"):
         if job.native is None:
             return Rendered(job, job.text, job.output_steps, [job.frames])
         return Rendered(job, job.text, job.output_steps, [job.frames, *job.native.xyz],
-                        finished=_report_outside(model))
+                        finished=report_outside(model))
     return build
-
-
-def _report_outside(model: "Model"):
-    """After the run: the fix's wall check (``to_fibrenet.outside_message``, the warning the
-    converter gives when it reads the frames itself)."""
-    def finished(lmp) -> None:
-        from fibrelmp.post.to_fibrenet import OUTSIDE_KIND, outside_message
-        from fibrelmp.translate.lammps_job import OUTPUT_FIX
-
-        step, count = (int(lmp.extract_fix(OUTPUT_FIX, 0, 1, k)) for k in (0, 1))   # global vector
-        if step >= 0:
-            model.warn(OUTSIDE_KIND, outside_message(step, count, model.box.lengths))
-    return finished
-
-
-class DumpFrames:
-    """The frames of the job's dump (``write_dump`` commands), read as LAMMPS writes them."""
-
-    def __init__(self, path: Path):
-        self.path = path
-        self.frames: Iterator["Frame"] | None = None
-
-    def is_frame(self, words: list[str]) -> bool:
-        return words[0] == "write_dump"
-
-    def read(self, step: int) -> "Frame":
-        from fibrelmp.post.lammps_dump.reader import iter_frames
-
-        if self.frames is None:
-            self.frames = iter_frames(self.path)
-        frame = next(self.frames, None)
-        if frame is None or frame.step != step:
-            raise wrong_frame(self.path, step, None if frame is None else frame.step)
-        return frame
-
-    def close(self) -> None:
-        if self.frames is not None:
-            self.frames.close()
-
-
-class WrittenFrames:
-    """The frames of a job that writes FibreNet's files itself: every ``write_dump`` is
-    followed by ``fibrenet/frame``, so nothing is read back (the schedule is still checked)."""
-
-    def is_frame(self, words: list[str]) -> bool:
-        return words[0] == "write_dump"
-
-    def read(self, step: int) -> int:
-        return step
-
-    def close(self) -> None:
-        pass
 
 
 def results(model: "Model", folder: Path, prefix: str,
@@ -142,24 +60,11 @@ def results(model: "Model", folder: Path, prefix: str,
     return make
 
 
-def convert_frames(model: "Model", job: "Job", frames: Iterator["Frame"], folder: Path,
-                   prefix: str) -> list[Path]:
-    """FibreNet's files from the job's dump frames (``post.to_fibrenet``): the path without
-    fibrelmp's plugin, and the reference its ``fix fibrenet/output`` matches byte for byte."""
-    from fibrelmp.post import to_fibrenet
-
-    spec = model.plan.output
-    names = {lt: model.particles.type_names[t] for lt, t in enumerate(job.type_of_ltype) if lt > 0}
-    types = None if spec.types is None else {model.particles.type_names[t] for t in spec.types}
-    return to_fibrenet.write_fibrenet(frames, prefix, folder, spec.fields, names, model.dynamics.dt,
-                                      model.box.lengths, types, warn=model.warn)
-
-
 def _move_native(native, folder: Path, prefix: str, fields) -> Consumer:
     """A consumer for a job that wrote FibreNet's files itself: when every scheduled frame
     was written, the files move from the job folder into place (nothing moves after a
     failure: the job folder keeps them, like its dump)."""
-    from fibrelmp.translate.fibrenet.writer import RESTART_SUFFIX, XYZ_SUFFIX
+    from fibrelmp.translate.lammps_job import RESTART_SUFFIX, XYZ_SUFFIX
 
     def consume(frames: Iterator[int]) -> list[Path]:
         for _ in frames:            # the steps, checked against the schedule
@@ -176,31 +81,6 @@ def _move_native(native, folder: Path, prefix: str, fields) -> Consumer:
             move_file(src, dst)
         return [dst for _, dst in moves]
     return consume
-
-
-def move_file(src: Path, dst: Path) -> None:
-    """Rename ``src`` to ``dst`` (replacing it); across file systems through a temp file
-    beside ``dst``, so ``dst`` is never half written."""
-    import errno
-    import shutil
-
-    from fibrelmp.formatbase import place
-    from fibrelmp.textio import discard, temp_name, write_failure
-
-    try:
-        place(src, dst)          # undone with the run's other results if the run fails
-        return
-    except OSError as exc:
-        if exc.errno != errno.EXDEV:
-            raise write_failure(dst, exc) from None
-    tmp = temp_name(dst)
-    try:
-        shutil.copyfile(src, tmp)
-        place(tmp, dst)
-    except OSError as exc:
-        discard(tmp)
-        raise write_failure(dst, exc) from None
-    src.unlink(missing_ok=True)
 
 
 def fibrenet_plan(model: "Model", out: str | Path | None = None, work: str | Path | None = None,

@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any, Callable, Iterator
 
 from fibrelmp.errors import InputError, RunError
+from fibrelmp.checkpoint import has_checkpoint
 from fibrelmp.pipeline.request import (Action, Consumer, Outcome, Rendered, RunOptions, RunPlan,
                                        RunRequest)
 
@@ -85,14 +86,6 @@ def run(plan: RunPlan, warn: Warn | None = None) -> Outcome:
             for cleanup in plan.cleanup:
                 cleanup()
     return outcome
-
-
-def has_checkpoint(work: Path) -> bool:
-    """Is there a checkpoint in the work folder (a cmusen script's: in a job's sub-folder)?"""
-    from fibrelmp.checkpoint import STATE
-
-    work = Path(work)
-    return work.is_dir() and next(work.rglob(STATE), None) is not None
 
 
 def simulate(request: RunRequest, options: RunOptions, rank: int = 0, size: int = 1,

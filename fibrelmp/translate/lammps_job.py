@@ -25,6 +25,11 @@ from fibrelmp.translate.lammps_format import atomfile_blocks, float_text
 from fibrelmp.translate.steps import MIN_PIECE_STEPS, SaveSteps, run_piece
 from fibrelmp.translate.work_facts import WorkFacts, write_facts
 
+# FibreNet's result file names (<prefix><suffix>): fix fibrenet/output writes them in the job
+# folder, the FibreNet home's writers (translate.fibrenet.writer) beside the input
+XYZ_SUFFIX = {"position": "_coord.xyz", "velocity": "_vel.xyz", "force": "_force.xyz"}
+RESTART_SUFFIX = "_restart.res"
+
 SCRIPT_NAME = "in.lammps"
 DATA_NAME = "data.lammps"
 FRAMES_NAME = "frames.dump"
@@ -370,9 +375,7 @@ def _native_output(model: Model, folder: Path, type_names: list[str],
     """The ``fix fibrenet/output`` that writes FibreNet's files from inside LAMMPS (template
     values, and the files in the job folder), or (None, None): without fibrelmp's plugin, or
     when a name cannot reach LAMMPS verbatim, the job writes only its dump and fibrelmp
-    converts the frames (``post.to_fibrenet``), as before the plugin existed."""
-    from fibrelmp.translate.fibrenet.writer import RESTART_SUFFIX, XYZ_SUFFIX
-
+    converts the frames (``translate.fibrenet.target``), as before the plugin existed."""
     if not plugin:
         return None, None
     spec = model.plan.output

@@ -119,7 +119,7 @@ class InputConformance(Conformance):
         return tmp_path / "in" / source.name
 
     def test_hook_and_example(self):
-        from fibrelmp.pipeline.inputs import InputFormat
+        from fibrelmp.inputformat import InputFormat
 
         fmt = self.registered()
         assert (REPO / fmt.example).is_file(), fmt.name       # the example help texts show

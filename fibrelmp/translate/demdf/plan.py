@@ -16,7 +16,7 @@ import numpy as np
 
 from fibrelmp.errors import InputError
 from fibrelmp.granmodel import GranularPlan
-from fibrelmp.translate.demdf.json_doc import describe
+from fibrelmp.translate.json_doc import describe
 
 # the keys of a snapshot output entry (BOS: output.snapshot; the draft: output[i] named "demdf")
 _SNAPSHOT_KEYS = ("name", "filename", "saveCount", "savePeriodInTime", "savePeriodInTimeSteps")

@@ -23,7 +23,7 @@ from fibrelmp.granmodel import ContactLaw, GranularModel, Material, Plane, Spher
 from fibrelmp.sanity import close_pairs
 from fibrelmp.units import DIMENSIONLESS
 from fibrelmp.translate.demdf import contact as hertz
-from fibrelmp.translate.demdf.json_doc import JsonDoc, describe, load_json
+from fibrelmp.translate.json_doc import JsonDoc, describe, load_json
 from fibrelmp.translate.demdf.plan import Output, PlanMixin
 
 DEFAULT_RADIUS = 0.5          # BOS hard-codes this radius

@@ -17,9 +17,8 @@ from fibrelmp.formatbase import Writer
 from fibrelmp.textio import check_text_file, format_rows, parse_table, read_text
 from fibrelmp.numtext.fast import format_g_rows, format_xyz_parts
 from fibrelmp.numtext.printf import fixed_chars, join_fields, name_chars
-
-XYZ_SUFFIX = {"position": "_coord.xyz", "velocity": "_vel.xyz", "force": "_force.xyz"}
-RESTART_SUFFIX = "_restart.res"
+# FibreNet's result names: defined with the bead-spring job, whose fix fibrenet/output writes them
+from fibrelmp.translate.lammps_job import RESTART_SUFFIX, XYZ_SUFFIX
 
 
 def _rows(fmt_row: str, names: np.ndarray, values: np.ndarray) -> str:

@@ -1,4 +1,6 @@
-"""DEMDF JSON documents (an input, or a snapshot to continue from)."""
+"""DEMDF JSON documents (an input, or a snapshot to continue from): the input hook, and where
+a run writes.  The run itself is the pipeline's granular run (``pipeline.granular``, reached
+by name: a format home lies below the pipeline)."""
 
 from __future__ import annotations
 
@@ -7,7 +9,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from fibrelmp.errors import InputError
-from fibrelmp.pipeline.inputs import InputFormat, RunSettings, Say, Warn
+from fibrelmp.inputformat import InputFormat, RunSettings, Say, Warn, pipeline_part
 
 if TYPE_CHECKING:
     from fibrelmp.granmodel import GranularModel
@@ -45,10 +47,11 @@ class DemdfInput(InputFormat):
              warn: Warn) -> "RunPlan":
         """Snapshots ``<filename>_<saveCount>.json`` next to the input (or in ``out``);
         earlier snapshots of the same name are replaced, all of them, only with ``force``."""
-        from fibrelmp.pipeline.granular import granular_request
-        from fibrelmp.pipeline.request import RunPlan
-        from fibrelmp.pipeline.also import granular_writers
         from fibrelmp.translate.demdf.writer import DemdfSnapshotWriter
+
+        granular_request = pipeline_part("fibrelmp.pipeline.granular:granular_request")
+        granular_writers = pipeline_part("fibrelmp.pipeline.also:granular_writers")
+        RunPlan = pipeline_part("fibrelmp.pipeline.request:RunPlan")
 
         model = self.read(path, settings)
         warn(model.warnings)

@@ -1,14 +1,17 @@
-"""FibreNet inputs (``input.txt`` with a ``model_file`` line)."""
+"""FibreNet inputs (``input.txt`` with a ``model_file`` line): the input hook, and where a
+run writes.  Its run plan is the pipeline's (``pipeline.fibrenet``, reached by name)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from fibrelmp.pipeline.inputs import InputFormat, RunSettings, Say, Warn, no_overrides
+from fibrelmp.errors import InputError
+from fibrelmp.inputformat import InputFormat, RunSettings, Say, Warn, no_overrides, pipeline_part
 
 if TYPE_CHECKING:
     from fibrelmp.model import Model
+    from fibrelmp.outputs import Outputs
     from fibrelmp.pipeline.request import RunOptions, RunPlan
     from fibrelmp.textio import Patch
     from fibrelmp.translate.lammps_job import Job
@@ -32,7 +35,6 @@ class FibreNetInput(InputFormat):
                 "significant digits)")
 
     def check_lines(self, path: Path, model: "Model") -> list[str]:
-        from fibrelmp.pipeline.fibrenet import fibrenet_outputs
         from fibrelmp.sanity import spring_check, units_line
 
         p = model.particles
@@ -63,17 +65,48 @@ class FibreNetInput(InputFormat):
 
     def plan(self, path: Path, settings: RunSettings, options: "RunOptions", say: Say,
              warn: Warn) -> "RunPlan":
-        from fibrelmp.pipeline.fibrenet import fibrenet_plan
-
         no_overrides(path, settings, "FibreNet inputs set their own steps: --end-time/--step/"
                      "--save-step/--steps are for MUSEN and DEMDF inputs")
         model = self.read(path)
         warn(model.warnings)
+        fibrenet_plan = pipeline_part("fibrelmp.pipeline.fibrenet:fibrenet_plan")
         return fibrenet_plan(model, settings.out, settings.work, options, settings.also)
 
     def work_folder(self, path: Path, out: Path | None, work: Path | None) -> Path:
-        from fibrelmp.pipeline.fibrenet import fibrenet_outputs
-
         if work is not None:
             return Path(work)
         return fibrenet_outputs(self.read(path), out)[0].work
+
+
+def fibrenet_outputs(model: "Model", out: str | Path | None = None,
+                     work: str | Path | None = None) -> tuple["Outputs", Path, str]:
+    """Where a FibreNet run writes: (outputs, output folder, file name prefix).
+
+    ``output_file`` is a name inside the output folder (``-o``, default the input's folder);
+    one that leaves it (``..``) is refused, and an absolute one is honoured only without
+    ``-o`` (as FibreNet would write it)."""
+    from fibrelmp.outputs import Outputs
+    from fibrelmp.translate.lammps_job import RESTART_SUFFIX, XYZ_SUFFIX
+
+    spec = model.plan.output
+    name = Path(spec.basename)
+    if name.is_absolute():
+        if out is not None:
+            raise InputError(model.source, spec.line, f"output_file {spec.basename} is an absolute "
+                             "path, which -o cannot place: give a plain name, or leave out -o")
+        target = name
+    else:
+        folder = (Path(out) if out is not None else spec.folder).resolve()
+        if ".." in name.parts:
+            raise InputError(model.source, spec.line, f"output_file {spec.basename} leaves the "
+                             f"output folder {folder}: give a name inside it")
+        target = folder / name
+    if not target.name or target.name in (".", ".."):
+        raise InputError(model.source, spec.line, f"output_file {spec.basename!r} names no file")
+    folder, prefix = target.parent, target.name
+    from fibrelmp.outputs import work_folder as job_folder
+
+    work_folder = job_folder(folder, prefix, work)
+    files = [folder / f"{prefix}{XYZ_SUFFIX[f]}" for f in spec.fields] + [folder / f"{prefix}{RESTART_SUFFIX}"]
+    family = [folder / f"{prefix}{suffix}" for suffix in (*XYZ_SUFFIX.values(), RESTART_SUFFIX)]
+    return Outputs(model.source, work_folder, files, family, inputs=list(model.inputs)), folder, prefix

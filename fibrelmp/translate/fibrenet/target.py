@@ -1,11 +1,12 @@
-"""LAMMPS dump frames -> FibreNet's own output files: ``write_fibrenet`` (``fibrelmp run``)
-and the ``post --to xyz|res`` targets."""
+"""LAMMPS dump frames -> FibreNet's own output files: ``write_fibrenet`` and ``convert_frames``
+(``fibrelmp run`` without the plugin's native files; ``report_outside`` when LAMMPS wrote
+them), and the ``post --to xyz|res`` targets."""
 
 from __future__ import annotations
 
 import warnings
 from pathlib import Path
-from typing import Callable, ClassVar, Iterable, Mapping, Sequence
+from typing import TYPE_CHECKING, Callable, ClassVar, Iterable, Iterator, Mapping, Sequence
 
 import numpy as np
 
@@ -15,6 +16,10 @@ from fibrelmp.post.target import DumpTarget, ReadBack
 from fibrelmp.translate.fibrenet.writer import (RESTART_SUFFIX, XYZ_SUFFIX, FibreNetWriter, RestartState,
                                                 XyzRows, read_restart, read_xyz)
 from fibrelmp.units import LJ
+
+if TYPE_CHECKING:
+    from fibrelmp.model import Model
+    from fibrelmp.translate.lammps_job import Job
 
 # dump column names for the velocity FibreNet writes (v~) and its total force
 VEL_COLUMNS = ("v_fn_vx", "v_fn_vy", "v_fn_vz")
@@ -273,3 +278,26 @@ class RestartTarget(_FibreNetTarget):
         names, rows = read_restart(files[0])
         return [ReadBack(rows[:, 0:3], rtol=6e-6, atol=1e-300,       # %g: 6 significant digits
                          values={("vx", "vy", "vz"): rows[:, 6:9], ("fx", "fy", "fz"): rows[:, 9:12]})]
+
+
+def convert_frames(model: Model, job: Job, frames: Iterator[Frame], folder: Path,
+                   prefix: str) -> list[Path]:
+    """FibreNet's files from a run's dump frames (``write_fibrenet``): the path without
+    fibrelmp's plugin, and the reference its ``fix fibrenet/output`` matches byte for byte."""
+    spec = model.plan.output
+    names = {lt: model.particles.type_names[t] for lt, t in enumerate(job.type_of_ltype) if lt > 0}
+    types = None if spec.types is None else {model.particles.type_names[t] for t in spec.types}
+    return write_fibrenet(frames, prefix, folder, spec.fields, names, model.dynamics.dt,
+                          model.box.lengths, types, warn=model.warn)
+
+
+def report_outside(model: Model):
+    """After a run whose job wrote FibreNet's files itself: the fix's wall check (the
+    warning ``outside_message`` the converter gives when it reads the frames itself)."""
+    def finished(lmp) -> None:
+        from fibrelmp.translate.lammps_job import OUTPUT_FIX
+
+        step, count = (int(lmp.extract_fix(OUTPUT_FIX, 0, 1, k)) for k in (0, 1))   # global vector
+        if step >= 0:
+            model.warn(OUTSIDE_KIND, outside_message(step, count, model.box.lengths))
+    return finished

@@ -1,4 +1,5 @@
-"""Strict JSON loading and typed access with JSON-location error messages (DEMDF).
+"""Strict JSON loading and typed access with JSON-location error messages (DEMDF documents,
+CardioProof cases).
 
 Every problem becomes ``InputError(path, line, "location: message")`` where ``location`` is
 the JSON path (``objects.particles[3][6]``); syntax errors carry the line and column.

@@ -129,6 +129,7 @@ MUSEN = _command(_c("MUSEN scene", "musen", [
     ("negative_density", "negative density"),
     ("zero_length_bond", "solid bond with initial length 0"),
     ("coincident_bond", "solid bond between two spheres at one position"),
+    ("coincident_spheres", "two unbonded spheres at one position"),
     ("activity", "activity interval starting after its end"),
     ("domain", "simulation domain with min > max"),
     ("wall_list", "geometry wall list naming a sphere"),

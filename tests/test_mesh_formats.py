@@ -12,21 +12,10 @@ import numpy as np
 import pytest
 
 from fibrelmp.errors import InputError
-from fibrelmp.mesh.model import CellBlock, Mesh
 from fibrelmp.mesh.opencarp.dynpt import HEADER, DynptReader, DynptWriter, igb_header
 from fibrelmp.mesh.opencarp.mesh import OpenCarpMeshReader, OpenCarpMeshWriter
 
-
-def _mesh() -> Mesh:
-    """A tetra, a prism and two triangles (mixed kinds, element order kept) in µm."""
-    rng = np.random.default_rng(3)
-    points = rng.random((9, 3)) * 1000.0          # µm, arbitrary doubles
-    points[0] = (10.34, -15.0023, 12.023)
-    cells = [CellBlock("tetra", [[0, 1, 2, 3]], [1]),
-             CellBlock("wedge", [[1, 2, 3, 4, 5, 6]], [2]),
-             CellBlock("triangle", [[6, 7, 8], [0, 7, 8]], [3, 3]),
-             CellBlock("tetra", [[2, 3, 4, 5]], [1])]
-    return Mesh(points.astype(np.float32).astype(np.float64), cells, unit=1e-6)
+from .conformance.base import mixed_mesh as _mesh      # a tetra, a prism and two triangles, in µm
 
 
 @pytest.mark.parametrize("binary", [False, True], ids=["text", "binary"])

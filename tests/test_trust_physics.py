@@ -17,25 +17,12 @@ from fibrelmp.errors import RunError
 from fibrelmp.granmodel import GranularFrame
 from fibrelmp.pipeline import finite
 
+from .test_musen_bad_input import BASE
+
 CLI = [sys.executable, "-m", "fibrelmp.cli"]
 
 # two glass spheres (ids 1, 2) and a solid bond (id 3) between them, on a steel triangle
-SCENE = """\
-0 0 1 14 5  23 STEEL 24 0 1e+300 2 0 44 0 0 0 1 0 0 0 1 0 15 0 0 0
-0 1 1 1 5 0.001 0.001 23 GLASS 24 0 1e+300 2 0 12 0 0 0.01 15 0 0 0 31 1 0 0 0
-0 2 1 1 5 0.001 0.001 23 GLASS 24 0 1e+300 2 0 12 0 0 0.012 15 0 0 0 31 1 0 0 0
-0 3 1 9 5 1 2 0.001 0.002 23 GLASS 24 0 1e+300 2 0 12 0 0 0 20 0 0 0
-22 -1 -1 -1 1 1 1
-28 0 0 0 0 0 0 0 0 0 0
-25 Plate GEOKEY 0 0 0 0 0
-26 0 0
-27 1 0
-32 STEEL Steel 0 7800 7 2e11 10 0.3
-32 GLASS Glass 0 2500 7 5e10 10 0.2
-33 STEEL STEEL 200 0.5 201 0.3 202 0.01
-33 GLASS STEEL 200 0.5 201 0.3 202 0.01
-33 GLASS GLASS 200 0.5 201 0.3 202 0.01
-"""
+SCENE = BASE
 COINCIDENT = SCENE.replace("12 0 0 0.012 15", "12 0 0 0.01 15")    # sphere 2 onto sphere 1
 SHORT = ["--end-time", "1e-5", "--step", "1e-7", "--save-step", "1e-6"]
 

@@ -127,7 +127,6 @@ void PairMusenHM::compute(int eflag, int vflag)
   const double dt = update->dt;
 
   double **x = atom->x;
-  double **v = atom->v;
   double **f = atom->f;
   double **omega = atom->omega;
   double **torque = atom->torque;
@@ -181,33 +180,8 @@ void PairMusenHM::compute(int eflag, int vflag)
 
       // ---- CalculatePP
       const double *w1 = omega[i], *w2 = omega[j];
-      const double s1 = r1 / (r1 + r2);
-      const double s2 = -r2 / (r1 + r2);
-      const double rc1[3] = {cv[0] * s1, cv[1] * s1, cv[2] * s1};
-      const double rc2[3] = {cv[0] * s2, cv[1] * s2, cv[2] * s2};
-      double n[3] = {0.0, 0.0, 0.0};
-      const double cvlen = length(cv);
-      if (cvlen != 0) {
-        n[0] = cv[0] / cvlen;
-        n[1] = cv[1] / cvlen;
-        n[2] = cv[2] / cvlen;
-      }
-
-      // normal and tangential relative velocity (dst minus src at the contact point)
-      double w2rc2[3], w1rc1[3];
-      cross(w2, rc2, w2rc2);
-      cross(w1, rc1, w1rc1);
-      double rel[3];
-      for (int k = 0; k < 3; k++) rel[k] = (v[j][k] + w2rc2[k]) - (v[i][k] + w1rc1[k]);
-      const double vn = n[0] * rel[0] + n[1] * rel[1] + n[2] * rel[2];
-      double vt[3];
-      for (int k = 0; k < 3; k++) vt[k] = rel[k] - vn * n[k];
-
-      // normal force with damping (negative: pushes src away from dst)
-      double kn, kt, fn_el;
-      stiffness(itype, jtype, overlap, equiv_radius, kn, kt, fn_el);
-      const double fn_damp =
-          -MUSEN_2_SQRT_5_6 * alpha[itype][jtype] * vn * std::sqrt(kn * equiv_mass);
+      double n[3], cvlen, vn, vt[3];
+      kinematics(i, j, cv, n, cvlen, vn, vt);
 
       // rotate the old tangential overlap into the tangent plane, keeping its length
       const double xi_n = n[0] * xi_old[0] + n[1] * xi_old[1] + n[2] * xi_old[2];
@@ -220,24 +194,8 @@ void PairMusenHM::compute(int eflag, int vflag)
       double xi[3];
       for (int k = 0; k < 3; k++) xi[k] = xi_rot[k] + vt[k] * dt;
 
-      // tangential force with damping
-      double ft_spring[3];
-      for (int k = 0; k < 3; k++) ft_spring[k] = xi[k] * kt;
-      const double damp_t = -MUSEN_2_SQRT_5_6 * alpha[itype][jtype] * std::sqrt(kt * equiv_mass);
-
-      // MUSEN tests the spring force alone against mu |Fn_el + Fn_damp|; when it slips the
-      // force is the capped spring force (no damping) and xi shrinks to match it
-      double ft[3];
-      const double ft_spring_len = length(ft_spring);
-      const double friction_len = mu[itype][jtype] * std::fabs(fn_el + fn_damp);
-      if (ft_spring_len > friction_len) {
-        for (int k = 0; k < 3; k++) {
-          ft[k] = ft_spring[k] * friction_len / ft_spring_len;
-          xi[k] = ft[k] / kt;
-        }
-      } else {
-        for (int k = 0; k < 3; k++) ft[k] = ft_spring[k] + vt[k] * damp_t;
-      }
+      double fn_el, fn_damp, ft[3];
+      contact_force(itype, jtype, overlap, equiv_radius, equiv_mass, vn, vt, xi, fn_el, fn_damp, ft);
 
       // rolling torque on each sphere's own angular velocity, with the elastic normal force
       double roll1[3] = {0.0, 0.0, 0.0}, roll2[3] = {0.0, 0.0, 0.0};
@@ -418,6 +376,63 @@ double PairMusenHM::init_one(int i, int j)
   return maxrad[i] + maxrad[j];
 }
 
+void PairMusenHM::kinematics(int i, int j, const double cv[3], double n[3], double &cvlen,
+                             double &vn, double vt[3]) const
+{
+  double **v = atom->v;
+  double **omega = atom->omega;
+  const double r1 = atom->radius[i], r2 = atom->radius[j];
+  const double *w1 = omega[i], *w2 = omega[j];
+  const double s1 = r1 / (r1 + r2);
+  const double s2 = -r2 / (r1 + r2);
+  const double rc1[3] = {cv[0] * s1, cv[1] * s1, cv[2] * s1};
+  const double rc2[3] = {cv[0] * s2, cv[1] * s2, cv[2] * s2};
+  n[0] = n[1] = n[2] = 0.0;
+  cvlen = length(cv);
+  if (cvlen != 0) {
+    n[0] = cv[0] / cvlen;
+    n[1] = cv[1] / cvlen;
+    n[2] = cv[2] / cvlen;
+  }
+
+  // normal and tangential relative velocity (dst minus src at the contact point)
+  double w2rc2[3], w1rc1[3];
+  cross(w2, rc2, w2rc2);
+  cross(w1, rc1, w1rc1);
+  double rel[3];
+  for (int k = 0; k < 3; k++) rel[k] = (v[j][k] + w2rc2[k]) - (v[i][k] + w1rc1[k]);
+  vn = n[0] * rel[0] + n[1] * rel[1] + n[2] * rel[2];
+  for (int k = 0; k < 3; k++) vt[k] = rel[k] - vn * n[k];
+}
+
+void PairMusenHM::contact_force(int itype, int jtype, double overlap, double equiv_radius,
+                                double equiv_mass, double vn, const double vt[3], double xi[3],
+                                double &fn_el, double &fn_damp, double ft[3]) const
+{
+  // normal force with damping (negative: pushes src away from dst)
+  double kn, kt;
+  stiffness(itype, jtype, overlap, equiv_radius, kn, kt, fn_el);
+  fn_damp = -MUSEN_2_SQRT_5_6 * alpha[itype][jtype] * vn * std::sqrt(kn * equiv_mass);
+
+  // tangential force with damping
+  double ft_spring[3];
+  for (int k = 0; k < 3; k++) ft_spring[k] = xi[k] * kt;
+  const double damp_t = -MUSEN_2_SQRT_5_6 * alpha[itype][jtype] * std::sqrt(kt * equiv_mass);
+
+  // MUSEN tests the spring force alone against mu |Fn_el + Fn_damp|; when it slips the
+  // force is the capped spring force (no damping) and xi shrinks to match it
+  const double ft_spring_len = length(ft_spring);
+  const double friction_len = mu[itype][jtype] * std::fabs(fn_el + fn_damp);
+  if (ft_spring_len > friction_len) {
+    for (int k = 0; k < 3; k++) {
+      ft[k] = ft_spring[k] * friction_len / ft_spring_len;
+      xi[k] = ft[k] / kt;
+    }
+  } else {
+    for (int k = 0; k < 3; k++) ft[k] = ft_spring[k] + vt[k] * damp_t;
+  }
+}
+
 /* ----------------------------------------------------------------------
    The contact force on i (compute pair/local, between runs): the force compute() applied
    in the last step, as its history entry keeps it (a contact is swept the step it ends, so
@@ -432,8 +447,6 @@ double PairMusenHM::single(int i, int j, int itype, int jtype, double rsq, doubl
                            double factor_lj, double &fforce)
 {
   double **x = atom->x;
-  double **v = atom->v;
-  double **omega = atom->omega;
   double *radius = atom->radius;
   double *rmass = atom->rmass;
   tagint *tag = atom->tag;
@@ -456,43 +469,12 @@ double PairMusenHM::single(int i, int j, int itype, int jtype, double rsq, doubl
     return 0.0;
   }
 
-  const double *w1 = omega[i], *w2 = omega[j];
-  const double s1 = r1 / (r1 + r2);
-  const double s2 = -r2 / (r1 + r2);
-  const double rc1[3] = {cv[0] * s1, cv[1] * s1, cv[2] * s1};
-  const double rc2[3] = {cv[0] * s2, cv[1] * s2, cv[2] * s2};
-  double n[3] = {0.0, 0.0, 0.0};
-  const double cvlen = length(cv);
-  if (cvlen != 0) {
-    n[0] = cv[0] / cvlen;
-    n[1] = cv[1] / cvlen;
-    n[2] = cv[2] / cvlen;
-  }
-  double w2rc2[3], w1rc1[3];
-  cross(w2, rc2, w2rc2);
-  cross(w1, rc1, w1rc1);
-  double rel[3];
-  for (int k = 0; k < 3; k++) rel[k] = (v[j][k] + w2rc2[k]) - (v[i][k] + w1rc1[k]);
-  const double vn = n[0] * rel[0] + n[1] * rel[1] + n[2] * rel[2];
-  double vt[3];
-  for (int k = 0; k < 3; k++) vt[k] = rel[k] - vn * n[k];
+  double n[3], cvlen, vn, vt[3];
+  kinematics(i, j, cv, n, cvlen, vn, vt);
   double xi[3];
   for (int k = 0; k < 3; k++) xi[k] = 0.0 + vt[k] * update->dt;    // a new contact's first xi
-
-  double kn, kt, fn_el;
-  stiffness(itype, jtype, overlap, equiv_radius, kn, kt, fn_el);
-  const double fn_damp = -MUSEN_2_SQRT_5_6 * alpha[itype][jtype] * vn * std::sqrt(kn * equiv_mass);
-  double ft_spring[3];
-  for (int k = 0; k < 3; k++) ft_spring[k] = xi[k] * kt;
-  const double damp_t = -MUSEN_2_SQRT_5_6 * alpha[itype][jtype] * std::sqrt(kt * equiv_mass);
-  double ft[3];
-  const double ft_spring_len = length(ft_spring);
-  const double friction_len = mu[itype][jtype] * std::fabs(fn_el + fn_damp);
-  if (ft_spring_len > friction_len) {
-    for (int k = 0; k < 3; k++) ft[k] = ft_spring[k] * friction_len / ft_spring_len;
-  } else {
-    for (int k = 0; k < 3; k++) ft[k] = ft_spring[k] + vt[k] * damp_t;
-  }
+  double fn_el, fn_damp, ft[3];
+  contact_force(itype, jtype, overlap, equiv_radius, equiv_mass, vn, vt, xi, fn_el, fn_damp, ft);
 
   // normal force on i: n (fn_el + fn_damp) = (x_i - x_j) fforce
   if (cvlen != 0) fforce = -(fn_el + fn_damp) / cvlen;

@@ -68,6 +68,16 @@ class PairMusenHM : public Pair {
   virtual void stiffness(int itype, int jtype, double overlap, double equiv_radius,
                          double &kn, double &kt, double &fn_el) const;
 
+  // MUSEN's CalculatePP for spheres i (src) and j (dst), cv = x_j - x_i: the unit normal n
+  // (zero with cv), |cv|, and the normal and tangential relative velocity at the contact point
+  void kinematics(int i, int j, const double cv[3], double n[3], double &cvlen, double &vn,
+                  double vt[3]) const;
+  // the normal force (elastic fn_el <= 0, damping fn_damp) and tangential force ft from the
+  // tangential overlap xi (this step's, shrunk to match ft when the contact slips)
+  void contact_force(int itype, int jtype, double overlap, double equiv_radius,
+                     double equiv_mass, double vn, const double vt[3], double xi[3],
+                     double &fn_el, double &fn_damp, double ft[3]) const;
+
   void allocate();
 };
 

@@ -5,41 +5,32 @@ musen/linear) against the real cmusen: an oblique, spinning impact of two glass 
 
 from __future__ import annotations
 
-import os
-import shutil
-import subprocess
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from fibrelmp import lammps_styles, python_api
+from fibrelmp import python_api
 from fibrelmp.errors import InputError
 from fibrelmp.translate.musen.text import read_time_points
 
 from .conftest import data_path
+from .musen_model_checks import (ANGVEL, COORD, VEL, check_reference_is_cmusens_output,
+                                 check_refused_without_styles, model_job, needs_cmusen,
+                                 styles_or_skip)
 
 DATA = data_path("real-outputs/musen/models/pp_linear_elastic")
-CMUSEN = os.environ.get("FIBRELMP_CMUSEN")
-VEL, ANGVEL, COORD = 15, 16, 12                # MUSEN text tags
 # cmusen saves the half-step velocity during a contact (README.md): compare outside it
 IN_CONTACT = (2e-4, 4e-4)
+PARAMS = "Kn 2000 Kt 1500"
 
 
-def _styles_or_skip():
-    if not lammps_styles.plugin().available:
-        pytest.skip("fibrelmp's LAMMPS styles are not available")
-
-
-def _job(tmp_path: Path, params: str = "Kn 2000 Kt 1500") -> Path:
-    shutil.copy(DATA / "le_scene.txt", tmp_path)
-    job = (DATA / "job_le.txt").read_text().replace("Kn 2000 Kt 1500", params)
-    (tmp_path / "job_le.txt").write_text(job)
-    return tmp_path / "job_le.txt"
+def _job(tmp_path: Path, params: str = PARAMS) -> Path:
+    return model_job(tmp_path, DATA, "le", PARAMS, params)
 
 
 def test_two_sphere_impact_is_cmusens(tmp_path):
-    _styles_or_skip()
+    styles_or_skip()
     python_api.run(_job(tmp_path), work=tmp_path / "work")
     ours = read_time_points(tmp_path / "le_result_prec17.txt")
     theirs = read_time_points(DATA / "cmusen_le_result_prec17.txt")
@@ -72,7 +63,7 @@ def test_check_gives_the_linear_contact_time(tmp_path):
 @pytest.mark.parametrize("params,word,line", [("Kn -5", "Kn", 11), ("Kt 0", "Kt", 11),
                                               ("Kn x", "Kn", 10)])
 def test_bad_stiffness_is_an_input_error(tmp_path, params, word, line):
-    _styles_or_skip()
+    styles_or_skip()
     job = _job(tmp_path, params)
     with pytest.raises(InputError, match=rf"ModelPPLinearElastic parameter {word}") as err:
         python_api.run(job)
@@ -80,22 +71,10 @@ def test_bad_stiffness_is_an_input_error(tmp_path, params, word, line):
     assert not (tmp_path / "le_init.mdem").exists()
 
 
-@pytest.mark.skipif(not CMUSEN, reason="set FIBRELMP_CMUSEN to the real cmusen")
+@needs_cmusen
 def test_reference_is_cmusens_output(tmp_path):
-    for name in ("le_scene.txt", "job_le.txt"):
-        shutil.copy(DATA / name, tmp_path)
-    done = subprocess.run([CMUSEN, "-t=1", "-s=job_le.txt"], cwd=tmp_path, capture_output=True,
-                          text=True, timeout=300)
-    assert done.returncode == 0 and "Error:" not in done.stdout, done.stdout + done.stderr
-    assert (tmp_path / "le_result_prec17.txt").read_bytes() == \
-        (DATA / "cmusen_le_result_prec17.txt").read_bytes()
+    check_reference_is_cmusens_output(tmp_path, DATA, "le")
 
 
 def test_refused_without_fibrelmps_styles(tmp_path):
-    """Stock LAMMPS has no such law: an InputError at the model line, nothing written."""
-    job = _job(tmp_path)
-    with lammps_styles.stock(True), pytest.raises(InputError, match="ModelPPLinearElastic needs "
-                                                  "fibrelmp's LAMMPS styles") as err:
-        python_api.run(job)
-    assert str(err.value).startswith(f"{job}:10: ")
-    assert not (tmp_path / "le_init.mdem").exists()
+    check_refused_without_styles(_job(tmp_path), "ModelPPLinearElastic", 10, tmp_path / "le_init.mdem")

@@ -6,41 +6,32 @@ bouncing obliquely on a steel plate
 
 from __future__ import annotations
 
-import os
-import shutil
-import subprocess
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from fibrelmp import lammps_styles, python_api
+from fibrelmp import python_api
 from fibrelmp.errors import InputError
 from fibrelmp.translate.musen.text import read_time_points
 
 from .conftest import data_path
+from .musen_model_checks import (ANGVEL, COORD, VEL, check_reference_is_cmusens_output,
+                                 check_refused_without_styles, model_job, needs_cmusen,
+                                 styles_or_skip)
 
 DATA = data_path("real-outputs/musen/models/pw_simple_viscoelastic")
-CMUSEN = os.environ.get("FIBRELMP_CMUSEN")
-VEL, ANGVEL, COORD = 15, 16, 12                # MUSEN text tags
 PARAMS = "NORMAL_FORCE_COEFF 3000 NORMAL_DAMPING_PARAMETER 0.002"
 # cmusen saves the half-step velocity during a contact (README.md): compare outside it
 IN_CONTACT = (0.9e-4, 3.1e-4)
 
 
-def _styles_or_skip():
-    if not lammps_styles.plugin().available:
-        pytest.skip("fibrelmp's LAMMPS styles are not available")
-
-
 def _job(tmp_path: Path, params: str = PARAMS) -> Path:
-    shutil.copy(DATA / "sve_scene.txt", tmp_path)
-    (tmp_path / "job_sve.txt").write_text((DATA / "job_sve.txt").read_text().replace(PARAMS, params))
-    return tmp_path / "job_sve.txt"
+    return model_job(tmp_path, DATA, "sve", PARAMS, params)
 
 
 def test_oblique_bounce_is_cmusens(tmp_path):
-    _styles_or_skip()
+    styles_or_skip()
     python_api.run(_job(tmp_path), work=tmp_path / "work")
     ours = read_time_points(tmp_path / "sve_result_prec17.txt")
     theirs = read_time_points(DATA / "cmusen_sve_result_prec17.txt")
@@ -71,7 +62,7 @@ def test_check_gives_the_spring_contact_time(tmp_path):
     ("NORMAL_DAMPING_PARAMETER -1", "NORMAL_DAMPING_PARAMETER", 12),
     ("NORMAL_FORCE_COEFF x", "NORMAL_FORCE_COEFF", 11)])
 def test_bad_parameter_is_an_input_error(tmp_path, params, word, line):
-    _styles_or_skip()
+    styles_or_skip()
     job = _job(tmp_path, params)
     with pytest.raises(InputError, match=rf"ModelPWSimpleViscoElastic parameter {word}") as err:
         python_api.run(job)
@@ -79,22 +70,10 @@ def test_bad_parameter_is_an_input_error(tmp_path, params, word, line):
     assert not (tmp_path / "sve_init.mdem").exists()
 
 
-@pytest.mark.skipif(not CMUSEN, reason="set FIBRELMP_CMUSEN to the real cmusen")
+@needs_cmusen
 def test_reference_is_cmusens_output(tmp_path):
-    for name in ("sve_scene.txt", "job_sve.txt"):
-        shutil.copy(DATA / name, tmp_path)
-    done = subprocess.run([CMUSEN, "-t=1", "-s=job_sve.txt"], cwd=tmp_path, capture_output=True,
-                          text=True, timeout=300)
-    assert done.returncode == 0 and "Error:" not in done.stdout, done.stdout + done.stderr
-    assert (tmp_path / "sve_result_prec17.txt").read_bytes() == \
-        (DATA / "cmusen_sve_result_prec17.txt").read_bytes()
+    check_reference_is_cmusens_output(tmp_path, DATA, "sve")
 
 
 def test_refused_without_fibrelmps_styles(tmp_path):
-    """Stock LAMMPS walls have no such law: an InputError at the model line, nothing written."""
-    job = _job(tmp_path)
-    with lammps_styles.stock(True), pytest.raises(InputError, match="ModelPWSimpleViscoElastic "
-                                                  "needs fibrelmp's LAMMPS styles") as err:
-        python_api.run(job)
-    assert str(err.value).startswith(f"{job}:11: ")
-    assert not (tmp_path / "sve_init.mdem").exists()
+    check_refused_without_styles(_job(tmp_path), "ModelPWSimpleViscoElastic", 11, tmp_path / "sve_init.mdem")

@@ -1,0 +1,54 @@
+"""What every MUSEN model's test module shares (tests/test_<kind>_<model>.py): its case in
+tests/data/real-outputs/musen/models/<model>/ (``<prefix>_scene.txt``, the cmusen job script
+``job_<prefix>.txt`` and cmusen's 17-digit result ``cmusen_<prefix>_result_prec17.txt``), the
+job with other parameters, the opt-in rerun of the real cmusen, and the refusal without
+fibrelmp's LAMMPS styles."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from fibrelmp import lammps_styles, python_api
+from fibrelmp.errors import InputError
+
+CMUSEN = os.environ.get("FIBRELMP_CMUSEN")
+needs_cmusen = pytest.mark.skipif(not CMUSEN, reason="set FIBRELMP_CMUSEN to the real cmusen")
+VEL, ANGVEL, COORD = 15, 16, 12                # MUSEN text tags
+
+
+def styles_or_skip() -> None:
+    if not lammps_styles.plugin().available:
+        pytest.skip("fibrelmp's LAMMPS styles are not available")
+
+
+def model_job(tmp_path: Path, data: Path, prefix: str, params: str, new_params: str | None = None) -> Path:
+    """The case's job script and scene in ``tmp_path``, its ``params`` line replaced by
+    ``new_params``."""
+    shutil.copy(data / f"{prefix}_scene.txt", tmp_path)
+    job = (data / f"job_{prefix}.txt").read_text()
+    (tmp_path / f"job_{prefix}.txt").write_text(job if new_params is None else job.replace(params, new_params))
+    return tmp_path / f"job_{prefix}.txt"
+
+
+def check_reference_is_cmusens_output(tmp_path: Path, data: Path, prefix: str) -> None:
+    for name in (f"{prefix}_scene.txt", f"job_{prefix}.txt"):
+        shutil.copy(data / name, tmp_path)
+    done = subprocess.run([CMUSEN, "-t=1", f"-s=job_{prefix}.txt"], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=300)
+    assert done.returncode == 0 and "Error:" not in done.stdout, done.stdout + done.stderr
+    assert (tmp_path / f"{prefix}_result_prec17.txt").read_bytes() == \
+        (data / f"cmusen_{prefix}_result_prec17.txt").read_bytes()
+
+
+def check_refused_without_styles(job: Path, model: str, line: int, init: Path) -> None:
+    """Stock LAMMPS has no such law: an InputError at the model line, nothing written."""
+    with lammps_styles.stock(True), pytest.raises(InputError, match=f"{model} needs fibrelmp's "
+                                                  "LAMMPS styles") as err:
+        python_api.run(job)
+    assert str(err.value).startswith(f"{job}:{line}: ")
+    assert not init.exists()

@@ -21,6 +21,7 @@ from fibrelmp.translate.fibrenet.writer import read_xyz
 
 from .test_post_robust import ROWS, frame, write
 from .test_post_roundtrip import post
+from .test_vtk_viewers import vtk_read
 
 CLI = [sys.executable, "-m", "fibrelmp.cli"]
 
@@ -192,19 +193,6 @@ def test_an_id_of_nan_is_refused_by_vtk_too(tmp_path):
 
 
 # ------------------------------------------------------------- 3. names in VTK's XML files
-def vtk_read(path: Path):
-    """``.vtp``/``.vtm`` through VTK's own XML readers; any VTK error or warning fails."""
-    xml = pytest.importorskip("vtkmodules.vtkIOXML", reason="VTK not installed (pip install vtk)")
-    reader = xml.vtkXMLMultiBlockDataReader() if path.suffix == ".vtm" else xml.vtkXMLPolyDataReader()
-    events: list[str] = []
-    for kind in ("ErrorEvent", "WarningEvent"):
-        reader.AddObserver(kind, lambda obj, event: events.append(event))
-    reader.SetFileName(str(path))
-    reader.Update()
-    assert not events, f"VTK reports {events} for {path}"
-    return reader.GetOutput()
-
-
 def vtk_array(data, name: str) -> np.ndarray:
     from vtkmodules.util.numpy_support import vtk_to_numpy
 

@@ -350,7 +350,7 @@ def check_steps(model, where, allow_huge: bool) -> None:
     if steps > MAXBIGINT:
         raise InputError(where, None, f"the run has {steps} time steps; LAMMPS counts at most "
                          f"{MAXBIGINT} (2^63-1)")
-    seconds = steps / FASTEST_STEPS_PER_SECOND + planned_runs(model) / FASTEST_RUNS_PER_SECOND
+    seconds = _least_seconds(model, steps)
     if steps > MOST_STEPS or (seconds > LONGEST_RUN_SECONDS and not allow_huge):
         override = "" if steps > MOST_STEPS else ", or give --yes-i-mean-it"
         raise InputError(where, None, f"the run has {steps} time steps: at least "
@@ -365,12 +365,17 @@ def long_run_check(model) -> None:
     steps = planned_steps(model)
     if steps is None or not hasattr(model, "warn"):
         return
-    runs = planned_runs(model)
-    seconds = steps / FASTEST_STEPS_PER_SECOND + runs / FASTEST_RUNS_PER_SECOND
+    seconds = _least_seconds(model, steps)
     if seconds > LONG_RUN_SECONDS:
-        model.warn("long run", f"the run has {steps} time steps in {runs} LAMMPS runs (chunks): "
+        model.warn("long run", f"the run has {steps} time steps in {planned_runs(model)} LAMMPS runs (chunks): "
                    f"at least {_duration(seconds)} even at {FASTEST_STEPS_PER_SECOND:.0e} steps/s "
                    f"and {FASTEST_RUNS_PER_SECOND:.0e} runs/s (the progress line gives the ETA)")
+
+
+def _least_seconds(model, steps: int) -> float:
+    """The wall time of ``steps`` steps at the fastest speeds LAMMPS could reach (per step, and
+    per separate 'run' command)."""
+    return steps / FASTEST_STEPS_PER_SECOND + planned_runs(model) / FASTEST_RUNS_PER_SECOND
 
 
 def planned_runs(model) -> int:

@@ -1,17 +1,17 @@
-"""Granular runs (MUSEN scenes and cmusen scripts, DEMDF): a ``GranularModel`` rendered by
-``translate.granular_job``, its frames built by ``FrameBuilder``, fed to the format's writers."""
+"""The run request of a granular simulation (MUSEN scenes and cmusen scripts, DEMDF): a
+``GranularModel`` rendered by ``translate.granular_job``, its frames built by
+``granular_run.frames.FrameBuilder``, fed to the format's writers.  The format homes build
+their plans with it; the pipeline executes them."""
 
 from __future__ import annotations
 
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable
 
-from fibrelmp.pipeline.request import Rendered, RunOptions, RunPlan, RunRequest
-from fibrelmp.pipeline.run import feed, run
+from fibrelmp.runplan import Rendered, RunRequest, feed
 
 if TYPE_CHECKING:
-    from fibrelmp.granmodel import GranularFrame, GranularModel
-    from fibrelmp.translate.granular_job import GranularJob
+    from fibrelmp.granmodel import GranularModel
 
 
 def render(model: "GranularModel"):
@@ -34,34 +34,7 @@ def granular_request(model: "GranularModel", work: str | Path,
                      writers: Callable[[], list]) -> RunRequest:
     """One simulation of ``model`` in ``work``, its frames added to ``writers()`` (made on
     rank 0 once the outputs are locked; closed on success, aborted on failure)."""
-    from fibrelmp.pipeline.granular_frames import FrameBuilder
+    from fibrelmp.granular_run.frames import FrameBuilder
 
     return RunRequest(model, render(model), lambda rendered: FrameBuilder(model, rendered.job),
                       lambda rendered: feed(writers(), model), Path(work))
-
-
-class _Calls:
-    """A writer that hands every frame to a function."""
-
-    def __init__(self, on_frame: Callable[["GranularFrame"], None]):
-        self.add = on_frame
-
-    def close(self) -> None:
-        pass
-
-    def abort(self) -> None:
-        pass
-
-
-def run_granular(model: "GranularModel", work: str | Path,
-                 on_frame: Callable[["GranularFrame"], None], progress: bool = True,
-                 checkpoint_every: int | None = None, resume: bool = False) -> "GranularJob":
-    """Translate ``model`` into ``work``, run it and call ``on_frame`` for every saved frame
-    (rank 0 only), in time order.  ``checkpoint_every``/``resume``: see fibrelmp.checkpoint
-    (a resumed run feeds the frames saved before the checkpoint again, from the dumps)."""
-    from fibrelmp.outputs import Outputs
-
-    work = Path(work).resolve()
-    plan = RunPlan(Outputs(model.source, work), [granular_request(model, work, lambda: [_Calls(on_frame)])],
-                   RunOptions(progress, False, checkpoint_every, resume))
-    return run(plan).jobs[0].job

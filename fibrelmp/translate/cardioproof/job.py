@@ -26,8 +26,8 @@ from pathlib import Path
 
 import numpy as np
 
-from fibrelmp.cardioproof import geometry
-from fibrelmp.cardioproof.case import MAX_SOUND_SPEED, SphCase
+from fibrelmp.translate.cardioproof import geometry
+from fibrelmp.translate.cardioproof.case import MAX_SOUND_SPEED, SphCase
 from fibrelmp.errors import InputError
 from fibrelmp.mesh.outflow import MARGIN
 from fibrelmp.translate.lammps_format import float_text

@@ -1,7 +1,7 @@
 """MUSEN's contact and bond laws, as translated to LAMMPS, against independent formulas.
 
 Every model is built directly in Python (tests/granular_models.py) and run through
-``fibrelmp.pipeline.granular.run_granular``; the forces, velocities and break times LAMMPS
+``fibrelmp.pipeline.run_model.run_granular``; the forces, velocities and break times LAMMPS
 reports in the frames are compared with closed-form expressions written from
 shared/research/musen.md section 2 (not from the translator).
 """

@@ -1,7 +1,6 @@
-"""The run request of a granular simulation (MUSEN scenes and cmusen scripts, DEMDF): a
-``GranularModel`` rendered by ``translate.granular_job``, its frames built by
-``granular_run.frames.FrameBuilder``, fed to the format's writers.  The format homes build
-their plans with it; the pipeline executes them."""
+"""Granular runs (MUSEN scenes and cmusen scripts, DEMDF): a ``GranularModel`` rendered by
+``translate.granular_job``, its frames built by ``FrameBuilder``, fed to the format's writers.
+The format homes build their plans with ``granular_request``; the pipeline executes them."""
 
 from __future__ import annotations
 

@@ -2,8 +2,8 @@
 
 ``run``             ``run(plan)``: lock, render, checkpoint, run (serial or overlapped),
                     feed the writers, check the frame schedule, finish the outputs
-``fibrenet``        ``run_fibrenet``: FibreNet's plan (``translate.fibrenet.plan``), run
-``granular``        ``run_granular``: a granular model's request (``granular_run``), run
+``run_model``       ``run_fibrenet``, ``run_granular``: a model's plan (FibreNet's,
+                    ``translate.fibrenet.plan``; the granular request, ``granular_run``), run
 ``evaluate``        one LAMMPS force evaluation of a FibreNet model (tests)
 
 The plan types (``RunPlan``, ``RunRequest``, ``RunOptions``, ``feed``) live in the core

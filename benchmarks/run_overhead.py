@@ -5,7 +5,7 @@ Generates a random ~50,000-bead FibreNet network (examples/generate_network.py; 
 a frame every 250 steps) in a temporary folder, then in the same process measures:
 
   (a) fibrelmp = fibrelmp.translate.fibrenet.reader.read(input.txt) +
-      fibrelmp.pipeline.fibrenet.run_fibrenet(model, out=..., progress=False): translation, LAMMPS run (line by line, as the CLI does) and writing
+      fibrelmp.pipeline.run_model.run_fibrenet(model, out=..., progress=False): translation, LAMMPS run (line by line, as the CLI does) and writing
       FibreNet's output files from the dump;
   (b) bare     = new_lammps([...]); chdir(job folder); lmp.file('in.lammps'); close, on the
       job folder (a) rendered, i.e. the same LAMMPS work (including its write_dump frames)
@@ -69,7 +69,7 @@ def run_fibrelmp(input_path: Path, out: Path) -> tuple[float, dict[str, float], 
     import fibrelmp.post.to_fibrenet as to_fibrenet
     import fibrelmp.runner as runner
     import fibrelmp.translate.lammps_job as lammps_job
-    from fibrelmp.pipeline.fibrenet import run_fibrenet
+    from fibrelmp.pipeline.run_model import run_fibrenet
     from fibrelmp.translate.fibrenet.reader import read
 
     timers = Timers()

@@ -4,14 +4,12 @@ The registry (``fibrelmp.registry``, role INPUT) names one ``InputFormat`` subcl
 format; ``python_api`` detects the format, loads its hook and calls only the methods below,
 so a new input format is one subclass and one ``register_format`` line, and never falls into
 another format's code.  This base sits in the core layer so that a format's home (which the
-pipeline imports, never the other way) can derive its hook; a hook reaches the pipeline's
-run-plan code through ``pipeline_part`` ("module:name", imported when the run is planned),
-as the registry reaches hooks.
+pipeline imports, never the other way) can derive its hook; a hook builds its ``RunPlan``
+from the core's plan types (``fibrelmp.runplan``) and the pipeline executes it.
 """
 
 from __future__ import annotations
 
-import importlib
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
 from pathlib import Path
@@ -20,7 +18,7 @@ from typing import TYPE_CHECKING, Any, Callable, ClassVar
 from fibrelmp.errors import InputError
 
 if TYPE_CHECKING:
-    from fibrelmp.pipeline.request import RunOptions, RunPlan
+    from fibrelmp.runplan import RunOptions, RunPlan
     from fibrelmp.textio import Patch
 
 Say = Callable[[str], None]
@@ -37,7 +35,7 @@ class RunSettings:
     save_step: float | None = None     # --save-step
     steps: int | None = None           # --steps
     precision: int = 6                 # significant digits of text results that take it
-    also: tuple[str, ...] = ()         # --also: formats also written from the frames (pipeline.also)
+    also: tuple[str, ...] = ()         # --also: formats also written from the frames (fibrelmp.also)
 
     def overrides(self) -> tuple:
         return (self.end_time, self.step, self.save_step, self.steps)
@@ -98,11 +96,3 @@ def no_overrides(path: Path, settings: RunSettings, message: str) -> None:
     """Refuse --end-time/--step/--save-step/--steps for inputs that set their own."""
     if any(v is not None for v in settings.overrides()):
         raise InputError(path, None, message)
-
-
-def pipeline_part(spec: str) -> Any:
-    """The pipeline object ``"module:name"`` names, imported now: a format home lies below the
-    pipeline (docs/architecture.md, the layers) and plans its run with the pipeline's parts
-    without importing them at module level or by name in its imports."""
-    module, _, name = spec.partition(":")
-    return getattr(importlib.import_module(module), name)

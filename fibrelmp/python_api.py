@@ -106,7 +106,7 @@ def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | N
     digits of text results that take it (default 6; refused for the others).  ``stock_styles``: stock LAMMPS
     styles instead of fibrelmp's own (see ``translate_job``).  ``also`` (``run --also``):
     formats also written from every saved frame beside the results, any of
-    ``fibrelmp.registry.names("also")`` (``fibrelmp.pipeline.also``; the files are in
+    ``fibrelmp.registry.names("also")`` (``fibrelmp.also``; the files are in
     ``outputs``); ``viewer_files=True`` is deprecated: every one of them.  ``say`` receives progress notes, ``warn`` lists of
     ``(kind, text)`` warnings as they are found (they are also in the result).  ``progress``:
     a bar on a terminal, else a line on stderr every ``log_every`` (``"10%"``, ``"60s"``,
@@ -119,7 +119,7 @@ def run(path: str | Path, out: str | Path | None = None, *, work: str | Path | N
     (``run --yes-i-mean-it``) lifts the last two."""
     from fibrelmp.checkpoint import check_every
     from fibrelmp.pipeline import RunOptions, run as run_plan
-    from fibrelmp.pipeline.also import chosen
+    from fibrelmp.also import chosen
     from fibrelmp.inputformat import RunSettings
 
     path = Path(path)

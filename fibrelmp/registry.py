@@ -9,10 +9,9 @@ targets, help texts list names); no other module names formats.  Code is importe
 Roles
   ``input``   a simulation input ``run``/``check``/``translate`` accept; its hook is an
               ``InputFormat`` (``fibrelmp.inputformat``): read, check, translate, and
-              the ``RunPlan`` of a run.  A format home holds its hook (FibreNet, DEMDF;
-              the MUSEN and CardioProof hooks are still in ``pipeline.inputs``); a home
-              lies below the pipeline and names the pipeline's run-plan parts it uses
-              (``inputformat.pipeline_part``).
+              the ``RunPlan`` of a run.  A format home holds its hook and builds its
+              plan from the core's plan types (``fibrelmp.runplan``); a home lies below
+              the pipeline, which only executes plans.
   ``result``  written by ``run`` as the input's native results (its hook is a ``Writer``).
   ``target``  a ``post --to`` output; its hook is a ``post.target.DumpTarget`` (a ``Writer``
               of LAMMPS dump frames).
@@ -22,7 +21,7 @@ Roles
   ``mesh``    a finite-element mesh; its hook is a ``mesh.model.MeshFormat`` (reader, writer).
   ``motion``  mesh node positions over time; its hook is a frame ``Reader``.
   ``also``    written from a run's own frames beside the input's results (``run --also
-              NAME``, any input); its hook is a ``pipeline.also.RunOutput`` (it declares the
+              NAME``, any input); its hook is a ``fibrelmp.also.RunOutput`` (it declares the
               files among the run's outputs and makes the writer the frames are fed to).
 
 A record's ``pictures`` names the source ``fibrelmp plot``/``snapshot`` read its results with
@@ -178,37 +177,37 @@ register_format(Format(
     example="examples/fibre_network/input.txt", home="fibrelmp.translate.fibrenet"))
 register_format(Format(
     "musen-script", "a cmusen job script", "si",
-    {INPUT: "fibrelmp.pipeline.inputs.musen_script:ScriptInput"},
+    {INPUT: "fibrelmp.translate.musen.script_input:ScriptInput"},
     magic=re.compile(rb"^[ \t]*(JOB|SOURCE_FILE|COMPONENT)\b", re.M),
     example="examples/musen/single_particle_job.txt", home="fibrelmp.translate.musen"))
 register_format(Format(
     # the signature 0x12345678 (little endian); binary: detected before the text formats, so
     # that no text magic can match inside its compressed data
     "mdem", "a MUSEN .mdem scene or result", "si",
-    {INPUT: "fibrelmp.pipeline.inputs.mdem:MdemSceneInput",
+    {INPUT: "fibrelmp.translate.musen.mdem.input:MdemSceneInput",
      RESULT: "fibrelmp.translate.musen.mdem.result:MdemResultWriter",
-     TARGET: "fibrelmp.post.to_granular:MdemTarget",
+     TARGET: "fibrelmp.translate.musen.mdem.target:MdemTarget",
      DOCUMENT: "fibrelmp.translate.musen.mdem.convert:MdemDocument"},
-    pictures="fibrelmp.pictures.sources:MdemSource",
+    pictures="fibrelmp.translate.musen.mdem.pictures:MdemSource",
     extensions=(".mdem",), magic=re.compile(rb"\Ax\x56\x34\x12", re.S), binary=True,
     example="examples/musen/SingelParticle.mdem", home="fibrelmp.translate.musen.mdem"))
 register_format(Format(
     # an object line "0 ID 1 TYPE 5 ...", or a scene line (22 domain / 32 material) of an
     # object-less scene; ".txt" is too common to mean MUSEN
     "musen", "a MUSEN text scene or result", "si",
-    {INPUT: "fibrelmp.pipeline.inputs.musen:SceneInput",
+    {INPUT: "fibrelmp.translate.musen.input:SceneInput",
      RESULT: "fibrelmp.translate.musen.writer:MusenResultWriter",
-     TARGET: "fibrelmp.post.to_granular:MusenTarget",
+     TARGET: "fibrelmp.translate.musen.target:MusenTarget",
      DOCUMENT: "fibrelmp.translate.musen.mdem.convert:MusenTextDocument"},
-    pictures="fibrelmp.pictures.sources:MusenTextSource",
+    pictures="fibrelmp.translate.musen.pictures:MusenTextSource",
     magic=re.compile(rb"\A\s*(0\s+\d+\s+1\s+\d+\s+5\b|(22|32)\s+\S)"),
     example="examples/musen/SingelParticle_text.txt", home="fibrelmp.translate.musen"))
 register_format(Format(
     # JSON whose first key is "cardioproof" (before DEMDF, whose magic is any JSON object)
     "cardioproof", "a CardioProof case (JSON: moving FE wall, SPH water, outflow openings)", "si",
-    {INPUT: "fibrelmp.pipeline.inputs.cardioproof:CaseInput"},
+    {INPUT: "fibrelmp.translate.cardioproof.input:CaseInput"},
     magic=re.compile(rb'\A\s*\{\s*"cardioproof"\s*:'),
-    example="examples/cardioproof/piston_tube.json", home="fibrelmp.cardioproof"))
+    example="examples/cardioproof/piston_tube.json", home="fibrelmp.translate.cardioproof"))
 register_format(Format(
     "demdf", "a DEMDF JSON file (input or snapshot)", "dimensionless",
     {INPUT: "fibrelmp.translate.demdf.input:DemdfInput",
@@ -232,9 +231,9 @@ register_format(Format(
     {TARGET: "fibrelmp.post.mercury:MercuryTarget"},
     extensions=(".data", ".ene", ".fstat", ".restart"), home="fibrelmp.post.mercury"))
 register_format(Format(
-    # also written by ``run --also vtk`` beside the results (fibrelmp.pipeline.viewer)
+    # also written by ``run --also vtk`` beside the results (fibrelmp.post.vtk.run_output)
     "vtk", "VTK .vtp/.vtm frames with a .pvd index (ParaView, OVITO)", "any",
-    {TARGET: "fibrelmp.post.vtk:VtkTarget", ALSO: "fibrelmp.pipeline.viewer:ViewerOutput"},
+    {TARGET: "fibrelmp.post.vtk:VtkTarget", ALSO: "fibrelmp.post.vtk.run_output:ViewerOutput"},
     extensions=(".pvd", ".vtp", ".vtm"), home="fibrelmp.post.vtk"))
 register_format(Format(
     "lammps-dump", "a LAMMPS text dump (plain or .gz)", "any",

@@ -130,7 +130,7 @@ def two_materials():
 
 def run(model: GranularModel, folder: Path, name: str = "job"):
     """Run ``model`` in ``folder/name``: (job, every saved frame in order)."""
-    from fibrelmp.pipeline.granular import run_granular
+    from fibrelmp.pipeline.run_model import run_granular
 
     frames = []
     job = run_granular(model, Path(folder) / name, frames.append, progress=False)

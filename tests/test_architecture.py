@@ -200,7 +200,8 @@ class ImportGraph:
 # ``translate(path, folder)`` and imports ``python_api`` only when called.
 # The format homes under translate/ are parts of fibrelmp of their own (a layer above post and
 # pictures, LAYERS): translate/ (the shared job code) and each home are taken whole apart.
-HOMES = ("fibrelmp.translate.fibrenet", "fibrelmp.translate.demdf")
+HOMES = ("fibrelmp.translate.fibrenet", "fibrelmp.translate.demdf", "fibrelmp.translate.musen",
+         "fibrelmp.translate.cardioproof")
 GRAPH = ImportGraph(PACKAGE, {("fibrelmp.translate", "fibrelmp.python_api")}, HOMES)
 MODULES, IMPORTS = GRAPH.modules, GRAPH.imports
 
@@ -242,11 +243,12 @@ LAYERS = [
     ("base", ["errors", "textio", "units", "registry", "formatbase", "lammps_text", "_lammps",
               "lammps_log", "numtext/", "lammps_styles/"]),
     ("core", ["model", "granmodel", "sanity", "record", "runner", "checkpoint", "outputs",
-              "inputformat"]),
+              "inputformat", "runplan", "also", "finite"]),
     ("mesh", ["mesh/"]),
     ("translate", ["translate/"]),
     ("post", ["post/"]),
-    ("cases", ["cardioproof/", "granular_check"]),
+    # what the granular formats' homes share: the check summary, the run request and frames
+    ("cases", ["granular_check", "granular_run/"]),
     ("pictures", ["pictures/"]),
     # a format's home: reader, writers, input hook, post target, picture source; it uses the
     # shared translate code, post's and pictures' bases, never the pipeline
@@ -313,7 +315,7 @@ BASES = {
     DOCUMENT: ("fibrelmp.formatbase", "DocumentFormat"),
     MESH: ("fibrelmp.mesh.model", "MeshFormat"),
     MOTION: ("fibrelmp.formatbase", "Reader"),
-    ALSO: ("fibrelmp.pipeline.also", "RunOutput"),
+    ALSO: ("fibrelmp.also", "RunOutput"),
 }
 
 
@@ -352,7 +354,7 @@ def test_input_hooks_pick_no_run_output_writer():
     homes = {f.hooks[ALSO].partition(":")[0] for f in registry.formats(ALSO)}
     hooks = {f.hooks[INPUT].partition(":")[0] for f in registry.formats(INPUT)}
     bad = [f"{module} imports {name}" for module, imports in sorted(GRAPH.imports.items())
-           if module.startswith("fibrelmp.pipeline.inputs") or module in hooks
+           if module in hooks
            for name in imports if name in homes]
     assert homes and not bad, "\n".join(bad)
 

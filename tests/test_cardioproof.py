@@ -228,9 +228,9 @@ def test_bad_cases_are_input_errors(tmp_path, edit, message):
 def test_fluid_lost_through_a_wall_is_a_warning(piston_run):
     """The summary's balance: fluid at the start = in the cavity + crossed an opening; the rest
     went through a wall (LAMMPS drops it at the box's faces) and is warned about."""
-    from fibrelmp.cardioproof.case import read_case
-    from fibrelmp.cardioproof.job import plan_job
-    from fibrelmp.pipeline.inputs.cardioproof import SphRecorder
+    from fibrelmp.translate.cardioproof.case import read_case
+    from fibrelmp.translate.cardioproof.job import plan_job
+    from fibrelmp.translate.cardioproof.input import SphRecorder
 
     tmp, _ = piston_run
     case = read_case(tmp / "piston_tube.json")
@@ -349,8 +349,8 @@ def test_fix_addforce_applies_the_numpy_forces_to_each_particle(tmp_path, monkey
     """The force each fluid particle gets from the outflow fixes (LAMMPS's forces with them
     minus without them) equals the numpy reference's share, particle by particle."""
     import fibrelmp
-    from fibrelmp.cardioproof.case import read_case
-    from fibrelmp.cardioproof.job import write_job
+    from fibrelmp.translate.cardioproof.case import read_case
+    from fibrelmp.translate.cardioproof.job import write_job
 
     case = read_case(_cube(tmp_path))
     job, text = write_job(case, tmp_path / "job")
@@ -436,8 +436,8 @@ def test_bad_geometry_is_an_input_error(tmp_path, make, message):
 
 
 def test_in_front_of_an_opening():
-    from fibrelmp.cardioproof.case import Opening as CaseOpening
-    from fibrelmp.cardioproof.job import _opening, in_front
+    from fibrelmp.translate.cardioproof.case import Opening as CaseOpening
+    from fibrelmp.translate.cardioproof.job import _opening, in_front
 
     square = CUBE_POINTS[np.array(CUBE_TRIANGLES[2:4])]                     # z = 1 mm, outward +z
     o = _opening(CaseOpening("top", np.arange(2), np.array([[0.0, 0.0]]), 1e-4), square)
@@ -599,8 +599,8 @@ def _beyond_side_wall(x: np.ndarray) -> np.ndarray:
 def test_fill_starts_a_quarter_spacing_from_the_walls(tmp_path):
     """The lattice's points nearest the tube's wall were 0.035 dx from it (0.535 dx from the
     first wall sheet): the fill now keeps dx/4; a lattice-aligned wall keeps its dx/2 row."""
-    from fibrelmp.cardioproof.case import read_case
-    from fibrelmp.cardioproof.job import plan_job
+    from fibrelmp.translate.cardioproof.case import read_case
+    from fibrelmp.translate.cardioproof.job import plan_job
 
     dx = 1.25e-4
     fluid = plan_job(read_case(_copy(tmp_path)))["fluid"]
@@ -642,9 +642,9 @@ def test_fluid_beyond_a_wall_is_counted_and_warned(tmp_path):
     """The run's counter (results.BeyondWalls) against particles put at known places in the
     static cube: 0.3 dx beyond the side wall x = 0 and 0.2 dx below the floor count; inside,
     or over the top opening (leaving), they do not."""
-    from fibrelmp.cardioproof.case import read_case
-    from fibrelmp.cardioproof.job import write_job
-    from fibrelmp.cardioproof.results import BeyondWalls, SphFrame
+    from fibrelmp.translate.cardioproof.case import read_case
+    from fibrelmp.translate.cardioproof.job import write_job
+    from fibrelmp.translate.cardioproof.results import BeyondWalls, SphFrame
 
     case = read_case(_cube(tmp_path))
     job, _ = write_job(case, tmp_path / "job", write_files=False)

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from fibrelmp.pipeline.granular import run_granular
+from fibrelmp.pipeline.run_model import run_granular
 from fibrelmp.translate.demdf.writer import DemdfSnapshotWriter
 from fibrelmp.translate.demdf import reader as demdf
 

@@ -5,7 +5,7 @@ import sys
 
 import numpy as np
 
-from fibrelmp.pipeline.fibrenet import run_fibrenet
+from fibrelmp.pipeline.run_model import run_fibrenet
 from fibrelmp.translate.fibrenet.reader import read as read_fibrenet
 from fibrelmp.translate.lammps_job import write_job
 from fibrelmp.model import Stage

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from fibrelmp.pipeline.evaluate import evaluate
-from fibrelmp.pipeline.fibrenet import run_fibrenet
+from fibrelmp.pipeline.run_model import run_fibrenet
 from fibrelmp.translate.fibrenet.reader import read as read_fibrenet
 from fibrelmp.post.lammps_dump.reader import iter_frames
 

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from fibrelmp.pipeline.fibrenet import run_fibrenet
+from fibrelmp.pipeline.run_model import run_fibrenet
 from fibrelmp.translate.fibrenet.reader import read as read_fibrenet
 from fibrelmp.translate.fibrenet.writer import read_xyz
 

@@ -8,7 +8,7 @@ significant digits (restart).
 import numpy as np
 import pytest
 
-from fibrelmp.pipeline.fibrenet import run_fibrenet
+from fibrelmp.pipeline.run_model import run_fibrenet
 from fibrelmp.translate.fibrenet.reader import read as read_fibrenet
 from fibrelmp.translate.fibrenet.writer import XYZ_SUFFIX, read_restart, read_xyz
 

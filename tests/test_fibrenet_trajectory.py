@@ -1,4 +1,4 @@
-"""A small damped fibre network run through ``fibrelmp.pipeline.fibrenet.run_fibrenet`` against the reference
+"""A small damped fibre network run through ``fibrelmp.pipeline.run_model.run_fibrenet`` against the reference
 integrator (tests/fibrenet_reference.py, FibreNet's modified velocity-Verlet).
 
 Compared frame by frame: the full-precision LAMMPS dump (``<work>/frames.dump``) to 1e-6 in
@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pytest
 
-from fibrelmp.pipeline.fibrenet import run_fibrenet
+from fibrelmp.pipeline.run_model import run_fibrenet
 from fibrelmp.translate.fibrenet.reader import read as read_fibrenet
 from fibrelmp.translate.fibrenet.writer import read_xyz
 from fibrelmp.post.lammps_dump.reader import iter_frames

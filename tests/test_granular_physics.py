@@ -1,7 +1,7 @@
 """MUSEN's contact and bond laws, as translated to LAMMPS, against independent formulas.
 
 Every model is built directly in Python (tests/granular_models.py) and run through
-``fibrelmp.pipeline.granular.run_granular``; the forces, velocities and break times LAMMPS
+``fibrelmp.pipeline.run_model.run_granular``; the forces, velocities and break times LAMMPS
 reports in the frames are compared with closed-form expressions written from
 shared/research/musen.md section 2 (not from the translator).
 """
@@ -16,7 +16,7 @@ import pytest
 
 from fibrelmp.errors import InputError
 from fibrelmp.granmodel import ContactLaw, hertz_effective
-from fibrelmp.pipeline.granular_frames import quat_multiply
+from fibrelmp.granular_run.frames import quat_multiply
 from fibrelmp.translate.granular_job import law_args, write_granular_job
 
 from . import granular_models as gm

@@ -567,7 +567,7 @@ import pickle, sys
 import numpy as np
 sys.path.insert(0, {str(REPO)!r})
 from tests import granular_models as gm
-from fibrelmp.pipeline.granular import run_granular
+from fibrelmp.pipeline.run_model import run_granular
 from fibrelmp.runner import mpi_rank_size
 mats, contacts = gm.two_materials()
 x = np.array([[i * 0.0011, j * 0.0011, 0.002 + k * 0.0011] for i in range(6) for j in range(6) for k in range(3)])

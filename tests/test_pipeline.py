@@ -10,8 +10,9 @@ from pathlib import Path
 import pytest
 
 from fibrelmp.errors import RunError
-from fibrelmp.pipeline.request import Rendered
-from fibrelmp.pipeline.run import _EXTRA, _scheduled, feed
+from fibrelmp.runplan import Rendered
+from fibrelmp.pipeline.run import _EXTRA, _scheduled
+from fibrelmp.runplan import feed
 from fibrelmp.registry import formats
 
 from .conftest import REPO
@@ -86,7 +87,7 @@ def test_a_writer_failing_at_the_end_leaves_no_output_of_the_others(tmp_path):
     """``feed`` prepares every writer (their last files written) before renaming any file into
     place: the last writer failing in ``finish`` leaves nothing of the first one."""
     from fibrelmp.formatbase import Writer
-    from fibrelmp.pipeline.run import feed
+    from fibrelmp.runplan import feed
 
     class Lines(Writer):
         def write(self, frame) -> None:

@@ -141,7 +141,7 @@ def test_res_round_trip_last_and_chosen_frame(granular, tmp_path):
 def test_res_restores_a_fibrenet_run(tmp_path):
     """FibreNet run -> dump -> post --to res -> restart_file of a new FibreNet run: the new
     run starts from the converted state."""
-    from fibrelmp.pipeline.fibrenet import run_fibrenet
+    from fibrelmp.pipeline.run_model import run_fibrenet
     from fibrelmp.translate.fibrenet.reader import read as read_fibrenet
 
     from . import fibrenet_reference as ref

@@ -322,7 +322,7 @@ def test_breaks_removals_and_losses_are_counted(tmp_path):
     import signal
 
     from fibrelmp.checkpoint import CheckpointStop, Checkpointing
-    from fibrelmp.pipeline.granular import run_granular
+    from fibrelmp.pipeline.run_model import run_granular
 
     model, steps = eventful_model()
     frames: list = []

@@ -1,5 +1,5 @@
 """``fibrelmp run --also NAME``: the formats written from a run's own frames come from the
-registry (its ALSO role, ``fibrelmp.pipeline.also``), not from the input hooks or the CLI.
+registry (its ALSO role, ``fibrelmp.also``), not from the input hooks or the CLI.
 
 - ``--also vtk`` writes the same files, byte for byte, as the deprecated ``--vtk`` (which the
   CLI rewrites into ``--also vtk`` with a one-line note on stderr);
@@ -23,7 +23,7 @@ from fibrelmp import python_api, registry
 from fibrelmp.cli import app
 from fibrelmp.errors import InputError
 from fibrelmp.formatbase import Writer
-from fibrelmp.pipeline.also import RunOutput, chosen
+from fibrelmp.also import RunOutput, chosen
 from fibrelmp.registry import ALSO, Format
 
 REPO = Path(__file__).resolve().parents[1]

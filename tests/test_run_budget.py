@@ -88,7 +88,7 @@ def test_the_override_skips_the_estimates_only(tmp_path):
     """run_budget with allow_huge: no disk or time refusal (the same job is refused without)."""
     import fibrelmp
     from fibrelmp.errors import InputError
-    from fibrelmp.pipeline.fibrenet import render
+    from fibrelmp.translate.fibrenet.plan import render
     from fibrelmp.translate.fibrenet.input import fibrenet_outputs
 
     folder = _fibrenet(tmp_path, run="2000000000", output_freq="1")

@@ -26,7 +26,7 @@ import pytest
 
 from fibrelmp import lammps_styles
 from fibrelmp._lammps import new_lammps
-from fibrelmp.pipeline.fibrenet import run_fibrenet
+from fibrelmp.pipeline.run_model import run_fibrenet
 from fibrelmp.post.lammps_dump.reader import iter_frames
 from fibrelmp.translate.fibrenet.target import OUTSIDE_KIND, convert_frames, write_fibrenet
 from fibrelmp.translate.fibrenet.reader import read as read_fibrenet

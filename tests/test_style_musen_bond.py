@@ -986,7 +986,7 @@ import sys
 import numpy as np
 sys.path.insert(0, {repo!r})
 from tests.test_style_musen_bond import falling_cluster
-from fibrelmp.pipeline.granular import run_granular
+from fibrelmp.pipeline.run_model import run_granular
 
 frames = []
 run_granular(falling_cluster(), {work!r}, frames.append, progress=False,

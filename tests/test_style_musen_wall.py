@@ -889,7 +889,7 @@ def test_wall_keeps_velocity_after_its_interval(plugin_path, tmp_path):
 def test_kept_velocity_is_reported_and_warned(plugin_path, tmp_path):
     """Through fibrelmp: the frames report MUSEN's kept wall velocity and the translation says
     so; without the plugin the same job names the stock representation."""
-    from fibrelmp.pipeline.granular import run_granular
+    from fibrelmp.pipeline.run_model import run_granular
     from fibrelmp.translate.granular_job import build_granular_job
 
     from . import granular_models as gm

@@ -277,7 +277,7 @@ def test_rendered_granular_job_with_hostile_names_is_safe(tmp_path, monkeypatch)
     from fibrelmp.translate import granular_job
     from fibrelmp.translate.granular import walls
     from fibrelmp.translate.musen import scene as musen
-    from fibrelmp.pipeline.inputs.musen import bare_scene_settings
+    from fibrelmp.translate.musen.input import bare_scene_settings
 
     scene = _musen_scene(tmp_path, "scene.txt")
     model = musen.read(scene)

@@ -14,7 +14,7 @@ import warnings
 import numpy as np
 import pytest
 
-from fibrelmp.pipeline.fibrenet import run_fibrenet
+from fibrelmp.pipeline.run_model import run_fibrenet
 from fibrelmp.translate.fibrenet.reader import read as read_fibrenet
 from fibrelmp.errors import InputError, RunError
 from fibrelmp.translate.fibrenet import target as to_fibrenet

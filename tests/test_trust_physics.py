@@ -12,10 +12,10 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from fibrelmp.cardioproof.results import SphFrame
+from fibrelmp.translate.cardioproof.results import SphFrame
 from fibrelmp.errors import RunError
 from fibrelmp.granmodel import GranularFrame
-from fibrelmp.pipeline import finite
+from fibrelmp import finite
 
 from .test_musen_bad_input import BASE
 

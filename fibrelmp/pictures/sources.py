@@ -3,8 +3,8 @@
 One source class per kind of result, named by its format's registry record (``pictures``;
 ``open_source`` picks it from ``locate``), each reading through the format's own reader:
 FibreNet xyz (``translate.fibrenet.pictures``), DEMDF snapshots (``translate.demdf.pictures``,
-one file per frame), and here MUSEN ``.mdem`` (``MdemReader``) and text results
-(``scene.read`` + ``read_time_points``) and LAMMPS dumps (``post.lammps_dump``, with the
+one file per frame), MUSEN text results (``translate.musen.pictures``) and ``.mdem`` results
+(``translate.musen.mdem.pictures``), and here LAMMPS dumps (``post.lammps_dump``, with the
 run's ``data.lammps`` for radii, masses, type names and bonds).  Sources stream: one frame is
 in memory at a time (a MUSEN text result is read whole, as its reader does).
 """
@@ -97,82 +97,6 @@ def noted_radii(data: Path) -> dict[str, float]:
             if hit:
                 radii[hit.group(1)] = float(hit.group(2))
     return radii
-
-
-# -- MUSEN -----------------------------------------------------------------------------------
-def _musen_frame(model, index: int, time: float, rows: np.ndarray, position: np.ndarray,
-                 velocity: np.ndarray | None, triangles: np.ndarray | None) -> SceneFrame:
-    """A frame of the spheres at ``rows`` of the model (bonds between them, if intact)."""
-    s = model.spheres
-    kinds, names = kind_indices([m.name for m in model.materials], s.material[rows])
-    bonds, broken = np.zeros((0, 2), np.int64), None
-    if model.bonds is not None and model.bonds.count:
-        b = model.bonds
-        where = np.full(s.count, -1)
-        where[rows] = np.arange(len(rows))
-        intact = (b.active_start <= time) & (time < b.active_end)
-        ends = where[b.pair]
-        bonds = ends[intact & (ends >= 0).all(axis=1)]
-        broken = int(np.count_nonzero(b.active_end <= time))
-    domain = model.plan.domain
-    return SceneFrame(index, time, None, position, s.radius[rows], kinds, names,
-                      velocity=velocity, mass=s.mass[rows], bonds=bonds, broken_bonds=broken,
-                      triangles=triangles, box=domain)
-
-
-class MdemSource(Source):
-    what = "MUSEN .mdem result"
-    time_unit, energy_unit = "s", "J"
-
-    def __init__(self, path: Path):
-        from fibrelmp.translate.musen.mdem.model import MdemReader
-
-        super().__init__(path)
-        self.reader = MdemReader(path)
-        self.model = self.reader.read()
-
-    def count(self) -> int:
-        from fibrelmp.translate.musen.mdem.document import MdemFile
-
-        with MdemFile(self.path) as mdem:
-            return sum(1 for _ in mdem.time_points())
-
-    def frames(self) -> Iterator[SceneFrame]:
-        for i, f in enumerate(self.reader):
-            yield _musen_frame(self.model, i, f.time, f.sphere_rows, f.position, f.velocity,
-                               f.triangle_vertices)
-
-
-class MusenTextSource(Source):
-    what = "MUSEN text result"
-    time_unit, energy_unit = "s", "J"
-
-    def __init__(self, path: Path):
-        from fibrelmp.translate.musen import scene
-        from fibrelmp.translate.musen.text import SPHERE, WALL, read_time_points
-
-        super().__init__(path)
-        self.model = scene.read(path)
-        self.tp = read_time_points(path, types=(SPHERE, WALL), tags=(12, 15, 44))
-        ids = self.tp.ids
-        self.sphere_cols = np.searchsorted(ids, self.model.spheres.ids)
-        t = self.model.triangles
-        self.wall_cols = np.searchsorted(ids, t.ids) if t is not None and t.count else None
-
-    def count(self) -> int:
-        return len(self.tp.times)
-
-    def frames(self) -> Iterator[SceneFrame]:
-        f = self.tp.fields
-        for k, time in enumerate(self.tp.times):
-            pos = f[12][k, self.sphere_cols]
-            rows = np.flatnonzero(self.tp.present[k, self.sphere_cols] & np.isfinite(pos).all(axis=1))
-            vel = f[15][k, self.sphere_cols][rows] if 15 in f else None
-            tri = None
-            if self.wall_cols is not None and 44 in f:
-                tri = f[44][k, self.wall_cols].reshape(-1, 3, 3)
-                tri = tri[np.isfinite(tri).all(axis=(1, 2))]
-            yield _musen_frame(self.model, k, float(time), rows, pos[rows], vel, tri)
 
 
 # -- LAMMPS dumps ----------------------------------------------------------------------------

@@ -19,8 +19,8 @@ from typing import Any, Callable, Iterator
 
 from fibrelmp.errors import InputError, RunError
 from fibrelmp.checkpoint import has_checkpoint
-from fibrelmp.pipeline.request import (Action, Consumer, Outcome, Rendered, RunOptions, RunPlan,
-                                       RunRequest)
+from fibrelmp.runplan import (Action, Consumer, Outcome, Rendered, RunOptions, RunPlan,
+                              RunRequest)
 
 Warn = Callable[[list[tuple[str, str]]], None]
 _EXTRA = object()            # the token of a frame beyond the schedule
@@ -246,51 +246,3 @@ def prepare_checkpoints(folder: Path, text: str, every: int | None, resume: bool
     if state is not None and rank == 0:
         truncate_outputs(folder, state)
     return Checkpointing(Path(folder), every, state, list(appended), list(inputs))
-
-
-def feed(writers: list, model: Any = None) -> Consumer:
-    """A consumer that adds every frame to each writer (``add``/``close``/``abort``): all are
-    closed when the frames end and aborted (their temp files removed) on any failure.  It
-    returns the files the writers report (``close()``'s paths, or their ``written`` list).
-    A frame holding nan/inf is a RunError (``pipeline.finite``; ``model`` names its particles)."""
-    from fibrelmp.pipeline.finite import guarded
-
-    def consume(frames: Iterator[Any]) -> list[Path]:
-        try:
-            for frame in guarded(frames, model):
-                for writer in writers:
-                    writer.add(frame)
-        except BaseException:
-            for writer in writers:
-                writer.abort()
-            raise
-        # every writer writes its last files before any file is renamed into place: a
-        # writer failing at the end leaves no output of the others behind
-        try:
-            for writer in writers:
-                prepare = getattr(writer, "prepare", None)
-                if prepare is not None:
-                    prepare()
-        except BaseException:
-            for writer in writers:      # abort never raises, and a closed writer ignores it
-                writer.abort()
-            raise
-        written: list[Path] = []
-        for k, writer in enumerate(writers):
-            try:
-                done = writer.close()
-            except BaseException:
-                for rest in writers[k + 1:]:
-                    rest.abort()
-                raise
-            written += _files(writer, done)
-        return written
-    return consume
-
-
-def _files(writer, closed) -> list[Path]:
-    if isinstance(closed, (str, os.PathLike)):
-        return [Path(closed)]
-    if closed:
-        return [Path(p) for p in closed]
-    return [Path(p) for p in getattr(writer, "written", [])]

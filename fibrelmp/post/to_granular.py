@@ -1,6 +1,7 @@
-"""LAMMPS dump frames -> the neutral GranularModel/GranularFrame, for the MUSEN and DEMDF
-writers (``fibrelmp post --to musen|mdem``; DEMDF's target, ``translate.demdf.target``,
-derives ``GranularTarget``).
+"""LAMMPS dump frames -> the neutral GranularModel/GranularFrame, shared by the granular post
+targets, which live in their homes and derive ``GranularTarget`` (``post --to musen``:
+``translate.musen.target``, ``mdem``: ``translate.musen.mdem.target``, ``demdf``:
+``translate.demdf.target``).
 
 The model is built from the first frame (plus ``--data`` facts): one sphere per atom id,
 one material per atom type.  A dump says nothing about materials or contact laws, so the
@@ -27,9 +28,8 @@ from fibrelmp.errors import InputError
 from fibrelmp.formatbase import Writer
 from fibrelmp.granmodel import GranularFrame, GranularModel, GranularPlan, Material, Spheres, quat_multiply
 from fibrelmp.post.lammps_dump.reader import Frame
-from fibrelmp.post.target import DumpTarget, ReadBack
+from fibrelmp.post.target import DumpTarget
 from fibrelmp.translate.work_facts import WorkFacts
-from fibrelmp.units import SI
 
 
 def _vector(frame: Frame, names: tuple[str, str, str], n: int) -> np.ndarray:
@@ -181,7 +181,7 @@ class GranularTarget(DumpTarget):
                 self.context.warn(kind, text)
 
 
-class _SingleFileTarget(GranularTarget):
+class SingleFileTarget(GranularTarget):
     """One result file: ``<base>`` as given when it has a suffix, else ``<base>`` plus the
     format's usual one (``-o out/run`` writes ``out/run.txt`` / ``out/run.mdem``)."""
 
@@ -197,62 +197,3 @@ class _SingleFileTarget(GranularTarget):
     @classmethod
     def files(cls, base: Path) -> list[Path]:
         return [cls.named(base)]
-
-
-class MusenTarget(_SingleFileTarget):
-    """``<base>`` (``.txt`` added to a name without a suffix): a MUSEN text result (SI units)."""
-
-    kind = "musen"
-    keeps_ids = True                 # MUSEN objects keep their ids
-    units = ("MUSEN", SI)
-    takes_precision = True
-    suffix = ".txt"                  # MUSEN's text results (and scenes) are .txt files
-
-    def result_writer(self, model: GranularModel, dt: float) -> Writer:
-        from fibrelmp.translate.musen.writer import MusenResultWriter
-
-        precision = self.context.precision
-        return MusenResultWriter(model, self.target, precision=6 if precision is None else precision)
-
-    @classmethod
-    def read_back(cls, files: list[Path]) -> list[ReadBack]:
-        from fibrelmp.translate.musen.scene import read_time_points
-
-        tp = read_time_points(files[0], tags=(12, 15, 20))       # objects in id order
-        return [ReadBack(tp.fields[12][k], rtol=6e-6, atol=1e-12,      # %g: 6 significant digits
-                         values={("vx", "vy", "vz"): tp.fields[15][k], ("fx", "fy", "fz"): tp.fields[20][k]})
-                for k in range(len(tp.times))]
-
-
-class MdemTarget(_SingleFileTarget):
-    """``<base>`` (``.mdem`` added to a name without a suffix): a MUSEN ``.mdem`` result (SI
-    units), as ``fibrelmp run`` writes one."""
-
-    kind = "musen"
-    keeps_ids = True
-    units = ("MUSEN", SI)
-    suffix = ".mdem"                 # MUSEN opens results by this extension
-
-    def result_writer(self, model: GranularModel, dt: float) -> Writer:
-        from fibrelmp.translate.musen.mdem.result import MdemResultWriter
-
-        return MdemResultWriter(model, self.target)
-
-    @classmethod
-    def read_back(cls, files: list[Path]) -> list[ReadBack]:
-        """Sphere positions, velocities and forces of every time point, as stored (exact)."""
-        from fibrelmp.translate.musen.mdem.document import MdemFile
-        from fibrelmp.translate.musen.mdem.objects import SPHERE, read_objects
-        from fibrelmp.translate.musen.mdem.timepoints import columns
-
-        out = []
-        with MdemFile(files[0]) as mdem:
-            obj = read_objects(mdem.info, mdem.version, mdem.path)
-            ids = obj.ids[obj.types == SPHERE]
-            for _, values, masks in mdem.time_points():
-                live = ids[masks[ids] != 0]
-                v = values[live]
-                out.append(ReadBack(v[:, columns("coord")], rtol=0.0, atol=0.0,
-                                    values={("vx", "vy", "vz"): v[:, columns("vel")],
-                                            ("fx", "fy", "fz"): v[:, columns("force")]}))
-        return out

@@ -1,5 +1,6 @@
-"""Translators: the simulation formats' homes (``fibrenet``, ``musen``, ``demdf``: readers and
-native writers) and the LAMMPS job renderers that turn their neutral models into scripts.
+"""Translators: the simulation formats' homes (``fibrenet``, ``musen`` with ``musen/mdem``,
+``demdf``, ``cardioproof``: readers, native writers, input hooks, run plans, post targets,
+picture sources) and the LAMMPS job renderers that turn their neutral models into scripts.
 
 ``fibrelmp.translate`` is also the Python API's ``translate(path, folder)`` (docs/python.md):
 a package cannot be a function, so the module itself is made callable (the one supported way:

@@ -127,7 +127,7 @@ class InputConformance(Conformance):
         assert issubclass(hook, InputFormat) and hook.name == fmt.name
 
     def test_detect_read_check_translate(self, example, tmp_path):
-        from fibrelmp.cardioproof.case import SphCase
+        from fibrelmp.translate.cardioproof.case import SphCase
         from fibrelmp.granmodel import GranularModel
         from fibrelmp.model import Model
 

@@ -1,29 +1,27 @@
-"""DEMDF JSON: input, run result (snapshots) and ``post --to`` target."""
+"""DEMDF JSON: input, run result (snapshots) and ``post --to`` target; the samples come from
+the home (``fibrelmp.translate.demdf.samples``)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
+from fibrelmp.translate.demdf import samples
+
 from ..conftest import REPO
 from .base import InputConformance, ResultConformance, TargetConformance, granular_frames
-
-SAMPLE = "examples/demdf/head_on.json"
 
 
 class TestDemdfInput(InputConformance):
     format = "demdf"
-    sample = SAMPLE
+    sample = samples.DOCUMENT
 
 
 class TestDemdfResult(ResultConformance):
     format = "demdf"
 
     def case(self, folder: Path):
-        from fibrelmp.translate.demdf import reader as demdf
-        from fibrelmp.translate.demdf.writer import DemdfSnapshotWriter
-
-        model = demdf.read(REPO / SAMPLE)
-        return (lambda: DemdfSnapshotWriter(model, folder)), granular_frames(model, 3)
+        model = samples.sample_model(REPO)
+        return (lambda: samples.result_writer(model, folder)), granular_frames(model, 3)
 
 
 class TestDemdfTarget(TargetConformance):

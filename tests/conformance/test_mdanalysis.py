@@ -1,4 +1,5 @@
-"""Trajectories read through MDAnalysis: the ``frames`` role, on a small XYZ file."""
+"""Trajectories read through MDAnalysis: the ``frames`` role, on a small XYZ file made by the
+home's samples (``fibrelmp.post.mdanalysis.samples``)."""
 
 from __future__ import annotations
 
@@ -6,17 +7,15 @@ from pathlib import Path
 
 import pytest
 
+from fibrelmp.post.mdanalysis import samples
+
 from .base import FramesConformance
 
 
 class TestMdanalysisFrames(FramesConformance):
     format = "mdanalysis"
-    atoms = 2
+    atoms = samples.ATOMS
 
     def sample(self, folder: Path) -> tuple[Path, Path]:
         pytest.importorskip("MDAnalysis")
-        good = folder / "t.xyz"
-        good.write_text("".join(f"2\nframe {k}\nC 0 0 {k}\nO 1 0 {k}\n" for k in range(3)))
-        bad = folder / "bad.xyz"
-        bad.write_text("not a trajectory\n")
-        return good, bad
+        return samples.trajectories(folder)

@@ -1,28 +1,27 @@
-"""MUSEN ``.mdem`` files: input, run result, ``post --to`` target and ``convert`` document."""
+"""MUSEN ``.mdem`` files: input, run result, ``post --to`` target and ``convert`` document;
+the samples come from the home (``fibrelmp.translate.musen.mdem.samples``)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
+from fibrelmp.translate.musen.mdem import samples
+
 from .base import (DocumentConformance, InputConformance, ResultConformance, TargetConformance,
                    granular_frames, two_glass_spheres)
-
-SAMPLE = "examples/musen/SingelParticle.mdem"
 
 
 class TestMdemInput(InputConformance):
     format = "mdem"
-    sample = SAMPLE
+    sample = samples.SCENE
 
 
 class TestMdemResult(ResultConformance):
     format = "mdem"
 
     def case(self, folder: Path):
-        from fibrelmp.translate.musen.mdem.result import MdemResultWriter
-
         model = two_glass_spheres()
-        return (lambda: MdemResultWriter(model, folder / "result.mdem")), granular_frames(model, 3)
+        return (lambda: samples.result_writer(model, folder)), granular_frames(model, 3)
 
 
 class TestMdemTarget(TargetConformance):
@@ -31,5 +30,5 @@ class TestMdemTarget(TargetConformance):
 
 class TestMdemDocument(DocumentConformance):
     format = "mdem"
-    sample = SAMPLE
-    cut = 3000                # a data block beyond the end
+    sample = samples.SCENE
+    cut = samples.DOCUMENT_CUT

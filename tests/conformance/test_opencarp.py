@@ -1,8 +1,11 @@
-"""openCARP meshes (``.pts``/``.elem``): the conformance checks of the ``mesh`` role."""
+"""openCARP meshes (``.pts``/``.elem``): the conformance checks of the ``mesh`` role; the bad
+sample comes from the home (``fibrelmp.mesh.opencarp.samples``)."""
 
 from __future__ import annotations
 
 from pathlib import Path
+
+from fibrelmp.mesh.opencarp import samples
 
 from .base import MeshConformance
 
@@ -12,6 +15,4 @@ class TestOpencarpMesh(MeshConformance):
     suffix = ""
 
     def bad_sample(self, folder: Path) -> Path:
-        (folder / "bad.pts").write_text("3\n0 0 0\n1 1 1\n")        # says 3 points, has 2
-        (folder / "bad.elem").write_text("0\n")
-        return folder / "bad.pts"
+        return samples.bad_mesh(folder)

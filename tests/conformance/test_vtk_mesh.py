@@ -1,8 +1,11 @@
-"""VTK unstructured-grid meshes (through meshio): the conformance checks of the ``mesh`` role."""
+"""VTK unstructured-grid meshes (through meshio): the conformance checks of the ``mesh`` role;
+the bad sample comes from the home (``fibrelmp.mesh.vtkmesh.samples``)."""
 
 from __future__ import annotations
 
 from pathlib import Path
+
+from fibrelmp.mesh.vtkmesh import samples
 
 from .base import MeshConformance
 
@@ -13,6 +16,4 @@ class TestVtkMesh(MeshConformance):
     needs = ("meshio",)
 
     def bad_sample(self, folder: Path) -> Path:
-        bad = folder / "bad.vtu"
-        bad.write_text("<VTKFile type='UnstructuredGrid'> not XML to the end\n")
-        return bad
+        return samples.bad_mesh(folder)

@@ -1,10 +1,11 @@
-"""FibreNet ``.xyz`` trajectories: run result and ``post --to`` target."""
+"""FibreNet ``.xyz`` trajectories: run result and ``post --to`` target; the result sample
+comes from the home (``fibrelmp.translate.fibrenet.samples``)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
+from fibrelmp.translate.fibrenet import samples
 
 from .base import ResultConformance, TargetConformance
 
@@ -13,11 +14,7 @@ class TestXyzResult(ResultConformance):
     format = "xyz"
 
     def case(self, folder: Path):
-        from fibrelmp.translate.fibrenet.writer import XyzFrame, XyzWriter
-
-        frames = [XyzFrame(10 * k, 0.1, np.ones(3) * 5, ["a", "b"], np.full((2, 3), 0.5 + k))
-                  for k in range(3)]
-        return (lambda: XyzWriter(folder / "run", fields=("position",))), frames
+        return samples.xyz_result(folder)
 
 
 class TestXyzTarget(TargetConformance):

@@ -2,7 +2,7 @@
 positions wrapped into the periodic box, bonds split where they cross a periodic face.
 
 A frame comes from a LAMMPS dump frame (``from_dump``: ``post --to vtk``, FibreNet runs) or
-from a run's own frames (``fibrelmp.pipeline.viewer``).  Point arrays carry the names OVITO
+from a run's own frames (``fibrelmp.post.vtk.run_output``).  Point arrays carry the names OVITO
 gives its standard particle properties (``Radius``, ``Velocity``, ``Force``, ``Orientation``,
 ...), so OVITO maps them on import and ParaView shows the same names.
 """

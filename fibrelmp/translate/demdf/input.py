@@ -1,6 +1,6 @@
 """DEMDF JSON documents (an input, or a snapshot to continue from): the input hook, and where
-a run writes.  The run itself is the pipeline's granular run (``pipeline.granular``, reached
-by name: a format home lies below the pipeline)."""
+a run writes.  Its run plan is the shared granular request (``granular_run.request``) fed to
+the snapshot writer; the pipeline executes it."""
 
 from __future__ import annotations
 
@@ -9,12 +9,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from fibrelmp.errors import InputError
-from fibrelmp.inputformat import InputFormat, RunSettings, Say, Warn, pipeline_part
+from fibrelmp.inputformat import InputFormat, RunSettings, Say, Warn
 
 if TYPE_CHECKING:
     from fibrelmp.granmodel import GranularModel
     from fibrelmp.outputs import Outputs
-    from fibrelmp.pipeline.request import RunOptions, RunPlan
+    from fibrelmp.runplan import RunOptions, RunPlan
     from fibrelmp.translate.granular_job import GranularJob
 
 
@@ -47,11 +47,10 @@ class DemdfInput(InputFormat):
              warn: Warn) -> "RunPlan":
         """Snapshots ``<filename>_<saveCount>.json`` next to the input (or in ``out``);
         earlier snapshots of the same name are replaced, all of them, only with ``force``."""
+        from fibrelmp.also import granular_writers
+        from fibrelmp.granular_run.request import granular_request
+        from fibrelmp.runplan import RunPlan
         from fibrelmp.translate.demdf.writer import DemdfSnapshotWriter
-
-        granular_request = pipeline_part("fibrelmp.pipeline.granular:granular_request")
-        granular_writers = pipeline_part("fibrelmp.pipeline.also:granular_writers")
-        RunPlan = pipeline_part("fibrelmp.pipeline.request:RunPlan")
 
         model = self.read(path, settings)
         warn(model.warnings)

@@ -1,5 +1,5 @@
 """FibreNet inputs (``input.txt`` with a ``model_file`` line): the input hook, and where a
-run writes.  Its run plan is the pipeline's (``pipeline.fibrenet``, reached by name)."""
+run writes.  Its run plan is built in the home (``plan.fibrenet_plan``)."""
 
 from __future__ import annotations
 
@@ -7,12 +7,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from fibrelmp.errors import InputError
-from fibrelmp.inputformat import InputFormat, RunSettings, Say, Warn, no_overrides, pipeline_part
+from fibrelmp.inputformat import InputFormat, RunSettings, Say, Warn, no_overrides
 
 if TYPE_CHECKING:
     from fibrelmp.model import Model
     from fibrelmp.outputs import Outputs
-    from fibrelmp.pipeline.request import RunOptions, RunPlan
+    from fibrelmp.runplan import RunOptions, RunPlan
     from fibrelmp.textio import Patch
     from fibrelmp.translate.lammps_job import Job
 
@@ -69,7 +69,8 @@ class FibreNetInput(InputFormat):
                      "--save-step/--steps are for MUSEN and DEMDF inputs")
         model = self.read(path)
         warn(model.warnings)
-        fibrenet_plan = pipeline_part("fibrelmp.pipeline.fibrenet:fibrenet_plan")
+        from fibrelmp.translate.fibrenet.plan import fibrenet_plan
+
         return fibrenet_plan(model, settings.out, settings.work, options, settings.also)
 
     def work_folder(self, path: Path, out: Path | None, work: Path | None) -> Path:

@@ -1,6 +1,6 @@
 """Walls of granular models: shape detection, rigid-motion kinematics, wall-particle tiling.
 
-Used by ``granular.walls`` / ``granular.tiles`` (LAMMPS script) and ``pipeline.granular_frames`` (frames).
+Used by ``granular.walls`` / ``granular.tiles`` (LAMMPS script) and ``granular_run.frames`` (frames).
 Everything here is numpy only; nothing writes files.
 
 Shapes a triangle group can be represented by exactly (LAMMPS regions + fix wall/gran/region):

@@ -9,7 +9,10 @@ Layers, bottom up (each module says more):
 * ``objects``    spheres, bonds and walls of a scene as arrays;
 * ``text_export`` MUSEN text exactly as MUSEN's EXPORT_TO_TEXT writes it;
 * ``text_import`` MUSEN text -> ``.mdem`` as MUSEN's IMPORT_FROM_TEXT makes it;
-* ``model``      the neutral ``GranularModel`` of a ``.mdem`` scene, and ``MdemResultWriter``.
+* ``model``      the neutral ``GranularModel`` of a ``.mdem`` scene, and ``MdemResultWriter``;
+* ``input``      the input hook (``MdemSceneInput``, the text scene hook's subclass);
+* ``target``     ``post --to mdem``; ``pictures``: the ``plot``/``snapshot`` source;
+* ``samples``    the reference samples of the conformance tests.
 
 A ``.mdem`` scene means what its text export means: ``read_scene`` hands MUSEN's own text form
 of the scene to the text scene reader, so a scene reads the same from either form.

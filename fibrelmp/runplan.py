@@ -1,14 +1,18 @@
 """What a run is made of: ``RunRequest`` (one LAMMPS simulation) and ``RunPlan`` (the
 requests of one input, with the import/export ``Action``\\ s of a cmusen script between them,
-and the outputs they lock together).
+and the outputs they lock together); ``feed``, the consumer that hands a request's frames to
+its result writers.
 
 The pieces are plain callables, so a request says *what* to run and the pipeline
 (``fibrelmp.pipeline.run``) alone decides *how*: rendering, checkpoints, the converter
-thread, frame scheduling, locking and finishing outputs.
+thread, frame scheduling, locking and finishing outputs.  These types sit in the core layer
+so that each format's home builds its own plan (``InputFormat.plan``) without importing the
+pipeline, which only executes plans.
 """
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Iterable, Iterator, Protocol, Union
@@ -120,3 +124,51 @@ class Outcome:
     outputs: list[Path] = field(default_factory=list)
     jobs: list[Rendered] = field(default_factory=list)
     summaries: list[dict] = field(default_factory=list)   # fibrelmp.record, one per simulation
+
+
+def feed(writers: list, model: Any = None) -> Consumer:
+    """A consumer that adds every frame to each writer (``add``/``close``/``abort``): all are
+    closed when the frames end and aborted (their temp files removed) on any failure.  It
+    returns the files the writers report (``close()``'s paths, or their ``written`` list).
+    A frame holding nan/inf is a RunError (``fibrelmp.finite``; ``model`` names its particles)."""
+    from fibrelmp.finite import guarded
+
+    def consume(frames: Iterator[Any]) -> list[Path]:
+        try:
+            for frame in guarded(frames, model):
+                for writer in writers:
+                    writer.add(frame)
+        except BaseException:
+            for writer in writers:
+                writer.abort()
+            raise
+        # every writer writes its last files before any file is renamed into place: a
+        # writer failing at the end leaves no output of the others behind
+        try:
+            for writer in writers:
+                prepare = getattr(writer, "prepare", None)
+                if prepare is not None:
+                    prepare()
+        except BaseException:
+            for writer in writers:      # abort never raises, and a closed writer ignores it
+                writer.abort()
+            raise
+        written: list[Path] = []
+        for k, writer in enumerate(writers):
+            try:
+                done = writer.close()
+            except BaseException:
+                for rest in writers[k + 1:]:
+                    rest.abort()
+                raise
+            written += _files(writer, done)
+        return written
+    return consume
+
+
+def _files(writer, closed) -> list[Path]:
+    if isinstance(closed, (str, os.PathLike)):
+        return [Path(closed)]
+    if closed:
+        return [Path(p) for p in closed]
+    return [Path(p) for p in getattr(writer, "written", [])]

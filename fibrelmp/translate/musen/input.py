@@ -10,11 +10,11 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from fibrelmp.errors import InputError
-from fibrelmp.pipeline.inputs import InputFormat, RunSettings, Say, Warn
+from fibrelmp.inputformat import InputFormat, RunSettings, Say, Warn
 
 if TYPE_CHECKING:
     from fibrelmp.granmodel import GranularModel
-    from fibrelmp.pipeline.request import RunOptions, RunPlan
+    from fibrelmp.runplan import RunOptions, RunPlan
     from fibrelmp.textio import Patch
     from fibrelmp.translate.granular_job import GranularJob
 
@@ -84,11 +84,11 @@ def scene_plan(model: "GranularModel", result: str | Path, work: str | Path | No
                also: tuple[str, ...] = ()) -> "RunPlan":
     """The run of a MUSEN scene whose plan (step, end, saves) is set: one simulation, its
     result at ``result`` (MUSEN text, or ``.mdem`` by its name); ``also``: the formats also
-    written from the frames beside it (``pipeline.also``)."""
+    written from the frames beside it (``fibrelmp.also``)."""
     from fibrelmp.outputs import Outputs
-    from fibrelmp.pipeline.granular import granular_request
-    from fibrelmp.pipeline.request import RunOptions, RunPlan
-    from fibrelmp.pipeline.also import granular_writers
+    from fibrelmp.granular_run.request import granular_request
+    from fibrelmp.runplan import RunOptions, RunPlan
+    from fibrelmp.also import granular_writers
 
     check_musen_runnable(model)
     target = Path(result).resolve()
@@ -122,9 +122,11 @@ def musen_result_writer(model: "GranularModel", target: str | Path, precision: i
     """The writer of a MUSEN result at ``target``: ``.mdem`` by its name, else MUSEN text
     (``text``: the text writer's ``time_interval``/``selectors``)."""
     if is_mdem(target):
-        from fibrelmp.translate.musen.mdem.result import MdemResultWriter
+        # the .mdem home (mdem/) imports this module: its writer comes through the registry
+        from fibrelmp import registry
 
-        return MdemResultWriter(model, target, time_interval=text.get("time_interval"))
+        writer = registry.get("mdem").load(registry.RESULT)
+        return writer(model, target, time_interval=text.get("time_interval"))
     from fibrelmp.translate.musen.writer import MusenResultWriter
 
     return MusenResultWriter(model, target, precision=precision, **text)

@@ -35,7 +35,7 @@ from fibrelmp.errors import InputError
 from fibrelmp.mesh.model import Mesh
 
 if TYPE_CHECKING:
-    from fibrelmp.cardioproof.case import SphCase
+    from fibrelmp.translate.cardioproof.case import SphCase
 
 SHELL = ("triangle", "quad")
 # memory bounds (docs/cardioproof.md): the fluid lattice over the mesh's bounding box and the
@@ -313,7 +313,7 @@ def motion_frames(case: "SphCase") -> Iterator[np.ndarray]:
         for frame in DynptReader(case.motion.files[0]):
             yield frame.points * case.mesh.unit
         return
-    from fibrelmp.cardioproof.case import read_mesh
+    from fibrelmp.translate.cardioproof.case import read_mesh
 
     for path in case.motion.files:
         mesh = read_mesh(path, case.mesh.unit)

@@ -26,8 +26,8 @@ from pathlib import Path
 
 import numpy as np
 
-from fibrelmp.cardioproof import geometry
-from fibrelmp.cardioproof.case import MAX_SOUND_SPEED, SphCase
+from fibrelmp.translate.cardioproof import geometry
+from fibrelmp.translate.cardioproof.case import MAX_SOUND_SPEED, SphCase
 from fibrelmp.errors import InputError
 from fibrelmp.mesh.outflow import MARGIN
 from fibrelmp.translate.lammps_format import float_text
@@ -126,18 +126,64 @@ def plan_job(case: SphCase) -> dict:
 
 
 def _plan(case: SphCase) -> dict:
+    """The job's numbers, in named steps; each step's input errors and warnings come in this
+    order (the mesh's motion first, the time step last)."""
     tri4, _ = geometry.shell_elements(case.mesh, case.mesh_file)
     opening_of = np.full(len(tri4), -1)
     for k, o in enumerate(case.openings):
         opening_of[np.isin(tri4[:, 3], o.elements)] = k
     opening_nodes = np.unique(tri4[opening_of >= 0, :3])
-    first = None
+    swept = _sweep_motion(case, tri4, opening_nodes)
+    x0 = swept.first
+    tri = _oriented_surface(case, x0, tri4, opening_of)
+    openings, moving_openings = _opening_shapes(case, x0, tri, opening_of, opening_nodes, swept)
+    wall_tri = tri[opening_of < 0]
+    dx = case.spacing
+    margin = (case.layers + 2) * dx + max((3 * o.search_distance for o in case.openings), default=0.0)
+    box_lo, box_hi = swept.lo - margin, swept.hi + margin
+    fluid = _fluid_points(case, x0, tri, wall_tri, openings, moving_openings)
+    walls = geometry.wall_particles(x0, wall_tri, dx, case.layers, box_lo)
+    stretch = float((swept.longest / swept.first_edges)[opening_of < 0].max())
+    if stretch > geometry.STRETCHED:
+        case.warnings.append(("wall stretch", f"wall triangles stretch up to {stretch:.2f}x over the motion: "
+                              "their particles, placed at the start, are then that much farther apart "
+                              "than fluid.spacing and fluid may get through (a finer spacing helps)"))
+    # the fluid carries the cavity's mass: each particle stands for volume / count
+    volume = geometry.enclosed_volume(x0, tri)
+    if not volume > 0:
+        raise InputError(case.source, None, "the walls and openings do not close the cavity (its "
+                         f"volume from the surface is {volume:g} m^3)")
+    particle_volume = volume / len(fluid)
+    wall_moving = swept.moved[wall_tri[walls.rows]].any(axis=1)
+    c0 = _checked_sound_speed(case, swept.wall_speed)
+    dt, frame_steps = _steps_per_frame(case, time_step(case, c0))
+    total, every, series = _step_counts(case, dt)
+    saves = list(range(0, total, every)) + [total]
+    return dict(moving_openings=moving_openings, particle_volume=particle_volume, x0=x0, wall_tri=wall_tri,
+                surface=tri4[:, :3], opening_of=opening_of, walls=walls, wall_moving=wall_moving, fluid=fluid,
+                openings=openings, c0=c0, dt=dt, frame_steps=frame_steps, total=total, saves=saves,
+                series=series, box=(box_lo, box_hi))
+
+
+@dataclass
+class _SweptMesh:
+    """What the mesh does over its motion frames (one frame: a static wall)."""
+    first: np.ndarray              # node positions at the start
+    moved: np.ndarray              # (n,) bool: the node moves at some frame
+    lo: np.ndarray                 # the bounding box over all frames
+    hi: np.ndarray
+    wall_speed: float              # the fastest node's speed between frames (m/s)
+    at_frames: list[np.ndarray]    # the openings' nodes at every frame (for moving openings)
+    longest: np.ndarray            # each triangle's longest edge over the frames
+    first_edges: np.ndarray        # ... and at the start
+
+
+def _sweep_motion(case: SphCase, tri4: np.ndarray, opening_nodes: np.ndarray) -> _SweptMesh:
+    """One pass over the motion frames (streamed: one frame in memory)."""
+    first = lo = hi = prev = longest = first_edges = None
     moved = np.zeros(len(case.mesh.points), bool)
-    lo = hi = None
     wall_speed = 0.0
-    prev = None
-    at_frames = []                 # the openings' nodes at every frame (for moving openings)
-    longest = first_edges = None   # each triangle's longest edge: over the frames, at the start
+    at_frames = []
     for x in geometry.motion_frames(case):
         if first is None:
             first = x
@@ -152,7 +198,12 @@ def _plan(case: SphCase) -> dict:
             longest = first_edges = edges
         longest = np.maximum(longest, edges)
         prev = x
-    x0 = first
+    return _SweptMesh(first, moved, lo, hi, wall_speed, at_frames, longest, first_edges)
+
+
+def _oriented_surface(case: SphCase, x0: np.ndarray, tri4: np.ndarray, opening_of: np.ndarray) -> np.ndarray:
+    """The surface triangles wound with their normals out of the fluid; an opening's triangle
+    with the fluid on neither or both sides is an error, a wall's a warning."""
     geometry.lattice_counts(x0, case.spacing)       # the spacing's scale first: every test below uses it
     _check_surface(case, x0, tri4)
     tri, unclear = geometry.orient_outward(x0, tri4[:, :3], case.spacing)
@@ -163,15 +214,24 @@ def _plan(case: SphCase) -> dict:
     if unclear.any():
         case.warnings.append(("mesh", f"{int(unclear.sum())} of {len(tri)} shell triangles have the fluid "
                               "on neither or both sides (their winding is kept)"))
+    return tri
+
+
+def _opening_shapes(case: SphCase, x0: np.ndarray, tri: np.ndarray, opening_of: np.ndarray,
+                    opening_nodes: np.ndarray, swept: _SweptMesh
+                    ) -> tuple[list[OpeningGeometry], dict[str, list[OpeningGeometry]]]:
+    """Each opening where it starts, and the places of a moving one over the motion intervals
+    (each must give LAMMPS regions; a non-planar one is warned)."""
     openings, moving_openings = [], {}
     for k, o in enumerate(case.openings):
         rows = opening_of == k
         openings.append(_opening(o, x0[tri[rows]]))
         shapes = [openings[-1]]
-        if moved[np.unique(tri[rows])].any():
+        if swept.moved[np.unique(tri[rows])].any():
             # the opening where the mesh is halfway through each motion interval, moving with
             # its centre's velocity over the interval
             local = np.searchsorted(opening_nodes, tri[rows])
+            at_frames = swept.at_frames
             centres = [_opening(o, a[local]).centre for a in at_frames]
             shapes = [_opening(o, (0.5 * (a + b))[local], (cb - ca) / case.motion.frame_interval)
                       for a, b, ca, cb in zip(at_frames[:-1], at_frames[1:], centres[:-1], centres[1:])]
@@ -184,10 +244,13 @@ def _plan(case: SphCase) -> dict:
             case.warnings.append(("opening", f"opening {o.name!r} is not planar (nodes up to "
                                   f"{worst:.3g} m from its plane): LAMMPS measures the normal "
                                   "distance to that plane"))
-    wall_tri = tri[opening_of < 0]
+    return openings, moving_openings
+
+
+def _fluid_points(case: SphCase, x0: np.ndarray, tri: np.ndarray, wall_tri: np.ndarray,
+                  openings: list[OpeningGeometry], moving_openings: dict) -> np.ndarray:
+    """The fluid lattice inside the cavity; none, or fluid in front of an opening, is an error."""
     dx = case.spacing
-    margin = (case.layers + 2) * dx + max((3 * o.search_distance for o in case.openings), default=0.0)
-    box_lo, box_hi = lo - margin, hi + margin
     fluid = geometry.fluid_points(x0, tri, dx, wall_tri)
     if not len(fluid):
         raise InputError(case.source, None, "the walls and openings enclose no fluid: they must close "
@@ -198,19 +261,11 @@ def _plan(case: SphCase) -> dict:
             raise InputError(case.source, None, f"opening {o.name!r}: {int(ahead.sum())} fluid particles start "
                              "in front of it (within 2 search distances, over the opening): the cavity must "
                              "not continue beyond an opening")
-    walls = geometry.wall_particles(x0, wall_tri, dx, case.layers, box_lo)
-    stretch = float((longest / first_edges)[opening_of < 0].max())
-    if stretch > geometry.STRETCHED:
-        case.warnings.append(("wall stretch", f"wall triangles stretch up to {stretch:.2f}x over the motion: "
-                              "their particles, placed at the start, are then that much farther apart "
-                              "than fluid.spacing and fluid may get through (a finer spacing helps)"))
-    # the fluid carries the cavity's mass: each particle stands for volume / count
-    volume = geometry.enclosed_volume(x0, tri)
-    if not volume > 0:
-        raise InputError(case.source, None, "the walls and openings do not close the cavity (its "
-                         f"volume from the surface is {volume:g} m^3)")
-    particle_volume = volume / len(fluid)
-    wall_moving = moved[wall_tri[walls.rows]].any(axis=1)
+    return fluid
+
+
+def _checked_sound_speed(case: SphCase, wall_speed: float) -> float:
+    """c0 (``sound_speed``); an opening pressure above the Tait stiffness is an error."""
     c0 = sound_speed(case, wall_speed)
     pmax = max((float(np.abs(o.pressure[:, 1]).max()) for o in case.openings), default=0.0)
     stiffness = c0 * c0 * case.density / 7.0
@@ -219,24 +274,22 @@ def _plan(case: SphCase) -> dict:
         raise InputError(case.source, None, f"an opening's pressure {pmax:g} Pa is above the Tait stiffness "
                          f"B = c0^2 rho0 / 7 = {stiffness:g} Pa (it would compress the water by over 10 %): "
                          f"fluid.sound_speed at least {math.sqrt(7 * pmax / case.density):.3g} m/s")
-    dt = time_step(case, c0)
+    return c0
+
+
+def _steps_per_frame(case: SphCase, dt: float) -> tuple[float, int | None]:
+    """(the time step, shortened so a whole number of steps spans each motion frame interval;
+    those steps, None without motion)."""
     _step_counts(case, dt)                   # the run's length first (dt only shrinks below)
-    if case.motion is not None:
-        per_frame = case.motion.frame_interval / dt
-        if not per_frame <= MAX_STEPS:
-            raise InputError(case.source, None, f"motion.frame_interval {case.motion.frame_interval:g} s is "
-                             f"{per_frame:.3g} time steps of {dt:g} s; LAMMPS counts steps in 32-bit integers "
-                             f"(at most {MAX_STEPS})")
-        frame_steps = max(1, math.ceil(per_frame * (1 - 1e-12)))
-        dt = case.motion.frame_interval / frame_steps
-    else:
-        frame_steps = None
-    total, every, series = _step_counts(case, dt)
-    saves = list(range(0, total, every)) + [total]
-    return dict(moving_openings=moving_openings, particle_volume=particle_volume, x0=x0, wall_tri=wall_tri,
-                surface=tri4[:, :3], opening_of=opening_of, walls=walls, wall_moving=wall_moving, fluid=fluid,
-                openings=openings, c0=c0, dt=dt, frame_steps=frame_steps, total=total, saves=saves,
-                series=series, box=(box_lo, box_hi))
+    if case.motion is None:
+        return dt, None
+    per_frame = case.motion.frame_interval / dt
+    if not per_frame <= MAX_STEPS:
+        raise InputError(case.source, None, f"motion.frame_interval {case.motion.frame_interval:g} s is "
+                         f"{per_frame:.3g} time steps of {dt:g} s; LAMMPS counts steps in 32-bit integers "
+                         f"(at most {MAX_STEPS})")
+    frame_steps = max(1, math.ceil(per_frame * (1 - 1e-12)))
+    return case.motion.frame_interval / frame_steps, frame_steps
 
 
 def _step_counts(case: SphCase, dt: float) -> tuple[int, int, int]:

@@ -3,7 +3,7 @@
 A simulation that blew up (or met a case its law divides by zero in) keeps running in LAMMPS
 and writes nan/inf into its dumps; every result format would then carry ``nan`` tokens and
 the run would exit 0.  ``guarded(frames)`` checks each frame as it is fed to the writers
-(``pipeline.run.feed``) and raises a RunError naming the first non-finite value: its
+(``runplan.feed``) and raises a RunError naming the first non-finite value: its
 quantity, the particle (source id), the time and step.  The writers' loop aborts them on it,
 so no result is written, half or whole.
 

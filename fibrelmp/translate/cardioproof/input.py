@@ -1,5 +1,5 @@
 """CardioProof case files (JSON, first key ``"cardioproof"``): SPH water in a moving
-finite-element wall with pressure-outflow openings (``fibrelmp.cardioproof``)."""
+finite-element wall with pressure-outflow openings (``fibrelmp.translate.cardioproof``)."""
 
 from __future__ import annotations
 
@@ -8,13 +8,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from fibrelmp.errors import InputError
-from fibrelmp.pipeline.inputs import InputFormat, RunSettings, Say, Warn, no_overrides
+from fibrelmp.inputformat import InputFormat, RunSettings, Say, Warn, no_overrides
 
 if TYPE_CHECKING:
-    from fibrelmp.cardioproof.case import SphCase
-    from fibrelmp.cardioproof.job import SphJob
+    from fibrelmp.translate.cardioproof.case import SphCase
+    from fibrelmp.translate.cardioproof.job import SphJob
     from fibrelmp.outputs import Outputs
-    from fibrelmp.pipeline.request import Rendered, RunOptions, RunPlan
+    from fibrelmp.runplan import Rendered, RunOptions, RunPlan
 
 
 class CaseInput(InputFormat):
@@ -22,7 +22,7 @@ class CaseInput(InputFormat):
     styles = "stock LAMMPS only (packages SPH and MISC)"
 
     def read(self, path: Path) -> "SphCase":
-        from fibrelmp.cardioproof.case import read_case
+        from fibrelmp.translate.cardioproof.case import read_case
 
         return read_case(path)
 
@@ -30,7 +30,7 @@ class CaseInput(InputFormat):
         return "its VTK frames and CSV series keep every number exactly"
 
     def check_lines(self, path: Path, model: "SphCase") -> list[str]:
-        from fibrelmp.cardioproof.job import plan_job
+        from fibrelmp.translate.cardioproof.job import plan_job
 
         p = plan_job(model)
         mesh = model.mesh
@@ -55,24 +55,23 @@ class CaseInput(InputFormat):
         return lines
 
     def write_job(self, model: "SphCase", folder: Path) -> "SphJob":
-        from fibrelmp.cardioproof.job import write_job
+        from fibrelmp.translate.cardioproof.job import write_job
 
         return write_job(model, folder)[0]
 
     def plan(self, path: Path, settings: RunSettings, options: "RunOptions", say: Say,
              warn: Warn) -> "RunPlan":
-        from fibrelmp.cardioproof.results import SphFrames, result_writers
-        from fibrelmp.pipeline.request import Rendered, RunPlan, RunRequest
-        from fibrelmp.pipeline.run import feed
+        from fibrelmp.translate.cardioproof.results import SphFrames, result_writers
+        from fibrelmp.runplan import Rendered, RunPlan, RunRequest, feed
 
         no_overrides(path, settings, "a CardioProof case sets its own times (run.end_time, "
                      "output.interval): --end-time/--step/--save-step/--steps are for MUSEN and DEMDF inputs")
         if options.resume or options.checkpoint_every:
             raise InputError(path, None, "CardioProof runs cannot be checkpointed or resumed yet "
                              "(the wall velocity files are read as the run goes): run it again")
-        from fibrelmp.cardioproof.job import plan_job
+        from fibrelmp.translate.cardioproof.job import plan_job
 
-        from fibrelmp.cardioproof.results import SphVtkWriter
+        from fibrelmp.translate.cardioproof.results import SphVtkWriter
 
         for name in settings.also:     # its frames are VTK already; nothing else is written from them
             if name != SphVtkWriter.format:
@@ -84,7 +83,7 @@ class CaseInput(InputFormat):
         outputs, folder = case_outputs(model, settings.out, settings.work)
 
         def build(work: Path, write_files: bool) -> Rendered:
-            from fibrelmp.cardioproof.job import write_job
+            from fibrelmp.translate.cardioproof.job import write_job
 
             job, text = write_job(model, work, write_files)
             dumps = [job.frames] + ([job.walls] if job.walls else []) + [work / o.series_name() for o in job.openings]

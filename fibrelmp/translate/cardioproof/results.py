@@ -23,9 +23,9 @@ from typing import Any, Iterator
 
 import numpy as np
 
-from fibrelmp.cardioproof import geometry
-from fibrelmp.cardioproof.case import SphCase
-from fibrelmp.cardioproof.job import SphJob
+from fibrelmp.translate.cardioproof import geometry
+from fibrelmp.translate.cardioproof.case import SphCase
+from fibrelmp.translate.cardioproof.job import SphJob
 from fibrelmp.errors import RunError, wrong_frame
 from fibrelmp.formatbase import Writer
 

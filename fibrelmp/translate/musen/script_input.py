@@ -6,7 +6,7 @@ settings applied and its LAMMPS job built, every result located), then it become
 results are locked together.  Every job writes what cmusen writes: IMPORT_FROM_TEXT the
 ``.mdem`` scene, SIMULATOR its result (``.mdem``, or text by its name), EXPORT_TO_TEXT MUSEN
 text.  Within a script, the scene an import made and the frames a simulation saved (in an
-on-disk spool, ``pipeline.spool``) are handed on in memory; a ``.mdem`` made elsewhere is read
+on-disk spool, ``granular_run.spool``) are handed on in memory; a ``.mdem`` made elsewhere is read
 from its file (a scene to simulate, or a file to export with MUSEN's exporter).
 """
 
@@ -19,13 +19,13 @@ from typing import TYPE_CHECKING
 
 from fibrelmp.errors import InputError
 from fibrelmp.granmodel import GranularModel
-from fibrelmp.pipeline.inputs import InputFormat, RunSettings, Say, Warn, no_overrides
-from fibrelmp.pipeline.inputs.musen import check_musen_runnable, is_mdem, musen_result_writer
+from fibrelmp.inputformat import InputFormat, RunSettings, Say, Warn, no_overrides
+from fibrelmp.translate.musen.input import check_musen_runnable, is_mdem, musen_result_writer
 
 if TYPE_CHECKING:
     from fibrelmp.outputs import Outputs
-    from fibrelmp.pipeline.request import RunOptions, RunPlan, Step
-    from fibrelmp.pipeline.spool import FrameSpool
+    from fibrelmp.runplan import RunOptions, RunPlan, Step
+    from fibrelmp.granular_run.spool import FrameSpool
     from fibrelmp.textio import Patch
     from fibrelmp.translate.granular_job import GranularJob
 
@@ -68,7 +68,7 @@ class ScriptInput(InputFormat):
     def plan(self, path: Path, settings: RunSettings, options: "RunOptions", say: Say,
              warn: Warn) -> "RunPlan":
         from fibrelmp.outputs import Outputs
-        from fibrelmp.pipeline.request import Action, RunPlan
+        from fibrelmp.runplan import Action, RunPlan
 
         no_overrides(path, settings, "a cmusen job script sets END_TIME, SIMULATION_STEP and "
                      "SAVING_STEP itself; edit the script instead")
@@ -107,10 +107,10 @@ def _announce(step: "ScriptStep", say: Say, warn: Warn, rank0: bool) -> list[Pat
 def _simulation(step: "ScriptStep", work: Path, spools: dict, outputs: "Outputs",
                 also: tuple[str, ...]):
     """A SIMULATOR job: its frames go to a spool (exported later) and/or its MUSEN result
-    (and to the ``--also`` formats, named after its RESULT_FILE: ``pipeline.also``)."""
-    from fibrelmp.pipeline.granular import granular_request
-    from fibrelmp.pipeline.spool import FrameSpool
-    from fibrelmp.pipeline.also import granular_writers
+    (and to the ``--also`` formats, named after its RESULT_FILE: ``fibrelmp.also``)."""
+    from fibrelmp.granular_run.request import granular_request
+    from fibrelmp.granular_run.spool import FrameSpool
+    from fibrelmp.also import granular_writers
 
     extra = granular_writers(also, step.model, outputs, Path(step.written or step.handle).with_suffix(""))
 
@@ -143,7 +143,7 @@ def _import(step: "ScriptStep", spools: dict, say: Say, rank0: bool) -> list[Pat
 def _export(step: "ScriptStep", spools: dict, say: Say, rank0: bool) -> list[Path]:
     """EXPORT_TO_TEXT: the spooled frames of an earlier simulation (or, for a scene that was
     never simulated, its start state) as MUSEN text."""
-    from fibrelmp.pipeline.run import feed
+    from fibrelmp.runplan import feed
     from fibrelmp.translate.musen.writer import MusenResultWriter
 
     job = step.job

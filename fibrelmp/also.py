@@ -1,7 +1,7 @@
 """``fibrelmp run --also NAME``: formats written from a run's own frames beside its results.
 
 The registry's ALSO role names one ``RunOutput`` per such format (today ``vtk``,
-``pipeline.viewer``).  An input hook does not pick these writers: it hands the names the user
+``post.vtk.run_output``).  An input hook does not pick these writers: it hands the names the user
 chose (``RunSettings.also``) and the base name of its result to ``granular_writers`` or
 ``fibrenet_writers``, which ask the registry.  The files are declared among the run's outputs
 at plan time (checked and locked before LAMMPS starts, replaced only with ``--force``), and
@@ -22,7 +22,7 @@ if TYPE_CHECKING:
     from fibrelmp.granmodel import GranularModel
     from fibrelmp.model import Model
     from fibrelmp.outputs import Outputs
-    from fibrelmp.pipeline.request import Consumer
+    from fibrelmp.runplan import Consumer
 
 OPTION = "--also"
 

@@ -15,7 +15,7 @@ What: every saved frame; ids, types, ``Radius``, ``Mass``, ``Velocity``, ``Force
 ``Angular Velocity`` and ``Orientation`` where the run has them (post/vtk/frame.py); the
 time is the simulation time.
 
-``ViewerOutput`` is the registry's ALSO hook of ``vtk`` (``pipeline.also``).
+``ViewerOutput`` is the registry's ALSO hook of ``vtk`` (``fibrelmp.also``).
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
-from fibrelmp.pipeline.also import RunOutput
+from fibrelmp.also import RunOutput
 from fibrelmp.post.vtk.frame import ViewerFrame, box_of, from_dump, wrap
 from fibrelmp.post.vtk.target import frame_pattern
 from fibrelmp.post.vtk.writer import VtkWriter, check_output_name

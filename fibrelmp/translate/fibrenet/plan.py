@@ -1,19 +1,17 @@
 """FibreNet's run plan: the bead-spring job, its dump frames and FibreNet's own result files
 (``_coord/_vel/_force.xyz``, ``_restart.res``): written by LAMMPS itself with fibrelmp's
 plugin (``fix fibrenet/output``; moved into place after the run), else converted from the
-dump frames by ``translate.fibrenet.target``.  The rest of FibreNet lives in its home,
-``fibrelmp/translate/fibrenet/``; this module joins it with the pipeline (``run``,
-``RunRequest``, ``pipeline.also``), which a home may not import."""
+dump frames by ``translate.fibrenet.target``.  The plan is built of the core's plan types
+(``fibrelmp.runplan``) and ``run --also`` writers (``fibrelmp.also``); the pipeline only
+executes it (``pipeline.run``)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable, Iterator
 
 from fibrelmp.errors import RunError
-from fibrelmp.pipeline.request import Consumer, Rendered, RunOptions, RunPlan, RunRequest
-from fibrelmp.pipeline.run import run
+from fibrelmp.runplan import Consumer, Rendered, RunOptions, RunPlan, RunRequest
 from fibrelmp.translate.fibrenet.frames import DumpFrames, WrittenFrames, move_file
 from fibrelmp.translate.fibrenet.input import fibrenet_outputs
 from fibrelmp.translate.fibrenet.target import convert_frames, report_outside
@@ -21,7 +19,6 @@ from fibrelmp.translate.fibrenet.target import convert_frames, report_outside
 if TYPE_CHECKING:
     from fibrelmp.model import Model
     from fibrelmp.post.lammps_dump.reader import Frame
-    from fibrelmp.translate.lammps_job import Job
 
 
 def render(model: "Model"):
@@ -42,7 +39,7 @@ def render(model: "Model"):
 def results(model: "Model", folder: Path, prefix: str,
             also: Callable[[], list] = lambda: []):
     """The FibreNet writers of a rendered job: a consumer of its frames (and, with ``also``'s
-    writers, of the dump frames their files are made of: ``pipeline.also``)."""
+    writers, of the dump frames their files are made of: ``fibrelmp.also``)."""
     spec = model.plan.output
 
     def make(rendered: Rendered) -> Consumer:
@@ -51,10 +48,10 @@ def results(model: "Model", folder: Path, prefix: str,
             consume = _move_native(job.native, folder, prefix, spec.fields)
         else:
             def consume(frames: Iterator["Frame"]) -> list[Path]:
-                from fibrelmp.pipeline.finite import guarded
+                from fibrelmp.finite import guarded
 
                 return convert_frames(model, job, guarded(frames), folder, prefix)
-        from fibrelmp.pipeline.also import also_to
+        from fibrelmp.also import also_to
 
         return also_to(consume, also())
     return make
@@ -74,7 +71,7 @@ def _move_native(native, folder: Path, prefix: str, fields) -> Consumer:
         for src, dst in moves:
             if not src.is_file():
                 raise RunError(f"{src}: the job did not write this FibreNet file (fix fibrenet/output)")
-        from fibrelmp.pipeline.finite import scan_text_files
+        from fibrelmp.finite import scan_text_files
 
         scan_text_files(src for src, _ in moves)      # nan/inf: nothing moves into place
         for src, dst in moves:
@@ -87,8 +84,8 @@ def fibrenet_plan(model: "Model", out: str | Path | None = None, work: str | Pat
                   options: RunOptions = RunOptions(), also: tuple[str, ...] = ()) -> RunPlan:
     """The run of a FibreNet model: one simulation, its results next to the input (or in
     ``out``), its job in ``work`` (default ``<prefix>_work`` beside the results);
-    ``also``: the formats also written from the frames, named ``<prefix>`` (``pipeline.also``)."""
-    from fibrelmp.pipeline.also import fibrenet_writers
+    ``also``: the formats also written from the frames, named ``<prefix>`` (``fibrelmp.also``)."""
+    from fibrelmp.also import fibrenet_writers
 
     outputs, folder, prefix = fibrenet_outputs(model, out, work)
     extra = fibrenet_writers(also, model, outputs, folder / prefix)
@@ -101,23 +98,3 @@ def fibrenet_plan(model: "Model", out: str | Path | None = None, work: str | Pat
     request = RunRequest(model, render(model), frames, results(model, folder, prefix, extra),
                          outputs.work)
     return RunPlan(outputs, [request], options)
-
-
-@dataclass
-class FibreNetRun:
-    job: "Job"                                         # the rendered job (script, dump)
-    outputs: list[Path] = field(default_factory=list)  # the FibreNet files written
-
-
-def run_fibrenet(model: "Model", out: str | Path | None = None, work: str | Path | None = None,
-                 progress: bool = True, checkpoint_every: int | None = None,
-                 resume: bool = False, force: bool = False) -> FibreNetRun:
-    """Translate, run in-process and write FibreNet's result files for ``model``.
-
-    ``checkpoint_every`` writes a checkpoint every that many steps (and one on SIGTERM or
-    Ctrl-C in any case); ``resume`` continues from the checkpoint in the work folder.
-    Existing results are replaced (completely) only with ``force``; the output and work
-    folders are locked for the run."""
-    plan = fibrenet_plan(model, out, work, RunOptions(progress, force, checkpoint_every, resume))
-    outcome = run(plan)
-    return FibreNetRun(outcome.jobs[0].job, outcome.outputs)

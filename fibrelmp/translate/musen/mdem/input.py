@@ -7,7 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from fibrelmp.pipeline.inputs.musen import SceneInput
+from fibrelmp.translate.musen.input import SceneInput
 
 if TYPE_CHECKING:
     from fibrelmp.granmodel import GranularModel

@@ -254,7 +254,7 @@ def _motion(j: JsonDoc, spec: Any, folder: Path, mesh: Mesh) -> Motion | None:
 
 
 def _openings(j: JsonDoc, spec: Any, mesh: Mesh, dx: float, mesh_file: Path) -> list[Opening]:
-    from fibrelmp.cardioproof.geometry import shell_elements
+    from fibrelmp.translate.cardioproof.geometry import shell_elements
 
     items = j.array(spec, "openings")
     _, tags = shell_elements(mesh, mesh_file)

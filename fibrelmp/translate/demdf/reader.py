@@ -488,7 +488,7 @@ class _Reader(PlanMixin):
                 contacts[p.key] = law
         for p in partners:
             # with the law that runs (the stiffest of a material pair's): the contact time
-            # ``fibrelmp check`` prints (sanity.granular_contact_time) is this same figure
+            # ``fibrelmp check`` prints (granmodel.contact_time) is this same figure
             possible = p.speed > 0
             speed = p.speed if possible else fastest
             e_star = contacts[p.key].youngs_eff

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, Callable, ClassVar
 
 import numpy as np
@@ -177,6 +178,43 @@ class GranularPlan:
     dimension: int = 3
 
 
+class SourceRecord:
+    """What a format keeps of its source to write it back (MUSEN's scene lines, a DEMDF
+    document): each format's home derives its own record (``translate.musen.scene_record.
+    MusenSceneRecord``, ``translate.demdf.record.DemdfDocument``)."""
+
+    def post_facts(self) -> dict[str, Any] | None:
+        """What ``post`` needs of it beside the job's data file (``WorkFacts``; JSON)."""
+        return None
+
+
+@dataclass
+class LiquidBond:
+    """A MUSEN liquid bond (object type 13), kept for the result files: not simulated (a
+    later issue adds the liquid-bridge model)."""
+
+    id: int                    # source id
+    left: int                  # the two spheres' source ids
+    right: int
+    diameter: float
+    length0: float
+    key: str                   # its material's key
+    active_start: float
+    active_end: float
+
+
+@dataclass
+class ModelChoice:
+    """A physics model a scene runs (``translate/granular/models``, the one place that knows
+    each model): MUSEN's name and kind, its checked parameters and where it was chosen."""
+
+    name: str                  # MUSEN's, e.g. "ModelPPHertzMindlin"
+    kind: str                  # "PP", "PW", "SB", "LB", "EF"
+    parameters: dict[str, float]
+    source: Path | None = None  # the job script or .mdem that chose it
+    line: int | None = None     # its MODEL_ line (None: a .mdem's stored model)
+
+
 @dataclass
 class GranularModel(ParticleModel):
     """A DEM scene (MUSEN, DEMDF)."""
@@ -190,8 +228,13 @@ class GranularModel(ParticleModel):
     triangles: Triangles | None = None
     geometries: list[Geometry] = field(default_factory=list)
     planes: list[Plane] = field(default_factory=list)
-    # Everything a writer copies through untouched (MUSEN scene lines 22..41, DEMDF document).
-    passthrough: dict[str, Any] = field(default_factory=dict)
+    # what the format keeps of its source to write it back (MUSEN scene lines, DEMDF document)
+    origin: SourceRecord | None = None
+    liquid_bonds: list[LiquidBond] = field(default_factory=list)
+    models: dict[str, ModelChoice] = field(default_factory=dict)   # kind -> chosen model
+    # post: the dump's atom ids of the spheres and their sort order (post.to_granular)
+    atom_ids: np.ndarray | None = None
+    atom_order: np.ndarray | None = None
 
     particle_noun: ClassVar[str] = "spheres"
     # measured on 2 cores, docs/performance.md#ranks-and-threads

@@ -150,7 +150,7 @@ def test_scene_warnings(tmp_path, text, kind):
 def test_liquid_bonds_refused_only_when_simulated(tmp_path):
     text = BASE + "0 4 1 13 5 1 2 0.001 0.002 23 GLASS 24 0 1e+300 2 0\n"
     m = musen.read(scene(tmp_path, text))
-    assert m.passthrough["liquid_bonds"][0]["id"] == 4
+    assert m.liquid_bonds[0].id == 4
     with pytest.raises(InputError, match="liquid bonds"):
         musen.check_simulable(m)
     job = tmp_path / "job.txt"

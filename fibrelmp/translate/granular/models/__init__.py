@@ -126,9 +126,9 @@ def default_model(kind: str) -> type[PhysicsModel] | None:
 def chosen(model: GranularModel, kind: str) -> tuple[type[PhysicsModel], dict[str, float]]:
     """The model of ``kind`` a scene runs and its parameters: the one its settings chose
     (``script_settings``), else the stock default with MUSEN's defaults (a DEMDF scene)."""
-    picked = model.passthrough.get("musen_models", {}).get(kind)
+    picked = model.models.get(kind)
     if picked is not None:
-        return find(picked[0]), picked[1]
+        return find(picked.name), picked.parameters
     stock = default_model(kind)
     return stock, dict(stock.parameters)
 

@@ -57,6 +57,19 @@ class ContactLaw:
     restitution: float         # e in (0, 1]
     friction: float = 0.0      # mu sliding
     rolling_friction: float = 0.0
+    # the MUSEN PP model it stands for (translate/granular/models; None: a law no MUSEN model
+    # chose, DEMDF's Hertz law)
+    model: str | None = None
+
+
+@dataclass
+class SolidBondLaw:
+    """The law a scene's solid bonds follow (MUSEN type 9), naming its MUSEN SB model (the
+    module in translate/granular/models that set it) and the form ``granular.bonds`` renders."""
+
+    model: str | None = None   # MUSEN's name, e.g. "ModelSBKelvin" (None: no SB model chosen)
+    form: str = "elastic"      # "elastic" (ModelSBElastic) | "kelvin" (ModelSBKelvin)
+    max_damp_ratio: float = 1.0   # ModelSBKelvin's MAX_DAMP_RATIO (0: no cap)
 
 
 @dataclass
@@ -166,8 +179,7 @@ class GranularPlan:
     periodic: tuple[bool, bool, bool] = (False, False, False)
     periodic_box: tuple[np.ndarray, np.ndarray] | None = None
     bond_breakage: int = 1                  # MUSEN CONSIDER_BREAKAGE: 0 none, 1 combined, 2 separate
-    bond_model: str = "elastic"             # MUSEN solid bond: "elastic" (ModelSBElastic), "kelvin"
-    bond_max_damp_ratio: float = 1.0        # ModelSBKelvin MAX_DAMP_RATIO (0: no cap)
+    bond_law: SolidBondLaw = field(default_factory=SolidBondLaw)   # the solid bonds' law
     contacts_between_bonded: bool = True    # MUSEN default
     # the particle-particle law's contact duration (m*, R*, E*, approach speed) when it is not
     # Hertz's (set by its model in translate/granular/models; None: Hertz)

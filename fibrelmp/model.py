@@ -86,6 +86,16 @@ class PairLaw:
     type_j: int
     params: dict[str, float]
 
+    @property
+    def law(self) -> str:
+        """The law's name (docs/fibrenet.md, "Physics mapping")."""
+        return PAIR_LAWS[self.kind]
+
+
+# FibreNet's pair keywords and the laws they name
+PAIR_LAWS = {"hs": "harmonic soft-sphere repulsion", "st": "FibreNet's sticky spring",
+             "lj": "FibreNet's shifted Lennard-Jones"}
+
 
 @dataclass
 class Box:

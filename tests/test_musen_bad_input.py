@@ -306,7 +306,8 @@ def test_kelvin_bond_needs_the_styles(tmp_path):
     m = musen.read(scene(tmp_path, BASE))
     ms.apply_simulator_settings(m, job)
     # Kelvin: any non-zero CONSIDER_BREAKAGE is MUSEN's criterion 1
-    assert (m.plan.bond_model, m.plan.bond_breakage, m.plan.bond_max_damp_ratio) == ("kelvin", 1, 0.5)
+    assert (m.plan.bond_law.form, m.plan.bond_breakage, m.plan.bond_law.max_damp_ratio) == ("kelvin", 1, 0.5)
+    assert m.plan.bond_law.model == "ModelSBKelvin" and m.models["SB"].name == "ModelSBKelvin"
 
 
 def test_job_warnings_and_motion(tmp_path):

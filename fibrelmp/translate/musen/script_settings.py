@@ -118,6 +118,9 @@ def apply_simulator_settings(model: GranularModel, job: MusenJob) -> None:
     models = _resolve_models(model, job)
     model.models = models
     _check_models(model, job, models)
+    if "PP" in models:                            # the laws stand for the PP model chosen
+        for law in model.contacts.values():
+            law.model = models["PP"].name
     for kind, choice in models.items():
         # a kind's parameter errors point at its PARAMS line (cmusen reads them there)
         physics.find(choice.name).apply(plan, choice.parameters, job.path,

@@ -37,7 +37,7 @@ class PhysicsModel:
     needs_styles: ClassVar[str | None] = None
     # the only model of its kind fibrelmp translates with stock LAMMPS (bare scenes use it)
     default: ClassVar[bool] = False
-    # SB models: their GranularPlan.bond_model (what granular.bonds renders)
+    # SB models: their SolidBondLaw.form (what granular.bonds renders)
     plan_bond_model: ClassVar[str | None] = None
 
     @classmethod
@@ -134,8 +134,8 @@ def chosen(model: GranularModel, kind: str) -> tuple[type[PhysicsModel], dict[st
 
 
 def solid_bond_model(plan: GranularPlan) -> type[PhysicsModel]:
-    """The SB model of ``plan.bond_model``."""
-    return next(m for m in of_kind("SB") if m.plan_bond_model == plan.bond_model)
+    """The SB model of ``plan.bond_law`` (the form's model when no SB model chose it)."""
+    return next(m for m in of_kind("SB") if m.plan_bond_model == plan.bond_law.form)
 
 
 def mdem_key(name: str) -> str:

@@ -14,11 +14,15 @@ converts, it only has to be self-consistent.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, ClassVar
 
 import numpy as np
+
+from fibrelmp.particles import ModelCounts, ParticleModel, ParticleView, TimeScale
+from fibrelmp.sanity import hertz_contact_time, pair_speed, speed_bounds
 
 
 @dataclass
@@ -53,6 +57,19 @@ class ContactLaw:
     restitution: float         # e in (0, 1]
     friction: float = 0.0      # mu sliding
     rolling_friction: float = 0.0
+    # the MUSEN PP model it stands for (translate/granular/models; None: a law no MUSEN model
+    # chose, DEMDF's Hertz law)
+    model: str | None = None
+
+
+@dataclass
+class SolidBondLaw:
+    """The law a scene's solid bonds follow (MUSEN type 9), naming its MUSEN SB model (the
+    module in translate/granular/models that set it) and the form ``granular.bonds`` renders."""
+
+    model: str | None = None   # MUSEN's name, e.g. "ModelSBKelvin" (None: no SB model chosen)
+    form: str = "elastic"      # "elastic" (ModelSBElastic) | "kelvin" (ModelSBKelvin)
+    max_damp_ratio: float = 1.0   # ModelSBKelvin's MAX_DAMP_RATIO (0: no cap)
 
 
 @dataclass
@@ -162,8 +179,7 @@ class GranularPlan:
     periodic: tuple[bool, bool, bool] = (False, False, False)
     periodic_box: tuple[np.ndarray, np.ndarray] | None = None
     bond_breakage: int = 1                  # MUSEN CONSIDER_BREAKAGE: 0 none, 1 combined, 2 separate
-    bond_model: str = "elastic"             # MUSEN solid bond: "elastic" (ModelSBElastic), "kelvin"
-    bond_max_damp_ratio: float = 1.0        # ModelSBKelvin MAX_DAMP_RATIO (0: no cap)
+    bond_law: SolidBondLaw = field(default_factory=SolidBondLaw)   # the solid bonds' law
     contacts_between_bonded: bool = True    # MUSEN default
     # the particle-particle law's contact duration (m*, R*, E*, approach speed) when it is not
     # Hertz's (set by its model in translate/granular/models; None: Hertz)
@@ -174,9 +190,47 @@ class GranularPlan:
     dimension: int = 3
 
 
+class SourceRecord:
+    """What a format keeps of its source to write it back (MUSEN's scene lines, a DEMDF
+    document): each format's home derives its own record (``translate.musen.scene_record.
+    MusenSceneRecord``, ``translate.demdf.record.DemdfDocument``)."""
+
+    def post_facts(self) -> dict[str, Any] | None:
+        """What ``post`` needs of it beside the job's data file (``WorkFacts``; JSON)."""
+        return None
+
+
 @dataclass
-class GranularModel:
-    source: Path
+class LiquidBond:
+    """A MUSEN liquid bond (object type 13), kept for the result files: not simulated (a
+    later issue adds the liquid-bridge model)."""
+
+    id: int                    # source id
+    left: int                  # the two spheres' source ids
+    right: int
+    diameter: float
+    length0: float
+    key: str                   # its material's key
+    active_start: float
+    active_end: float
+
+
+@dataclass
+class ModelChoice:
+    """A physics model a scene runs (``translate/granular/models``, the one place that knows
+    each model): MUSEN's name and kind, its checked parameters and where it was chosen."""
+
+    name: str                  # MUSEN's, e.g. "ModelPPHertzMindlin"
+    kind: str                  # "PP", "PW", "SB", "LB", "EF"
+    parameters: dict[str, float]
+    source: Path | None = None  # the job script or .mdem that chose it
+    line: int | None = None     # its MODEL_ line (None: a .mdem's stored model)
+
+
+@dataclass
+class GranularModel(ParticleModel):
+    """A DEM scene (MUSEN, DEMDF)."""
+
     kind: str                              # "musen" | "demdf"
     materials: list[Material]
     contacts: dict[tuple[int, int], ContactLaw]   # key (a, b) with a <= b, material indices
@@ -186,16 +240,152 @@ class GranularModel:
     triangles: Triangles | None = None
     geometries: list[Geometry] = field(default_factory=list)
     planes: list[Plane] = field(default_factory=list)
-    # Everything a writer copies through untouched (MUSEN scene lines 22..41, DEMDF document).
-    passthrough: dict[str, Any] = field(default_factory=dict)
-    warnings: list[tuple[str, str]] = field(default_factory=list)
-    units: str = "si"
+    # what the format keeps of its source to write it back (MUSEN scene lines, DEMDF document)
+    origin: SourceRecord | None = None
+    liquid_bonds: list[LiquidBond] = field(default_factory=list)
+    models: dict[str, ModelChoice] = field(default_factory=dict)   # kind -> chosen model
+    # post: the dump's atom ids of the spheres and their sort order (post.to_granular)
+    atom_ids: np.ndarray | None = None
+    atom_order: np.ndarray | None = None
 
-    def warn(self, kind: str, message: str) -> None:
-        self.warnings.append((kind, message))
+    particle_noun: ClassVar[str] = "spheres"
+    # measured on 2 cores, docs/performance.md#ranks-and-threads
+    min_per_rank: ClassVar[int | None] = 1_000
+    time_scale_title: ClassVar[str | None] = "Hertz contact time"
 
     def contact(self, a: int, b: int) -> ContactLaw:
         return self.contacts[(min(a, b), max(a, b))]
+
+    def particles_view(self) -> ParticleView:
+        s = self.spheres
+        return ParticleView(s.ids, s.position, s.velocity, s.radius, s.mass, s.material,
+                            {"omega": s.omega, "quaternion": s.quaternion})
+
+    @property
+    def particle_count(self) -> int:
+        return self.spheres.count
+
+    def counts(self) -> ModelCounts:
+        bonds = 0 if self.bonds is None else self.bonds.count
+        triangles = 0 if self.triangles is None else self.triangles.count
+        return ModelCounts(bonds, 0, triangles + len(self.planes), len(self.materials))
+
+    def given_time_step(self) -> float:
+        return self.plan.dt
+
+    def planned_steps(self) -> int:
+        span = (self.plan.t_end - self.plan.t_start) / self.plan.dt
+        # beyond LAMMPS's step counter (2^63-1): sanity refuses it
+        return int(math.ceil(span)) if math.isfinite(span) else 2 ** 63
+
+    def time_scale(self) -> TimeScale | None:
+        """The shortest contact duration (``contact_time``), when finite."""
+        with np.errstate(all="ignore"):
+            found = contact_time(self)
+        if found is None or not math.isfinite(found[0]):
+            return None
+        tc, pair, law = found
+        return TimeScale("contact time", tc, f"{law}, {pair}, fastest approach in the input",
+                         f"contact time {tc:.3g} ({law}, {pair}, fastest approach in the input)",
+                         f"{law} contact time {tc:.3g}: contacts will be poorly resolved")
+
+    def run_time_step(self, job: Any) -> float:
+        return float(job.dt)
+
+    def final_gather(self, lmp: Any) -> dict[str, Any]:
+        from fibrelmp.record import gather_atoms
+
+        return {"radius": gather_atoms(lmp, "radius", 1, 1)}
+
+    def final_figures(self, job: Any, ids: np.ndarray, x: np.ndarray, box: tuple,
+                      gathered: dict[str, Any]) -> dict[str, Any]:
+        from fibrelmp.record import largest_overlap
+
+        spheres = np.isin(ids, np.asarray(job.sphere_rows, np.int64) + 1)
+        if job.domain_lo is not None:          # beyond the domain: removed (the frames' rule)
+            for a in np.flatnonzero(job.removal_axes):
+                spheres &= (x[:, a] >= job.domain_lo[a]) & (x[:, a] <= job.domain_hi[a])
+        radius = gathered["radius"]
+        return {"overlap": largest_overlap(ids[spheres], x[spheres], radius[spheres], *box)}
+
+    def summary_figures(self, job: Any, final: dict[str, Any], last: dict | None,
+                        tally: dict | None) -> dict[str, Any]:
+        from fibrelmp.record import line_count, thermo_int
+
+        tally = tally or {}
+        out: dict[str, Any] = {
+            "particles": {"kind": "spheres", "start": len(job.sphere_rows), "end": tally.get("spheres"),
+                          "removed_at_activity_end": tally.get("activity_end"),
+                          "left_domain": tally.get("left_domain")},
+            "contacts": thermo_int(last, "Contacts"),
+            "max_overlap": final["overlap"]}
+        nbonds = len(job.bond_rows)
+        if nbonds:
+            out["bonds"] = {"start": nbonds, "end": tally.get("bonds"),
+                            "broken": line_count(job.breaks) if job.breaks is not None else 0}
+        return out
+
+
+def extent(model: GranularModel) -> np.ndarray:
+    """The box gravity can accelerate spheres over: the domain, else the spheres' and walls'
+    bounding box grown by a diameter."""
+    if model.plan.domain is not None:
+        return model.plan.domain[1] - model.plan.domain[0]
+    s = model.spheres
+    parts = [s.position] + [p.point[None, :] for p in model.planes]
+    if model.triangles is not None and model.triangles.count:
+        parts.append(model.triangles.vertices.reshape(-1, 3))
+    points = np.vstack(parts)
+    return points.max(axis=0) - points.min(axis=0) + 2 * float(s.contact_radius.max(initial=0))
+
+
+def contact_time(model: GranularModel) -> tuple[float, str, str] | None:
+    """The shortest contact duration (Hertz's, or the PP / PW model's ``plan.pp_contact_time``,
+    ``plan.pw_contact_time``) of the contacts the input can have, at the fastest
+    approach: for each material pair with a contact law, the smallest spheres of each
+    (m* = m1 m2 / (m1 + m2), R* = r1 r2 / (r1 + r2); a sphere-sphere pair of one material
+    needs two spheres of it) approaching at the sum of the two fastest speed bounds, and
+    for a wall material, the smallest sphere (m* = m, R* = r) at its material's fastest
+    bound (``sanity.speed_bounds``).  Where nothing can move (no speed, no gravity), at an
+    approach speed of 1.  (time, "material-material", law); None when there are no spheres.
+    DEMDF's reader sizes its contact stiffness and time step by this same figure."""
+    s = model.spheres
+    if s.count == 0:
+        return None
+    bounds = speed_bounds(s.velocity, model.plan.gravity, extent(model))
+    walls = {int(p.material) for p in model.planes}
+    if model.triangles is not None and model.triangles.count:
+        walls |= {int(m) for m in np.unique(model.triangles.material)}
+    smallest: dict[int, tuple[float, float, np.ndarray]] = {}
+    for mat in np.unique(s.material).tolist():
+        rows = np.flatnonzero(s.material == mat)
+        # the contact time grows as (m^2 / r)^(1/5): the smallest sphere of a material
+        k = rows[int(np.argmin(s.mass[rows] ** 2 / s.contact_radius[rows]))]
+        smallest[mat] = (float(s.mass[k]), float(s.contact_radius[k]), bounds[rows])
+    partners = []                      # (m*, R*, E*, approach speed, name, duration law)
+    pp_time = model.plan.pp_contact_time or hertz_contact_time
+    pp_law = model.plan.pp_contact_law if model.plan.pp_contact_time else "Hertz"
+    pw_time = model.plan.pw_contact_time or hertz_contact_time
+    pw_law = model.plan.pw_contact_law if model.plan.pw_contact_time else "Hertz"
+    for (a, b), law in model.contacts.items():
+        if not law.youngs_eff > 0:
+            continue
+        name = f"{model.materials[a].name}-{model.materials[b].name}"
+        if a in smallest and b in smallest:
+            (ma, ra, va), (mb, rb, vb) = smallest[a], smallest[b]
+            partners.append((ma * mb / (ma + mb), ra * rb / (ra + rb), law.youngs_eff,
+                             pair_speed(va, va if a == b else vb), name, pp_time, pp_law))
+        for sphere, wall in ((a, b), (b, a)):
+            if sphere in smallest and wall in walls:
+                m, r, v = smallest[sphere]
+                partners.append((m, r, law.youngs_eff, pair_speed(v, None), name, pw_time, pw_law))
+    possible = [p for p in partners if p[3] > 0] or [p[:3] + (1.0,) + p[4:] for p in partners]
+    best = None
+    for m_eff, r_eff, e_star, speed, name, duration, law in possible:
+        tc = duration(m_eff, r_eff, e_star, speed)
+        if best is None or tc < best[0]:
+            best = (tc, name, law)
+    return best
 
 
 def quat_multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -4,7 +4,7 @@ the time-step check lives in ``sanity``."""
 from __future__ import annotations
 
 from fibrelmp.granmodel import GranularModel
-from fibrelmp.sanity import contact_check, units_line
+from fibrelmp.sanity import time_step_check, units_line
 
 
 def summary(model: GranularModel) -> list[str]:
@@ -39,4 +39,4 @@ def summary(model: GranularModel) -> list[str]:
         lines.append(f"saves        every {plan.save_every_time:g} time units")
     elif plan.save_every_steps is not None:
         lines.append(f"saves        every {plan.save_every_steps} steps")
-    return lines + contact_check(model)
+    return lines + time_step_check(model)

@@ -6,10 +6,14 @@ model are 0-based; LAMMPS ids are ``index + 1``.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any, ClassVar
 
 import numpy as np
+
+from fibrelmp.particles import ModelCounts, ParticleModel, ParticleView, TimeScale
 
 
 @dataclass
@@ -82,6 +86,16 @@ class PairLaw:
     type_j: int
     params: dict[str, float]
 
+    @property
+    def law(self) -> str:
+        """The law's name (docs/fibrenet.md, "Physics mapping")."""
+        return PAIR_LAWS[self.kind]
+
+
+# FibreNet's pair keywords and the laws they name
+PAIR_LAWS = {"hs": "harmonic soft-sphere repulsion", "st": "FibreNet's sticky spring",
+             "lj": "FibreNet's shifted Lennard-Jones"}
+
 
 @dataclass
 class Box:
@@ -134,8 +148,9 @@ class RunPlan:
 
 
 @dataclass
-class Model:
-    source: Path
+class Model(ParticleModel):
+    """A bead-spring network (FibreNet)."""
+
     particles: Particles
     bonds: Bonds
     angles: Angles
@@ -143,9 +158,89 @@ class Model:
     box: Box
     dynamics: Dynamics
     plan: RunPlan
-    warnings: list[tuple[str, str]] = field(default_factory=list)   # (kind, message)
-    units: str = "lj"
+    units: str = field(default="lj", kw_only=True)
     inputs: list[Path] = field(default_factory=list)     # every file it was read from
 
-    def warn(self, kind: str, message: str) -> None:
-        self.warnings.append((kind, message))
+    kind: ClassVar[str] = "fibrenet"
+    particle_noun: ClassVar[str] = "beads"
+    # measured on 2 cores, docs/performance.md#ranks-and-threads
+    min_per_rank: ClassVar[int | None] = 2_000
+    time_scale_title: ClassVar[str | None] = "shortest spring period"
+
+    def particles_view(self) -> ParticleView:
+        p = self.particles
+        state = {name: array for name, array in (("initial_forces", p.initial_forces),
+                                                 ("display_velocities", p.display_velocities))
+                 if array is not None}
+        return ParticleView(np.arange(1, p.count + 1), p.positions, p.velocities, p.radii,
+                            p.masses, p.types, state)
+
+    @property
+    def particle_count(self) -> int:
+        return self.particles.count
+
+    def counts(self) -> ModelCounts:
+        walls = 0 if self.box.wall_stiffness is None else 6 - 2 * sum(self.box.periodic)
+        return ModelCounts(self.bonds.count, self.angles.count, walls,
+                           len(self.particles.type_names))
+
+    def given_time_step(self) -> float:
+        return self.dynamics.dt
+
+    def planned_steps(self) -> int:
+        """Relaxation and production."""
+        return int(sum(st.steps for st in self.plan.stages))
+
+    def planned_runs(self) -> int:
+        """One per chunk of each stage."""
+        return int(sum(-(-st.steps // max(st.chunk, 1)) for st in self.plan.stages if st.steps > 0))
+
+    def time_scale(self) -> TimeScale | None:
+        """The shortest spring period (``spring_period``)."""
+        found = spring_period(self)
+        if found is None:
+            return None
+        period, row = found
+        i, j = (int(x) for x in self.bonds.atoms[row])
+        return TimeScale("spring period", period, f"spring {row}: beads {i}-{j}",
+                         f"spring period {period:.4g} (shortest, spring {row}: beads {i}-{j})",
+                         f"shortest spring period {period:.4g} (spring {row}, beads {i}-{j}): "
+                         "the run will be inaccurate or blow up")
+
+    def final_gather(self, lmp: Any) -> dict[str, Any]:
+        from fibrelmp.record import gather_bonds
+
+        return {"bonds": gather_bonds(lmp)}
+
+    def final_figures(self, job: Any, ids: np.ndarray, x: np.ndarray, box: tuple,
+                      gathered: dict[str, Any]) -> dict[str, Any]:
+        from fibrelmp.record import largest_strain
+
+        bonds = gathered["bonds"]
+        return {"bonds": len(bonds), "strain": largest_strain(ids, x, bonds, job.bond_lengths, *box)}
+
+    def summary_figures(self, job: Any, final: dict[str, Any], last: dict | None,
+                        tally: dict | None) -> dict[str, Any]:
+        out: dict[str, Any] = {"particles": {"kind": "beads", "start": self.particles.count,
+                                             "end": self.particles.count}}
+        if self.bonds.count:
+            out["bonds"] = {"start": self.bonds.count, "end": final["bonds"],
+                            "broken": self.bonds.count - final["bonds"]}
+        out["max_spring_strain"] = final["strain"]
+        return out
+
+
+def spring_period(model: Model) -> tuple[float, int] | None:
+    """Shortest oscillation period 2 pi sqrt(mu / k) over the springs (mu the reduced mass of
+    the two beads; a mass-0 bead moves at constant velocity, i.e. acts as infinitely heavy),
+    and that spring's row.  None without a spring that can oscillate."""
+    p, b = model.particles, model.bonds
+    if not p.count or not b.count:
+        return None
+    inv = np.zeros(p.count)
+    np.divide(1.0, p.masses, out=inv, where=p.masses > 0)
+    omega2 = b.k * (inv[b.atoms[:, 0]] + inv[b.atoms[:, 1]])
+    if not (omega2 > 0).any():
+        return None
+    row = int(np.argmax(omega2))
+    return 2 * math.pi / math.sqrt(float(omega2[row])), row

@@ -29,8 +29,7 @@ from typing import TYPE_CHECKING, Any, Iterator
 import numpy as np
 
 if TYPE_CHECKING:
-    from fibrelmp.granmodel import GranularModel
-    from fibrelmp.model import Model
+    from fibrelmp.particles import ParticleModel
 
 LOG_NAME = "log.lammps"
 SUMMARY_NAME = "summary.json"
@@ -102,7 +101,7 @@ class Recorder:
     """What the summary needs from the running LAMMPS (hooks called by ``runner.run_script``
     on every rank) and the summary itself (rank 0)."""
 
-    def __init__(self, model: "Model | GranularModel", job: Any, script: str = ""):
+    def __init__(self, model: "ParticleModel", job: Any, script: str = ""):
         self.model, self.job = model, job
         self.colnames = column_names(script)
         self.steps = self.resumed = 0
@@ -110,8 +109,8 @@ class Recorder:
         self.final: dict = {}                    # figures of the final state (end())
 
     def end(self, lmp, steps: int, resumed: int) -> None:
-        """After the last command, on every rank (the gathers are collective)."""
-        from fibrelmp.granmodel import GranularModel
+        """After the last command, on every rank (the gathers are collective); the model
+        says what it gathers and which figures its final state gives."""
         from fibrelmp.runner import mpi_rank_size
 
         self.steps, self.resumed = steps, resumed
@@ -120,44 +119,31 @@ class Recorder:
         self.final["step"] = int(lmp.extract_global("ntimestep"))
         lo, hi, _, _, _, periodic, _ = lmp.extract_box()
         box = (np.array(lo, float), np.array(hi, float), np.array(periodic, bool))
-        ids = _gather(lmp, "id", 0, 1).astype(np.int64)
-        x = _gather(lmp, "x", 1, 3).reshape(-1, 3)
-        granular = isinstance(self.model, GranularModel)
-        radius = _gather(lmp, "radius", 1, 1) if granular else None
-        bonds = None if granular else _gather_bonds(lmp)
+        ids = gather_atoms(lmp, "id", 0, 1).astype(np.int64)
+        x = gather_atoms(lmp, "x", 1, 3).reshape(-1, 3)
+        gathered = self.model.final_gather(lmp)
         if mpi_rank_size()[0] != 0:                # the summary is rank 0's
             return
-        if granular:
-            job = self.job
-            spheres = np.isin(ids, np.asarray(job.sphere_rows, np.int64) + 1)
-            if job.domain_lo is not None:          # beyond the domain: removed (the frames' rule)
-                for a in np.flatnonzero(job.removal_axes):
-                    spheres &= (x[:, a] >= job.domain_lo[a]) & (x[:, a] <= job.domain_hi[a])
-            self.final["overlap"] = largest_overlap(ids[spheres], x[spheres], radius[spheres], *box)
-        else:
-            self.final["bonds"] = len(bonds)
-            self.final["strain"] = largest_strain(ids, x, bonds, self.job.bond_lengths, *box)
+        self.final.update(self.model.final_figures(self.job, ids, x, box, gathered))
 
     # ---- rank 0, after LAMMPS closed (the log is complete)
     def summary(self, rendered: Any, wall_time: float, warnings: list[tuple[str, str]],
                 tally: dict | None = None) -> dict:
         """The summary (docs/record.md); ``tally``: the frame source's counts of spheres and
         bonds at the last frame (``FrameBuilder.tally()``)."""
-        from fibrelmp.granmodel import GranularModel
         from fibrelmp.sanity import STEP_FRACTION, time_step_scale
         from fibrelmp.units import system
 
         model, job = self.model, self.job
-        granular = isinstance(model, GranularModel)
         folder = Path(rendered.folder)
         log = folder / LOG_NAME
         start = first_state(log) if log.exists() else None
-        dt = float(job.dt) if granular else float(model.dynamics.dt)
+        dt = model.run_time_step(job)
         session = self.steps - self.resumed
         out: dict[str, Any] = {
             "summary_version": SUMMARY_VERSION,
             "input": str(model.source),
-            "kind": model.kind if granular else "fibrenet",
+            "kind": model.kind,
             "units": system(model.units).name,
             "folder": str(folder),
             "log": LOG_NAME if log.exists() else None,
@@ -169,25 +155,7 @@ class Recorder:
             "frames": _count(rendered.schedule),
             "energy": {"start": _energies(start), "end": _energies(self.last)},
         }
-        if granular:
-            tally = tally or {}
-            out["particles"] = {"kind": "spheres", "start": len(job.sphere_rows),
-                                "end": tally.get("spheres"),
-                                "removed_at_activity_end": tally.get("activity_end"),
-                                "left_domain": tally.get("left_domain")}
-            out["contacts"] = _int(self.last, "Contacts")
-            out["max_overlap"] = self.final["overlap"]
-            nbonds = len(job.bond_rows)
-            if nbonds:
-                out["bonds"] = {"start": nbonds, "end": tally.get("bonds"),
-                                "broken": _lines(job.breaks) if job.breaks is not None else 0}
-        else:
-            out["particles"] = {"kind": "beads", "start": model.particles.count,
-                                "end": model.particles.count}
-            if model.bonds.count:
-                out["bonds"] = {"start": model.bonds.count, "end": self.final["bonds"],
-                                "broken": model.bonds.count - self.final["bonds"]}
-            out["max_spring_strain"] = self.final["strain"]
+        out.update(model.summary_figures(job, self.final, self.last, tally))
         out["final_step"] = self.final["step"]
         scale = time_step_scale(model)
         if scale is not None:
@@ -224,7 +192,7 @@ def _json_default(value):
 
 # ---------------------------------------------------------------------------------------
 # the final state
-def _gather(lmp, name: str, dtype: int, count: int) -> np.ndarray:
+def gather_atoms(lmp, name: str, dtype: int, count: int) -> np.ndarray:
     n = int(lmp.get_natoms())
     data = lmp.gather_atoms_concat(name, dtype, count)
     if not n or data is None:
@@ -232,7 +200,7 @@ def _gather(lmp, name: str, dtype: int, count: int) -> np.ndarray:
     return np.ctypeslib.as_array(data)[: n * count].copy()
 
 
-def _gather_bonds(lmp) -> np.ndarray:
+def gather_bonds(lmp) -> np.ndarray:
     """(type, id1, id2) of every bond LAMMPS holds (type <= 0: turned off)."""
     got = lmp.numpy.gather_bonds()
     bonds = np.zeros((0, 3), np.int64) if got is None else np.asarray(got, np.int64).reshape(-1, 3)
@@ -316,7 +284,7 @@ def _num(row: dict | None, key: str) -> float | None:
     return value if math.isfinite(value) else None
 
 
-def _int(row: dict | None, key: str) -> int | None:
+def thermo_int(row: dict | None, key: str) -> int | None:
     value = _num(row, key)
     return None if value is None else int(round(value))
 
@@ -324,7 +292,7 @@ def _int(row: dict | None, key: str) -> int | None:
 def _energies(row: dict | None) -> dict | None:
     if row is None:
         return None
-    out: dict[str, Any] = {"step": _int(row, "Step"), "time": _num(row, "Time")}
+    out: dict[str, Any] = {"step": thermo_int(row, "Step"), "time": _num(row, "Time")}
     for column, name in ENERGY_COLUMNS.items():
         if column in row:
             out[name] = _num(row, column)
@@ -338,7 +306,7 @@ def _count(schedule) -> int | None:
         return None
 
 
-def _lines(path: Path) -> int:
+def line_count(path: Path) -> int:
     """Non-empty lines of a file (0 when it does not exist)."""
     try:
         with open(path, "rb") as fh:

@@ -18,9 +18,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Iterable, Iterator, Protocol, Union
 
 if TYPE_CHECKING:
-    from fibrelmp.granmodel import GranularModel
-    from fibrelmp.model import Model
     from fibrelmp.outputs import Outputs
+    from fibrelmp.particles import ParticleModel
     from fibrelmp.runner import LogEvery
 
 
@@ -88,7 +87,7 @@ Consumer = Callable[[Iterator[Any]], list[Path]]
 @dataclass
 class RunRequest:
     """One simulation: a neutral model, how to render and read it, and what its frames feed."""
-    model: "Model | GranularModel"
+    model: "ParticleModel"          # any family (Model, GranularModel, SphCase)
     build: JobBuilder                                  # renders the LAMMPS job
     frames: Callable[[Rendered], FrameSource]          # reads the frames the job saves
     results: Callable[[Rendered], Consumer]            # the native writers (rank 0 only)

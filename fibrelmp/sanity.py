@@ -1,14 +1,16 @@
 """Derived quantities ``fibrelmp check`` prints so a user can sanity-check an input's time
-step, and the warnings they trigger.  Plain physics on the neutral models, no LAMMPS.
+step, and the warnings they trigger.  Plain physics on the particle models, no LAMMPS.
 
-* granular inputs (MUSEN, DEMDF): the Hertz contact duration against the time step;
-* FibreNet: the shortest spring oscillation period against the time step;
+* the time the step has to resolve, which each model family computes itself
+  (``ParticleModel.time_scale``: granular inputs (MUSEN, DEMDF) the Hertz contact duration,
+  FibreNet the shortest spring oscillation period; a CardioProof case checks its own step);
 * any run under MPI: particles per rank against the size below which more ranks are slower
-  (``rank_check``).
+  (``rank_check``, the family's ``min_per_rank``).
 
 Either warns when the step exceeds ``STEP_FRACTION`` of the time it has to resolve: a
 contact or an oscillation spanning fewer than ten steps is integrated poorly, and one
-spanning fewer than about three is unstable.
+spanning fewer than about three is unstable.  This module asks a model; it never switches on
+its family.
 """
 
 from __future__ import annotations
@@ -16,11 +18,14 @@ from __future__ import annotations
 import math
 import re
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
-from fibrelmp.granmodel import GranularModel
-from fibrelmp.model import Model
 from fibrelmp.units import system
+
+if TYPE_CHECKING:
+    from fibrelmp.particles import ParticleModel
 
 STEP_FRACTION = 0.1
 # 2 * integral_0^1 dx / sqrt(1 - x^(5/2)): the duration of an elastic Hertz impact in units of
@@ -95,145 +100,35 @@ def pair_speed(bounds_a: np.ndarray, bounds_b: np.ndarray | None) -> float:
     return float(bounds_a.max() + bounds_b.max())
 
 
-def granular_extent(model: GranularModel) -> np.ndarray:
-    """The box gravity can accelerate spheres over: the domain, else the spheres' and walls'
-    bounding box grown by a diameter."""
-    if model.plan.domain is not None:
-        return model.plan.domain[1] - model.plan.domain[0]
-    s = model.spheres
-    parts = [s.position] + [p.point[None, :] for p in model.planes]
-    if model.triangles is not None and model.triangles.count:
-        parts.append(model.triangles.vertices.reshape(-1, 3))
-    points = np.vstack(parts)
-    return points.max(axis=0) - points.min(axis=0) + 2 * float(s.contact_radius.max(initial=0))
-
-
-def granular_contact_time(model: GranularModel) -> tuple[float, str, str] | None:
-    """The shortest contact duration (Hertz's, or the PP / PW model's ``plan.pp_contact_time``,
-    ``plan.pw_contact_time``) of the contacts the input can have, at the fastest
-    approach: for each material pair with a contact law, the smallest spheres of each
-    (m* = m1 m2 / (m1 + m2), R* = r1 r2 / (r1 + r2); a sphere-sphere pair of one material
-    needs two spheres of it) approaching at the sum of the two fastest speed bounds, and
-    for a wall material, the smallest sphere (m* = m, R* = r) at its material's fastest
-    bound (``speed_bounds``).  Where nothing can move (no speed, no gravity), at an
-    approach speed of 1.  (time, "material-material", law); None when there are no spheres.
-    DEMDF's reader sizes its contact stiffness and time step by this same figure."""
-    s = model.spheres
-    if s.count == 0:
-        return None
-    bounds = speed_bounds(s.velocity, model.plan.gravity, granular_extent(model))
-    walls = {int(p.material) for p in model.planes}
-    if model.triangles is not None and model.triangles.count:
-        walls |= {int(m) for m in np.unique(model.triangles.material)}
-    smallest: dict[int, tuple[float, float, np.ndarray]] = {}
-    for mat in np.unique(s.material).tolist():
-        rows = np.flatnonzero(s.material == mat)
-        # the contact time grows as (m^2 / r)^(1/5): the smallest sphere of a material
-        k = rows[int(np.argmin(s.mass[rows] ** 2 / s.contact_radius[rows]))]
-        smallest[mat] = (float(s.mass[k]), float(s.contact_radius[k]), bounds[rows])
-    partners = []                      # (m*, R*, E*, approach speed, name, duration law)
-    pp_time = model.plan.pp_contact_time or hertz_contact_time
-    pp_law = model.plan.pp_contact_law if model.plan.pp_contact_time else "Hertz"
-    pw_time = model.plan.pw_contact_time or hertz_contact_time
-    pw_law = model.plan.pw_contact_law if model.plan.pw_contact_time else "Hertz"
-    for (a, b), law in model.contacts.items():
-        if not law.youngs_eff > 0:
-            continue
-        name = f"{model.materials[a].name}-{model.materials[b].name}"
-        if a in smallest and b in smallest:
-            (ma, ra, va), (mb, rb, vb) = smallest[a], smallest[b]
-            partners.append((ma * mb / (ma + mb), ra * rb / (ra + rb), law.youngs_eff,
-                             pair_speed(va, va if a == b else vb), name, pp_time, pp_law))
-        for sphere, wall in ((a, b), (b, a)):
-            if sphere in smallest and wall in walls:
-                m, r, v = smallest[sphere]
-                partners.append((m, r, law.youngs_eff, pair_speed(v, None), name, pw_time, pw_law))
-    possible = [p for p in partners if p[3] > 0] or [p[:3] + (1.0,) + p[4:] for p in partners]
-    best = None
-    for m_eff, r_eff, e_star, speed, name, contact_time, law in possible:
-        tc = contact_time(m_eff, r_eff, e_star, speed)
-        if best is None or tc < best[0]:
-            best = (tc, name, law)
-    return best
-
-
-def spring_period(model: Model) -> tuple[float, int] | None:
-    """Shortest oscillation period 2 pi sqrt(mu / k) over the springs (mu the reduced mass of
-    the two beads; a mass-0 bead moves at constant velocity, i.e. acts as infinitely heavy),
-    and that spring's row.  None without a spring that can oscillate."""
-    p, b = model.particles, model.bonds
-    if not p.count or not b.count:
-        return None
-    inv = np.zeros(p.count)
-    np.divide(1.0, p.masses, out=inv, where=p.masses > 0)
-    omega2 = b.k * (inv[b.atoms[:, 0]] + inv[b.atoms[:, 1]])
-    if not (omega2 > 0).any():
-        return None
-    row = int(np.argmax(omega2))
-    return 2 * math.pi / math.sqrt(float(omega2[row])), row
-
-
-def units_line(model: Model | GranularModel) -> str:
+def units_line(model: ParticleModel) -> str:
     return f"units        {system(model.units).describe()}"
 
 
-def spring_check(model: Model) -> list[str]:
-    """The spring period against the time step; warns (kind "time step")."""
-    lines: list[str] = []
-    found = spring_period(model)
-    dt = model.dynamics.dt
-    if found is not None:
-        period, row = found
-        i, j = (int(x) for x in model.bonds.atoms[row])
-        lines.append(f"spring period {period:.4g} (shortest, spring {row}: beads {i}-{j}) = "
-                     f"{period / dt:.1f} time steps")
-        if dt > STEP_FRACTION * period:
-            model.warn("time step", f"the time step {dt:g} exceeds 1/10 of the shortest spring "
-                       f"period {period:.4g} (spring {row}, beads {i}-{j}): the run will be "
-                       "inaccurate or blow up")
+def time_step_check(model: ParticleModel) -> list[str]:
+    """The model's time scale (``time_scale``) against its time step: ``check``'s line, and a
+    warning (kind "time step") when the step exceeds ``STEP_FRACTION`` of it (``run`` warns
+    before it starts, as ``check`` does)."""
+    scale = model.time_scale()
+    dt = model.given_time_step()
+    if scale is None or dt is None or not (math.isfinite(dt) and dt > 0):
+        return []
+    lines = [f"{scale.line} = {scale.value / dt:.1f} time steps"]
+    if dt > STEP_FRACTION * scale.value:
+        model.warn("time step", f"the time step {dt:g} exceeds 1/10 of the {scale.warning}")
     return lines
 
 
-def contact_check(model: GranularModel) -> list[str]:
-    """The Hertz contact time against the time step; warns (kind "time step")."""
-    lines: list[str] = []
-    plan = model.plan
-    with np.errstate(all="ignore"):
-        tc = granular_contact_time(model)
-    if tc is not None and math.isfinite(plan.dt) and plan.dt > 0 and math.isfinite(tc[0]):
-        lines.append(f"contact time {tc[0]:.3g} ({tc[2]}, {tc[1]}, fastest approach in the input) "
-                     f"= {tc[0] / plan.dt:.1f} time steps")
-        if plan.dt > STEP_FRACTION * tc[0]:
-            model.warn("time step", f"the time step {plan.dt:g} exceeds 1/10 of the {tc[2]} "
-                       f"contact time {tc[0]:.3g}: contacts will be poorly resolved")
-    return lines
-
-
-def time_step_check(model: Model | GranularModel) -> list[str]:
-    """``spring_check`` or ``contact_check``, by the kind of model (``run`` warns before it
-    starts, as ``check`` does)."""
-    if isinstance(model, GranularModel):
-        return contact_check(model)
-    if isinstance(model, Model):
-        return spring_check(model)
-    return []                  # a CardioProof case checks its own step (cardioproof.job)
-
-
-# Particles per MPI rank below which a run is faster on fewer ranks (measured on 2 cores,
-# docs/performance.md#ranks-and-threads): a rank's fixed costs (ghost exchange every step,
-# every rank reading the input) outweigh its share of the work on smaller systems
-MIN_PER_RANK = {"beads": 2_000, "spheres": 1_000}
-
-
-def rank_check(model: Model | GranularModel, ranks: int) -> None:
+def rank_check(model: ParticleModel, ranks: int) -> None:
     """Warns (kind "ranks"; said once, on rank 0, like every warning) when ``ranks`` MPI
-    ranks leave fewer particles per rank than ``MIN_PER_RANK`` (not measured for SPH cases)."""
-    if not isinstance(model, (Model, GranularModel)):
+    ranks leave fewer particles per rank than the family's ``min_per_rank`` (measured on 2
+    cores, docs/performance.md#ranks-and-threads: a rank's fixed costs, ghost exchange every
+    step and every rank reading the input, outweigh its share of the work on smaller systems;
+    not measured for SPH cases)."""
+    limit = model.min_per_rank
+    if limit is None:
         return
-    granular = isinstance(model, GranularModel)
-    what = "spheres" if granular else "beads"
-    count = model.spheres.count if granular else model.particles.count
-    limit = MIN_PER_RANK[what]
+    what = model.particle_noun
+    count = model.particle_count
     if ranks > 1 and count < limit * ranks:
         best = max(1, count // limit)
         named = what if count != 1 else what[:-1]          # 1 sphere, 2 spheres
@@ -243,22 +138,13 @@ def rank_check(model: Model | GranularModel, ranks: int) -> None:
                    f"{'1 (no mpiexec)' if best == 1 else f'mpiexec -n {best}'} (docs/performance.md)")
 
 
-def time_step_scale(model: Model | GranularModel) -> dict | None:
+def time_step_scale(model: ParticleModel) -> dict | None:
     """The time the step has to resolve, for the run summary: ``{"name": "spring period" |
     "contact time", "value", "where"}`` (None: no spring / no sphere with a contact law)."""
-    if isinstance(model, GranularModel):
-        with np.errstate(all="ignore"):
-            found = granular_contact_time(model)
-        if found is None or not math.isfinite(found[0]):
-            return None
-        return {"name": "contact time", "value": found[0],
-                "where": f"{found[2]}, {found[1]}, fastest approach in the input"}
-    found = spring_period(model)
-    if found is None:
+    scale = model.time_scale()
+    if scale is None:
         return None
-    period, row = found
-    i, j = (int(x) for x in model.bonds.atoms[row])
-    return {"name": "spring period", "value": period, "where": f"spring {row}: beads {i}-{j}"}
+    return {"name": scale.name, "value": scale.value, "where": scale.where}
 
 
 # LAMMPS errors of atoms that moved too far in one step (a blown-up run)
@@ -268,23 +154,17 @@ _BLOW_UP = re.compile(r"(Bond|Angle|Dihedral|Improper) atoms? .*missing|Lost ato
                       re.IGNORECASE)
 
 
-def blow_up_hint(model: Model | GranularModel, message: str) -> str | None:
+def blow_up_hint(model: ParticleModel, message: str) -> str | None:
     """The hint a LAMMPS error gets when atoms flew apart: the time step warning ``run``
-    printed before it started, or the figures to check; None for other errors."""
+    printed before it started, or the family's advice (``unstable_hint``); None for other
+    errors."""
     if not _BLOW_UP.search(message):
         return None
     warned = [text for kind, text in model.warnings if kind == "time step"]
     if warned:
         return (f"hint: atoms moved too far in one step, as the 'time step' warning above "
                 f"foresaw ({warned[0].split(':')[0]}): run again with a smaller time step")
-    if not isinstance(model, (Model, GranularModel)):
-        return ("hint: atoms moved too far in one step: the SPH run became unstable; a higher "
-                "fluid.sound_speed (with its smaller step), more artificial_viscosity or a finer "
-                "spacing usually help")
-    what = "Hertz contact time" if isinstance(model, GranularModel) else "shortest spring period"
-    return (f"hint: atoms moved too far in one step: the run became unstable. `fibrelmp check` "
-            f"shows the time step against the {what}; a smaller step, stiffer walls or less "
-            "overlap at the start usually help")
+    return f"hint: atoms moved too far in one step: {model.unstable_hint()}"
 
 
 # ---------------------------------------------------------------------------------------
@@ -325,26 +205,13 @@ def _duration(seconds: float) -> str:
 MOST_STEPS = 10 ** 15
 
 
-def planned_steps(model) -> int | None:
-    """The time steps a model's run takes, known before its job is rendered (None: only the
-    rendered job says)."""
-    plan = getattr(model, "plan", None)
-    stages = getattr(plan, "stages", None)
-    if stages is not None:                                  # FibreNet: relaxation + production
-        return int(sum(st.steps for st in stages))
-    if isinstance(model, GranularModel):
-        span = (plan.t_end - plan.t_start) / plan.dt
-        return int(math.ceil(span)) if math.isfinite(span) else MAXBIGINT + 1
-    return None
-
-
-def check_steps(model, where, allow_huge: bool) -> None:
+def check_steps(model: ParticleModel, where, allow_huge: bool) -> None:
     """Refuse (InputError at ``where``) before the job is rendered a run of more steps than
     LAMMPS counts, than ``MOST_STEPS``, or (unless ``allow_huge``) than it can make in
     ``LONGEST_RUN_SECONDS`` at ``FASTEST_STEPS_PER_SECOND``."""
     from fibrelmp.errors import InputError
 
-    steps = planned_steps(model)
+    steps = model.planned_steps()
     if steps is None:
         return
     if steps > MAXBIGINT:
@@ -359,11 +226,11 @@ def check_steps(model, where, allow_huge: bool) -> None:
                          f"(LAMMPS is slower): run fewer steps{override}")
 
 
-def long_run_check(model) -> None:
+def long_run_check(model: ParticleModel) -> None:
     """Warn (kind 'long run') before a run that takes more than a day even at the optimistic
     speeds ``check_steps`` refuses beyond a month with."""
-    steps = planned_steps(model)
-    if steps is None or not hasattr(model, "warn"):
+    steps = model.planned_steps()
+    if steps is None:
         return
     seconds = _least_seconds(model, steps)
     if seconds > LONG_RUN_SECONDS:
@@ -372,42 +239,32 @@ def long_run_check(model) -> None:
                    f"and {FASTEST_RUNS_PER_SECOND:.0e} runs/s (the progress line gives the ETA)")
 
 
-def _least_seconds(model, steps: int) -> float:
+def _least_seconds(model: ParticleModel, steps: int) -> float:
     """The wall time of ``steps`` steps at the fastest speeds LAMMPS could reach (per step, and
     per separate 'run' command)."""
     return steps / FASTEST_STEPS_PER_SECOND + planned_runs(model) / FASTEST_RUNS_PER_SECOND
 
 
-def planned_runs(model) -> int:
-    """The separate LAMMPS 'run' commands a FibreNet model's stages make (one per chunk; each
-    sets the system up again: neighbour lists, forces), known before rendering; 0 otherwise."""
-    stages = getattr(getattr(model, "plan", None), "stages", None) or []
-    return int(sum(-(-st.steps // max(st.chunk, 1)) for st in stages if st.steps > 0))
+def planned_runs(model: ParticleModel) -> int:
+    """The separate LAMMPS 'run' commands a model's run makes (each sets the system up again:
+    neighbour lists, forces), known before rendering (``ParticleModel.planned_runs``)."""
+    return model.planned_runs()
 
 
-def needs_job(model, outputs) -> bool:
+def needs_job(model: ParticleModel, outputs) -> bool:
     """Must the job be rendered to tell whether the run can finish?  Not when even a frame at
-    every step (``planned_steps`` + 1 frames) fits the estimate: every count then fits a
+    every step (``planned_steps()`` + 1 frames) fits the estimate: every count then fits a
     LAMMPS int, and the output and the time are within bounds (rendering a large model twice
     costs a tenth of a second per 50,000 beads)."""
-    steps = planned_steps(model)
+    steps = model.planned_steps()
     if steps is None or steps >= MAXSMALLINT - 1:
         return True
-    n = particle_count(model)
+    n = model.particle_count
     frames = steps + 1
     size = frames * (FRAME_HEADER_BYTES + n * ROW_BYTES + (FILE_BYTES if outputs.patterns else 0))
     seconds = n * steps / FASTEST_PARTICLE_STEPS_PER_SECOND
     folders = [outputs.work] + [f.parent for f in outputs.files[:1]]
     return seconds > LONGEST_RUN_SECONDS or any(size > _free_space(f)[0] for f in folders)
-
-
-def particle_count(model) -> int:
-    """Beads, spheres or SPH particles of a model (for the estimates; 0 when unknown)."""
-    for name in ("particles", "spheres"):
-        group = getattr(model, name, None)
-        if group is not None and hasattr(group, "count"):
-            return int(group.count)
-    return 0
 
 
 def representable(rendered, where) -> None:
@@ -463,7 +320,7 @@ def run_budget(jobs: list[tuple[object, object]], outputs, ranks: int, allow_hug
     seconds = 0.0
     frames_total = 0
     for model, rendered in jobs:
-        n = particle_count(model)
+        n = model.particle_count
         try:
             frames = len(rendered.schedule)
         except TypeError:

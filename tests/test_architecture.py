@@ -242,8 +242,8 @@ def test_the_cycle_check_sees_function_level_imports_and_skips_type_checking_one
 LAYERS = [
     ("base", ["errors", "textio", "units", "registry", "formatbase", "lammps_text", "_lammps",
               "lammps_log", "numtext/", "lammps_styles/"]),
-    ("core", ["model", "granmodel", "sanity", "record", "runner", "checkpoint", "outputs",
-              "inputformat", "runplan", "also", "finite"]),
+    ("core", ["particles", "model", "granmodel", "sanity", "record", "runner", "checkpoint",
+              "outputs", "inputformat", "runplan", "also", "finite"]),
     ("mesh", ["mesh/"]),
     ("translate", ["translate/"]),
     ("post", ["post/"]),
@@ -287,6 +287,54 @@ def test_built_parts_import_nothing_of_fibrelmp(unit):
     """The C fast path and the LAMMPS plugin build on their own."""
     bad = [GRAPH.where(m, t) for m, targets in IMPORTS.items() if _unit(m) == unit
            for t in targets if _unit(t) != unit]
+    assert not bad, "\n".join(bad)
+
+
+# The particle model's families (fibrelmp/particles.py) and their homes: only there may code
+# switch on a family; a shared module asks the model (docs/architecture.md, "The particle model")
+FAMILY_HOMES = {"Model": "fibrelmp.model", "GranularModel": "fibrelmp.granmodel",
+                "SphCase": "fibrelmp.cardioproof"}
+
+
+def family_switches(tree: ast.Module) -> list[tuple[int, str]]:
+    """(line, family) of every switch on a model family in ``tree``: ``isinstance`` /
+    ``issubclass`` naming a family class, or ``type(x) is/== Family``."""
+    def families(node: ast.AST) -> set[str]:
+        names = {n.id for n in ast.walk(node) if isinstance(n, ast.Name)}
+        names |= {n.attr for n in ast.walk(node) if isinstance(n, ast.Attribute)}
+        return names & set(FAMILY_HOMES)
+
+    found = []
+    for node in ast.walk(tree):
+        if (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
+                and node.func.id in ("isinstance", "issubclass") and len(node.args) == 2):
+            found += [(node.lineno, name) for name in families(node.args[1])]
+        elif isinstance(node, ast.Compare) and any(
+                isinstance(side, ast.Call) and isinstance(side.func, ast.Name) and side.func.id == "type"
+                for side in [node.left, *node.comparators]):
+            found += [(node.lineno, name) for side in [node.left, *node.comparators]
+                      for name in families(side) if not isinstance(side, ast.Call)]
+    return sorted(found)
+
+
+def test_family_switches_are_found():
+    tree = ast.parse("import fibrelmp.granmodel as g\n"
+                     "def f(m):\n"
+                     "    if isinstance(m, (g.GranularModel, int)):\n"
+                     "        return 1\n"
+                     "    return type(m) is SphCase or isinstance(m, ParticleModel)\n")
+    assert family_switches(tree) == [(3, "GranularModel"), (5, "SphCase")]
+
+
+def test_no_module_switches_on_a_model_family_outside_its_home():
+    """sanity, record, the pipeline, the API ... ask a ``ParticleModel`` (its ``kind``,
+    ``time_scale``, ``summary_figures`` ...) instead of testing which family it is."""
+    bad = []
+    for module, path in MODULES.items():
+        for line, family in family_switches(ast.parse(path.read_text())):
+            home = FAMILY_HOMES[family]
+            if module != home and not module.startswith(home + "."):
+                bad.append(f"{path.relative_to(REPO)}:{line}: switches on {family}")
     assert not bad, "\n".join(bad)
 
 

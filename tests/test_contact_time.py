@@ -1,6 +1,6 @@
 """Issue 24: ``check`` printed two different "fastest approach" contact times for one DEMDF
 example, and examples/musen/README.md another than ``check`` for the MUSEN one.  One
-definition (``sanity.granular_contact_time``), one figure, equal to the Hertz contact time
+definition (``granmodel.contact_time``), one figure, equal to the Hertz contact time
 computed here from the example files' own numbers."""
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from fibrelmp import sanity
+from fibrelmp import granmodel
 from fibrelmp.cli import app
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -51,7 +51,7 @@ def test_musen_example_contact_time_is_the_sphere_on_plate_impact():
 
     model = read(EXAMPLES / "musen" / "SingelParticle_text.txt")
     model.plan.gravity[:] = (0.0, 0.0, -9.81)              # the job's EXT_ACCEL
-    assert sanity.granular_contact_time(model) == (pytest.approx(expected, rel=1e-9), "Steel-Glass",
+    assert granmodel.contact_time(model) == (pytest.approx(expected, rel=1e-9), "Steel-Glass",
                                                    "Hertz")
     readme = (EXAMPLES / "musen" / "README.md").read_text()
     assert f"{expected * 1e6:.2f} µs" in readme and "3.6 µs" not in readme
@@ -72,7 +72,7 @@ def test_demdf_example_prints_one_contact_time():
 
     model = read(EXAMPLES / "demdf" / "head_on.json")
     law = model.contacts[(0, 0)]
-    assert sanity.granular_contact_time(model)[0] == pytest.approx(expected, rel=1e-9)
+    assert granmodel.contact_time(model)[0] == pytest.approx(expected, rel=1e-9)
     assert _hertz_time(0.5, 0.25, law.youngs_eff, 2.0) == pytest.approx(expected, rel=1e-9)
 
 

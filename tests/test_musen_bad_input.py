@@ -150,7 +150,7 @@ def test_scene_warnings(tmp_path, text, kind):
 def test_liquid_bonds_refused_only_when_simulated(tmp_path):
     text = BASE + "0 4 1 13 5 1 2 0.001 0.002 23 GLASS 24 0 1e+300 2 0\n"
     m = musen.read(scene(tmp_path, text))
-    assert m.passthrough["liquid_bonds"][0]["id"] == 4
+    assert m.liquid_bonds[0].id == 4
     with pytest.raises(InputError, match="liquid bonds"):
         musen.check_simulable(m)
     job = tmp_path / "job.txt"
@@ -306,7 +306,8 @@ def test_kelvin_bond_needs_the_styles(tmp_path):
     m = musen.read(scene(tmp_path, BASE))
     ms.apply_simulator_settings(m, job)
     # Kelvin: any non-zero CONSIDER_BREAKAGE is MUSEN's criterion 1
-    assert (m.plan.bond_model, m.plan.bond_breakage, m.plan.bond_max_damp_ratio) == ("kelvin", 1, 0.5)
+    assert (m.plan.bond_law.form, m.plan.bond_breakage, m.plan.bond_law.max_damp_ratio) == ("kelvin", 1, 0.5)
+    assert m.plan.bond_law.model == "ModelSBKelvin" and m.models["SB"].name == "ModelSBKelvin"
 
 
 def test_job_warnings_and_motion(tmp_path):

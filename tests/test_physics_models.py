@@ -57,3 +57,28 @@ def test_parameters_are_cmusens():
 def test_mdem_key_of_unknown_model_is_empty():
     assert physics.mdem_key("ModelPPJKR") == ""
     assert physics.mdem_key("ModelSBKelvin") == "09405654485642A686561E1FC646DF1E"
+
+
+def test_laws_name_the_models_that_chose_them():
+    """Each law a scene carries names its MUSEN model (issue 25): the contact laws the PP
+    model, the solid-bond law the SB model, and ``model.models`` where each was chosen."""
+    import fibrelmp
+
+    job = Path(__file__).resolve().parents[1] / "examples" / "musen" / "agglomerate_short_job.txt"
+    [model] = [step.model for step in fibrelmp.read(job).steps if step.kind == "simulate"]
+    assert {law.model for law in model.contacts.values()} == {"ModelPPHertzMindlin"}
+    assert model.plan.bond_law.model == "ModelSBElastic" and model.plan.bond_law.form == "elastic"
+    sb = model.models["SB"]
+    assert (sb.kind, sb.source, sb.line) == ("SB", job, 11)        # MODEL_SB, line 11
+    assert sb.parameters == {"CONSIDER_BREAKAGE": 1.0}
+    for kind, choice in model.models.items():
+        assert physics.find(choice.name).kind == kind
+
+
+def test_bead_spring_pair_laws_name_their_law():
+    import fibrelmp
+
+    network = Path(__file__).resolve().parents[1] / "examples" / "fibre_network" / "input.txt"
+    laws = {law.kind: law.law for law in fibrelmp.read(network).pairs}
+    assert laws and all(name for name in laws.values())
+    assert laws.get("hs", "harmonic soft-sphere repulsion") == "harmonic soft-sphere repulsion"

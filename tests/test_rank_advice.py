@@ -1,5 +1,5 @@
 """The "too many MPI ranks" advice (``sanity.rank_check``, issue 17): ``fibrelmp run`` warns
-when the ranks leave fewer particles per rank than ``MIN_PER_RANK`` (measured crossovers,
+when the ranks leave fewer particles per rank than the family's ``min_per_rank`` (measured crossovers,
 docs/performance.md).  That the line is printed once, by rank 0, under ``mpiexec -n 2`` and
 not in a serial run: tests/test_mpi.py::test_messages_are_printed_by_rank_0_only."""
 
@@ -9,6 +9,8 @@ import pytest
 
 import fibrelmp
 from fibrelmp import sanity
+from fibrelmp.granmodel import GranularModel
+from fibrelmp.model import Model
 
 from .conftest import REPO
 
@@ -32,7 +34,7 @@ def test_small_network_on_two_ranks_is_warned_once(network):
     sanity.rank_check(network, 2)
     (text,) = _ranks_warnings(network)
     assert "2 MPI ranks for 128 beads (64 per rank)" in text
-    assert f"~{sanity.MIN_PER_RANK['beads']} beads per rank" in text and "1 (no mpiexec)" in text
+    assert f"~{Model.min_per_rank} beads per rank" in text and "1 (no mpiexec)" in text
 
 
 @pytest.mark.parametrize("ranks, warned, advice", [(2, False, None), (3, True, "mpiexec -n 2"),
@@ -40,7 +42,7 @@ def test_small_network_on_two_ranks_is_warned_once(network):
 def test_limit_is_particles_per_rank(network, monkeypatch, ranks, warned, advice):
     """128 beads with a limit of 64 per rank: 2 ranks are fine (exactly 64 each), 3 or 4 are
     too many, and 128 // 64 = 2 is the advice."""
-    monkeypatch.setitem(sanity.MIN_PER_RANK, "beads", 64)
+    monkeypatch.setattr(Model, "min_per_rank", 64)
     sanity.rank_check(network, ranks)
     found = _ranks_warnings(network)
     assert bool(found) == warned
@@ -52,7 +54,7 @@ def test_granular_scenes_count_spheres(monkeypatch):
     scene = fibrelmp.read(REPO / "examples" / "musen" / "SphericalAgglomerate_text.txt")
     n = scene.spheres.count
     assert n == 5696
-    monkeypatch.setitem(sanity.MIN_PER_RANK, "spheres", n // 2)
+    monkeypatch.setattr(GranularModel, "min_per_rank", n // 2)
     sanity.rank_check(scene, 2)
     assert _ranks_warnings(scene) == []                  # 2848 per rank: at the limit
     sanity.rank_check(scene, 3)

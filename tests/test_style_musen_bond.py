@@ -34,6 +34,7 @@ import numpy as np
 import pytest
 
 from fibrelmp import lammps_styles
+from fibrelmp.granmodel import SolidBondLaw
 from fibrelmp._lammps import new_lammps
 
 MUSEN_PI = 3.14159265358979323846
@@ -856,8 +857,8 @@ def test_job_keeps_each_bonds_geometry_exactly(tmp_path):
     pairs = [[0, 1], [1, 2], [0, 2], [3, 2]]
     d = [0.0006, 0.00060000000000000001, 0.00061, 0.0005]
     L0 = [0.0008, 0.00080001, 0.0016000001, 0.00081]
-    model, glass = _glass_pair_model(x, None, pairs, d, L0, 1e-8, 10, bond_model="kelvin",
-                                     bond_max_damp_ratio=0.5, viscosity=123.5)
+    model, glass = _glass_pair_model(x, None, pairs, d, L0, 1e-8, 10, bond_law=SolidBondLaw(
+                                         "ModelSBKelvin", "kelvin", 0.5), viscosity=123.5)
     model.bonds.tangential_overlap = np.array([[0, 0, 0], [1e-9, 2e-9, 3e-9], [0, 0, 0], [4e-9, 0, 0]])
     job = write_granular_job(model, tmp_path / "job")
     script = job.script.read_text()
@@ -914,7 +915,7 @@ def test_stock_job_warns_about_the_approximation(tmp_path):
     msgs = [w for k, w in model.warnings if k == "approximate MUSEN physics"]
     assert any("LAMMPS bpm/rotational breaks on the sum of four load ratios, not MUSEN's two "
                "criteria" in w for w in msgs), msgs
-    model.plan.bond_model = "kelvin"
+    model.plan.bond_law = SolidBondLaw("ModelSBKelvin", "kelvin")
     with lammps_styles.stock(True), pytest.raises(Exception, match="needs fibrelmp's LAMMPS styles"):
         write_granular_job(model, tmp_path / "job2")
 
@@ -933,7 +934,8 @@ def test_pipeline_break_time_is_musens(tmp_path, model_name, criterion):
     x = np.array([[0, 0, 0], [L0, 0, 0]])
     vel = np.array([[-v / 2, 0, 0], [v / 2, 0, 0]])
     model, glass = _glass_pair_model(x, vel, [[0, 1]], [d], [L0], dt, 1200, save=100,
-                                     density=1e20, bond_breakage=criterion, bond_model=model_name,
+                                     density=1e20, bond_breakage=criterion,
+                                     bond_law=SolidBondLaw(None, model_name),
                                      viscosity=1e40)
     job, frames = run(model, tmp_path)
     assert ("kelvin 1.0" in job.script.read_text()) == (model_name == "kelvin")

@@ -94,8 +94,7 @@ def model_from_frame(first: Frame, source: Path, names: Mapping[int, str], kind:
                         domain=(first.lo.copy(), first.hi.copy()),
                         periodic=tuple(bool(p) for p in first.periodic))
     model = GranularModel(source=source, kind=kind, materials=materials, contacts={},
-                          spheres=spheres, plan=plan)
-    model.passthrough["atom_ids"] = ids
+                          spheres=spheres, plan=plan, atom_ids=ids)
     return model
 
 
@@ -113,8 +112,10 @@ def granular_frame(frame: Frame, time: float, model: GranularModel,
                    facts: WorkFacts | None = None) -> GranularFrame:
     """A dump frame as a GranularFrame; atoms missing from it count as removed, atoms the
     first frame did not have are an error (a model cannot grow)."""
-    ids = model.passthrough["atom_ids"]
-    order = model.passthrough.setdefault("atom_order", np.argsort(ids))
+    ids = model.atom_ids
+    if model.atom_order is None:
+        model.atom_order = np.argsort(ids)
+    order = model.atom_order
     fid = frame.column("id").astype(np.int64)
     pos = np.searchsorted(ids, fid, sorter=order)
     pos = np.minimum(pos, len(ids) - 1)

@@ -125,7 +125,7 @@ def job_facts(model: GranularModel, spheres, tiles, t_start: float, dt: float) -
     types = {**spheres.type_of_mat, **tiles.type_of_mat}          # material -> LAMMPS type
     q = np.asarray(sp.quaternion, float)
     identity = bool((q == np.array([1.0, 0.0, 0.0, 0.0])).all()) if len(q) else True
-    demdf = model.passthrough.get("demdf")
+    demdf = model.origin.post_facts() if model.origin is not None else None
     return WorkFacts(
         kind=model.kind, source=model.source.name, time_start=t_start, time_step=dt,
         type_names={t: model.materials[m].name for m, t in types.items()},

@@ -22,13 +22,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
 from fibrelmp.errors import InputError
 from fibrelmp.lammps_text import lammps_word
 from fibrelmp.mesh.model import Mesh
+from fibrelmp.particles import ModelCounts, ParticleModel, ParticleView
 from fibrelmp.translate.json_doc import JsonDoc, load_json
 
 VERSION = 1
@@ -88,8 +89,10 @@ class Motion:
 
 
 @dataclass
-class SphCase:
-    source: Path
+class SphCase(ParticleModel):
+    """SPH water in a moving finite-element wall (CardioProof).  Its particles are made when
+    the job is planned (``cardioproof.job.plan_job``: the fluid lattice inside the wall)."""
+
     mesh: Mesh
     mesh_file: Path
     motion: Motion | None
@@ -108,9 +111,33 @@ class SphCase:
     series_interval: float | None
     name: str
     kind: str = "cardioproof"
-    units: str = "si"
-    warnings: list[tuple[str, str]] = field(default_factory=list)
     plan: dict | None = field(default=None, repr=False)       # cardioproof.job.plan_job's, once
+
+    particle_noun: ClassVar[str] = "SPH particles"
+
+    def particles_view(self) -> ParticleView:
+        """The fluid particles at rest on their lattice (none before the job is planned; the
+        wall particles follow the mesh and are the job's)."""
+        if self.plan is None:
+            return ParticleView.empty()
+        fluid = np.asarray(self.plan["fluid"], float).reshape(-1, 3)
+        n = len(fluid)
+        return ParticleView(np.arange(1, n + 1), fluid, np.zeros((n, 3)),
+                            np.full(n, 0.5 * self.spacing),
+                            np.full(n, self.density * self.plan["particle_volume"]),
+                            np.zeros(n, np.int64))
+
+    def counts(self) -> ModelCounts:
+        """The wall: the mesh's cells; one fluid."""
+        return ModelCounts(walls=self.mesh.cell_count, materials=1)
+
+    def given_time_step(self) -> float | None:
+        """run.time_step (None: the job takes the CFL limit, cardioproof.job.time_step)."""
+        return self.time_step
+
+    def unstable_hint(self) -> str:
+        return ("the SPH run became unstable; a higher fluid.sound_speed (with its smaller step), "
+                "more artificial_viscosity or a finer spacing usually help")
 
     @property
     def smoothing(self) -> float:

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 
 from fibrelmp.errors import InputError
 from fibrelmp.inputformat import InputFormat, RunSettings, Say, Warn
+from fibrelmp.translate.demdf.record import demdf_record
 
 if TYPE_CHECKING:
     from fibrelmp.granmodel import GranularModel
@@ -35,7 +36,7 @@ class DemdfInput(InputFormat):
         from fibrelmp.granular_check import summary
 
         folder = demdf_outputs(model)[1]
-        return summary(model) + [f"results      {folder / model.passthrough['demdf']['filename']}"
+        return summary(model) + [f"results      {folder / demdf_record(model).filename}"
                                  "_<n>.json (or in -o DIR)"]
 
     def write_job(self, model: "GranularModel", folder: Path) -> "GranularJob":
@@ -56,7 +57,7 @@ class DemdfInput(InputFormat):
         warn(model.warnings)
         outputs, folder = demdf_outputs(model, settings.out, settings.work)
         extra = granular_writers(settings.also, model, outputs,
-                                 folder / str(model.passthrough["demdf"]["filename"]))
+                                 folder / str(demdf_record(model).filename))
         request = granular_request(model, outputs.work,
                                    lambda: [DemdfSnapshotWriter(model, folder)] + extra())
         return RunPlan(outputs, [request], options)
@@ -80,12 +81,12 @@ def demdf_outputs(model: "GranularModel", out: str | Path | None = None,
     a ``filename`` that leaves that folder is refused."""
     from fibrelmp.outputs import Outputs
 
-    info = model.passthrough["demdf"]
+    info = demdf_record(model)
     folder, work_folder = _folders(model.source, out, work)
-    name = str(info["filename"])
+    name = str(info.filename)
     if Path(name).is_absolute() or ".." in Path(name).parts or "/" in name or "\\" in name:
         raise InputError(model.source, None, f"output filename {name!r} must be a plain file name: "
                          f"snapshots are written into {folder}")
-    inputs = [Path(model.source)] + ([Path(info["particles_file"])] if info.get("particles_file") else [])
+    inputs = [Path(model.source)] + ([Path(info.particles_file)] if info.particles_file else [])
     pattern = re.compile(re.escape(name) + r"_\d+\.json")
     return Outputs(Path(model.source), work_folder, patterns=[(folder, pattern)], inputs=inputs), folder

@@ -6,7 +6,7 @@ docs/demdf.md for the accepted layout, the choices made and the deviations from 
 
 ``read`` gives a runnable GranularModel (kind "demdf"); ``read_snapshot`` reads a snapshot a
 run wrote (BOS's or fibrelmp's ``<filename>_<saveCount>.json``) without asking it to be
-runnable.  ``model.passthrough["demdf"]`` keeps the parsed document and what the snapshot
+runnable.  ``model.origin`` (a ``DemdfDocument``) keeps the parsed document and what the snapshot
 writer needs.
 """
 
@@ -25,6 +25,7 @@ from fibrelmp.units import DIMENSIONLESS
 from fibrelmp.translate.demdf import contact as hertz
 from fibrelmp.translate.json_doc import JsonDoc, describe, load_json
 from fibrelmp.translate.demdf.plan import Output, PlanMixin
+from fibrelmp.translate.demdf.record import DemdfDocument
 
 DEFAULT_RADIUS = 0.5          # BOS hard-codes this radius
 DEFAULT_MASS = 1.0
@@ -120,12 +121,11 @@ class _Reader(PlanMixin):
         model = GranularModel(source=self.path, kind="demdf", materials=self.materials,
                               contacts=contacts, spheres=spheres, plan=plan, planes=planes,
                               units=DIMENSIONLESS.name)
-        model.passthrough["demdf"] = {
-            "document": doc, "dimensionality": self.dim, "particle_rows": rows,
-            "particles_file": source_file, "output_location": out.location,
-            "filename": out.filename, "save_count": out.save_count,
-            "file_time_step": self.file_dt, "substeps": self.substeps, "time_step_count": self.step0,
-        }
+        model.origin = DemdfDocument(
+            document=doc, dimensionality=self.dim, particle_rows=rows,
+            particles_file=source_file, output_location=out.location,
+            filename=out.filename, save_count=out.save_count,
+            file_time_step=self.file_dt, substeps=self.substeps, time_step_count=self.step0)
         model.warnings.extend(self.notes)
         return model
 
@@ -488,7 +488,7 @@ class _Reader(PlanMixin):
                 contacts[p.key] = law
         for p in partners:
             # with the law that runs (the stiffest of a material pair's): the contact time
-            # ``fibrelmp check`` prints (sanity.granular_contact_time) is this same figure
+            # ``fibrelmp check`` prints (granmodel.contact_time) is this same figure
             possible = p.speed > 0
             speed = p.speed if possible else fastest
             e_star = contacts[p.key].youngs_eff

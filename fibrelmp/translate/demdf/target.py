@@ -13,6 +13,7 @@ from fibrelmp.formatbase import Writer
 from fibrelmp.granmodel import GranularModel
 from fibrelmp.post.target import ReadBack
 from fibrelmp.post.to_granular import GranularTarget
+from fibrelmp.translate.demdf.record import DemdfDocument
 
 
 def demdf_document(model: GranularModel, filename: str) -> dict:
@@ -61,14 +62,14 @@ class DemdfTarget(GranularTarget):
             demdf = None
         if demdf is not None:
             # the run's document, counters and object types (the rows' last entry)
-            model.passthrough["demdf"] = {**copy.deepcopy(demdf), "filename": name}
+            model.origin = DemdfDocument(**{**copy.deepcopy(demdf), "filename": name})
         else:
-            model.passthrough["demdf"] = {
-                "document": demdf_document(model, name), "dimensionality": 3,
-                "particle_rows": [[0.0] * 6 + [int(t)] for t in model.spheres.material],
-                "particles_file": None, "output_location": ("output", "snapshot"),
-                "filename": name, "save_count": 0, "file_time_step": dt, "substeps": 1,
-                "time_step_count": 0}
+            model.origin = DemdfDocument(
+                document=demdf_document(model, name), dimensionality=3,
+                particle_rows=[[0.0] * 6 + [int(t)] for t in model.spheres.material],
+                particles_file=None, output_location=("output", "snapshot"),
+                filename=name, save_count=0, file_time_step=dt, substeps=1,
+                time_step_count=0)
         return DemdfSnapshotWriter(model, self.target.parent)
 
     @classmethod

@@ -24,6 +24,7 @@ from fibrelmp.errors import RunError
 from fibrelmp.granmodel import GranularFrame, GranularModel
 from fibrelmp.formatbase import Writer
 from fibrelmp.translate.demdf.reader import read_snapshot
+from fibrelmp.translate.demdf.record import demdf_record
 
 __all__ = ["DemdfSnapshotWriter", "read_snapshot"]
 
@@ -38,18 +39,18 @@ class DemdfSnapshotWriter(Writer):
     format = "demdf"
 
     def __init__(self, model: GranularModel, folder: str | Path, *, force: bool = True):
-        info = model.passthrough["demdf"]
+        info = demdf_record(model)
         super().__init__(folder, force=force)
         self.model = model
         self.folder = self.target
-        self.doc = copy.deepcopy(info["document"])
-        self.dim: int = info["dimensionality"]
-        self.types = [row[-1] for row in info["particle_rows"]]
-        self.filename: str = info["filename"]
-        self.save_count: int = info["save_count"]
-        self.location = info["output_location"]
-        self.file_dt: float = info["file_time_step"]
-        self.step0: int = info["time_step_count"]
+        self.doc = copy.deepcopy(info.document)
+        self.dim: int = info.dimensionality
+        self.types = [row[-1] for row in info.particle_rows]
+        self.filename: str = info.filename
+        self.save_count: int = info.save_count
+        self.location = info.output_location
+        self.file_dt: float = info.file_time_step
+        self.step0: int = info.time_step_count
         self.t0 = model.plan.t_start
         self.position = model.spheres.position.copy()
         self.velocity = model.spheres.velocity.copy()

@@ -35,7 +35,7 @@ class FibreNetInput(InputFormat):
                 "significant digits)")
 
     def check_lines(self, path: Path, model: "Model") -> list[str]:
-        from fibrelmp.sanity import spring_check, units_line
+        from fibrelmp.sanity import time_step_check, units_line
 
         p = model.particles
         lines = [f"input        {model.source}",
@@ -53,7 +53,7 @@ class FibreNetInput(InputFormat):
             extra = f" in chunks of {st.chunk}" + (", velocities reset" if st.reset else "") if st.name == "relax" else \
                 f", output every {model.plan.output.every}"
             lines.append(f"stage        {st.name}: {st.steps} steps{extra}")
-        lines += spring_check(model)
+        lines += time_step_check(model)
         outputs = fibrenet_outputs(model)[0]
         lines.append(f"results      {', '.join(str(p) for p in outputs.files)} (or in -o DIR)")
         return lines

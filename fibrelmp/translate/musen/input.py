@@ -133,7 +133,7 @@ def musen_result_writer(model: "GranularModel", target: str | Path, precision: i
 
 
 def check_musen_runnable(model: GranularModel) -> None:
-    if model.passthrough.get("liquid_bonds"):
+    if model.liquid_bonds:
         raise InputError(model.source, None, "the scene has liquid bonds (type 13), which need a "
                          "liquid-bridge model fibrelmp does not translate; remove them or export "
                          "the scene without them")
@@ -162,16 +162,17 @@ def bare_scene_settings(model: GranularModel, end_time: float | None, step: floa
     from fibrelmp.translate.granular.models import default_model
     from fibrelmp.translate.musen.script import (MUSEN_DEFAULTS, MusenJob, MusenModelSpec,
                                          apply_simulator_settings)
+    from fibrelmp.translate.musen.scene_record import scene_record
 
     for name, value in (("end-time", end_time), ("step", step), ("save-step", save_step)):
         if value is not None and not value > 0:
             raise InputError(model.source, None, f"--{name} must be positive, got {value:g}")
-    file_set = model.passthrough.get("musen_gravity_set")          # a .mdem's own settings
+    file_set = scene_record(model).gravity_set          # a .mdem's own settings
     job = MusenJob(path=model.source, index=0, line=0, component="SIMULATOR",
                    simulation_step=step or 0.0, saving_step=save_step or 0.0,
                    end_time=end_time or 0.0,
                    ext_accel=None if file_set else tuple(MUSEN_DEFAULTS["gravity"]))
-    stored = {spec.kind for spec in model.passthrough.get("mdem_models", [])}
+    stored = {spec.kind for spec in scene_record(model).file_models}
     job.models = [MusenModelSpec(name=default_model(kind).name, params="", kind=kind, line=0)
                   for kind, wanted in (("PP", True),
                                        ("PW", model.triangles is not None and model.triangles.count),
@@ -187,7 +188,7 @@ def bare_scene_settings(model: GranularModel, end_time: float | None, step: floa
     if job.models:
         said.append(f"models {', '.join(spec.name for spec in job.models)} (MUSEN's for a bare scene)")
     if stored:
-        said.append(f"models {', '.join(s.name for s in model.passthrough['mdem_models'])} (the file's)")
+        said.append(f"models {', '.join(s.name for s in scene_record(model).file_models)} (the file's)")
     said.append("gravity 0 0 -9.81 m/s^2 (MUSEN's default)" if not file_set else
                 f"gravity {' '.join('%g' % g for g in model.plan.gravity)} m/s^2 (the file's)")
     for name, value in (("end time", end_time), ("simulation step", step), ("saving step", save_step)):

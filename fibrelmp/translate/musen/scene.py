@@ -16,8 +16,9 @@ import numpy as np
 
 from fibrelmp.errors import InputError
 from fibrelmp.units import SI
-from fibrelmp.granmodel import (ContactLaw, Geometry, GranularModel, GranularPlan, Material,
+from fibrelmp.granmodel import (ContactLaw, Geometry, GranularModel, GranularPlan, LiquidBond, Material,
                          MotionInterval, SolidBonds, Spheres, Triangles, hertz_effective)
+from fibrelmp.translate.musen.scene_record import MusenSceneRecord
 from fibrelmp.translate.musen.text import (LIQUID_BOND, SOLID_BOND, SPHERE, TD_SIZE, TYPE_NAMES, WALL,  # noqa: F401
                          TimePoints, _bool, check_duplicate_ids, _fill, _int, _num, scan_text, TextScan,
                          _state, read_time_points)
@@ -65,19 +66,20 @@ def read(path: str | Path) -> GranularModel:
                            "`24`: fibrelmp makes them active from 0 for ever, while MUSEN imports "
                            "them as never active (interval 0..0)"))
 
-    passthrough = {"liquid_bonds": _liquid_bonds(scan, rows[LIQUID_BOND], ids, types, path),
-                   "raw": {}}
-    if passthrough["liquid_bonds"]:
-        model_warn.append(("musen-liquid-bonds", f"{len(passthrough['liquid_bonds'])} liquid "
+    liquid_bonds = _liquid_bonds(scan, rows[LIQUID_BOND], ids, types, path)
+    record = MusenSceneRecord()
+    if liquid_bonds:
+        model_warn.append(("musen-liquid-bonds", f"{len(liquid_bonds)} liquid "
                            "bond(s) (type 13) are kept for the result file; simulating them is "
                            "not supported"))
     plan = GranularPlan(dt=float("nan"), t_start=t_start, t_end=float("nan"))
-    geometries = _scene(scan, plan, passthrough, triangles, ids, types, rows[WALL], path,
+    geometries = _scene(scan, plan, record, triangles, ids, types, rows[WALL], path,
                         model_warn)
-    contacts = _contacts(scan, materials, key_index, path, model_warn, passthrough)
+    contacts = _contacts(scan, materials, key_index, path, model_warn, record)
     model = GranularModel(source=path, kind="musen", materials=materials, contacts=contacts,
                           spheres=spheres, plan=plan, bonds=bonds, triangles=triangles,
-                          geometries=geometries, passthrough=passthrough, units=SI.name)
+                          geometries=geometries, origin=record, liquid_bonds=liquid_bonds,
+                          units=SI.name)
     model.warnings.extend(model_warn)
     domain_warning(model)
     return model
@@ -267,7 +269,7 @@ def _walls(scan, rows, key_index, t, late, path) -> Triangles | None:
                      active_end=end, compound_key=[scan.keys[r] for r in rows])
 
 
-def _liquid_bonds(scan, rows, ids, types, path) -> list[dict]:
+def _liquid_bonds(scan, rows, ids, types, path) -> list[LiquidBond]:
     if not len(rows):
         return []
     sphere_rows = np.flatnonzero(types == SPHERE)
@@ -276,14 +278,14 @@ def _liquid_bonds(scan, rows, ids, types, path) -> list[dict]:
     out = []
     for j, r in enumerate(rows):
         g = scan.geoms[r]
-        out.append({"id": int(scan.ids[r]), "left": int(g[0]), "right": int(g[1]),
-                    "diameter": g[2], "length0": g[3], "key": scan.keys[r],
-                    "active_start": float(start[j]), "active_end": float(end[j])})
+        out.append(LiquidBond(id=int(scan.ids[r]), left=int(g[0]), right=int(g[1]),
+                              diameter=g[2], length0=g[3], key=scan.keys[r],
+                              active_start=float(start[j]), active_end=float(end[j])))
     return out
 
 
-def _scene(scan, plan, passthrough, triangles, ids, types, wall_rows, path, warn) -> list[Geometry]:
-    raw = passthrough["raw"]
+def _scene(scan, plan, record, triangles, ids, types, wall_rows, path, warn) -> list[Geometry]:
+    raw = record.raw
     geometries: list[Geometry] = []
     domain = None
     pbc = None
@@ -302,7 +304,10 @@ def _scene(scan, plan, passthrough, triangles, ids, types, wall_rows, path, warn
             pbc = (flags, box)
         elif tag in (29, 30):
             flag = _bool(tok, 0, path, ln, f"flag `{tag}`")
-            passthrough["anisotropy" if tag == 29 else "contact_radius_flag"] = flag
+            if tag == 29:
+                record.anisotropy = flag
+            else:
+                record.contact_radius_flag = flag
             if tag == 29 and flag:
                 warn.append(("musen-anisotropy", f"{path}:{ln}: anisotropy (`29 1`) is on; "
                              "fibrelmp's spheres are isotropic, orientations are only carried"))
@@ -329,7 +334,7 @@ def _scene(scan, plan, passthrough, triangles, ids, types, wall_rows, path, warn
                      "default, a 1 cm cube centred on the origin, is used"))
     plan.domain = domain
     flags, box = pbc if pbc else ([False] * 4, [-5e-3] * 3 + [5e-3] * 3)
-    passthrough["pbc"] = (flags, box)
+    record.pbc = (flags, box)
     plan.periodic = tuple(flags[0] and f for f in flags[1:])
     plan.periodic_box = (np.array(box[:3]), np.array(box[3:]))
     return geometries
@@ -381,7 +386,7 @@ def _wall_list(tok, ids, types, wall_rows, path, ln) -> np.ndarray:
     return np.array(out, np.int64)
 
 
-def _contacts(scan, materials, key_index, path, warn, passthrough) -> dict:
+def _contacts(scan, materials, key_index, path, warn, record) -> dict:
     given: dict[tuple[int, int], dict[int, float]] = {}
     for ln, tag, tok in scan.scene:
         if tag != 33:
@@ -406,7 +411,7 @@ def _contacts(scan, materials, key_index, path, warn, passthrough) -> dict:
                              f"{pid} is not a MUSEN property; ignored as MUSEN does"))
                 continue
             props[pid] = value
-    passthrough["interactions"] = {}
+    record.interactions = {}
     contacts = {}
     defaulted = []
     for b in range(len(materials)):
@@ -416,7 +421,7 @@ def _contacts(scan, materials, key_index, path, warn, passthrough) -> dict:
                 props.update(given[(a, b)])
             else:
                 defaulted.append(f"{materials[b].name}-{materials[a].name}")
-            passthrough["interactions"][(a, b)] = props
+            record.interactions[(a, b)] = props
             contacts[(a, b)] = contact_law(materials[a], materials[b], props)
     if defaulted:
         warn.append(("musen-default-interaction", f"{path}: no `33` line for {', '.join(defaulted)}: "
@@ -444,7 +449,7 @@ def domain_warning(model: GranularModel) -> None:
 
 def check_simulable(model: GranularModel) -> None:
     """Raise if the model holds what fibrelmp cannot simulate (liquid bonds)."""
-    if model.passthrough.get("liquid_bonds"):
+    if model.liquid_bonds:
         raise InputError(model.source, None, "the scene has liquid bonds (type 13): simulating "
                          "them is not supported")
 

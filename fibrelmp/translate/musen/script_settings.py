@@ -7,34 +7,36 @@ from __future__ import annotations
 
 import difflib
 import math
+from pathlib import Path
 
 import numpy as np
 
 from fibrelmp import lammps_styles
 from fibrelmp.errors import InputError
-from fibrelmp.granmodel import GranularModel
+from fibrelmp.granmodel import GranularModel, ModelChoice
 from fibrelmp.translate.musen.scene import (INTERACTION_DEFAULTS, _check_material, check_simulable, contact_law,
                     domain_warning)
 from fibrelmp.translate.granular import models as physics
+from fibrelmp.translate.musen.scene_record import scene_record
 from fibrelmp.translate.musen.script_parse import MUSEN_MODELS, REFUSED_MODEL, MusenJob, model_kind
 
 MUSEN_DEFAULTS = {"dt": 1e-6, "save": 1e-3, "t_end": 1.0, "gravity": (0.0, 0.0, -9.81)}
 
 
-def _resolve_models(model: GranularModel, job: MusenJob) -> dict[str, tuple[str, dict]]:
+def _resolve_models(model: GranularModel, job: MusenJob) -> dict[str, ModelChoice]:
     """The models a SIMULATOR job runs: the scene's (a ``.mdem`` stores its models, as MUSEN
     loads them with the file; a kind the job names again is replaced), then the job's."""
-    chosen: dict[str, tuple[str, dict]] = dict(model.passthrough.get("musen_models", {}))
+    chosen: dict[str, ModelChoice] = dict(model.models)
     given = {model_kind(spec) for spec in job.models}
-    for spec in model.passthrough.get("mdem_models", []):
+    for spec in scene_record(model).file_models:
         if model_kind(spec) not in given:
-            kind, choice = _model_choice(model, spec, model.source, None)
-            chosen[kind] = choice
+            choice = _model_choice(model, spec, model.source, None)
+            chosen[choice.kind] = choice
     for spec in job.models:
         if spec.name.startswith(REFUSED_MODEL):    # check's stand-in for a model refused above
             continue
-        kind, choice = _model_choice(model, spec, job.path, spec.line)
-        chosen[kind] = choice
+        choice = _model_choice(model, spec, job.path, spec.line)
+        chosen[choice.kind] = choice
     return chosen
 
 
@@ -43,8 +45,8 @@ def accepted_models(kind: str) -> list[str]:
     return [m.name for m in physics.of_kind(kind)]
 
 
-def _model_choice(model: GranularModel, spec, path, line: int | None) -> tuple[str, tuple[str, dict]]:
-    """(kind, (name, parameters)) of one model named at ``path``:``line``, checked."""
+def _model_choice(model: GranularModel, spec, path, line: int | None) -> ModelChoice:
+    """One model named at ``path``:``line`` (None: a .mdem's stored model), checked."""
     kind = model_kind(spec)
     where = "" if line is not None else "the file's model "
     known = [n for names in MUSEN_MODELS.values() for n in names]
@@ -75,7 +77,7 @@ def _model_choice(model: GranularModel, spec, path, line: int | None) -> tuple[s
                             else f"; fibrelmp translates no {what} model")
                          + ("; name another in the job script (MODEL_" + kind + ")" if line is None else ""))
     params = found.read_parameters(spec.params, path, line, model)
-    return kind, (spec.name, params)
+    return ModelChoice(spec.name, kind, params, Path(path), line)
 
 
 def apply_simulator_settings(model: GranularModel, job: MusenJob) -> None:
@@ -95,9 +97,9 @@ def apply_simulator_settings(model: GranularModel, job: MusenJob) -> None:
         model.warn("musen-anisotropy", f"{job.path}:{job.where('ANISOTROPY')}: ANISOTROPY 1: "
                    "fibrelmp's spheres are isotropic")
     if job.anisotropy is not None:
-        model.passthrough["anisotropy"] = job.anisotropy
+        scene_record(model, keep=True).anisotropy = job.anisotropy
     if job.contact_radius is not None:
-        model.passthrough["contact_radius_flag"] = job.contact_radius
+        scene_record(model, keep=True).contact_radius_flag = job.contact_radius
     if job.simulation_domain is not None:
         d = job.simulation_domain
         if any(d[j] >= d[j + 3] for j in range(3)):
@@ -114,11 +116,15 @@ def apply_simulator_settings(model: GranularModel, job: MusenJob) -> None:
         reset_bond_lengths(model)
     _apply_motion(model, job)
     models = _resolve_models(model, job)
-    model.passthrough["musen_models"] = models
+    model.models = models
     _check_models(model, job, models)
-    for kind, (name, params) in models.items():
+    if "PP" in models:                            # the laws stand for the PP model chosen
+        for law in model.contacts.values():
+            law.model = models["PP"].name
+    for kind, choice in models.items():
         # a kind's parameter errors point at its PARAMS line (cmusen reads them there)
-        physics.find(name).apply(plan, params, job.path, job.where(f"MODEL_{kind}_PARAMS"))
+        physics.find(choice.name).apply(plan, choice.parameters, job.path,
+                                        job.where(f"MODEL_{kind}_PARAMS"))
     if job.connected_pp_contact is not None:
         plan.contacts_between_bonded = job.connected_pp_contact
     _apply_times(model, job)
@@ -146,7 +152,7 @@ def _apply_materials(model: GranularModel, job: MusenJob) -> None:
             setattr(mat, attr, value)
         _check_material(mat.key, mat.name, mat.props, job.path, ln)
         changed = True
-    inter = model.passthrough.setdefault("interactions", {})
+    inter = scene_record(model, keep=True).interactions
     for pid, k1, k2, value, ln in job.interaction_properties:
         a, b = sorted((index(k1, ln), index(k2, ln)))
         inter.setdefault((a, b), dict(INTERACTION_DEFAULTS))[pid] = value
@@ -276,10 +282,10 @@ def _apply_times(model: GranularModel, job: MusenJob) -> None:
     plan.save_every_steps = None
     if job.ext_accel is not None:
         plan.gravity = np.array(job.ext_accel, np.float64)
-    elif not model.passthrough.get("musen_gravity_set"):
+    elif not scene_record(model).gravity_set:
         plan.gravity = np.array(MUSEN_DEFAULTS["gravity"])
         used.append("gravity (0, 0, -9.81)")
-    model.passthrough["musen_gravity_set"] = True
+    scene_record(model, keep=True).gravity_set = True
     if used:
         model.warn("musen-default-settings", f"{job.path}:{job.line}: job {job.index} does not "
                    f"set {', '.join(used)}: MUSEN's defaults for a freshly imported scene are used")

@@ -28,6 +28,7 @@ from fibrelmp.granmodel import GranularFrame, GranularModel
 from fibrelmp.textio import temp_name, write_failure
 from fibrelmp.translate.musen.scene import (ACTIVE_INTERACTIONS, ACTIVE_PROPERTIES, DEFAULT_ACTIVITY_END,
                                PROPERTY_DEFAULTS)
+from fibrelmp.translate.musen.scene_record import scene_record
 from fibrelmp.translate.musen.text_writer import (export_selectors, gather_spool, object_header, scene_line,
                                                   time_point_lines)
 
@@ -182,9 +183,9 @@ class MusenResultWriter(Writer):
             parts.append((m.bonds.ids, 9))
         if m.triangles is not None:
             parts.append((m.triangles.ids, 14))
-        liquid = m.passthrough.get("liquid_bonds") or []
+        liquid = m.liquid_bonds
         if liquid:
-            parts.append((np.array([lb["id"] for lb in liquid], np.int64), 13))
+            parts.append((np.array([lb.id for lb in liquid], np.int64), 13))
         ids = np.concatenate([np.asarray(p[0], np.int64) for p in parts])
         types = np.concatenate([np.full(len(p[0]), p[1]) for p in parts])
         rows = np.concatenate([np.arange(len(p[0])) for p in parts])
@@ -218,9 +219,9 @@ class MusenResultWriter(Writer):
                 start[sel], end[sel] = s[rows[sel]], e[rows[sel]]
         sel = types == 13
         if sel.any():
-            liquid = m.passthrough["liquid_bonds"]
-            start[sel] = [liquid[r]["active_start"] for r in rows[sel]]
-            end[sel] = [liquid[r]["active_end"] for r in rows[sel]]
+            liquid = m.liquid_bonds
+            start[sel] = [liquid[r].active_start for r in rows[sel]]
+            end[sel] = [liquid[r].active_end for r in rows[sel]]
         return start, end
 
     def _write_objects(self, out) -> None:
@@ -272,9 +273,9 @@ class MusenResultWriter(Writer):
             geom = [""] * len(rows)
         else:
             obj = None
-            liquid = m.passthrough["liquid_bonds"]
-            geom = ["%d %d %.25g %.25g" % (liquid[r]["left"], liquid[r]["right"],
-                                          liquid[r]["diameter"], liquid[r]["length0"])
+            liquid = m.liquid_bonds
+            geom = ["%d %d %.25g %.25g" % (liquid[r].left, liquid[r].right,
+                                          liquid[r].diameter, liquid[r].length0)
                     for r in rows]
         start, end = self._activity(np.full(len(rows), otype), rows)
         const = self.sel["constProps"]
@@ -284,7 +285,7 @@ class MusenResultWriter(Writer):
 
     def _key(self, obj, otype: int, r: int) -> str:
         if otype == 13:
-            key = self.model.passthrough["liquid_bonds"][r]["key"]
+            key = self.model.liquid_bonds[r].key
         elif obj.compound_key is not None:
             key = obj.compound_key[r]
         else:
@@ -293,8 +294,8 @@ class MusenResultWriter(Writer):
 
     def _scene_text(self) -> str:
         m = self.model
-        pt = m.passthrough
-        raw = pt.get("raw", {})
+        record = scene_record(m)
+        raw = record.raw
         lines: list[str] = []
 
         def line(tag: int, *values) -> None:
@@ -304,7 +305,7 @@ class MusenResultWriter(Writer):
         if sc["domain"] and m.plan.domain is not None:
             line(22, *[_g(v) for v in np.concatenate(m.plan.domain)])
         if sc["pbc"]:
-            flags, box = pt.get("pbc", ([False] * 4, [-5e-3] * 3 + [5e-3] * 3))
+            flags, box = record.pbc
             periodic = tuple(bool(x) for x in m.plan.periodic)
             if periodic != tuple(flags[0] and f for f in flags[1:]):
                 flags = [any(periodic), *periodic]
@@ -312,9 +313,9 @@ class MusenResultWriter(Writer):
                 box = list(np.concatenate(m.plan.periodic_box))
             line(28, *[int(f) for f in flags], *[_g(v) for v in box])
         if sc["anisotropy"]:
-            line(29, int(bool(pt.get("anisotropy", False))))
+            line(29, int(bool(record.anisotropy)))
         if sc["contactRadius"]:
-            line(30, int(bool(pt.get("contact_radius_flag", False))))
+            line(30, int(bool(record.contact_radius_flag)))
         ge = self.sel["geometries"]
         tri_ids = m.triangles.ids if m.triangles is not None else np.zeros(0, np.int64)
         for g in m.geometries:
@@ -334,7 +335,7 @@ class MusenResultWriter(Writer):
                 props = [x for p in ACTIVE_PROPERTIES for x in (p, _g(_property(mat, p)))]
                 line(32, mat.key, mat.name, *props)
         if ma["interactions"]:
-            inter = pt.get("interactions", {})
+            inter = record.interactions
             for b in range(len(m.materials)):
                 for a in range(b + 1):
                     props = inter.get((a, b))

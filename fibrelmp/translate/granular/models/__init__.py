@@ -37,7 +37,7 @@ class PhysicsModel:
     needs_styles: ClassVar[str | None] = None
     # the only model of its kind fibrelmp translates with stock LAMMPS (bare scenes use it)
     default: ClassVar[bool] = False
-    # SB models: their GranularPlan.bond_model (what granular.bonds renders)
+    # SB models: their SolidBondLaw.form (what granular.bonds renders)
     plan_bond_model: ClassVar[str | None] = None
 
     @classmethod
@@ -126,16 +126,16 @@ def default_model(kind: str) -> type[PhysicsModel] | None:
 def chosen(model: GranularModel, kind: str) -> tuple[type[PhysicsModel], dict[str, float]]:
     """The model of ``kind`` a scene runs and its parameters: the one its settings chose
     (``script_settings``), else the stock default with MUSEN's defaults (a DEMDF scene)."""
-    picked = model.passthrough.get("musen_models", {}).get(kind)
+    picked = model.models.get(kind)
     if picked is not None:
-        return find(picked[0]), picked[1]
+        return find(picked.name), picked.parameters
     stock = default_model(kind)
     return stock, dict(stock.parameters)
 
 
 def solid_bond_model(plan: GranularPlan) -> type[PhysicsModel]:
-    """The SB model of ``plan.bond_model``."""
-    return next(m for m in of_kind("SB") if m.plan_bond_model == plan.bond_model)
+    """The SB model of ``plan.bond_law`` (the form's model when no SB model chose it)."""
+    return next(m for m in of_kind("SB") if m.plan_bond_model == plan.bond_law.form)
 
 
 def mdem_key(name: str) -> str:

@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from fibrelmp.errors import InputError
-from fibrelmp.granmodel import GranularPlan
+from fibrelmp.granmodel import GranularPlan, SolidBondLaw
 from fibrelmp.translate.granular.models import PhysicsModel, register
 
 
@@ -32,7 +32,7 @@ class SBElastic(PhysicsModel):
     def apply(cls, plan: GranularPlan, params: dict[str, float], path: Path | str | None,
               line: int | None) -> None:
         apply_breakage(plan, params, path, line)
-        plan.bond_model = cls.plan_bond_model
+        plan.bond_law = SolidBondLaw(cls.name, cls.plan_bond_model)
 
     @classmethod
     def bond_law(cls, plan: GranularPlan) -> tuple[str, str]:

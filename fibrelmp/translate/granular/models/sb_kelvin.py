@@ -7,7 +7,7 @@ import math
 from pathlib import Path
 
 from fibrelmp.errors import InputError
-from fibrelmp.granmodel import GranularPlan
+from fibrelmp.granmodel import GranularPlan, SolidBondLaw
 from fibrelmp.translate.granular.models import PhysicsModel, register
 from fibrelmp.translate.granular.models.sb_elastic import apply_breakage
 from fibrelmp.translate.lammps_format import float_text
@@ -26,15 +26,14 @@ class SBKelvin(PhysicsModel):
     def apply(cls, plan: GranularPlan, params: dict[str, float], path: Path | str | None,
               line: int | None) -> None:
         apply_breakage(plan, params, path, line)
-        plan.bond_model = cls.plan_bond_model
+        plan.bond_law = SolidBondLaw(cls.name, cls.plan_bond_model, float(params["MAX_DAMP_RATIO"]))
         # any non-zero CONSIDER_BREAKAGE is its one criterion (MUSEN's 1)
         plan.bond_breakage = 1 if plan.bond_breakage else 0
-        plan.bond_max_damp_ratio = float(params["MAX_DAMP_RATIO"])
-        if not (plan.bond_max_damp_ratio >= 0 and math.isfinite(plan.bond_max_damp_ratio)):
-            raise InputError(path, line, "MAX_DAMP_RATIO must be "
-                             f">= 0 (0: no cap; got {plan.bond_max_damp_ratio:g})")
+        cap = plan.bond_law.max_damp_ratio
+        if not (cap >= 0 and math.isfinite(cap)):
+            raise InputError(path, line, f"MAX_DAMP_RATIO must be >= 0 (0: no cap; got {cap:g})")
 
     @classmethod
     def bond_law(cls, plan: GranularPlan) -> tuple[str, str]:
         return ("Kelvin", f"breakage {int(plan.bond_breakage)} kelvin "
-                f"{float_text(plan.bond_max_damp_ratio)}")
+                f"{float_text(plan.bond_law.max_damp_ratio)}")

@@ -13,6 +13,7 @@ import numpy as np
 from fibrelmp.errors import InputError
 from fibrelmp.formatbase import Reader
 from fibrelmp.granmodel import GranularFrame, GranularModel
+from fibrelmp.translate.musen.scene_record import scene_record
 
 
 def read_scene(path: str | os.PathLike) -> GranularModel:
@@ -36,7 +37,7 @@ def read_scene(path: str | os.PathLike) -> GranularModel:
             raise InputError(path, None, f"{exc.message}{where}") from None
         _settings(model, mdem.storage.modules_data)
     model.source = path
-    model.passthrough["mdem_source"] = path
+    scene_record(model, keep=True).mdem_source = path
     return model
 
 
@@ -56,7 +57,7 @@ def _settings(model: GranularModel, modules) -> None:
     if modules.HasField("simulator"):
         g = sim.external_acceleration
         plan.gravity = np.array([g.x, g.y, g.z])
-        model.passthrough["musen_gravity_set"] = True
+        scene_record(model, keep=True).gravity_set = True
     manager = modules.model_manager
     entries = list(manager.models) or [manager.pp_model, manager.pw_model, manager.sb_model,
                                        manager.lb_model, manager.ef_model]
@@ -68,7 +69,7 @@ def _settings(model: GranularModel, modules) -> None:
         kind = next((k for k, names in MUSEN_MODELS.items() if name in names), name[5:7])
         specs.append(MusenModelSpec(name=name, params=entry.params, kind=kind, line=0))
     if specs:
-        model.passthrough["mdem_models"] = specs
+        scene_record(model, keep=True).file_models = specs
 
 
 class MdemReader(Reader):

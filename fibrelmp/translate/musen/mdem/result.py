@@ -25,6 +25,7 @@ from fibrelmp.granmodel import GranularFrame, GranularModel
 from fibrelmp.translate.granular.models import mdem_key
 from fibrelmp.translate.musen.mdem import timepoints as tp
 from fibrelmp.translate.musen.mdem.document import MdemFile, MdemWriter
+from fibrelmp.translate.musen.scene_record import scene_record
 from fibrelmp.translate.musen.writer import MusenResultWriter
 
 SPHERE_FIELDS = tp.bit("coord", "vel", "angle_vel", "force", "quaternion")
@@ -57,9 +58,9 @@ class MdemResultWriter(MusenResultWriter):
             sets.append(m.bonds.ids)
         if m.triangles is not None:
             sets.append(m.triangles.ids)
-        liquid = m.passthrough.get("liquid_bonds") or []
+        liquid = m.liquid_bonds
         if liquid:
-            sets.append(np.array([lb["id"] for lb in liquid], np.int64))
+            sets.append(np.array([lb.id for lb in liquid], np.int64))
         return sets
 
     def write(self, frame: GranularFrame) -> None:
@@ -110,7 +111,7 @@ class MdemResultWriter(MusenResultWriter):
 
     def scene(self) -> Any:
         """The scene message: the source ``.mdem``'s, else MUSEN's import of the scene text."""
-        source = self.model.passthrough.get("mdem_source")
+        source = scene_record(self.model).mdem_source
         if source is not None:
             with MdemFile(source) as mdem:
                 storage = mdem.storage
@@ -164,7 +165,7 @@ class MdemResultWriter(MusenResultWriter):
                 want = _property(mat, pid)
                 if want == want and want != property_value(c.property, pid, c.constProperty):
                     _replace_property(c.property, pid, want, set_constant)
-        inter = m.passthrough.get("interactions", {})
+        inter = scene_record(m).interactions
         for i in db.interaction:
             if i.compoundKey1 not in by_key or i.compoundKey2 not in by_key:
                 continue
@@ -207,7 +208,7 @@ class MdemResultWriter(MusenResultWriter):
         sim.external_acceleration.x, sim.external_acceleration.y, sim.external_acceleration.z = \
             (float(g) for g in plan.gravity)
         sim.simulator_type = sim.simulator_type or 1           # CPU
-        models = m.passthrough.get("musen_models") or {}
+        models = m.models
         if models:
             manager = storage.modules_data.model_manager
             manager.version = 1
@@ -215,11 +216,11 @@ class MdemResultWriter(MusenResultWriter):
             for kind in ("PP", "PW", "SB", "LB", "EF"):
                 if kind not in models:
                     continue
-                name, params = models[kind]
+                choice = models[kind]
                 entry = manager.models.add()
-                entry.key = mdem_key(name)
-                entry.path = name
-                entry.params = "".join(f"{k} {v:g} " for k, v in params.items())
+                entry.key = mdem_key(choice.name)
+                entry.path = choice.name
+                entry.params = "".join(f"{k} {v:g} " for k, v in choice.parameters.items())
             manager.connected_pp_contact = bool(plan.contacts_between_bonded)
 
 

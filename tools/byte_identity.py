@@ -27,7 +27,8 @@ size, sha256 and, where something below had to be ignored, the sha256 of the com
 
 ``compare`` prints a Markdown table: case -> files -> identical / differing (which files, and
 for a text file its first differing compared line), plus files only one side wrote and exit
-codes that differ.
+codes that differ; for a differing text file also how many lines a line diff finds only on either side
+(files over 20,000 lines: how many differ position by position).
 
 Ignored (cannot be identical by construction), in text files only:
 
@@ -45,6 +46,7 @@ Nothing else: every other byte, timestamps included, is compared.
 from __future__ import annotations
 
 import argparse
+import difflib
 import gzip
 import hashlib
 import json
@@ -265,10 +267,18 @@ def _first_difference(a: Path, b: Path, root_a: Path, root_b: Path) -> str:
     if text_a is None or text_b is None:
         return "binary"
     lines_a, lines_b = text_a.split("\n"), text_b.split("\n")
-    for number, (x, y) in enumerate(zip(lines_a, lines_b), 1):
-        if x != y:
-            return f"line {number}: `{x[:70]}` vs `{y[:70]}`"
-    return f"line {min(len(lines_a), len(lines_b)) + 1}: one file ends ({len(lines_a)} vs {len(lines_b)} lines)"
+    unequal = [n for n, (x, y) in enumerate(zip(lines_a, lines_b), 1) if x != y]
+    if not unequal:
+        return f"line {min(len(lines_a), len(lines_b)) + 1}: one file ends ({len(lines_a)} vs {len(lines_b)} lines)"
+    first = unequal[0]
+    if max(len(lines_a), len(lines_b)) <= 20000:       # a line diff (quadratic at worst)
+        ops = difflib.SequenceMatcher(None, lines_a, lines_b, autojunk=False).get_opcodes()
+        removed = sum(i2 - i1 for tag, i1, i2, _, _ in ops if tag in ("replace", "delete"))
+        added = sum(j2 - j1 for tag, _, _, j1, j2 in ops if tag in ("replace", "insert"))
+        counts = f"diff: {removed} lines only before, {added} only after"
+    else:
+        counts = f"{len(unequal)} of {max(len(lines_a), len(lines_b))} lines differ by position"
+    return f"line {first}: `{lines_a[first - 1][:70]}` vs `{lines_b[first - 1][:70]}`; {counts}"
 
 
 def _key(entry: dict) -> str:

@@ -17,7 +17,7 @@ import sys
 import threading
 import time
 from contextlib import ExitStack, contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable, Iterator
 
@@ -277,8 +277,6 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
     ``log``: LAMMPS writes ``log.lammps`` in the job folder (rank 0; a resumed run appends).
     ``record`` (a ``fibrelmp.record.Recorder``) takes the final state, on every rank.  Progress (rank 0): ``Progress`` with ``log_every``.
     """
-    from fibrelmp.checkpoint import ACTIONS, CheckpointStop
-
     script = Path(script)
     rank, size = mpi_rank_size()
     resume = checkpoints.resume if checkpoints is not None else None
@@ -288,117 +286,19 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
     script_text = text if text is not None else read_script(script)
     commands, labels = parse_commands(script_text, str(script))
     folder = ExitStack()             # the job folder as this thread's working directory
-    skip_to = resume["commands"] if resume else 0     # commands done before the checkpoint
     steps = resume["steps"] if resume else 0
-    resumed_steps = steps
     bar = Progress(total_steps, progress and rank == 0, done=steps, every=log_every, label=label)
-    frames = 0
-    since = 0
-    done = 0                         # commands executed (the position in the command stream)
-    saved_state: dict = {}           # the step state at the last checkpoint
-    # a checkpoint (or a stop) due after a run is taken before the next run command, once the
-    # step's frame commands have written what an uninterrupted run writes there
-    due: tuple[int, int] | None = None   # (signal or 0, line of the run that made it due)
-    resumed_state = checkpoints.load_step_state() if resume else None
-    deferred: list[str] = []         # per-atom fixes: defined after read_restart to get their data
-    atomfiles: set[str] = set()      # atomfile variables skipped while replaying
-    lmp = None
+    run = _ScriptRun(script, script_text, rank, size, checkpoints, on_command, bar, resume,
+                     skip_to=resume["commands"] if resume else 0, steps=steps,
+                     resumed_state=checkpoints.load_step_state() if resume else None)
     try:
-        lmp = new_lammps(args)
-        if size > 1:
-            # rank 0 wrote the job files before it got here; LAMMPS's read_data checks the
-            # data file on every rank, so no rank may decide where to run before that
-            from fibrelmp._lammps import mpi_barrier
-            mpi_barrier()
-        try:
-            folder.enter_context(in_folder(script.parent))
-        except OSError as exc:
-            raise RunError(f"{script.parent}: job folder not visible on MPI rank {rank} ({exc.strerror}): "
-                           "the work folder must be on a file system shared by all ranks") from None
-        if log and resume:
-            lmp.command(f"log {LOG_NAME} append")      # LAMMPS opens it on rank 0
-        if checkpoints is not None:
-            checkpoints.install()
+        run.start(args, folder, log)
         for cmd in execute(commands, labels, str(script)):
-            done += 1
-            words, text = cmd.words, cmd.text
-            if words[0] in ("label", "jump"):
-                continue                 # followed by execute(); LAMMPS's own jump needs a file
-            replaying = done <= skip_to
-            if replaying:
-                # fix_modify ID write FILE: a frame of fix musen/wall/mesh's triangle forces
-                if words[0] in ACTIONS or (words[0] == "fix_modify" and words[2:3] == ["write"]):
-                    if words[0] == "write_dump":
-                        frames += 1
-                        if on_command is not None:
-                            on_command(words)
-                    continue
-                if words[0] == "fix" and len(words) > 3 and words[3] == "property/atom":
-                    deferred.append(text)
-                    continue
-                # per-atom values set from atomfiles (bond geometry, FibreNet's state) come
-                # back with read_restart; the files may name atoms lost before the checkpoint
-                if words[0] == "variable" and len(words) > 2 and words[2] == "atomfile":
-                    atomfiles.add(words[1])
-                    continue
-                if atomfiles and _uses_atomfile(words, atomfiles):
-                    continue
-                if words[0] == "read_data":
-                    text = f"read_restart {resume['restart']}"
-            if due is not None and words[0] == "run":
-                signum, run_line = due
-                due = None
-                saved_state = step_state(lmp)
-                checkpoints.write(lmp, rank, done - 1, run_line, steps, frames, script_text,
-                                  saved_state)
-                since = 0
-                if signum:
-                    raise CheckpointStop(script.parent, signum)
-                # write_restart re-exchanged the atoms (on several ranks their forces did not
-                # travel) and rebuilt the ghosts: put the step's state back (and the neighbour
-                # lists the "run ... pre no" uses)
-                try:
-                    restore_step_state(lmp, saved_state)
-                except Exception as exc:
-                    raise RunError(f"{script}:{cmd.number}: LAMMPS error after a checkpoint: "
-                                   f"{str(exc).strip()}") from None
-            try:
-                if not replaying and resumed_state is not None:
-                    # the first command after the checkpoint: computes set up and the step's
-                    # forces back (a write_dump or set may come before any run)
-                    restore_step_state(lmp, resumed_state)
-                    resumed_state = None
-                # FibreNet's first step after a (re)start is made by commands: its
-                # "reset_timestep $(step+1)" counts it; a reset to 0 (a new stage) none
-                counts = words[0] in ("run", "reset_timestep")
-                before = _timestep(lmp) if counts else 0
-                lmp.command(text)
-                if replaying and words[0] == "read_data":
-                    for fix in deferred:
-                        lmp.command(fix)
-                if replaying and words[0] == "dump":     # keep what it wrote before
-                    lmp.command(f"dump_modify {words[1]} append yes")
-            except RunError:
-                raise
-            except Exception as exc:       # LAMMPS raises plain Exception subclasses
-                raise RunError(f"{script}:{cmd.number}: LAMMPS error: {str(exc).strip()}") from None
-            if words[0] == "write_dump":
-                frames += 1
-            if counts:
-                n = max(_timestep(lmp) - before, 0)
-                bar.advance(n)
-                steps += n
-                since += n
-            if on_command is not None:
-                on_command(words)
-            if checkpoints is not None and words[0] == "run":
-                signum = checkpoints.stop_requested(size)
-                if signum or (checkpoints.every and since >= checkpoints.every):
-                    due = (signum, cmd.number)
+            run.command(cmd)
         if record is not None:
-            record.end(lmp, steps, resumed_steps)
+            record.end(run.lmp, run.steps, steps)
         if finished is not None:
-            finished(lmp)
+            finished(run.lmp)
         if checkpoints is not None:
             checkpoints.clear(rank)
     finally:
@@ -406,8 +306,152 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
         folder.close()
         if checkpoints is not None:
             checkpoints.uninstall()
-        if lmp is not None:
-            lmp.close()
+        if run.lmp is not None:
+            run.lmp.close()
+
+
+@dataclass
+class _ScriptRun:
+    """Where one run_script is: the command stream, steps, frames and checkpoints."""
+
+    script: Path
+    script_text: str
+    rank: int
+    size: int
+    checkpoints: "Checkpointing | None"
+    on_command: Callable[[list[str]], None] | None
+    bar: Progress
+    resume: dict | None
+    skip_to: int = 0                 # commands done before the checkpoint (replayed)
+    steps: int = 0
+    resumed_state: dict | None = None
+    frames: int = 0
+    since: int = 0                   # steps since the last checkpoint
+    done: int = 0                    # commands executed (the position in the command stream)
+    # a checkpoint (or a stop) due after a run is taken before the next run command, once the
+    # step's frame commands have written what an uninterrupted run writes there
+    due: tuple[int, int] | None = None   # (signal or 0, line of the run that made it due)
+    deferred: list[str] = field(default_factory=list)   # per-atom fixes: defined after read_restart
+    atomfiles: set[str] = field(default_factory=set)    # atomfile variables skipped while replaying
+    lmp: object = None
+
+    def start(self, args: list[str], folder: ExitStack, log: bool) -> None:
+        """Start LAMMPS and enter the job folder (every rank must see it)."""
+        self.lmp = new_lammps(args)
+        if self.size > 1:
+            # rank 0 wrote the job files before it got here; LAMMPS's read_data checks the
+            # data file on every rank, so no rank may decide where to run before that
+            from fibrelmp._lammps import mpi_barrier
+            mpi_barrier()
+        try:
+            folder.enter_context(in_folder(self.script.parent))
+        except OSError as exc:
+            raise RunError(f"{self.script.parent}: job folder not visible on MPI rank {self.rank} "
+                           f"({exc.strerror}): the work folder must be on a file system shared by "
+                           "all ranks") from None
+        if log and self.resume:
+            self.lmp.command(f"log {LOG_NAME} append")      # LAMMPS opens it on rank 0
+        if self.checkpoints is not None:
+            self.checkpoints.install()
+
+    def command(self, cmd: Command) -> None:
+        """Execute (or, up to the checkpoint, replay) one command of the stream."""
+        self.done += 1
+        words, text = cmd.words, cmd.text
+        if words[0] in ("label", "jump"):
+            return                       # followed by execute(); LAMMPS's own jump needs a file
+        replaying = self.done <= self.skip_to
+        if replaying:
+            text = self._replayed(words, text)
+            if text is None:
+                return
+        if self.due is not None and words[0] == "run":
+            self._checkpoint(cmd)
+        counts, before = self._execute(cmd, text, replaying)
+        if words[0] == "write_dump":
+            self.frames += 1
+        if counts:
+            n = max(_timestep(self.lmp) - before, 0)
+            self.bar.advance(n)
+            self.steps += n
+            self.since += n
+        if self.on_command is not None:
+            self.on_command(words)
+        if self.checkpoints is not None and words[0] == "run":
+            signum = self.checkpoints.stop_requested(self.size)
+            if signum or (self.checkpoints.every and self.since >= self.checkpoints.every):
+                self.due = (signum, cmd.number)
+
+    def _replayed(self, words: list[str], text: str) -> str | None:
+        """What replaying executes for a command done before the checkpoint (None: nothing)."""
+        from fibrelmp.checkpoint import ACTIONS
+
+        # fix_modify ID write FILE: a frame of fix musen/wall/mesh's triangle forces
+        if words[0] in ACTIONS or (words[0] == "fix_modify" and words[2:3] == ["write"]):
+            if words[0] == "write_dump":
+                self.frames += 1
+                if self.on_command is not None:
+                    self.on_command(words)
+            return None
+        if words[0] == "fix" and len(words) > 3 and words[3] == "property/atom":
+            self.deferred.append(text)
+            return None
+        # per-atom values set from atomfiles (bond geometry, FibreNet's state) come
+        # back with read_restart; the files may name atoms lost before the checkpoint
+        if words[0] == "variable" and len(words) > 2 and words[2] == "atomfile":
+            self.atomfiles.add(words[1])
+            return None
+        if self.atomfiles and _uses_atomfile(words, self.atomfiles):
+            return None
+        if words[0] == "read_data":
+            return f"read_restart {self.resume['restart']}"
+        return text
+
+    def _checkpoint(self, cmd: Command) -> None:
+        """Write the checkpoint that came due (and stop, if a signal asked for it)."""
+        from fibrelmp.checkpoint import CheckpointStop
+
+        signum, run_line = self.due
+        self.due = None
+        saved_state = step_state(self.lmp)
+        self.checkpoints.write(self.lmp, self.rank, self.done - 1, run_line, self.steps, self.frames,
+                               self.script_text, saved_state)
+        self.since = 0
+        if signum:
+            raise CheckpointStop(self.script.parent, signum)
+        # write_restart re-exchanged the atoms (on several ranks their forces did not
+        # travel) and rebuilt the ghosts: put the step's state back (and the neighbour
+        # lists the "run ... pre no" uses)
+        try:
+            restore_step_state(self.lmp, saved_state)
+        except Exception as exc:
+            raise RunError(f"{self.script}:{cmd.number}: LAMMPS error after a checkpoint: "
+                           f"{str(exc).strip()}") from None
+
+    def _execute(self, cmd: Command, text: str, replaying: bool) -> tuple[bool, int]:
+        """Give LAMMPS one command; whether it counts steps, and the step before it."""
+        words = cmd.words
+        try:
+            if not replaying and self.resumed_state is not None:
+                # the first command after the checkpoint: computes set up and the step's
+                # forces back (a write_dump or set may come before any run)
+                restore_step_state(self.lmp, self.resumed_state)
+                self.resumed_state = None
+            # FibreNet's first step after a (re)start is made by commands: its
+            # "reset_timestep $(step+1)" counts it; a reset to 0 (a new stage) none
+            counts = words[0] in ("run", "reset_timestep")
+            before = _timestep(self.lmp) if counts else 0
+            self.lmp.command(text)
+            if replaying and words[0] == "read_data":
+                for fix in self.deferred:
+                    self.lmp.command(fix)
+            if replaying and words[0] == "dump":     # keep what it wrote before
+                self.lmp.command(f"dump_modify {words[1]} append yes")
+        except RunError:
+            raise
+        except Exception as exc:       # LAMMPS raises plain Exception subclasses
+            raise RunError(f"{self.script}:{cmd.number}: LAMMPS error: {str(exc).strip()}") from None
+        return counts, before
 
 
 def _timestep(lmp) -> int:

@@ -419,3 +419,27 @@ def test_architecture_doc_draws_every_layer():
         for unit in units:
             shown = "fibrelmp/__init__.py" if unit == "__init__" else unit.rstrip("/")
             assert shown in text, f"docs/architecture.md: layer {name} does not show {unit}"
+
+
+MAX_FUNCTION_LINES = 80
+MAX_MODULE_LINES = 600
+LONG_MODULE_MARKER = "Longer than 600 lines because"
+
+
+def test_functions_and_modules_stay_readable():
+    """No function or method over 80 lines (``def`` to the last line of its body); no module
+    over 600 lines unless its docstring says why (a line starting with LONG_MODULE_MARKER)."""
+    offenders = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        text = path.read_text()
+        tree = ast.parse(text)
+        where = path.relative_to(REPO).as_posix()
+        for node in ast.walk(tree):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                length = node.end_lineno - node.lineno + 1
+                if length > MAX_FUNCTION_LINES:
+                    offenders.append(f"{where}:{node.lineno}: function {node.name} has {length} lines")
+        lines = len(text.splitlines())
+        if lines > MAX_MODULE_LINES and LONG_MODULE_MARKER not in (ast.get_docstring(tree) or ""):
+            offenders.append(f"{where}: {lines} lines and no '{LONG_MODULE_MARKER} ...' in its docstring")
+    assert not offenders, "\n".join(offenders)

@@ -20,8 +20,8 @@ from fibrelmp.granmodel import ContactLaw, hertz_effective
 from fibrelmp.post.lammps_dump.reader import iter_frames
 from fibrelmp.translate.granular_job import describe_walls
 from fibrelmp.translate.granular.geometry import (detect_box, detect_cylinder, detect_oriented_box,
-                                                  geometry_kinematics,
                                                   nearest_triangle, closest_points, tile_triangles)
+from fibrelmp.translate.granular.kinematics import geometry_kinematics
 
 from . import granular_models as gm
 from .granular_models import run

@@ -21,16 +21,16 @@ from fibrelmp.granmodel import GranularModel
 from fibrelmp import lammps_styles
 from fibrelmp.lammps_text import lammps_path, template_environment
 from fibrelmp.textio import atomic_write
-from fibrelmp.translate.granular.bonds import (GEOMETRY_FIX, GEOMETRY_NAME, PARTNERS, VALUES,
-                                              bond_geometry, select_bonds)
-from fibrelmp.translate.granular.box import box_axes, box_commands, domain_bounds, fit_box, periodic_axes
+from fibrelmp.translate.granular.bonds import (GEOMETRY_FIX, GEOMETRY_NAME, PARTNERS, VALUES, BondGeometry,
+                                              SimulatedBonds, bond_geometry, select_bonds)
+from fibrelmp.translate.granular.box import BoxAxes, box_axes, box_commands, domain_bounds, fit_box, periodic_axes
 from fibrelmp.translate.granular.contacts import (STOCK_PAIR_WARNING, law_args, pair_coeff_lines,
                                                   rolling_spring, stock_pair_deviates)
 from fibrelmp.translate.granular.data import write_data
 from fibrelmp.translate.granular.reach import Travel, speed_bound
-from fibrelmp.translate.granular.schedule import compress_ids, run_time, save_steps, schedule
-from fibrelmp.translate.granular.spheres import select_spheres
-from fibrelmp.translate.granular.tiles import TILE_MASS_FACTOR, place_tiles, tile_estimate, tile_types
+from fibrelmp.translate.granular.schedule import RunTime, compress_ids, run_time, save_steps, schedule
+from fibrelmp.translate.granular.spheres import SimulatedSpheres, select_spheres
+from fibrelmp.translate.granular.tiles import TILE_MASS_FACTOR, WallTiles, place_tiles, tile_estimate, tile_types
 from fibrelmp.translate.granular import models as physics
 from fibrelmp.translate.granular.mesh import MESH_FIX, MESH_FORCES_NAME, MESH_NAME, mesh_rows, write_mesh
 from fibrelmp.translate.granular.walls import (WallPlan, describe_walls, plan_walls, wall_commands,
@@ -140,6 +140,73 @@ def build_granular_job(model: GranularModel, folder: str | Path):
     """(job, script text, data-file writer) without touching the disk (MPI ranks > 0 need
     the script text only: LAMMPS reads data files on rank 0)."""
     folder = Path(folder)
+    parts = _plan_parts(model)
+    spheres, tiles, bonds, run = parts.spheres, parts.tiles, parts.bonds, parts.run
+    data_path = folder / DATA_NAME
+
+    def write_data_file() -> None:
+        write_data(model, data_path, spheres.rows, spheres.type_of_mat, spheres.smat, spheres.crad,
+                   parts.axes.lo, parts.axes.hi, parts.ntypes, tiles.x, tiles.types, tiles.v, tiles.ids,
+                   tiles.radius, TILE_MASS_FACTOR * float(spheres.mass.max() if len(spheres.mass) else 1.0),
+                   bonds.rows, bonds.type, len(bonds.types), parts.geometry)
+        if len(parts.mesh):
+            write_mesh(model, parts.wall_plans, spheres, folder / MESH_NAME)
+        write_facts(data_path, job_facts(model, spheres, tiles, run.t_start, run.dt))
+
+    saves = save_steps(model, run.total, run.dt)
+    script = _render_script(model, parts, saves)
+    has_bonds = len(bonds.rows) > 0
+    breakage = int(model.plan.bond_breakage) != 0
+    has_mesh = len(parts.mesh) > 0
+    job = GranularJob(
+        folder=folder, script=folder / SCRIPT_NAME, data=data_path, total_steps=run.total,
+        save_steps=saves,
+        frames=folder / FRAMES_NAME,
+        bond_dump=folder / BONDS_NAME if has_bonds else None,
+        tile_dump=folder / TILES_NAME if tiles.total else None,
+        breaks=folder / BREAKS_NAME if has_bonds and breakage else None,
+        walls=[(wp.name, wp.description) for wp in parts.wall_plans], dt=run.dt, t_start=run.t_start,
+        sphere_rows=spheres.rows, outside_rows=spheres.outside_rows, late_rows=spheres.late_rows,
+        bond_rows=bonds.rows, deletions=spheres.deletions, wall_plans=parts.wall_plans,
+        domain_lo=parts.dom_lo, domain_hi=parts.dom_hi, removal_axes=parts.axes.removal_axes,
+        frame_columns=parts.frame_columns, warnings=parts.warnings,
+        wall_forces=folder / MESH_FORCES_NAME if has_mesh else None, mesh_rows=parts.mesh,
+        geometry=folder / GEOMETRY_NAME if parts.geometry is not None else None,
+        contacts=folder / CONTACTS_NAME)
+    return job, script, write_data_file
+
+
+@dataclass
+class _JobParts:
+    """The planned pieces of a granular job (spheres, walls, box, bonds, laws) and the
+    warnings their steps gave, in order."""
+
+    run: RunTime
+    warnings: list[tuple[str, str]]
+    dom_lo: np.ndarray | None
+    dom_hi: np.ndarray | None
+    spheres: SimulatedSpheres
+    wall_plans: list[WallPlan]
+    mesh: np.ndarray
+    tiles: WallTiles
+    ntypes: int
+    axes: BoxAxes
+    styles: lammps_styles.Plugin
+    bonds: SimulatedBonds
+    musen_hm: bool
+    pair_lines: list[str]
+    pp_model: type[physics.PhysicsModel]
+    pp_params: dict[str, float]
+    sb_model: type[physics.PhysicsModel]
+    wall_cmds: list[str]
+    var_cmds: list[str]
+    frame_columns: list[str]
+    geometry: BondGeometry | None
+
+
+def _plan_parts(model: GranularModel) -> _JobParts:
+    """Run the steps of ``translate.granular`` in order (their checks and warnings come in
+    that order)."""
     plan = model.plan
     run = run_time(model)
     dim, dt, total, t_start = run.dim, run.dt, run.total, run.t_start
@@ -147,7 +214,6 @@ def build_granular_job(model: GranularModel, folder: str | Path):
     periodic = periodic_axes(plan, dim)
     dom_lo, dom_hi = domain_bounds(plan)
     spheres = select_spheres(model, run, periodic, dom_lo, dom_hi, warnings)
-    rows, r_max = spheres.rows, spheres.r_max
     wall_plans = plan_walls(model, dt, run.t_end)
     warnings.extend(wall_warnings(model, wall_plans, t_start, run.t_end, spheres))
     mesh = mesh_rows(wall_plans)
@@ -172,77 +238,57 @@ def build_granular_job(model: GranularModel, folder: str | Path):
     pp_model, pp_params = physics.chosen(model, "PP")
     sb_model = physics.solid_bond_model(plan)
     wall_cmds, var_cmds, frame_columns = wall_commands(model, wall_plans, spheres, dt)
-    wall_cmds = box_cmds + wall_cmds
-
-    data_path = folder / DATA_NAME
     # musen/elastic: each bond's d, L0 (and initial tangential overlap) on its first sphere
-    geometry = (bond_geometry(model, bonds, rows, len(rows) + len(tiles.x))
+    geometry = (bond_geometry(model, bonds, spheres.rows, len(spheres.rows) + len(tiles.x))
                 if bonds.exact and len(bonds.rows) else None)
+    return _JobParts(run, warnings, dom_lo, dom_hi, spheres, wall_plans, mesh, tiles, ntypes, axes,
+                     styles, bonds, musen_hm, pair_lines, pp_model, pp_params, sb_model, box_cmds + wall_cmds, var_cmds,
+                     frame_columns, geometry)
 
-    def write_data_file() -> None:
-        write_data(model, data_path, rows, spheres.type_of_mat, spheres.smat, spheres.crad, axes.lo, axes.hi,
-                   ntypes, tiles.x, tiles.types, tiles.v, tiles.ids, tiles.radius,
-                   TILE_MASS_FACTOR * float(spheres.mass.max() if len(spheres.mass) else 1.0),
-                   bonds.rows, bonds.type, len(bonds.types), geometry)
-        if len(mesh):
-            write_mesh(model, wall_plans, spheres, folder / MESH_NAME)
-        write_facts(data_path, job_facts(model, spheres, tiles, t_start, dt))
 
-    # ---- script
-    saves = save_steps(model, total, dt)
-    acts = schedule(total, saves, spheres.deletions)
-    skin = 0.5 * tiles.largest_radius(r_max)
-    pair_cut = 2.0 * tiles.largest_radius(r_max)
+def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> str:
+    """in.lammps of the planned job (templates/granular.lammps.j2)."""
+    plan, run, spheres, tiles, bonds = model.plan, parts.run, parts.spheres, parts.tiles, parts.bonds
+    acts = schedule(run.total, saves, spheres.deletions)
+    skin = 0.5 * tiles.largest_radius(spheres.r_max)
+    pair_cut = 2.0 * tiles.largest_radius(spheres.r_max)
     comm_cut = max(pair_cut, 1.5 * bonds.max_length) + skin
-    breakage = int(plan.bond_breakage) != 0
-    has_bonds = len(bonds.rows) > 0
     g = np.asarray(plan.gravity, float)
-    if dim == 2 and g[2] != 0:
+    if run.dim == 2 and g[2] != 0:
         raise InputError(model.source, None, "2D model with a z component of gravity")
-    tile_groups = [(wp, f"w{k + 1}") for k, wp in enumerate(wall_plans)
+    tile_groups = [(wp, f"w{k + 1}") for k, wp in enumerate(parts.wall_plans)
                    if wp.kind == "tiles" and wp.tile_ids is not None and len(wp.tile_ids)]
     mats, tile_mats = spheres.mats, tiles.materials
-    if model.kind == "musen" and not musen_hm and stock_pair_deviates(model, spheres.mats):
-        warnings.append(("approximate MUSEN physics (particle-particle contact)", STOCK_PAIR_WARNING))
+    if model.kind == "musen" and not parts.musen_hm and stock_pair_deviates(model, spheres.mats):
+        parts.warnings.append(("approximate MUSEN physics (particle-particle contact)", STOCK_PAIR_WARNING))
+    geometry, styles = parts.geometry, parts.styles
     # the plugin is loaded only for a style of its own (a DEMDF job uses stock styles only)
-    uses_plugin = bool(styles.path) and (musen_hm or geometry is not None or len(mesh) > 0)
-    script = template_environment().get_template("granular.lammps.j2").render(
+    uses_plugin = bool(styles.path) and (parts.musen_hm or geometry is not None or len(parts.mesh) > 0)
+    return template_environment().get_template("granular.lammps.j2").render(
         model=model, plugin=lammps_path(styles.path, "plugin") if uses_plugin else None,
-        packages=granular_packages(uses_plugin, wall_cmds),
-        fmt=float_text, dim=dim, bnd=axes.bnd, data_name=DATA_NAME, frames_name=FRAMES_NAME,
+        packages=granular_packages(uses_plugin, parts.wall_cmds),
+        fmt=float_text, dim=run.dim, bnd=parts.axes.bnd, data_name=DATA_NAME, frames_name=FRAMES_NAME,
         bonds_name=BONDS_NAME, tiles_name=TILES_NAME, breaks_name=BREAKS_NAME,
-        comm_cut=comm_cut, skin=skin, musen_hm=musen_hm, pair_lines=pair_lines, has_bonds=has_bonds,
-        overlay=bool(plan.contacts_between_bonded), breakage=breakage, bond_types=bonds.types,
+        comm_cut=comm_cut, skin=skin, musen_hm=parts.musen_hm, pair_lines=parts.pair_lines,
+        has_bonds=len(bonds.rows) > 0,
+        overlay=bool(plan.contacts_between_bonded), breakage=int(plan.bond_breakage) != 0,
+        bond_types=bonds.types,
         musen_bonds=geometry is not None, bond_geometry=geometry, bond_partners=PARTNERS,
         bond_values=VALUES, geometry_fix=GEOMETRY_FIX, geometry_name=GEOMETRY_NAME,
         bond_criterion=int(plan.bond_breakage),
-        bond_law=sb_model.bond_law(plan) if geometry is not None else None,
-        pair_style_lines=pp_model.pair_style_lines(pp_params, musen_hm),
+        bond_law=parts.sb_model.bond_law(plan) if geometry is not None else None,
+        pair_style_lines=parts.pp_model.pair_style_lines(parts.pp_params, parts.musen_hm),
         sphere_types=[spheres.type_of_mat[m] for m in mats],
         sphere_type_names=[model.materials[m].name for m in mats],
         tile_types=[tiles.type_of_mat[m] for m in tile_mats],
         tile_type_names=[model.materials[m].name for m in tile_mats],
         tile_groups=[(tag, compress_ids(wp.tile_ids)) for wp, tag in tile_groups],
-        mat_groups=spheres.material_groups(), dt=dt, t_start=t_start, gravity=g,
-        gnorm=float(np.linalg.norm(g)), var_cmds=var_cmds, wall_cmds=wall_cmds,
-        frame_columns=frame_columns, acts=acts, compress_ids=compress_ids,
-        lost=bool(axes.removal_axes.any()), walls=[(wp.name, wp.description) for wp in wall_plans],
-        mesh_fix=MESH_FIX if len(mesh) else None, mesh_forces_name=MESH_FORCES_NAME,
+        mat_groups=spheres.material_groups(), dt=run.dt, t_start=run.t_start, gravity=g,
+        gnorm=float(np.linalg.norm(g)), var_cmds=parts.var_cmds, wall_cmds=parts.wall_cmds,
+        frame_columns=parts.frame_columns, acts=acts, compress_ids=compress_ids,
+        lost=bool(parts.axes.removal_axes.any()),
+        walls=[(wp.name, wp.description) for wp in parts.wall_plans],
+        mesh_fix=MESH_FIX if len(parts.mesh) else None, mesh_forces_name=MESH_FORCES_NAME,
         contacts_name=CONTACTS_NAME,
         thermo_every=min(saves.period or 0, 2 ** 31 - 1),      # thermo N is a C int
     )
-    job = GranularJob(
-        folder=folder, script=folder / SCRIPT_NAME, data=data_path, total_steps=total,
-        save_steps=saves,
-        frames=folder / FRAMES_NAME,
-        bond_dump=folder / BONDS_NAME if has_bonds else None,
-        tile_dump=folder / TILES_NAME if tiles.total else None,
-        breaks=folder / BREAKS_NAME if has_bonds and breakage else None,
-        walls=[(wp.name, wp.description) for wp in wall_plans], dt=dt, t_start=t_start,
-        sphere_rows=rows, outside_rows=spheres.outside_rows, late_rows=spheres.late_rows,
-        bond_rows=bonds.rows, deletions=spheres.deletions, wall_plans=wall_plans, domain_lo=dom_lo,
-        domain_hi=dom_hi, removal_axes=axes.removal_axes, frame_columns=frame_columns, warnings=warnings,
-        wall_forces=folder / MESH_FORCES_NAME if len(mesh) else None, mesh_rows=mesh,
-        geometry=folder / GEOMETRY_NAME if geometry is not None else None,
-        contacts=folder / CONTACTS_NAME)
-    return job, script, write_data_file

@@ -90,12 +90,26 @@ def _strip(line: str) -> tuple[str, str]:
 
 
 def read_data(path: str | Path) -> DataFile:
+    """The data file at ``path``: header, sections, type names and masses, atoms, bonds."""
     path = Path(path)
     lines = read_text(path, "LAMMPS data file").splitlines()
+    k, lo, hi, tilt = _read_header(path, lines)
+    sections = _read_sections(path, lines, k)
+    type_masses, type_names = _type_masses_and_names(path, sections)
+    atoms = _read_atoms(path, sections, type_names, type_masses)
+    bonds = _read_bonds(path, sections)
+    facts = read_facts(path)
+    if facts is not None:
+        type_names.update(facts.type_names)
+    return DataFile(path, atoms.ids, atoms.types, atoms.mol, atoms.radius, atoms.mass, type_names,
+                    type_masses, bonds, lo, hi, tilt, atoms.style, facts=facts)
+
+
+def _read_header(path: Path, lines: list[str]) -> tuple[int, np.ndarray, np.ndarray, np.ndarray | None]:
+    """Box and tilt from the header (up to the first section keyword) and the index of that line."""
     counts: dict[str, int] = {}
     lo, hi, tilt = np.zeros(3), np.ones(3), None
     k = 1
-    # header: counts and box, up to the first section keyword
     while k < len(lines):
         body, _ = _strip(lines[k])
         if body in SECTIONS:
@@ -112,13 +126,22 @@ def read_data(path: str | Path) -> DataFile:
         except ValueError:
             raise InputError(path, k + 1, f"malformed header line {lines[k].strip()!r}") from None
         k += 1
+    return k, lo, hi, tilt
+
+
+# section name -> (line number of its keyword, keyword comment, data rows, their line numbers)
+Sections = dict[str, tuple[int, str, list[str], list[int]]]
+
+
+def _read_sections(path: Path, lines: list[str], k: int) -> Sections:
+    """Every section from line index ``k`` on, by name."""
     def is_section(j: int) -> bool:
         b = _strip(lines[j])[0]
         # known keywords, and sections of fixes (read_data ... fix ID NULL Name): a word
         # line followed by a blank line (data rows start with numbers)
         return b in SECTIONS or (bool(b) and b[0].isalpha() and (j + 1 >= len(lines) or not lines[j + 1].strip()))
 
-    sections: dict[str, tuple[int, str, list[str], list[int]]] = {}
+    sections: Sections = {}
     while k < len(lines):
         body, comment = _strip(lines[k])
         if not is_section(k):
@@ -137,7 +160,11 @@ def read_data(path: str | Path) -> DataFile:
                 numbers.append(k + 1)
             k += 1
         sections[body] = (start + 1, comment, rows, numbers)
+    return sections
 
+
+def _type_masses_and_names(path: Path, sections: Sections) -> tuple[dict[int, float], dict[int, str]]:
+    """Masses by type, and names from the Masses comments, overridden by Atom Type Labels."""
     type_masses: dict[int, float] = {}
     type_names: dict[int, str] = {}
     if "Masses" in sections:
@@ -158,7 +185,24 @@ def read_data(path: str | Path) -> DataFile:
             if len(w) != 2 or not w[0].isdigit():
                 raise InputError(path, ln, "Atom Type Labels line needs 'type label'")
             type_names[int(w[0])] = w[1]
+    return type_masses, type_names
 
+
+@dataclass
+class _Atoms:
+    """The Atoms section's columns, sorted by id."""
+
+    style: str
+    ids: np.ndarray
+    types: np.ndarray
+    mol: np.ndarray | None
+    radius: np.ndarray | None
+    mass: np.ndarray | None
+
+
+def _read_atoms(path: Path, sections: Sections, type_names: dict[int, str],
+                type_masses: dict[int, float]) -> _Atoms:
+    """Ids, types (numbers or labels), molecules, radii and masses of the Atoms section."""
     if "Atoms" not in sections:
         raise InputError(path, None, "data file has no Atoms section")
     line0, style_comment, rows, numbers = sections["Atoms"]
@@ -198,17 +242,17 @@ def read_data(path: str | Path) -> DataFile:
             if t < len(lut):
                 lut[t] = m
         mass = lut[types]
-    bonds = np.zeros((0, 2), np.int64)
-    if "Bonds" in sections:
-        _, _, brows, bnum = sections["Bonds"]
-        btab, bval = parse_table([r.partition("#")[0] for r in brows], bnum, 4, path, "Bonds")
-        bonds = np.column_stack([integer_column(bval, btab, 2, path, bnum, "Bonds"),
-                                 integer_column(bval, btab, 3, path, bnum, "Bonds")])
-    facts = read_facts(path)
-    if facts is not None:
-        type_names.update(facts.type_names)
-    return DataFile(path, ids, types, mol, radius, mass, type_names, type_masses, bonds, lo, hi,
-                    tilt, style, facts=facts)
+    return _Atoms(style, ids, types, mol, radius, mass)
+
+
+def _read_bonds(path: Path, sections: Sections) -> np.ndarray:
+    """(m, 2) atom ids of the Bonds section (none without one)."""
+    if "Bonds" not in sections:
+        return np.zeros((0, 2), np.int64)
+    _, _, brows, bnum = sections["Bonds"]
+    btab, bval = parse_table([r.partition("#")[0] for r in brows], bnum, 4, path, "Bonds")
+    return np.column_stack([integer_column(bval, btab, 2, path, bnum, "Bonds"),
+                            integer_column(bval, btab, 3, path, bnum, "Bonds")])
 
 
 def _style_columns(path: Path, line: int, comment: str, rows: list[str]) -> tuple[str, list[str]]:

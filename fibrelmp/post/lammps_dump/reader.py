@@ -307,6 +307,48 @@ def _item_row(block: bytes) -> int | None:
     return None if k < 0 else block.count(b"\n", 0, k + 1)
 
 
+def _not_an_item(text: str, is_first: bool, prev: tuple[int, Header] | None) -> str:
+    """Why a line where an ITEM line belongs is wrong (the frame's first line, or a later one)."""
+    if not is_first:
+        return f"expected an 'ITEM:' line, got {text[:60]!r}"
+    if prev is None:
+        return f"not a LAMMPS text dump: expected 'ITEM: TIMESTEP', got {text[:60]!r}"
+    i, ph = prev
+    return (f"expected 'ITEM: TIMESTEP' starting the next frame, got {text[:60]!r} "
+            f"(more atom lines than NUMBER OF {ph.kind} {ph.count} of "
+            f"{_frame_name(i, ph)}?)")
+
+
+def _box_bounds(path: Path, st: _Stream, item: str, values: list[str]
+                ) -> tuple[tuple[np.ndarray, np.ndarray, tuple[str, ...]], np.ndarray | None]:
+    """((lo, hi, boundary flags), tilt or None) of an ITEM: BOX BOUNDS and its three lines;
+    a ValueError for numbers that are not finite (the caller names the item)."""
+    words = item.split()[2:]
+    tilt = None
+    if "abc" in words or "origin" in words:
+        raise InputError(path, st.line - 3, "general triclinic boxes (BOX BOUNDS abc origin) "
+                         "are not supported; dump with dump_modify triclinic/general no")
+    nums = np.array([v.split()[:3] for v in values], dtype=float) if "xy" in words else \
+        np.array([v.split()[:2] for v in values], dtype=float)
+    if not np.isfinite(nums).all():
+        raise ValueError
+    bnd = tuple(w for w in words if w not in ("xy", "xz", "yz"))[-3:]
+    if len(bnd) != 3:
+        bnd = ("pp", "pp", "pp")
+    if "xy" in words:
+        xy, xz, yz = nums[:, 2]
+        tilt = np.array([xy, xz, yz])
+        # the dump holds the bounding box; the box itself is inside it
+        lo = nums[:, 0] - np.array([min(0.0, xy, xz, xy + xz), min(0.0, yz), 0.0])
+        hi = nums[:, 1] - np.array([max(0.0, xy, xz, xy + xz), max(0.0, yz), 0.0])
+    else:
+        lo, hi = nums[:, 0].copy(), nums[:, 1].copy()
+    if not (hi > lo).all():
+        raise InputError(path, st.line - 2, f"ITEM: {item}: the box has no volume "
+                         f"(lo {' '.join(map(str, lo))}, hi {' '.join(map(str, hi))})")
+    return (lo, hi, bnd), tilt
+
+
 def _read_header(st: _Stream, path: Path, first: bytes, warnings: list | None,
                  prev: tuple[int, Header] | None = None) -> Header | None:
     """Parse the ITEM lines of one frame, ``first`` being its first (already read) line;
@@ -319,16 +361,7 @@ def _read_header(st: _Stream, path: Path, first: bytes, warnings: list | None,
     while True:
         text = _decode(line)
         if not text.startswith("ITEM:"):
-            if line is not first:
-                msg = f"expected an 'ITEM:' line, got {text[:60]!r}"
-            elif prev is None:
-                msg = f"not a LAMMPS text dump: expected 'ITEM: TIMESTEP', got {text[:60]!r}"
-            else:
-                i, ph = prev
-                msg = (f"expected 'ITEM: TIMESTEP' starting the next frame, got {text[:60]!r} "
-                       f"(more atom lines than NUMBER OF {ph.kind} {ph.count} of "
-                       f"{_frame_name(i, ph)}?)")
-            raise InputError(path, st.line, msg)
+            raise InputError(path, st.line, _not_an_item(text, line is first, prev))
         item = text[5:].strip()
         if item.startswith(("ATOMS", "ENTRIES")):
             kind = "ATOMS" if item.startswith("ATOMS") else "ENTRIES"
@@ -338,9 +371,7 @@ def _read_header(st: _Stream, path: Path, first: bytes, warnings: list | None,
             names = item.split()[1:]
             if len(set(names)) != len(names):
                 raise InputError(path, st.line, f"repeated column name in ITEM: {kind}")
-            if box is None:
-                box = (np.zeros(3), np.zeros(3), ("pp", "pp", "pp"))
-            lo, hi, bnd = box
+            lo, hi, bnd = box or (np.zeros(3), np.zeros(3), ("pp", "pp", "pp"))
             return Header(step, count, lo, hi, bnd, names, start, time, units, tilt, kind)
         values = []
         nvalues = 3 if item.startswith("BOX BOUNDS") else 1
@@ -366,29 +397,8 @@ def _read_header(st: _Stream, path: Path, first: bytes, warnings: list | None,
                 if count < 0:
                     raise ValueError
             elif item.startswith("BOX BOUNDS"):
-                words = item.split()[2:]
-                if "abc" in words or "origin" in words:
-                    raise InputError(path, st.line - 3, "general triclinic boxes (BOX BOUNDS abc origin) "
-                                     "are not supported; dump with dump_modify triclinic/general no")
-                nums = np.array([v.split()[:3] for v in values], dtype=float) if "xy" in words else \
-                    np.array([v.split()[:2] for v in values], dtype=float)
-                if not np.isfinite(nums).all():
-                    raise ValueError
-                bnd = tuple(w for w in words if w not in ("xy", "xz", "yz"))[-3:]
-                if len(bnd) != 3:
-                    bnd = ("pp", "pp", "pp")
-                if "xy" in words:
-                    xy, xz, yz = nums[:, 2]
-                    tilt = np.array([xy, xz, yz])
-                    # the dump holds the bounding box; the box itself is inside it
-                    lo = nums[:, 0] - np.array([min(0.0, xy, xz, xy + xz), min(0.0, yz), 0.0])
-                    hi = nums[:, 1] - np.array([max(0.0, xy, xz, xy + xz), max(0.0, yz), 0.0])
-                else:
-                    lo, hi = nums[:, 0].copy(), nums[:, 1].copy()
-                if not (hi > lo).all():
-                    raise InputError(path, st.line - 2, f"ITEM: {item}: the box has no volume "
-                                     f"(lo {' '.join(map(str, lo))}, hi {' '.join(map(str, hi))})")
-                box = (lo, hi, bnd)
+                box, box_tilt = _box_bounds(path, st, item, values)
+                tilt = box_tilt if box_tilt is not None else tilt
             else:
                 raise InputError(path, st.line - nvalues, f"unknown dump item 'ITEM: {item}'")
         except (ValueError, IndexError):

@@ -2,6 +2,8 @@
 
 Semantics follow FibreNet's SimulationManager.cpp (commit fe11bbcc), not its README,
 where the two disagree; see docs/fibrenet.md for every quirk and deviation.
+This module reads the input file's keywords and applies them in FibreNet's order; the model
+file is read by ``model_file.py``, the network's geometric checks are ``network_checks.py``.
 """
 
 from __future__ import annotations
@@ -14,10 +16,13 @@ from pathlib import Path
 import numpy as np
 
 from fibrelmp.errors import InputError
-from fibrelmp.model import (Angles, Bonds, Box, Dynamics, Model, OutputSpec, PairLaw, Particles,
+from fibrelmp.model import (Box, Dynamics, Model, OutputSpec, PairLaw, Particles,
                      RunPlan, Stage)
-from fibrelmp.textio import integer_column, parse_table, read_checked_bytes, read_text, to_float, to_int
+from fibrelmp.textio import read_text, to_float, to_int
 from fibrelmp.units import LJ
+from fibrelmp.translate.fibrenet.model_file import Springs, read_model
+from fibrelmp.translate.fibrenet.network_checks import (bond_legs, check_lengths, check_periodic_extent,
+                                                        check_positions, exclusion_rule, note_quirks)
 
 EXTENSIONS = (".txt", ".in", ".inp")
 
@@ -36,7 +41,6 @@ REQUIRED = ("model_file", "step", "lambda", "run", "cutoff", "box_unit_cell", "b
             "box_type", "output_file", "output_freq", "output_type", "output_data")
 MAX_CHUNK = 2 ** 31 - 1        # steps of one LAMMPS ``run`` (fibrelmp runs whole chunks)
 _COMMENT = re.compile(r"^\s*(#|//|%|!)")
-_STOI = re.compile(r"^\s*[+-]?\d+")
 
 
 @dataclass
@@ -118,25 +122,6 @@ class _InputFile:
         return value
 
 
-def _model_sections(path: Path) -> dict[str, tuple[list[str], list[int]]]:
-    """Lines of the model file grouped by their first token (BEAD, SPRING, ANGLE)."""
-    text = read_text(path, "FibreNet model file")
-    sections: dict[str, tuple[list[str], list[int]]] = {k: ([], []) for k in ("BEAD", "SPRING", "ANGLE")}
-    for number, raw in enumerate(text.splitlines(), 1):
-        head = raw.lstrip()[:6]
-        for key in sections:
-            if head.startswith(key) and (len(raw.split(None, 1)[0]) == len(key)):
-                sections[key][0].append(raw)
-                sections[key][1].append(number)
-                break
-    return sections
-
-
-def _stoi(token: str) -> int | None:
-    m = _STOI.match(token)
-    return int(m.group()) if m else None
-
-
 def read(path: str | Path) -> Model:
     """Read a FibreNet input file (and the files it names) into a Model.
 
@@ -158,7 +143,7 @@ def read(path: str | Path) -> Model:
     if not model_path.exists():
         raise InputError(path, model_line.number, f"model file '{model_line.tokens[1]}' not found "
                          f"(looked in {folder})")
-    particles, springs, angles = _read_model(model_path, type_index, type_names, box.lengths, notes)
+    particles, springs, angles = read_model(model_path, type_index, type_names, box.lengths, notes)
 
     # restart, modif_bead, modif_spring: FibreNet's order
     restart = _apply_restart(inp, particles, type_names, notes)
@@ -172,17 +157,17 @@ def read(path: str | Path) -> Model:
     _apply_modif_spring(inp, springs, notes)
     bonds = springs.to_bonds()
     periodic = all(box.periodic)
-    _check_positions(particles, box, periodic, model_path, notes)
-    legs = _legs(particles, bonds, angles)
-    _check_lengths(particles, legs, model_path)
-    _check_periodic_extent(particles, legs, box, model_path)
-    exclusion = _exclusion_rule(particles, bonds, model_path)
+    check_positions(particles, box, periodic, model_path, notes)
+    legs = bond_legs(particles, bonds, angles)
+    check_lengths(particles, legs, model_path)
+    check_periodic_extent(particles, legs, box, model_path)
+    exclusion = exclusion_rule(particles, bonds, model_path)
 
     output = _output_spec(inp, type_index, settings.out_freq)
     stages = _stages(inp, settings, notes)
     dyn = Dynamics(dt=settings.dt, damping=settings.damping, lambda_=settings.lam,
                    gravity=settings.gravity, pair_cutoff=cutoff, exclusion=exclusion)
-    _note_quirks(particles, bonds, angles, legs, pairs, dyn, notes, model_path)
+    note_quirks(particles, bonds, angles, legs, pairs, dyn, notes, model_path)
     model = Model(path, particles, bonds, angles, pairs, box, dyn, RunPlan(stages, output),
                   units=LJ.name)
     model.warnings.extend(notes)
@@ -400,150 +385,6 @@ def _pair_law(path: Path, line: _Line, i: int, j: int, cutoff: float) -> PairLaw
                                 "cutoff": min(shift, cutoff)})
 
 
-def _read_model(path: Path, type_index: dict[str, int], type_names: list[str], size: np.ndarray,
-                notes: list) -> tuple[Particles, "_Springs", Angles]:
-    from fibrelmp.translate.fibrenet.fast_reader import fast_read_model
-
-    raw = read_checked_bytes(path, "FibreNet model file")    # encoding / binary checks
-    fast = fast_read_model(raw, type_index, type_names, size, _Springs)
-    del raw
-    if fast is not None:
-        return fast
-    sections = _model_sections(path)
-    lines, numbers = sections["BEAD"]
-    if not lines:
-        raise InputError(path, None, "no BEAD lines in the model file")
-    table, val = parse_table(lines, numbers, 18, path, "BEAD", text_cols=(0, 1))
-    names = table[:, 1]
-    unknown = [k for k, name in enumerate(names) if name not in type_index]
-    if unknown:
-        raise InputError(path, numbers[unknown[0]], f"bead type '{names[unknown[0]]}' is not "
-                         f"defined by a 'type' line (defined: {', '.join(type_names)})")
-    types = np.array([type_index[name] for name in names], dtype=np.int64)
-    tags = integer_column(val, table, 2, path, numbers, "BEAD")
-    loc = integer_column(val, table, 3, path, numbers, "BEAD")
-    radius, mass = val[:, 4], val[:, 5]
-    for col, arr, what in ((5, radius, "radius"), (6, mass, "mass")):
-        if (arr < 0).any():
-            row = int(np.flatnonzero(arr < 0)[0])
-            raise InputError(path, numbers[row], f"BEAD {what} must be >= 0, got {table[row, col - 1]}")
-    pos, vel, force, image = val[:, 6:9], val[:, 9:12], val[:, 12:15], val[:, 15:18]
-    outside = ((pos < 0) | (pos > size)).any(axis=1)
-    if outside.any():
-        row = int(np.flatnonzero(outside)[0])
-        raise InputError(path, numbers[row], f"bead {row} at ({pos[row, 0]:g}, {pos[row, 1]:g}, "
-                         f"{pos[row, 2]:g}) lies outside the box [0, L] (box_size "
-                         f"{size[0]:g} {size[1]:g} {size[2]:g})")
-    # FibreNet bug (S:1404): the integrator starts from v_old = (vx, vx, vx)
-    v_old = np.repeat(vel[:, :1], 3, axis=1)
-    particles = Particles(list(type_names), types, pos.copy(), image.copy(), v_old, mass.copy(),
-                          radius.copy(), tags, loc, force.copy(), vel.copy())
-    springs = _read_springs(path, sections["SPRING"], len(types), notes)
-    angles = _read_angles(path, sections["ANGLE"], len(types))
-    return particles, springs, angles
-
-
-def _check_index(idx: np.ndarray, n: int, path: Path, numbers: list[int], what: str) -> None:
-    bad = (idx < 0) | (idx >= n)
-    if bad.any():
-        row, col = np.argwhere(bad)[0]
-        raise InputError(path, numbers[row], f"{what} refers to bead {idx[row, col]}, but the "
-                         f"model has beads 0..{n - 1}")
-
-
-class _Springs:
-    """Spring data as read, before HR_FL parameters become break lengths."""
-
-    def __init__(self, m: int):
-        self.atoms = np.zeros((m, 2), np.int64)
-        self.r0, self.k = np.zeros(m), np.zeros(m)
-        self.tags = np.zeros(m, np.int64)
-        self.fl = np.zeros(m, bool)
-        self.c1, self.c2 = np.zeros(m), np.zeros(m)
-
-    def to_bonds(self) -> Bonds:
-        brk = np.full(len(self.r0), np.nan)
-        for r in np.flatnonzero(self.fl):
-            brk[r] = _break_length(self.r0[r], self.c1[r], self.c2[r])
-        return Bonds(self.atoms, self.k, self.r0, brk)
-
-
-def _read_springs(path: Path, section: tuple[list[str], list[int]], n: int, notes: list) -> _Springs:
-    lines, numbers = section
-    s = _Springs(len(lines))
-    if not lines:
-        return s
-    rows: list[list[str]] = [ln.split() for ln in lines]
-    if all(len(r) == 7 and r[1] == "HR" for r in rows):      # fast path: all plain HR
-        table, val = parse_table(lines, numbers, 7, path, "SPRING", text_cols=(0, 1))
-        s.tags = integer_column(val, table, 2, path, numbers, "SPRING")
-        s.atoms[:] = np.stack([integer_column(val, table, c, path, numbers, "SPRING") for c in (3, 4)], 1)
-        s.r0[:], s.k[:] = val[:, 5], val[:, 6]
-    else:
-        truncated = []
-        for r, tok in enumerate(rows):
-            ln = numbers[r]
-            kind = tok[1] if len(tok) > 1 else ""
-            if kind not in ("HR", "HR_FL"):
-                raise InputError(path, ln, f"unknown spring kind '{kind}' (HR or HR_FL)")
-            if kind == "HR" and len(tok) < 7:
-                raise InputError(path, ln, f"SPRING HR needs at least 7 tokens, found {len(tok)}")
-            if kind == "HR_FL" and len(tok) != 9:
-                raise InputError(path, ln, f"SPRING HR_FL needs 9 tokens, found {len(tok)}")
-            s.tags[r] = to_int(tok[2], path, ln, "SPRING tag")
-            s.atoms[r] = (to_int(tok[3], path, ln, "SPRING bead"), to_int(tok[4], path, ln, "SPRING bead"))
-            s.r0[r] = to_float(tok[5], path, ln, "SPRING rest length")
-            s.k[r] = to_float(tok[6], path, ln, "SPRING stiffness")
-            if kind == "HR_FL":
-                c1, c2 = _stoi(tok[7]), _stoi(tok[8])
-                if c1 is None or c2 is None:
-                    raise InputError(path, ln, "SPRING HR_FL c1/c2 must start with an integer "
-                                     "(FibreNet reads them with std::stoi)")
-                if str(c1) != tok[7].strip() or str(c2) != tok[8].strip():
-                    truncated.append(ln)
-                s.fl[r], s.c1[r], s.c2[r] = True, c1, c2
-        if truncated:
-            notes.append(("HR_FL integer truncation", f"{path}:{truncated[0]}: FibreNet reads "
-                          f"HR_FL c1 and c2 with std::stoi, truncating them to integers "
-                          f"({len(truncated)} spring(s)); fibrelmp reproduces this"))
-    _check_index(s.atoms, n, path, numbers, "SPRING")
-    for arr, what in ((s.r0, "rest length"), (s.k, "stiffness")):
-        if (arr < 0).any():
-            row = int(np.flatnonzero(arr < 0)[0])
-            raise InputError(path, numbers[row], f"SPRING {what} must be >= 0")
-    same = s.atoms[:, 0] == s.atoms[:, 1]
-    if same.any():
-        raise InputError(path, numbers[int(np.flatnonzero(same)[0])], "SPRING connects a bead to itself")
-    return s
-
-
-def _break_length(r0: float, c1: float, c2: float) -> float:
-    """Tension break length of HR_FL: |c1 (r - r0) / r| > c2  <=>  r > r0 c1 / (c1 - c2)."""
-    if c1 > c2:
-        return r0 * c1 / (c1 - c2)
-    return np.inf
-
-
-def _read_angles(path: Path, section: tuple[list[str], list[int]], n: int) -> Angles:
-    lines, numbers = section
-    if not lines:
-        return Angles.empty()
-    table, val = parse_table(lines, numbers, 10, path, "ANGLE", text_cols=(0, 1))
-    bad = [r for r in range(len(lines)) if table[r, 1] not in ("HR", "HR_FL")]
-    if bad:
-        raise InputError(path, numbers[bad[0]], f"unknown angle kind '{table[bad[0], 1]}' (HR or HR_FL)")
-    atoms = np.stack([integer_column(val, table, c, path, numbers, "ANGLE") for c in (3, 4, 5)], 1)
-    _check_index(atoms, n, path, numbers, "ANGLE")
-    twice = (atoms[:, 0] == atoms[:, 1]) | (atoms[:, 1] == atoms[:, 2]) | (atoms[:, 0] == atoms[:, 2])
-    if twice.any():
-        row = int(np.flatnonzero(twice)[0])
-        raise InputError(path, numbers[row], f"ANGLE uses one bead twice "
-                         f"({' '.join(map(str, atoms[row]))}): an angle needs three different beads")
-    # FibreNet reads theta0 with std::stof: float precision
-    theta0 = val[:, 8].astype(np.float32).astype(np.float64)
-    return Angles(atoms, val[:, 9].copy(), theta0)
-
-
 def _select(tokens: list[str], particles: Particles, type_index: dict[str, int], path: Path,
             number: int) -> np.ndarray:
     how, what = tokens[1], tokens[2]
@@ -627,7 +468,7 @@ def _skin_note(where: str, skin: float, p: Particles, mask: np.ndarray, pairs) -
             "results differ from FibreNet's while such pairs overlap (docs/fibrenet.md)")
 
 
-def _apply_modif_spring(inp: _InputFile, springs: _Springs, notes: list) -> None:
+def _apply_modif_spring(inp: _InputFile, springs: Springs, notes: list) -> None:
     for line in inp.all("modif_spring"):
         t, ln = line.tokens, line.number
         if len(t) != 5:
@@ -658,129 +499,6 @@ def _apply_modif_spring(inp: _InputFile, springs: _Springs, notes: list) -> None
         else:
             raise InputError(inp.path, ln, f"modif_spring property must be rest_length, "
                              f"stiffness, c1, c2 or damping, got '{t[3]}'")
-
-
-def _legs(p: Particles, bonds: Bonds, angles: Angles) -> list[tuple[str, np.ndarray, np.ndarray]]:
-    """(kind, index pairs (i, j), x_j - x_i on the unwrapped positions) of every spring and
-    both legs of every angle (the second angle leg is bead 2 -> bead 3), computed once for
-    the checks below."""
-    x = p.unwrapped
-    out = []
-    for kind, pairs in (("SPRING", bonds.atoms), ("ANGLE", angles.atoms[:, :2]),
-                        ("ANGLE", angles.atoms[:, 1:])):
-        with np.errstate(all="ignore"):
-            out.append((kind, pairs, x[pairs[:, 1]] - x[pairs[:, 0]]))
-    return out
-
-
-def _check_lengths(p: Particles, legs: list, path: Path) -> None:
-    """Springs and angle legs of zero length have no direction: FibreNet's forces divide by
-    the length (NaN), LAMMPS's bond style silently gives no force."""
-    x = p.unwrapped
-    for kind, pairs, d in legs:
-        if not len(pairs):
-            continue
-        same = (d == 0).all(axis=1)              # finite positions: x_j - x_i == 0 iff equal
-        if same.any():
-            row = int(np.flatnonzero(same)[0])
-            i, j = (int(v) for v in pairs[row])
-            line = _model_sections(path)[kind][1][row]     # only on error: no cost otherwise
-            what = "the spring has zero length" if kind == "SPRING" else "the angle is undefined"
-            raise InputError(path, line, f"{kind} joins beads {i} and {j}, which are at the same "
-                             f"position ({', '.join(f'{v:g}' for v in x[i])}): {what}")
-
-
-def _check_periodic_extent(p: Particles, legs: list, box: Box, path: Path) -> None:
-    """Springs and angle legs must span less than half the box along every periodic axis.
-
-    FibreNet computes springs and angles on the unwrapped positions (ix iy iz) with no minimum
-    image (kernel.cl ResolveSprings/ResolveAngles), so a spring longer than half the box acts
-    along its own, long, vector.  LAMMPS takes every bond and angle partner as the periodic
-    image nearest to the atom that owns it, i.e. the minimum image: such a spring would act on
-    a different, shorter vector (a spring at rest in FibreNet pulls hard in LAMMPS).  Nothing
-    in LAMMPS can reproduce that, so it is an error rather than a silently different run."""
-    per = np.asarray(box.periodic, bool)
-    if not per.any():
-        return
-    half = 0.5 * box.lengths
-    for kind, pairs, d in legs:
-        if not len(pairs):
-            continue
-        with np.errstate(all="ignore"):
-            bad = (~(np.abs(d[:, per]) < half[per])).any(axis=1)
-        if not bad.any():
-            continue
-        row = int(np.flatnonzero(bad)[0])
-        i, j = (int(v) for v in pairs[row])
-        with np.errstate(all="ignore"):
-            dv = d[row]
-            image = dv.copy()
-            image[per] -= box.lengths[per] * np.round(dv[per] / box.lengths[per])
-            r, r_img = float(np.linalg.norm(dv)), float(np.linalg.norm(image))
-        axes = "".join("xyz"[a] for a in range(3) if per[a] and not abs(dv[a]) < half[a])
-        line = _model_sections(path)[kind][1][row]     # only on error: no cost otherwise
-        what = "spring" if kind == "SPRING" else "angle leg"
-        raise InputError(path, line, f"{kind}: the {what} between beads {i} and {j} spans "
-                         f"{', '.join(f'{dv[a]:g}' for a in range(3))} (length {r:g}), at least half "
-                         f"the periodic box ({', '.join(f'{v:g}' for v in box.lengths)}) along "
-                         f"{axes} ({int(bad.sum())} {what}(s) do): FibreNet uses this unwrapped "
-                         f"vector, LAMMPS the nearest periodic image (length {r_img:g}), so the "
-                         "forces would differ; enlarge box_size or split the "
-                         f"{'spring' if kind == 'SPRING' else 'fibre'} into shorter segments")
-
-
-def _check_positions(p: Particles, box: Box, periodic: bool, path: Path, notes: list) -> None:
-    diff = p.unwrapped - p.positions
-    if periodic:
-        shift = diff / box.lengths
-        off = np.abs(shift - np.round(shift)) * box.lengths > 1e-6 * box.lengths.max()
-        if off.any():
-            row = int(np.flatnonzero(off.any(axis=1))[0])
-            notes.append(("wrapped/unwrapped mismatch", f"{path}: bead {row}: unwrapped position "
-                          "is not the wrapped one plus whole box lengths; fibrelmp uses the "
-                          "unwrapped position (bonds follow it) and wraps it"))
-    elif (np.abs(diff) > 0).any():
-        row = int(np.flatnonzero((np.abs(diff) > 0).any(axis=1))[0])
-        notes.append(("wrapped/unwrapped mismatch", f"{path}: bead {row}: in a finite box the "
-                      "unwrapped (ix iy iz) and wrapped positions differ; fibrelmp uses px py pz "
-                      "for everything (FibreNet uses ix for springs/angles)"))
-        p.unwrapped = p.positions.copy()
-
-
-def _exclusion_rule(p: Particles, bonds: Bonds, path: Path) -> str:
-    """FibreNet skips non-bonded pairs with the same tag and |loc_id_i - loc_id_j| <= 1."""
-    order = np.lexsort((p.loc_ids, p.molecules))
-    tag, loc = p.molecules[order], p.loc_ids[order]
-    starts = np.r_[0, np.flatnonzero(np.diff(tag)) + 1]
-    span = np.maximum.reduceat(loc, starts) - np.minimum.reduceat(loc, starts)
-    if (span <= 1).all():
-        return "molecule"       # every pair inside a tag is excluded
-    raise InputError(path, None, "beads of one tag have loc_id values more than 1 apart: "
-                     "FibreNet's partial exclusion (|loc_id_i - loc_id_j| <= 1) has no exact "
-                     "LAMMPS equivalent; give every bead of a fibre the same loc_id")
-
-
-def _note_quirks(p: Particles, bonds: Bonds, angles: Angles, legs: list, pairs: list[PairLaw],
-                 dyn: Dynamics, notes: list, path: Path) -> None:
-    for law in pairs:
-        if law.kind == "st" and law.params["B"] * (law.params["rstar"] - law.params["cutoff"]) != 0:
-            jump = law.params["B"] * (law.params["rstar"] - law.params["cutoff"])
-            notes.append(("st force jump", f"pair st {p.type_names[law.type_i]} "
-                          f"{p.type_names[law.type_j]}: as FibreNet runs it the force is one linear "
-                          f"spring B={law.params['B']:g}, r*={law.params['rstar']:.6g}, cut at "
-                          f"{law.params['cutoff']:g} where it jumps by {jump:.6g}; reproduced"))
-    if (~np.isnan(bonds.break_length)).any():
-        notes.append(("HR_FL breaking", f"{path}: HR_FL springs break only in tension here "
-                      "(fix bond/break); FibreNet also breaks them in compression and keeps HR "
-                      "angles that contain them"))
-    if angles.count:
-        u, v = -legs[1][2], legs[2][2]            # bead 1 - bead 2, bead 3 - bead 2
-        with np.errstate(all="ignore"):         # huge coordinates overflow: not straight
-            cos = (u * v).sum(1) / np.sqrt((u * u).sum(1) * (v * v).sum(1))
-        if (cos <= -1.0 + 1e-14).any():
-            notes.append(("straight triple", f"{path}: some angle triples are exactly straight; "
-                          "FibreNet clamps cos to -0.999999 there and applies a spurious force, "
-                          "fibrelmp does not"))
 
 
 # --------------------------------------------------------------------------- fibrelmp check

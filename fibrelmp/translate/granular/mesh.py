@@ -5,7 +5,7 @@ file the fix reads (``walls.mesh`` next to ``data.lammps``; format in the fix's 
 Every triangle of every geometry is written as it is, in MUSEN's wall order (geometries in
 scene order, each in its ``27`` list order: the order MUSEN breaks ties between touched
 triangles in), with its own wall material; each geometry with the coefficients of its exact
-rigid motion (the same ``geometry.Kinematics`` the frames report wall positions with) and its
+rigid motion (the same ``kinematics.Kinematics`` the frames report wall positions with) and its
 MUSEN motion intervals (the wall velocity the contact law sees)."""
 
 from __future__ import annotations

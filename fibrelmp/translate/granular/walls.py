@@ -19,10 +19,9 @@ from fibrelmp.errors import InputError
 from fibrelmp.granmodel import Geometry, GranularModel
 from fibrelmp.lammps_text import LammpsText, comment_text
 from fibrelmp.translate.granular.contacts import check_law, law_args, rolling_spring
-from fibrelmp.translate.granular.geometry import (BoxShape, CylinderShape, Kinematics, closest_points,
-                                                  detect_cylinder,
-                                                  detect_oriented_box, geometry_kinematics,
-                                                  geometry_triangle_rows, piecewise_expression)
+from fibrelmp.translate.granular.geometry import (BoxShape, CylinderShape, closest_points, detect_cylinder,
+                                                  detect_oriented_box, geometry_triangle_rows)
+from fibrelmp.translate.granular.kinematics import Kinematics, geometry_kinematics, piecewise_expression
 from fibrelmp.translate.granular import models as physics
 from fibrelmp.translate.granular.mesh import MESH_FIX, MESH_NAME
 from fibrelmp.translate.lammps_format import float_text

@@ -293,7 +293,7 @@ def test_built_parts_import_nothing_of_fibrelmp(unit):
 # The particle model's families (fibrelmp/particles.py) and their homes: only there may code
 # switch on a family; a shared module asks the model (docs/architecture.md, "The particle model")
 FAMILY_HOMES = {"Model": "fibrelmp.model", "GranularModel": "fibrelmp.granmodel",
-                "SphCase": "fibrelmp.cardioproof"}
+                "SphCase": "fibrelmp.translate.cardioproof"}
 
 
 def family_switches(tree: ast.Module) -> list[tuple[int, str]]:

@@ -418,13 +418,13 @@ def test_mpi_rank0_write_failure_always_prints(tmp_path, styles):
         "import errno, os\n"
         "if os.environ.get('PMI_RANK') == '0':\n"
         "    from fibrelmp.translate.fibrenet import writer as fibrenet_out\n"
-        "    from fibrelmp.pipeline import fibrenet as fibrenet_pipeline\n"
+        "    from fibrelmp.translate.fibrenet import plan as fibrenet_plan\n"
         "    def finish(self):\n"
         "        raise OSError(errno.ENOSPC, 'No space left on device', str(self.path))\n"
         "    def move_file(src, dst):\n"
         "        raise OSError(errno.ENOSPC, 'No space left on device', str(dst))\n"
         "    fibrenet_out.XyzWriter.finish = finish\n"
-        "    fibrenet_pipeline.move_file = move_file\n")
+        "    fibrenet_plan.move_file = move_file\n")
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(hook), str(REPO)]))
     inp = fibre_case(tmp_path / "in", run="200", output_freq="100")
     extra = ["--stock-styles"] if styles == "stock" else []

@@ -32,6 +32,8 @@ codes that differ; for a differing text file also how many lines a line diff fin
 
 Ignored (cannot be identical by construction), in text files only:
 
+* the inputs' checkout (``--tree``), written as ``<tree>`` (summary.json's ``input``: two
+  runs may read the same inputs from two checkouts);
 * the output root (``OUT_ROOT``), written as ``<root>`` (absolute paths in summary.json,
   data.fibrelmp.json, logs);
 * the styles plugin's file name in ``plugin load`` lines (its name carries a hash of the C++
@@ -71,7 +73,7 @@ AGGLOMERATE_IMPORT = ("JOB\nSOURCE_FILE SphericalAgglomerate_text.txt\nRESULT_FI
                       "COMPONENT IMPORT_FROM_TEXT\nJOB\n")
 NEEDS_IMPORT = ("job_own_domain_test.txt", "job_recommended_step.txt")
 
-IGNORED = ("the output root (written <root>); the styles plugin's file in 'plugin load' lines; "
+IGNORED = ("the output root (written <root>) and the inputs' checkout (<tree>); the styles plugin's file in 'plugin load' lines; "
            "log.lammps wall/CPU times (Loop time, Performance, % CPU use, CPU = s, Total wall "
            "time, timing table rows); summary.json wall_time and steps_per_second")
 
@@ -181,11 +183,13 @@ def _is_text(data: bytes) -> bool:
     return True
 
 
-def compared_text(path: Path, data: bytes, root: Path) -> str | None:
+def compared_text(path: Path, data: bytes, root: Path, tree: Path | None = None) -> str | None:
     """The text that is compared (IGNORED masked), or None for a binary file."""
     if not _is_text(data):
         return None
     text = data.decode("utf-8").replace(str(root), "<root>")
+    if tree is not None:                # the inputs' checkout (summary.json's "input")
+        text = text.replace(str(tree), "<tree>")
     text = _PLUGIN.sub(r"\1<fibrelmp styles plugin>", text)
     if path.name.startswith("log.lammps"):
         text = "\n".join("<time line>" if _LOG_TIMES.match(line) else line for line in text.split("\n"))
@@ -201,11 +205,11 @@ def compared_text(path: Path, data: bytes, root: Path) -> str | None:
     return text
 
 
-def file_entry(path: Path, root: Path) -> dict:
+def file_entry(path: Path, root: Path, tree: Path | None = None) -> dict:
     """Size, sha256 and (when masking changed it) the sha256 of the compared text."""
     data = path.read_bytes()
     entry = {"size": len(data), "sha256": hashlib.sha256(data).hexdigest()}
-    text = compared_text(path, data, root)
+    text = compared_text(path, data, root, tree)
     if text is not None and text.encode("utf-8") != data:
         entry["compared_sha256"] = hashlib.sha256(text.encode("utf-8")).hexdigest()
     return entry
@@ -213,7 +217,7 @@ def file_entry(path: Path, root: Path) -> dict:
 
 # ---- run mode ----------------------------------------------------------------------------
 
-def run_case(fibrelmp: str, case: Case, root: Path) -> dict:
+def run_case(fibrelmp: str, case: Case, root: Path, tree: Path | None = None) -> dict:
     """Run one case and describe what it wrote."""
     case.cwd.mkdir(parents=True, exist_ok=True)
     started = time.monotonic()
@@ -223,7 +227,7 @@ def run_case(fibrelmp: str, case: Case, root: Path) -> dict:
     for path in sorted(p for p in case.cwd.rglob("*") if p.is_file() and not p.is_symlink()):
         rel = path.relative_to(case.cwd).as_posix()
         if rel not in case.placed:
-            files[rel] = file_entry(path, root)
+            files[rel] = file_entry(path, root, tree)
     errors = [line for line in done.stderr.splitlines() if line.startswith("error")]
     return {"command": ["fibrelmp", *case.args], "cwd": str(case.cwd), "exit": done.returncode,
             "error": errors[-1] if errors else "", "seconds": round(time.monotonic() - started, 1),
@@ -246,7 +250,7 @@ def run_mode(args: argparse.Namespace) -> int:
         if args.only and not any(text in case.name for text in args.only):
             continue
         print(f"{case.name} ...", end=" ", flush=True, file=sys.stderr)
-        manifest["cases"][case.name] = result = run_case(fibrelmp, case, root)
+        manifest["cases"][case.name] = result = run_case(fibrelmp, case, root, tree)
         print(f"exit {result['exit']}, {len(result['files'])} files, {result['seconds']} s",
               file=sys.stderr)
         (root / "manifest.json").write_text(json.dumps(manifest, indent=1) + "\n")

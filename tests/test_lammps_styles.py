@@ -3,6 +3,7 @@ fallback and how jobs load it (the styles' physics: tests/test_style_*.py)."""
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -76,6 +77,22 @@ lmp.command("plugin load {path}")
               "write a frame of fix fibrenet/output"]
     assert len(loaded) == len(set(loaded)), loaded
     assert [info for info in loaded if info in before] == before, loaded
+
+
+def test_every_style_class_registers_itself_and_plugin_cpp_names_none():
+    """No central list: each LAMMPS style class is created by a registration in its own .cpp
+    (style_registry.h); plugin.cpp includes no style header."""
+    classes = {}
+    for header in build.SRC.glob("*.h"):
+        for name in re.findall(r"^class (\w+) : public \w+", header.read_text(), re.M):
+            classes[name] = header.with_suffix(".cpp")
+    assert {"PairMusenHM", "PairMusenLinear", "FibreNetFrame"} <= set(classes)
+    for name, source in classes.items():
+        text = source.read_text()
+        assert re.search(rf"return new {name}\(lmp", text), f"{source.name} creates no {name}"
+        assert "style_registry::Registration" in text, f"{source.name} does not register {name}"
+    plugin_cpp = (build.SRC / "plugin.cpp").read_text()
+    assert not re.findall(r'#include "(?:pair|bond|angle|fix)_\w+\.h"', plugin_cpp)
 
 
 def test_plugin_refuses_another_lammps_version(tmp_path):

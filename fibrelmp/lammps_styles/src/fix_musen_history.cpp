@@ -225,7 +225,8 @@ int FixMusenHistory::maxsize_restart()
   return most * stride() + 2;
 }
 
-// registration with LAMMPS when the plugin loads (style_registry.h); created by the MUSEN styles, not by input scripts
+// registration with LAMMPS when the plugin loads (style_registry.h); the MUSEN styles create
+// this fix, input scripts do not
 namespace {
 Fix *create(LAMMPS *lmp, int narg, char **arg)
 {

@@ -3,6 +3,7 @@ fallback and how jobs load it (the styles' physics: tests/test_style_*.py)."""
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -48,6 +49,50 @@ def test_plugin_registers_its_styles(tmp_path):
     for stem, line in expected.items():
         assert (line in listing) == (build.SRC / f"{stem}.cpp").exists(), line
     assert "WARNING" not in listing
+
+
+def test_self_registered_styles_load_in_a_fixed_order(tmp_path):
+    """Each style registers itself from its own .cpp (src/style_registry.h); the plugin hands
+    them to LAMMPS sorted by their order number, so log.lammps's "Loading plugin" lines keep
+    the order they had when plugin.cpp listed the styles by hand (a new style may add a line)."""
+    path = plugin_or_skip()
+    log = tmp_path / "screen.txt"
+    # a fresh process: a plugin already loaded in this one would not print its lines again
+    code = f"""
+from fibrelmp._lammps import new_lammps
+lmp = new_lammps(["-log", "none", "-screen", {str(log)!r}, "-nocite"])
+lmp.command("plugin load {path}")
+"""
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    loaded = [ln.removeprefix("Loading plugin: ").removesuffix(" by fibrelmp developers")
+              for ln in log.read_text().splitlines() if ln.startswith("Loading plugin: ")]
+    before = ["per-atom contact/bond history of fibrelmp styles",
+              "MUSEN Hertz-Mindlin particle-particle contact",
+              "MUSEN linear elastic particle-particle contact",
+              "MUSEN elastic/Kelvin solid bond with breakage",
+              "MUSEN particle-wall contact with triangle walls",
+              "FibreNet bending law",
+              "FibreNet xyz/res output written by LAMMPS",
+              "write a frame of fix fibrenet/output"]
+    assert len(loaded) == len(set(loaded)), loaded
+    assert [info for info in loaded if info in before] == before, loaded
+
+
+def test_every_style_class_registers_itself_and_plugin_cpp_names_none():
+    """No central list: each LAMMPS style class is created by a registration in its own .cpp
+    (style_registry.h); plugin.cpp includes no style header."""
+    classes = {}
+    for header in build.SRC.glob("*.h"):
+        for name in re.findall(r"^class (\w+) : public \w+", header.read_text(), re.M):
+            classes[name] = header.with_suffix(".cpp")
+    assert {"PairMusenHM", "PairMusenLinear", "FibreNetFrame"} <= set(classes)
+    for name, source in classes.items():
+        text = source.read_text()
+        assert re.search(rf"return new {name}\(lmp", text), f"{source.name} creates no {name}"
+        assert "style_registry::Registration" in text, f"{source.name} does not register {name}"
+    plugin_cpp = (build.SRC / "plugin.cpp").read_text()
+    assert not re.findall(r'#include "(?:pair|bond|angle|fix)_\w+\.h"', plugin_cpp)
 
 
 def test_plugin_refuses_another_lammps_version(tmp_path):

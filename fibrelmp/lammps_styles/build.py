@@ -116,8 +116,9 @@ def build(out_dir: Path | str = LIB_DIR, jobs: int | None = None, *, num_ver: in
     if target.exists():
         return target
     inc = ["-I", str(SRC), "-I", str(lammps_include()), "-I", str(mpi_include())]
-    defs = [f"-DFIBRELMP_LAMMPS_NUM_VER={num_ver or lammps_num_ver()}", f'-DFIBRELMP_STYLES_ID="{bid}"'] + (["-DFIBRELMP_CORE_ONLY"] if core_only else [])
+    defs = [f"-DFIBRELMP_LAMMPS_NUM_VER={num_ver or lammps_num_ver()}", f'-DFIBRELMP_STYLES_ID="{bid}"']
     cxx = _compiler()
+    # styles register themselves (src/style_registry.h): core_only = the files it compiles
     srcs = [SRC / "plugin.cpp", SRC / "fix_musen_history.cpp"] if core_only else sources()
     try:
         out_dir.mkdir(parents=True, exist_ok=True)

@@ -22,6 +22,7 @@
 ------------------------------------------------------------------------- */
 
 #include "angle_fibrenet.h"
+#include "style_registry.h"
 
 #include "atom.h"
 #include "comm.h"
@@ -296,3 +297,10 @@ void *AngleFibreNet::extract(const char *str, int &dim)
   if (strcmp(str, "theta0") == 0) return (void *) theta0;
   return nullptr;
 }
+
+// registration with LAMMPS when the plugin loads (style_registry.h)
+namespace {
+Angle *create(LAMMPS *lmp) { return new AngleFibreNet(lmp); }
+const style_registry::Registration registered(
+    60, "angle", "fibrenet", "FibreNet bending law", &create);
+}    // namespace

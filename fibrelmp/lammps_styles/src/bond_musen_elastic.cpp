@@ -20,6 +20,7 @@
 ------------------------------------------------------------------------- */
 
 #include "bond_musen_elastic.h"
+#include "style_registry.h"
 
 #include "fix_musen_history.h"
 
@@ -791,3 +792,10 @@ double BondMusenElastic::memory_usage()
   bytes += 8.0 * (atom->nbondtypes + 1) * sizeof(double);
   return bytes;
 }
+
+// registration with LAMMPS when the plugin loads (style_registry.h)
+namespace {
+Bond *create(LAMMPS *lmp) { return new BondMusenElastic(lmp); }
+const style_registry::Registration registered(
+    40, "bond", "musen/elastic", "MUSEN elastic/Kelvin solid bond with breakage", &create);
+}    // namespace

@@ -14,6 +14,7 @@
 ------------------------------------------------------------------------- */
 
 #include "fix_fibrenet_output.h"
+#include "style_registry.h"
 
 #include "atom.h"
 #include "comm.h"
@@ -599,3 +600,19 @@ void FibreNetFrame::command(int narg, char **arg)
   if (!domain->box_exist) error->all(FLERR, "fibrenet/frame before the simulation box exists");
   fix->write_frame();
 }
+
+// registration with LAMMPS when the plugin loads (style_registry.h); the command makes the fix
+// write a frame where the script says
+namespace {
+Fix *create_fix(LAMMPS *lmp, int narg, char **arg)
+{
+  return new FixFibreNetOutput(lmp, narg, arg);
+}
+Command *create_frame(LAMMPS *lmp) { return new FibreNetFrame(lmp); }
+const style_registry::Registration registered_fix(70, "fix", "fibrenet/output",
+                                                  "FibreNet xyz/res output written by LAMMPS",
+                                                  &create_fix);
+const style_registry::Registration registered_frame(80, "command", "fibrenet/frame",
+                                                    "write a frame of fix fibrenet/output",
+                                                    &create_frame);
+}    // namespace

@@ -4,6 +4,7 @@
 ------------------------------------------------------------------------- */
 
 #include "fix_musen_history.h"
+#include "style_registry.h"
 
 #include "atom.h"
 #include "error.h"
@@ -223,3 +224,14 @@ int FixMusenHistory::maxsize_restart()
   for (int i = 0; i < atom->nlocal; i++) most = std::max(most, num[i]);
   return most * stride() + 2;
 }
+
+// registration with LAMMPS when the plugin loads (style_registry.h); the MUSEN styles create
+// this fix, input scripts do not
+namespace {
+Fix *create(LAMMPS *lmp, int narg, char **arg)
+{
+  return new FixMusenHistory(lmp, narg, arg);
+}
+const style_registry::Registration registered(
+    10, "fix", "MUSEN/HISTORY", "per-atom contact/bond history of fibrelmp styles", &create);
+}    // namespace

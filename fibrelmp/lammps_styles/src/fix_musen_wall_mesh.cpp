@@ -9,6 +9,7 @@
 ------------------------------------------------------------------------- */
 
 #include "fix_musen_wall_mesh.h"
+#include "style_registry.h"
 #include "fix_musen_history.h"
 
 #include "atom.h"
@@ -1085,3 +1086,13 @@ double FixMusenWallMesh::memory_usage()
   bytes += sizeof(int) * (cell_start.size() + cell_entries.size() + all_entries.size() + adj.size());
   return bytes;
 }
+
+// registration with LAMMPS when the plugin loads (style_registry.h)
+namespace {
+Fix *create(LAMMPS *lmp, int narg, char **arg)
+{
+  return new FixMusenWallMesh(lmp, narg, arg);
+}
+const style_registry::Registration registered(
+    50, "fix", "musen/wall/mesh", "MUSEN particle-wall contact with triangle walls", &create);
+}    // namespace

@@ -27,6 +27,7 @@
 ------------------------------------------------------------------------- */
 
 #include "pair_musen_hm.h"
+#include "style_registry.h"
 
 #include "atom.h"
 #include "comm.h"
@@ -539,3 +540,10 @@ double PairMusenHM::memory_usage()
   const double np1 = atom->ntypes + 1;
   return np1 * np1 * (sizeof(int) + 7 * sizeof(double)) + np1 * sizeof(double);
 }
+
+// registration with LAMMPS when the plugin loads (style_registry.h)
+namespace {
+Pair *create(LAMMPS *lmp) { return new PairMusenHM(lmp); }
+const style_registry::Registration registered(
+    20, "pair", "musen/hm", "MUSEN Hertz-Mindlin particle-particle contact", &create);
+}    // namespace

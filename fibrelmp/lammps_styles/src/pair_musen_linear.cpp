@@ -5,6 +5,7 @@
 ------------------------------------------------------------------------- */
 
 #include "pair_musen_linear.h"
+#include "style_registry.h"
 
 #include "comm.h"
 #include "error.h"
@@ -50,3 +51,10 @@ void PairMusenLinear::read_restart_settings(FILE *fp)
   MPI_Bcast(&normal_stiffness, 1, MPI_DOUBLE, 0, world);
   MPI_Bcast(&tangential_stiffness, 1, MPI_DOUBLE, 0, world);
 }
+
+// registration with LAMMPS when the plugin loads (style_registry.h)
+namespace {
+Pair *create(LAMMPS *lmp) { return new PairMusenLinear(lmp); }
+const style_registry::Registration registered(
+    30, "pair", "musen/linear", "MUSEN linear elastic particle-particle contact", &create);
+}    // namespace

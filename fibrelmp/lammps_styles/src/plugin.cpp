@@ -12,38 +12,13 @@
 #include "lammps.h"
 #include "utils.h"
 
+#include "style_registry.h"
+
+#include <algorithm>
 #include <cstring>
 #include <string>
-
-#include "fix_musen_history.h"
-
-// FIBRELMP_CORE_ONLY: the registration and the history fix alone (tests of the version check)
-#ifndef FIBRELMP_CORE_ONLY
-#if __has_include("pair_musen_hm.h")
-#include "pair_musen_hm.h"
-#define HAVE_PAIR_MUSEN_HM
-#endif
-#if __has_include("pair_musen_linear.h")
-#include "pair_musen_linear.h"
-#define HAVE_PAIR_MUSEN_LINEAR
-#endif
-#if __has_include("bond_musen_elastic.h")
-#include "bond_musen_elastic.h"
-#define HAVE_BOND_MUSEN_ELASTIC
-#endif
-#if __has_include("fix_musen_wall_mesh.h")
-#include "fix_musen_wall_mesh.h"
-#define HAVE_FIX_MUSEN_WALL_MESH
-#endif
-#if __has_include("angle_fibrenet.h")
-#include "angle_fibrenet.h"
-#define HAVE_ANGLE_FIBRENET
-#endif
-#if __has_include("fix_fibrenet_output.h")
-#include "fix_fibrenet_output.h"
-#define HAVE_FIX_FIBRENET_OUTPUT
-#endif
-#endif
+#include <tuple>
+#include <vector>
 
 #ifndef FIBRELMP_LAMMPS_NUM_VER
 #error "build with -DFIBRELMP_LAMMPS_NUM_VER=<lammps num_ver> (fibrelmp/lammps_styles/build.py does)"
@@ -54,57 +29,35 @@
 
 using namespace LAMMPS_NS;
 
+namespace LAMMPS_NS {
+namespace style_registry {
+
 namespace {
-
-// one creator per style (LAMMPS calls them through the C plugin interface)
-Fix *fix_musen_history_creator(LAMMPS *lmp, int narg, char **arg)
+// a function-local list: the styles' registration objects run during static initialisation
+std::vector<Style> &registry()
 {
-  return new FixMusenHistory(lmp, narg, arg);
+  static std::vector<Style> styles;
+  return styles;
 }
-#ifdef HAVE_PAIR_MUSEN_HM
-Pair *pair_musen_hm_creator(LAMMPS *lmp) { return new PairMusenHM(lmp); }
-#endif
-#ifdef HAVE_PAIR_MUSEN_LINEAR
-Pair *pair_musen_linear_creator(LAMMPS *lmp) { return new PairMusenLinear(lmp); }
-#endif
-#ifdef HAVE_BOND_MUSEN_ELASTIC
-Bond *bond_musen_elastic_creator(LAMMPS *lmp) { return new BondMusenElastic(lmp); }
-#endif
-#ifdef HAVE_FIX_MUSEN_WALL_MESH
-Fix *fix_musen_wall_mesh_creator(LAMMPS *lmp, int narg, char **arg)
-{
-  return new FixMusenWallMesh(lmp, narg, arg);
-}
-#endif
-#ifdef HAVE_ANGLE_FIBRENET
-Angle *angle_fibrenet_creator(LAMMPS *lmp) { return new AngleFibreNet(lmp); }
-#endif
-#ifdef HAVE_FIX_FIBRENET_OUTPUT
-Fix *fix_fibrenet_output_creator(LAMMPS *lmp, int narg, char **arg)
-{
-  return new FixFibreNetOutput(lmp, narg, arg);
-}
-Command *fibrenet_frame_creator(LAMMPS *lmp) { return new FibreNetFrame(lmp); }
-#endif
-
-void add(lammpsplugin_regfunc reg, void *lmp, void *handle, const char *style, const char *name,
-         const char *info, lammpsplugin_factory1 *v1, lammpsplugin_factory2 *v2)
-{
-  lammpsplugin_t plugin;
-  plugin.version = static_cast<LAMMPS *>(lmp)->version;    // checked below, not by the string
-  plugin.style = style;
-  plugin.name = name;
-  plugin.info = info;
-  plugin.author = "fibrelmp developers";
-  if (v1)
-    plugin.creator.v1 = v1;
-  else
-    plugin.creator.v2 = v2;
-  plugin.handle = handle;
-  (*reg)(&plugin, lmp);
-}
-
 }    // namespace
+
+void add(const Style &style)
+{
+  registry().push_back(style);
+}
+
+std::vector<Style> sorted()
+{
+  std::vector<Style> styles = registry();
+  std::stable_sort(styles.begin(), styles.end(), [](const Style &a, const Style &b) {
+    return std::make_tuple(a.order, std::string(a.kind), std::string(a.name)) <
+        std::make_tuple(b.order, std::string(b.kind), std::string(b.name));
+  });
+  return styles;
+}
+
+}    // namespace style_registry
+}    // namespace LAMMPS_NS
 
 extern "C" void lammpsplugin_init(void *ptr, void *handle, void *regfunc)
 {
@@ -120,34 +73,20 @@ extern "C" void lammpsplugin_init(void *ptr, void *handle, void *regfunc)
                         FIBRELMP_STYLES_ID, FIBRELMP_LAMMPS_NUM_VER, lmp->num_ver, lmp->version);
     return;
   }
-  // per-atom history of the MUSEN styles (created by them, not by input scripts)
-  add(reg, lmp, handle, "fix", "MUSEN/HISTORY", "per-atom contact/bond history of fibrelmp styles",
-      nullptr, (lammpsplugin_factory2 *) &fix_musen_history_creator);
-#ifdef HAVE_PAIR_MUSEN_HM
-  add(reg, lmp, handle, "pair", "musen/hm", "MUSEN Hertz-Mindlin particle-particle contact",
-      (lammpsplugin_factory1 *) &pair_musen_hm_creator, nullptr);
-#endif
-#ifdef HAVE_PAIR_MUSEN_LINEAR
-  add(reg, lmp, handle, "pair", "musen/linear", "MUSEN linear elastic particle-particle contact",
-      (lammpsplugin_factory1 *) &pair_musen_linear_creator, nullptr);
-#endif
-#ifdef HAVE_BOND_MUSEN_ELASTIC
-  add(reg, lmp, handle, "bond", "musen/elastic", "MUSEN elastic/Kelvin solid bond with breakage",
-      (lammpsplugin_factory1 *) &bond_musen_elastic_creator, nullptr);
-#endif
-#ifdef HAVE_FIX_MUSEN_WALL_MESH
-  add(reg, lmp, handle, "fix", "musen/wall/mesh", "MUSEN particle-wall contact with triangle walls",
-      nullptr, (lammpsplugin_factory2 *) &fix_musen_wall_mesh_creator);
-#endif
-#ifdef HAVE_ANGLE_FIBRENET
-  add(reg, lmp, handle, "angle", "fibrenet", "FibreNet bending law",
-      (lammpsplugin_factory1 *) &angle_fibrenet_creator, nullptr);
-#endif
-#ifdef HAVE_FIX_FIBRENET_OUTPUT
-  add(reg, lmp, handle, "fix", "fibrenet/output", "FibreNet xyz/res output written by LAMMPS",
-      nullptr, (lammpsplugin_factory2 *) &fix_fibrenet_output_creator);
-  // the command that makes fix fibrenet/output write a frame (where the script says)
-  add(reg, lmp, handle, "command", "fibrenet/frame", "write a frame of fix fibrenet/output",
-      (lammpsplugin_factory1 *) &fibrenet_frame_creator, nullptr);
-#endif
+  // every style compiled in registered itself (style_registry.h); the FIBRELMP_CORE_ONLY build
+  // of the version-check tests compiles only this file and fix_musen_history.cpp
+  for (const style_registry::Style &style : style_registry::sorted()) {
+    lammpsplugin_t plugin;
+    plugin.version = lmp->version;    // checked above, not by the string
+    plugin.style = style.kind;
+    plugin.name = style.name;
+    plugin.info = style.info;
+    plugin.author = "fibrelmp developers";
+    if (style.v1)
+      plugin.creator.v1 = style.v1;
+    else
+      plugin.creator.v2 = style.v2;
+    plugin.handle = handle;
+    (*reg)(&plugin, lmp);
+  }
 }

@@ -302,5 +302,5 @@ void *AngleFibreNet::extract(const char *str, int &dim)
 namespace {
 Angle *create(LAMMPS *lmp) { return new AngleFibreNet(lmp); }
 const style_registry::Registration registered(
-    60, "angle", "fibrenet", "FibreNet bending law", &create);
+    60, "fibrenet", "FibreNet bending law", &create);
 }    // namespace

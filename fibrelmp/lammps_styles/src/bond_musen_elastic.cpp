@@ -797,5 +797,5 @@ double BondMusenElastic::memory_usage()
 namespace {
 Bond *create(LAMMPS *lmp) { return new BondMusenElastic(lmp); }
 const style_registry::Registration registered(
-    40, "bond", "musen/elastic", "MUSEN elastic/Kelvin solid bond with breakage", &create);
+    40, "musen/elastic", "MUSEN elastic/Kelvin solid bond with breakage", &create);
 }    // namespace

@@ -609,10 +609,8 @@ Fix *create_fix(LAMMPS *lmp, int narg, char **arg)
   return new FixFibreNetOutput(lmp, narg, arg);
 }
 Command *create_frame(LAMMPS *lmp) { return new FibreNetFrame(lmp); }
-const style_registry::Registration registered_fix(70, "fix", "fibrenet/output",
-                                                  "FibreNet xyz/res output written by LAMMPS",
-                                                  &create_fix);
-const style_registry::Registration registered_frame(80, "command", "fibrenet/frame",
-                                                    "write a frame of fix fibrenet/output",
-                                                    &create_frame);
+const style_registry::Registration registered_fix(
+    70, "fibrenet/output", "FibreNet xyz/res output written by LAMMPS", &create_fix);
+const style_registry::Registration registered_frame(
+    80, "fibrenet/frame", "write a frame of fix fibrenet/output", &create_frame);
 }    // namespace

@@ -233,5 +233,5 @@ Fix *create(LAMMPS *lmp, int narg, char **arg)
   return new FixMusenHistory(lmp, narg, arg);
 }
 const style_registry::Registration registered(
-    10, "fix", "MUSEN/HISTORY", "per-atom contact/bond history of fibrelmp styles", &create);
+    10, "MUSEN/HISTORY", "per-atom contact/bond history of fibrelmp styles", &create);
 }    // namespace

@@ -1094,5 +1094,5 @@ Fix *create(LAMMPS *lmp, int narg, char **arg)
   return new FixMusenWallMesh(lmp, narg, arg);
 }
 const style_registry::Registration registered(
-    50, "fix", "musen/wall/mesh", "MUSEN particle-wall contact with triangle walls", &create);
+    50, "musen/wall/mesh", "MUSEN particle-wall contact with triangle walls", &create);
 }    // namespace

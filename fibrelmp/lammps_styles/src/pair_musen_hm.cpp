@@ -545,5 +545,5 @@ double PairMusenHM::memory_usage()
 namespace {
 Pair *create(LAMMPS *lmp) { return new PairMusenHM(lmp); }
 const style_registry::Registration registered(
-    20, "pair", "musen/hm", "MUSEN Hertz-Mindlin particle-particle contact", &create);
+    20, "musen/hm", "MUSEN Hertz-Mindlin particle-particle contact", &create);
 }    // namespace

@@ -56,5 +56,5 @@ void PairMusenLinear::read_restart_settings(FILE *fp)
 namespace {
 Pair *create(LAMMPS *lmp) { return new PairMusenLinear(lmp); }
 const style_registry::Registration registered(
-    30, "pair", "musen/linear", "MUSEN linear elastic particle-particle contact", &create);
+    30, "musen/linear", "MUSEN linear elastic particle-particle contact", &create);
 }    // namespace

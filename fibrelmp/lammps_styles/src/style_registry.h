@@ -7,7 +7,7 @@
      namespace {
      Pair *create(LAMMPS *lmp) { return new PairMusenHM(lmp); }
      const style_registry::Registration registered(
-         20, "pair", "musen/hm", "MUSEN Hertz-Mindlin particle-particle contact", &create);
+         20, "musen/hm", "MUSEN Hertz-Mindlin particle-particle contact", &create);
      }
 
    lammpsplugin_init (plugin.cpp) hands the list to LAMMPS sorted by the first number (then
@@ -45,34 +45,28 @@ struct Style {
 void add(const Style &style);
 std::vector<Style> sorted();    // the registered styles in registration order
 
+// the LAMMPS plugin style of a creator's base class: the kind follows from the creator's
+// type, so a registration cannot name one kind and create another
+template <class Base> constexpr const char *kind_of() = delete;
+template <> constexpr const char *kind_of<Pair>() { return "pair"; }
+template <> constexpr const char *kind_of<Bond>() { return "bond"; }
+template <> constexpr const char *kind_of<Angle>() { return "angle"; }
+template <> constexpr const char *kind_of<Command>() { return "command"; }
+
 // a style's static registration object; the creators return the LAMMPS base class, as
-// LAMMPS's plugin loader casts them back to exactly these signatures
+// LAMMPS's plugin loader casts them back to exactly these signatures (a base without a
+// kind_of does not compile)
 class Registration {
  public:
-  Registration(int order, const char *kind, const char *name, const char *info,
-               Pair *(*create)(LAMMPS *))
+  template <class Base>
+  Registration(int order, const char *name, const char *info, Base *(*create)(LAMMPS *))
   {
-    add({order, kind, name, info, (lammpsplugin_factory1 *) create, nullptr});
+    add({order, kind_of<Base>(), name, info, (lammpsplugin_factory1 *) create, nullptr});
   }
-  Registration(int order, const char *kind, const char *name, const char *info,
-               Bond *(*create)(LAMMPS *))
-  {
-    add({order, kind, name, info, (lammpsplugin_factory1 *) create, nullptr});
-  }
-  Registration(int order, const char *kind, const char *name, const char *info,
-               Angle *(*create)(LAMMPS *))
-  {
-    add({order, kind, name, info, (lammpsplugin_factory1 *) create, nullptr});
-  }
-  Registration(int order, const char *kind, const char *name, const char *info,
-               Command *(*create)(LAMMPS *))
-  {
-    add({order, kind, name, info, (lammpsplugin_factory1 *) create, nullptr});
-  }
-  Registration(int order, const char *kind, const char *name, const char *info,
+  Registration(int order, const char *name, const char *info,
                Fix *(*create)(LAMMPS *, int, char **))
   {
-    add({order, kind, name, info, nullptr, (lammpsplugin_factory2 *) create});
+    add({order, "fix", name, info, nullptr, (lammpsplugin_factory2 *) create});
   }
 };
 

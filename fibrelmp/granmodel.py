@@ -144,6 +144,19 @@ class MotionInterval:
 
 
 @dataclass
+class ForceInterval:
+    """Force-dependent rigid motion (MUSEN 26 types 2 and 3, ``GeometryMotion.h``
+    SForceMotionInterval): the geometry moves with ``velocity`` until the z component of the
+    total force on its walls passes ``limit`` (above it when ``limit_max``, else below it)."""
+
+    limit: float
+    limit_max: bool
+    velocity: np.ndarray           # (3,)
+    centre: np.ndarray             # (3,)
+    angular_velocity: np.ndarray   # (3,)
+
+
+@dataclass
 class Geometry:
     """A named group of triangles that moves as one body (MUSEN 25/26/27)."""
 
@@ -156,6 +169,7 @@ class Geometry:
     motion: list[MotionInterval]
     triangle_rows: np.ndarray                # (k,) rows into GranularModel.triangles
     raw_lines: list[str] = field(default_factory=list)  # 25/26/27 lines as read, for write-back
+    force_motion: list[ForceInterval] = field(default_factory=list)   # motion types 2 and 3
 
 
 @dataclass

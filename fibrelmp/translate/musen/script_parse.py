@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from fibrelmp.errors import InputError
-from fibrelmp.granmodel import MotionInterval
+from fibrelmp.granmodel import ForceInterval, MotionInterval
 from fibrelmp.translate.granular import models as physics
 from fibrelmp.translate.musen.text_writer import EXPORT_FLAGS, all_on
 from fibrelmp.textio import read_text
@@ -118,7 +118,7 @@ class MusenJob:
     material_properties: list[tuple[int, str, float, int]] = field(default_factory=list)
     interaction_properties: list[tuple[int, str, str, float, int]] = field(default_factory=list)
     geometry_motion_time: list[tuple[str, MotionInterval, int]] = field(default_factory=list)
-    geometry_motion_force: list[tuple[str, int]] = field(default_factory=list)
+    geometry_motion_force: list[tuple[str, ForceInterval, int]] = field(default_factory=list)
     text_export: dict[str, dict[str, bool]] = field(default_factory=all_on)
     precision: int = 6
     time_interval: tuple[float, float] | None = None
@@ -384,7 +384,14 @@ def _motion_time(job: MusenJob, line: _Line) -> None:
 
 
 def _motion_force(job: MusenJob, line: _Line) -> None:
-    job.geometry_motion_force.append((line.tok[0] if line.tok else "", line.ln))
+    if len(line.tok) < 3:
+        raise line.error("needs GEOMETRY FORCE_LIMIT MIN|MAX vx vy vz wx wy wz cx cy cz")
+    limit = _Line(line.path, line.ln, line.key, line.tok[1]).floats(1)[0]
+    # ScriptAnalyzer: "MIN" is MIN, any other word MAX
+    v = _Line(line.path, line.ln, line.key, " ".join(line.tok[3:])).floats(9)
+    # script order: velocity, rotation velocity, rotation centre (the text file has v, c, w)
+    job.geometry_motion_force.append((line.tok[0], ForceInterval(
+        limit, line.tok[2].upper() != "MIN", np.array(v[0:3]), np.array(v[6:9]), np.array(v[3:6])), line.ln))
 
 
 def _set(attr: str):

@@ -201,14 +201,18 @@ def _apply_motion(model: GranularModel, job: MusenJob) -> None:
     for name, interval, ln in job.geometry_motion_time:
         g = geometry(name, ln)
         if id(g) not in cleared:
-            g.motion, g.motion_type = [], 1
+            g.motion, g.force_motion, g.motion_type = [], [], 1
             g.raw_lines = [r for r in g.raw_lines if not r.startswith("26")]
             cleared.add(id(g))
         g.motion.append(interval)
-    for name, ln in job.geometry_motion_force:
-        geometry(name, ln)
-        raise InputError(job.path, ln, "GEOMETRY_MOTION_FORCE: force-dependent geometry motion "
-                         "is not supported")
+    # ConsoleSimulator: the force intervals replace the motion of the geometries they name
+    cleared = set()
+    for name, interval, ln in job.geometry_motion_force:
+        g = geometry(name, ln)
+        if id(g) not in cleared:
+            g.motion, g.force_motion, g.motion_type = [], [], 2
+            cleared.add(id(g))
+        g.force_motion.append(interval)
 
 
 def _check_models(model: GranularModel, job: MusenJob, models: dict) -> None:

@@ -195,6 +195,11 @@ class MdemResultWriter(MusenResultWriter):
                 motion.Clear()
                 set_motion(motion, 1, [(iv.t_begin, iv.t_end, iv.velocity, iv.centre,
                                         iv.angular_velocity) for iv in g.motion])
+            elif g.motion_type in (2, 3):       # a script's GEOMETRY_MOTION_FORCE included
+                motion = geo.base_geometry.motion
+                motion.Clear()
+                set_motion(motion, g.motion_type, [(iv.limit, int(iv.limit_max), iv.velocity, iv.centre,
+                                                    iv.angular_velocity) for iv in g.force_motion])
 
     def _set_settings(self, storage: Any) -> None:
         m, plan = self.model, self.model.plan

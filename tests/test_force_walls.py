@@ -154,3 +154,62 @@ def test_saved_wall_force_is_the_previous_steps(tmp_path):
     steps = np.rint(theirs.times / DT).astype(int)[1:len(theirs.times) - 1]
     np.testing.assert_allclose(ours.fields[FORCE][steps - 1, 6, 2], force[1:len(steps) + 1],
                                rtol=0, atol=1e-12 * np.max(np.abs(force)))
+
+
+def _result_bytes(folder: Path) -> bytes:
+    return (folder / "press_result_prec17.txt").read_bytes()
+
+
+def test_checkpoint_and_resume_give_the_uninterrupted_run(tmp_path, monkeypatch):
+    """The stepped state (interval, velocities, vertices) goes through LAMMPS's restart file:
+    a run stopped after a checkpoint taken while the plate presses, then resumed, writes the
+    uninterrupted run's result byte for byte."""
+    import signal
+
+    from fibrelmp import checkpoint
+    styles_or_skip()
+    (tmp_path / "whole").mkdir()
+    _run(tmp_path / "whole", "press")
+    cut = tmp_path / "cut"
+    cut.mkdir()
+    write = checkpoint.Checkpointing.write
+
+    def write_then_stop(self, *args, **kwargs):
+        write(self, *args, **kwargs)
+        self._stop = signal.SIGTERM          # as if SIGTERM came: stop after this checkpoint
+    monkeypatch.setattr(checkpoint.Checkpointing, "write", write_then_stop)
+    shutil.copy(DATA / "press_scene.txt", cut)
+    shutil.copy(DATA / "job_press.txt", cut)
+    with pytest.raises(checkpoint.CheckpointStop):
+        python_api.run(cut / "job_press.txt", work=cut / "work", checkpoint_every=2290)
+    monkeypatch.setattr(checkpoint.Checkpointing, "write", write)
+    python_api.run(cut / "job_press.txt", work=cut / "work", resume=True)
+    assert _result_bytes(cut) == _result_bytes(tmp_path / "whole")
+
+
+def test_free_lid_starts_with_its_walls_velocity(tmp_path):
+    """Analytic (numpy) reference of MUSEN's MoveWalls rule for a free geometry without
+    contacts: v_k = mean wall velocity + dt (g m) / m, then x += v_k dt, once for the
+    prediction and once per step; the lid's walls start at 0.01 m/s upwards (their `15`)."""
+    styles_or_skip()
+    scene = (DATA / "free_scene.txt").read_text().splitlines()
+    for i in (5, 6):      # the lid's two triangles (lines 6 and 7): stored velocity 0.01 m/s up
+        assert scene[i].startswith(f"0 {i} 1 14 ") and scene[i].endswith("15 0 0 0")
+        scene[i] = scene[i][:-len("15 0 0 0")] + "15 0 0 0.01"
+    (tmp_path / "free_scene.txt").write_text("\n".join(scene) + "\n")
+    job = (DATA / "job_free.txt").read_text().replace("END_TIME             1.2e-3", "END_TIME 1e-4")
+    (tmp_path / "job_free.txt").write_text(job)
+    python_api.run(tmp_path / "job_free.txt", work=tmp_path / "work")
+    ours = read_time_points(tmp_path / "free_result_prec17.txt")
+    g, mass, z0 = -100.0, 0.002, 0.002005
+    vz, z, expect_z, expect_v = 0.01, z0, {0: z0}, {0: 0.01}
+    for k in range(501):        # k = 0: the prediction update
+        vz = (vz / 2 + vz / 2) + DT * (g * mass) / mass     # mean of the two walls' velocities
+        z += vz * DT
+        expect_z[k + 1], expect_v[k + 1] = z, vz
+    steps = np.rint(ours.times / DT).astype(int)
+    want_z = [expect_z[s + 1] if s else z0 for s in steps]    # walls one update ahead
+    want_v = [expect_v[s + 1] if s else 0.01 for s in steps]
+    np.testing.assert_allclose(ours.fields[WALL][:, 5, 2], want_z, rtol=0, atol=1e-18)
+    np.testing.assert_allclose(ours.fields[VEL][:, 5, 2], want_v, rtol=0, atol=1e-17)
+    assert ours.fields[VEL][-1, 5, 2] < 0.01 - 0.009      # gravity slowed it

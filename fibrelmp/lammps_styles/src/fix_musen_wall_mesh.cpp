@@ -417,6 +417,10 @@ void FixMusenWallMesh::parse(const std::string &text)
       for (int k = 0; k < 3; k++) G.free_axis[k] = in.integer("free-motion flag", 0, 1) != 0;
       G.mass = in.finite("geometry mass");
     }
+    if (G.stepped && in.next_is("velocity")) {
+      in.expect("velocity");
+      for (int k = 0; k < 3; k++) G.start_vel[k] = in.finite("start velocity");
+    }
     if (G.stepped) {
       if (!G.segments.empty())
         error->all(FLERR, "Fix musen/wall/mesh: {}: geometry {}: a stepped geometry has no segments", file, G.name);
@@ -426,7 +430,8 @@ void FixMusenWallMesh::parse(const std::string &text)
       any_stepped = true;
     }
     if (!G.segments.empty() || G.stepped) any_moving = true;
-    for (int k = 0; k < 3; k++) G.vel[k] = G.rotvel[k] = G.rotcentre[k] = 0.0;
+    for (int k = 0; k < 3; k++) G.rotvel[k] = G.rotcentre[k] = 0.0;
+    for (int k = 0; k < 3; k++) G.vel[k] = G.start_vel[k];    // MUSEN: the walls' stored velocity
   }
   if (in.next_is("gravity")) {
     in.expect("gravity");
@@ -1106,10 +1111,9 @@ int FixMusenWallMesh::modify_param(int narg, char **arg)
                 ftri_all[3 * (size_t) t + 1], ftri_all[3 * (size_t) t + 2]);
         if (any_stepped) {
           // before the first time step MUSEN's frame precedes its prediction update: the
-          // walls where they started, still
+          // walls where and as they started
           const bool first = ftri_step < 0 && !start_vert.empty();
-          const double still[3] = {0, 0, 0};
-          const double *gv = first ? still : geoms[tgeom[t]].vel;
+          const double *gv = first ? geoms[tgeom[t]].start_vel : geoms[tgeom[t]].vel;
           const double *p = first ? &start_vert[9 * (size_t) t] : &vert[9 * (size_t) t];
           fprintf(fp, " %.17g %.17g %.17g", gv[0], gv[1], gv[2]);
           for (int k = 0; k < 9; k++) fprintf(fp, " %.17g", p[k]);

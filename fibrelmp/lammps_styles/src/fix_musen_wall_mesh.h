@@ -63,6 +63,7 @@
                                      (MAX 1: the interval ends when the force exceeds LIMIT, 0: when
                                      it falls below; rotation velocities must be 0)
        optional:    free FX FY FZ MASS   (free axes 0/1 and the geometry's mass)
+       optional:    velocity vx vy vz    (a stepped geometry's walls' velocity at the start)
      gravity gx gy gz            (optional: the external acceleration a free geometry feels)
      triangles T                 then T lines:  GEOMETRY MATERIAL x1 y1 z1 x2 y2 z2 x3 y3 z3
    TYPE is a LAMMPS atom type, MATERIAL any integer >= 0 (a wall material), GEOMETRY the
@@ -149,6 +150,7 @@ class FixMusenWallMesh : public Fix {
     double cur_v[3] = {0, 0, 0}, cur_w[3] = {0, 0, 0}, cur_c[3] = {0, 0, 0};   // m_currentMotion
     bool free_axis[3] = {false, false, false};
     double mass = 0.0;
+    double start_vel[3] = {0, 0, 0};   // its walls' velocity at the start (the scene's)
     // the wall motion MUSEN's contact law sees now
     double vel[3], rotvel[3], rotcentre[3];
   };

@@ -83,7 +83,7 @@ def mesh_text(model: GranularModel, wall_plans, spheres) -> str:
     out.append(f"geometries {len(plans)}")
     for wp in plans:
         if wp.stepped is not None:
-            out += _stepped_lines(wp)
+            out += _stepped_lines(wp, tris)
             continue
         kin = wp.kinematics
         out.append(f"geometry {_words(wp.name)} {int(kin.around_centre)} {len(kin.segments)} "
@@ -105,7 +105,7 @@ def mesh_text(model: GranularModel, wall_plans, spheres) -> str:
     return "\n".join(out) + "\n"
 
 
-def _stepped_lines(wp) -> list[str]:
+def _stepped_lines(wp, tris) -> list[str]:
     """A geometry the fix moves step by step: MUSEN's intervals as they are (time intervals
     in MUSEN's order, force intervals), its free axes and mass."""
     g = wp.stepped
@@ -123,6 +123,9 @@ def _stepped_lines(wp) -> list[str]:
             out.append(f"fint {_num(f.limit)} {int(f.limit_max)} " + " ".join(_num(v) for v in vals))
     if any(g.free) and g.mass != 0:
         out.append("free " + " ".join(str(int(bool(x))) for x in g.free) + f" {_num(g.mass)}")
+    rows = np.asarray(wp.triangle_rows, np.int64)
+    if len(rows) and np.any(tris.velocity[rows[0]] != 0):    # one velocity (walls.py checks)
+        out.append("velocity " + " ".join(_num(v) for v in tris.velocity[rows[0]]))
     return out
 
 

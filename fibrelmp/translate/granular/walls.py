@@ -68,7 +68,7 @@ def plan_walls(model: GranularModel, dt: float, t_end: float, mesh: bool | None 
         v = tris.vertices[rows]
         stepped = geom is not None and is_stepped(geom)
         if geom is not None:
-            _check_motion(model, geom, mesh)
+            _check_motion(model, geom, mesh, rows)
             kin = stepped_kinematics(geom) if stepped else geometry_kinematics(geom, v, t0, t_end)
         else:
             kin = Kinematics()
@@ -142,7 +142,7 @@ def stepped_kinematics(geom: Geometry) -> Kinematics:
     return Kinematics(intervals=[(-math.inf, math.inf, np.asarray(v, float)) for v in vels])
 
 
-def _check_motion(model: GranularModel, geom: Geometry, mesh: bool) -> None:
+def _check_motion(model: GranularModel, geom: Geometry, mesh: bool, rows: np.ndarray) -> None:
     if geom.motion_type not in (0, 1, 2, 3):
         raise InputError(model.source, None, f"geometry '{geom.name}': unknown motion type "
                          f"{geom.motion_type}")
@@ -161,6 +161,11 @@ def _check_motion(model: GranularModel, geom: Geometry, mesh: bool) -> None:
     if rotating:
         raise InputError(model.source, None, f"geometry '{geom.name}': rotation in {what} "
                          "geometry motion is not supported (only translation)")
+    vel = model.triangles.velocity[np.asarray(rows, np.int64)]
+    if len(vel) and np.any(vel != vel[:1]):
+        # MUSEN starts each wall from its own stored velocity; fibrelmp's geometry has one
+        raise InputError(model.source, None, f"geometry '{geom.name}': its walls start with "
+                         f"different velocities; {what} motion needs one velocity per geometry")
 
 
 def describe_walls(model: GranularModel) -> list[str]:

@@ -213,3 +213,15 @@ def test_free_lid_starts_with_its_walls_velocity(tmp_path):
     np.testing.assert_allclose(ours.fields[WALL][:, 5, 2], want_z, rtol=0, atol=1e-18)
     np.testing.assert_allclose(ours.fields[VEL][:, 5, 2], want_v, rtol=0, atol=1e-17)
     assert ours.fields[VEL][-1, 5, 2] < 0.01 - 0.009      # gravity slowed it
+
+
+def test_mdem_scene_keeps_the_force_intervals(tmp_path):
+    """A `.mdem` scene (MUSEN's text import of the press scene) runs with the same force-
+    dependent motion as the text scene: its motion message read back field by field."""
+    from fibrelmp.translate.musen.mdem.model import read_scene
+    python_api.convert_file(DATA / "press_scene.txt", tmp_path / "press.mdem")
+    press = read_scene(tmp_path / "press.mdem").geometries[1]
+    text = read(DATA / "press_scene.txt").geometries[1]
+    assert press.motion_type == text.motion_type == 2
+    assert [(f.limit, f.limit_max, list(f.velocity)) for f in press.force_motion] == \
+        [(f.limit, f.limit_max, list(f.velocity)) for f in text.force_motion]

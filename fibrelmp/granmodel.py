@@ -195,6 +195,7 @@ class GranularPlan:
     bond_breakage: int = 1                  # MUSEN CONSIDER_BREAKAGE: 0 none, 1 combined, 2 separate
     bond_law: SolidBondLaw = field(default_factory=SolidBondLaw)   # the solid bonds' law
     contacts_between_bonded: bool = True    # MUSEN default
+    velocity_limit: float | None = None     # MUSEN's particle velocity limit (m/s; None: none)
     # the particle-particle law's contact duration (m*, R*, E*, approach speed) when it is not
     # Hertz's (set by its model in translate/granular/models; None: Hertz)
     pp_contact_time: Callable[[float, float, float, float], float] | None = None

@@ -263,7 +263,11 @@ def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> 
         parts.warnings.append(("approximate MUSEN physics (particle-particle contact)", STOCK_PAIR_WARNING))
     geometry, styles = parts.geometry, parts.styles
     # the plugin is loaded only for a style of its own (a DEMDF job uses stock styles only)
-    uses_plugin = bool(styles.path) and (parts.musen_hm or geometry is not None or len(parts.mesh) > 0)
+    if plan.velocity_limit is not None and not styles.path:
+        raise InputError(model.source, None, "a particle velocity limit needs fibrelmp's LAMMPS "
+                         "styles (fix musen/velocity/limit)")
+    uses_plugin = bool(styles.path) and (parts.musen_hm or geometry is not None or len(parts.mesh) > 0
+                                         or plan.velocity_limit is not None)
     return template_environment().get_template("granular.lammps.j2").render(
         model=model, plugin=lammps_path(styles.path, "plugin") if uses_plugin else None,
         packages=granular_packages(uses_plugin, parts.wall_cmds),
@@ -289,6 +293,6 @@ def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> 
         lost=bool(parts.axes.removal_axes.any()),
         walls=[(wp.name, wp.description) for wp in parts.wall_plans],
         mesh_fix=MESH_FIX if len(parts.mesh) else None, mesh_forces_name=MESH_FORCES_NAME,
-        contacts_name=CONTACTS_NAME,
+        contacts_name=CONTACTS_NAME, velocity_limit=plan.velocity_limit,
         thermo_every=min(saves.period or 0, 2 ** 31 - 1),      # thermo N is a C int
     )

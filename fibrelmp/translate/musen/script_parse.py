@@ -115,6 +115,7 @@ class MusenJob:
     contact_radius: bool | None = None
     reset_bonds: bool | None = None
     variable_time_step: bool | None = None
+    velocity_limit: float | None = None      # LIMIT_PARTICLE_VELOCITY (<= 0: no limit)
     material_properties: list[tuple[int, str, float, int]] = field(default_factory=list)
     interaction_properties: list[tuple[int, str, str, float, int]] = field(default_factory=list)
     geometry_motion_time: list[tuple[str, MotionInterval, int]] = field(default_factory=list)
@@ -320,6 +321,11 @@ def _variable_step(job: MusenJob, line: _Line) -> None:
         job.refused.append((line.key, line.ln, "a variable time step is not supported"))
 
 
+def _velocity_limit(job: MusenJob, line: _Line) -> None:
+    # cmusen: a value <= 0 removes the limit (CBaseSimulator::SetPartVelocityLimit)
+    job.velocity_limit = line.floats(1)[0]
+
+
 def _stop(job: MusenJob, line: _Line) -> None:
     value = line.tok[0].upper() if line.tok else ""
     if value == "BROKEN_BONDS":
@@ -423,7 +429,7 @@ _HANDLERS = {
     "EXT_ACCEL": _tuple("ext_accel", 3), "SIMULATION_DOMAIN": _tuple("simulation_domain", 6),
     "PBC_FLAGS": _pbc_flags, "PBC_DOMAIN": _tuple("pbc_domain", 6),
     "VARIABLE_TIME_STEP": _variable_step, "STOP_CRITERION": _stop,
-    "LIMIT_PARTICLE_VELOCITY": _refuse("limiting particle velocities is not supported"),
+    "LIMIT_PARTICLE_VELOCITY": _velocity_limit,
     "MATERIAL_PROPERTY": _material_property, "INTERACTION_PROPERTY": _interaction_property,
     "TEXT_EXPORT_PRECISION": _precision, "TIME_INTERVAL": _time_interval,
     "GEOMETRY_MOTION_TIME": _motion_time, "GEOMETRY_MOTION_FORCE": _motion_force,

@@ -127,6 +127,11 @@ def apply_simulator_settings(model: GranularModel, job: MusenJob) -> None:
                                         job.where(f"MODEL_{kind}_PARAMS"))
     if job.connected_pp_contact is not None:
         plan.contacts_between_bonded = job.connected_pp_contact
+    if job.velocity_limit is not None:
+        plan.velocity_limit = job.velocity_limit if job.velocity_limit > 0 else None
+        if plan.velocity_limit is not None and not lammps_styles.plugin().available:
+            raise InputError(job.path, job.where("LIMIT_PARTICLE_VELOCITY"), "LIMIT_PARTICLE_VELOCITY "
+                             "needs fibrelmp's LAMMPS styles (fix musen/velocity/limit)")
     _apply_times(model, job)
 
 

@@ -54,6 +54,8 @@ def _settings(model: GranularModel, modules) -> None:
         plan.save_every_time = sim.saving_step
     if sim.end_time > 0:
         plan.t_end = sim.end_time
+    if sim.part_velocity_limit > 0:        # MUSEN: 0 (the default) is no limit
+        plan.velocity_limit = sim.part_velocity_limit
     if modules.HasField("simulator"):
         g = sim.external_acceleration
         plan.gravity = np.array([g.x, g.y, g.z])

@@ -213,6 +213,7 @@ class MdemResultWriter(MusenResultWriter):
         sim.external_acceleration.x, sim.external_acceleration.y, sim.external_acceleration.z = \
             (float(g) for g in plan.gravity)
         sim.simulator_type = sim.simulator_type or 1           # CPU
+        sim.part_velocity_limit = plan.velocity_limit or 0.0   # as MUSEN saves it (0: none)
         models = m.models
         if models:
             manager = storage.modules_data.model_manager

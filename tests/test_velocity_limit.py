@@ -91,3 +91,52 @@ def test_refused_without_fibrelmps_styles(tmp_path):
 @needs_cmusen
 def test_reference_is_cmusens_output(tmp_path):
     check_reference_is_cmusens_output(tmp_path, DATA, "vlim")
+
+
+FLEX_JOB = """JOB
+SOURCE_FILE ./cmusen_flex_result.mdem
+RESULT_FILE ./again.mdem
+COMPONENT SIMULATOR
+MODEL_PP ModelPPHertzMindlin
+MODEL_PW ModelPWHertzMindlin
+END_TIME 2e-5
+"""
+
+
+def test_mdem_variable_step_and_stop_criterion_are_refused_by_name(tmp_path):
+    """cmusen's .mdem stores VARIABLE_TIME_STEP 1 and STOP_CRITERION BROKEN_BONDS 5: refused
+    with the file and the field's name, nothing written; a job that switches both off runs."""
+    styles_or_skip()
+    shutil.copy(DATA / "cmusen_flex_result.mdem", tmp_path)
+    job = tmp_path / "job.txt"
+    job.write_text(FLEX_JOB)
+    mdem = tmp_path / "cmusen_flex_result.mdem"
+    with pytest.raises(InputError) as err:
+        python_api.run(job, work=tmp_path / "work")
+    assert str(err.value) == f"{mdem}: flexible_time_step: MUSEN's variable time step is not supported"
+    job.write_text(FLEX_JOB + "VARIABLE_TIME_STEP 0\n")
+    with pytest.raises(InputError, match=f"{mdem}: stop_criteria: stopping on a number of broken"):
+        python_api.run(job, work=tmp_path / "work")
+    assert not (tmp_path / "again.mdem").exists()
+    job.write_text(FLEX_JOB + "VARIABLE_TIME_STEP 0\nSTOP_CRITERION NONE\n")
+    python_api.run(job, work=tmp_path / "work")
+    assert (tmp_path / "again.mdem").exists()
+
+
+def test_mdem_moving_periodic_box_is_refused():
+    """A moving periodic box (SPBC::vVel, the .mdem's periodic_conditions_vel) is kept by
+    name for the refusal; cmusen's file with that one field changed."""
+    from fibrelmp.translate.musen.mdem.document import MdemFile
+    from fibrelmp.translate.musen.mdem.model import _refused_settings
+    from fibrelmp.translate.musen.scene_record import scene_record
+
+    model = read_scene(DATA / "cmusen_vlim_result.mdem")
+    with MdemFile(DATA / "cmusen_vlim_result.mdem") as mdem:
+        storage = mdem.storage
+        _refused_settings(model, storage)
+        assert scene_record(model).refused == {}
+        storage.info.periodic_conditions_enabled = True
+        storage.info.periodic_conditions_vel.x = 1e-3
+        _refused_settings(model, storage)
+    assert scene_record(model).refused == {
+        "periodic_conditions_vel": "a moving periodic box is not supported"}

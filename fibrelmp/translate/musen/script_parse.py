@@ -116,6 +116,7 @@ class MusenJob:
     reset_bonds: bool | None = None
     variable_time_step: bool | None = None
     velocity_limit: float | None = None      # LIMIT_PARTICLE_VELOCITY (<= 0: no limit)
+    stop_none: bool = False                  # STOP_CRITERION NONE (replaces a .mdem's criteria)
     material_properties: list[tuple[int, str, float, int]] = field(default_factory=list)
     interaction_properties: list[tuple[int, str, str, float, int]] = field(default_factory=list)
     geometry_motion_time: list[tuple[str, MotionInterval, int]] = field(default_factory=list)
@@ -333,6 +334,8 @@ def _stop(job: MusenJob, line: _Line) -> None:
                             "supported; give END_TIME"))
     elif value != "NONE":
         raise line.error(f"expected NONE or BROKEN_BONDS, got {value!r}")
+    else:
+        job.stop_none = True
 
 
 def _pbc_flags(job: MusenJob, line: _Line) -> None:

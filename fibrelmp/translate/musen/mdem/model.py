@@ -36,6 +36,7 @@ def read_scene(path: str | os.PathLike) -> GranularModel:
             where = f" (its text form, line {exc.line})" if exc.line else ""
             raise InputError(path, None, f"{exc.message}{where}") from None
         _settings(model, mdem.storage.modules_data)
+        _refused_settings(model, mdem.storage)
     model.source = path
     scene_record(model, keep=True).mdem_source = path
     return model
@@ -72,6 +73,19 @@ def _settings(model: GranularModel, modules) -> None:
         specs.append(MusenModelSpec(name=name, params=entry.params, kind=kind, line=0))
     if specs:
         scene_record(model, keep=True).file_models = specs
+
+
+def _refused_settings(model: GranularModel, storage) -> None:
+    """Simulator settings of the file that fibrelmp does not simulate (MUSEN's
+    ``CBaseSimulator::LoadConfiguration``, ``SPBC``): kept by name, refused when simulated."""
+    refused = scene_record(model, keep=True).refused
+    if storage.modules_data.simulator.flexible_time_step:
+        refused["flexible_time_step"] = "MUSEN's variable time step is not supported"
+    if any(t != 0 for t in storage.info.stop_criteria.types):      # 0 NONE, 1 BROKEN_BONDS
+        refused["stop_criteria"] = "stopping on a number of broken bonds is not supported"
+    v = storage.info.periodic_conditions_vel
+    if storage.info.periodic_conditions_enabled and (v.x, v.y, v.z) != (0.0, 0.0, 0.0):
+        refused["periodic_conditions_vel"] = "a moving periodic box is not supported"
 
 
 class MdemReader(Reader):

@@ -192,6 +192,7 @@ class GranularPlan:
     domain: tuple[np.ndarray, np.ndarray] | None = None   # (lo, hi): particles leaving are removed
     periodic: tuple[bool, bool, bool] = (False, False, False)
     periodic_box: tuple[np.ndarray, np.ndarray] | None = None
+    periodic_velocity: np.ndarray | None = None   # MUSEN's moving periodic box: faces move out at v
     bond_breakage: int = 1                  # MUSEN CONSIDER_BREAKAGE: 0 none, 1 combined, 2 separate
     bond_law: SolidBondLaw = field(default_factory=SolidBondLaw)   # the solid bonds' law
     contacts_between_bonded: bool = True    # MUSEN default

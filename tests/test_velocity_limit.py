@@ -123,20 +123,19 @@ def test_mdem_variable_step_and_stop_criterion_are_refused_by_name(tmp_path):
     assert (tmp_path / "again.mdem").exists()
 
 
-def test_mdem_moving_periodic_box_is_refused():
-    """A moving periodic box (SPBC::vVel, the .mdem's periodic_conditions_vel) is kept by
-    name for the refusal; cmusen's file with that one field changed."""
+def test_mdem_moving_periodic_box_is_read():
+    """A moving periodic box (SPBC::vVel, the .mdem's periodic_conditions_vel) is the plan's
+    periodic_velocity (tests/test_moving_pbc.py runs it), not a refused setting."""
     from fibrelmp.translate.musen.mdem.document import MdemFile
     from fibrelmp.translate.musen.mdem.model import _refused_settings
     from fibrelmp.translate.musen.scene_record import scene_record
 
     model = read_scene(DATA / "cmusen_vlim_result.mdem")
+    assert model.plan.periodic_velocity is None
     with MdemFile(DATA / "cmusen_vlim_result.mdem") as mdem:
         storage = mdem.storage
-        _refused_settings(model, storage)
-        assert scene_record(model).refused == {}
         storage.info.periodic_conditions_enabled = True
         storage.info.periodic_conditions_vel.x = 1e-3
         _refused_settings(model, storage)
-    assert scene_record(model).refused == {
-        "periodic_conditions_vel": "a moving periodic box is not supported"}
+    assert scene_record(model).refused == {}
+    assert list(model.plan.periodic_velocity) == [1e-3, 0, 0]

@@ -77,7 +77,8 @@ def _settings(model: GranularModel, modules) -> None:
 
 def _refused_settings(model: GranularModel, storage) -> None:
     """Simulator settings of the file that fibrelmp does not simulate (MUSEN's
-    ``CBaseSimulator::LoadConfiguration``, ``SPBC``): kept by name, refused when simulated."""
+    ``CBaseSimulator::LoadConfiguration``): kept by name, refused when simulated; and the
+    moving periodic box (``SPBC::vVel``), which it does."""
     refused = scene_record(model, keep=True).refused
     if storage.modules_data.simulator.flexible_time_step:
         refused["flexible_time_step"] = "MUSEN's variable time step is not supported"
@@ -85,7 +86,7 @@ def _refused_settings(model: GranularModel, storage) -> None:
         refused["stop_criteria"] = "stopping on a number of broken bonds is not supported"
     v = storage.info.periodic_conditions_vel
     if storage.info.periodic_conditions_enabled and (v.x, v.y, v.z) != (0.0, 0.0, 0.0):
-        refused["periodic_conditions_vel"] = "a moving periodic box is not supported"
+        model.plan.periodic_velocity = np.array([v.x, v.y, v.z])    # fix musen/pbc/move
 
 
 class MdemReader(Reader):

@@ -142,7 +142,7 @@ def test_rotation_in_force_motion_is_refused(tmp_path):
 
 
 @needs_cmusen
-@pytest.mark.parametrize("prefix", ["press", "script", "free", "const"])
+@pytest.mark.parametrize("prefix", ["press", "script", "free", "const", "pack", "packg"])
 def test_reference_is_cmusens_output(tmp_path, prefix):
     check_reference_is_cmusens_output(tmp_path, DATA, prefix)
 
@@ -229,3 +229,26 @@ def test_mdem_scene_keeps_the_force_intervals(tmp_path):
     assert press.motion_type == text.motion_type == 2
     assert [(f.limit, f.limit_max, list(f.velocity)) for f in press.force_motion] == \
         [(f.limit, f.limit_max, list(f.velocity)) for f in text.force_motion]
+
+
+def test_pressed_packing_within_cmusens_spread(tmp_path):
+    """A packing of 48 spheres pressed by the force-controlled plate (chaotic): at every saved
+    time sphere positions and wall vertices within 3 x cmusen's own spread (cmusen rerun with
+    the plate speed x (1 + 1e-8); no gravity here), or 1e-6 of scale where that is larger."""
+    styles_or_skip()
+    ours, theirs = _run(tmp_path, "pack")
+    spread = read_time_points(DATA / "cmusen_packg_result_prec17.txt")
+    n = _same_times(ours, theirs)
+    assert np.max(theirs.fields[VEL][:n, 50, 2]) == 0.02           # it reached 20 N and turned
+    box = 8.4e-3
+
+    def deviation(a, b, periodic):
+        d = a - b
+        if periodic:               # the same sphere, wrapped by the other code one step apart
+            d[..., :2] -= box * np.round(d[..., :2] / box)
+        return np.abs(d).reshape(len(d), -1).max(1)
+    for tag, objects, periodic in ((COORD, slice(0, 48), True), (WALL, slice(48, 52), False)):
+        a, b, c = (tp.fields[tag][:n, objects] for tp in (ours, theirs, spread))
+        scale = np.max(deviation(b, b[:1], periodic))
+        d, s = deviation(a, b, periodic), deviation(c, b, periodic)
+        assert np.all(d <= np.maximum(3 * s, 1e-6 * scale)), (tag, d / scale, s / scale)

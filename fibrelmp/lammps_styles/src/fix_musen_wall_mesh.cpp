@@ -404,8 +404,6 @@ void FixMusenWallMesh::parse(const std::string &text)
         for (int k = 0; k < 3; k++) F.v[k] = in.finite("force interval velocity");
         for (int k = 0; k < 3; k++) F.c[k] = in.finite("force interval rotation centre");
         for (int k = 0; k < 3; k++) F.w[k] = in.finite("force interval rotation velocity");
-        if (!is_zero(F.w))
-          error->all(FLERR, "Fix musen/wall/mesh: {}: geometry {}: rotation in force-dependent motion is not supported", file, G.name);
         G.fints.push_back(F);
       }
       if (G.motion_kind != 1 && G.fints.empty())
@@ -424,9 +422,6 @@ void FixMusenWallMesh::parse(const std::string &text)
     if (G.stepped) {
       if (!G.segments.empty())
         error->all(FLERR, "Fix musen/wall/mesh: {}: geometry {}: a stepped geometry has no segments", file, G.name);
-      for (const auto &I : G.intervals)
-        if (!is_zero(I.w))
-          error->all(FLERR, "Fix musen/wall/mesh: {}: geometry {}: rotation of a free geometry is not supported", file, G.name);
       any_stepped = true;
     }
     if (!G.segments.empty() || G.stepped) any_moving = true;

@@ -61,7 +61,7 @@
        optional:    force KIND NF   (MUSEN's motion type: 1 time, 2 force-dependent, 3 constant
                                      force), then NF lines  fint LIMIT MAX vx vy vz cx cy cz wx wy wz
                                      (MAX 1: the interval ends when the force exceeds LIMIT, 0: when
-                                     it falls below; rotation velocities must be 0)
+                                     it falls below)
        optional:    free FX FY FZ MASS   (free axes 0/1 and the geometry's mass)
        optional:    velocity vx vy vz    (a stepped geometry's walls' velocity at the start)
      gravity gx gy gz            (optional: the external acceleration a free geometry feels)
@@ -219,6 +219,8 @@ class FixMusenWallMesh : public Fix {
   void motion_state(double t);
   void step_walls(double t);
   static void update_motion(Geometry &G, double value);
+  static void rotation_matrix(const double *w, double dt, double R[3][3]);
+  void centroid(const Geometry &G, double *centre) const;
   std::vector<double> stepped_state() const;
   void restore_stepped(const double *list);
   void build_grid(double rmax);

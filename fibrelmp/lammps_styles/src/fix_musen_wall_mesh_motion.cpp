@@ -4,9 +4,9 @@
    fix_musen_wall_mesh.h.
 
    Re-implemented from MUSEN 1.74.2 (BSD-3-Clause, (c) MUSEN Development Team, e0ff360):
-   CGeometryMotion::UpdateMotionInfo (Modules/Geometries/GeometryMotion.cpp) and the
-   translation part of CCPUSimulator::MoveWalls (Modules/Simulator/CPUSimulator.cpp), in
-   MUSEN's order of floating-point operations.
+   CGeometryMotion::UpdateMotionInfo (Modules/Geometries/GeometryMotion.cpp),
+   CCPUSimulator::MoveWalls (Modules/Simulator/CPUSimulator.cpp) and the rotation matrix of
+   CQuaternion (GeneralSources/Quaternion.h), in MUSEN's order of floating-point operations.
 ------------------------------------------------------------------------- */
 
 #include "fix_musen_wall_mesh.h"
@@ -95,6 +95,50 @@ void FixMusenWallMesh::update_motion(Geometry &G, double value)
   }
 }
 
+/* CQuaternion(w dt).ToRotmat(): the quaternion of the Euler angles XYZ w dt
+   (SetFromEulerAnglesXYZ, normalized with q0 >= 0), normalized again, as a matrix */
+void FixMusenWallMesh::rotation_matrix(const double *w, double dt, double R[3][3])
+{
+  const double a[3] = {w[0] * dt, w[1] * dt, w[2] * dt};
+  const double c1 = std::cos(a[2] * 0.5), s1 = std::sin(a[2] * 0.5);
+  const double c2 = std::cos(a[1] * 0.5), s2 = std::sin(a[1] * 0.5);
+  const double c3 = std::cos(a[0] * 0.5), s3 = std::sin(a[0] * 0.5);
+  double q[4] = {c1 * c2 * c3 + s1 * s2 * s3, c1 * c2 * s3 - s1 * s2 * c3,
+                 c1 * s2 * c3 + s1 * c2 * s3, s1 * c2 * c3 - c1 * s2 * s3};
+  for (int pass = 0; pass < 2; pass++) {    // Normalize, in the constructor and in ToRotmat
+    double sum = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    if (q[0] < 0) sum *= -1;
+    for (double &v : q) v /= sum;
+  }
+  const double w1 = q[0] * q[0], w2 = q[1] * q[1], w3 = q[2] * q[2], w4 = q[3] * q[3];
+  const double ij = 2 * q[1] * q[2], ik = 2 * q[1] * q[3], jk = 2 * q[2] * q[3];
+  const double iw = 2 * q[1] * q[0], jw = 2 * q[2] * q[0], kw = 2 * q[3] * q[0];
+  const double M[3][3] = {{w1 + w2 - w3 - w4, ij - kw, jw + ik},
+                          {ij + kw, w1 - w2 + w3 - w4, jk - iw},
+                          {ik - jw, jk + iw, w1 - w2 - w3 + w4}};
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) R[i][j] = M[i][j];
+}
+
+/* the area-weighted centroid of the geometry's triangles now (MoveWalls, RotateAroundCenter) */
+void FixMusenWallMesh::centroid(const Geometry &G, double *centre) const
+{
+  double total_area = 0.0, weighted[3] = {0, 0, 0};
+  for (int tr : G.tris) {
+    const double *p = &vert[9 * (size_t) tr];
+    double u[3], w[3];
+    for (int k = 0; k < 3; k++) {
+      u[k] = p[3 + k] - p[k];
+      w[k] = p[6 + k] - p[k];
+    }
+    const double c[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+    const double area = 0.5 * std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    total_area += area;
+    for (int k = 0; k < 3; k++) weighted[k] += area * ((p[k] + p[3 + k] + p[6 + k]) / 3.);
+  }
+  for (int k = 0; k < 3; k++) centre[k] = total_area != 0.0 ? weighted[k] / total_area : 0.0;
+}
+
 /* CCPUSimulator::MoveWalls for the stepped geometries, from the triangle forces in ftri
    (the last force evaluation's) at MUSEN's time t of that evaluation. */
 void FixMusenWallMesh::step_walls(double t)
@@ -127,17 +171,41 @@ void FixMusenWallMesh::step_walls(double t)
       for (int k = 0; k < 3; k++)
         if (G.free_axis[k]) vel[k] = mean[k] + dt * total[k] / G.mass;
     }
+    double centre[3] = {G.cur_c[0], G.cur_c[1], G.cur_c[2]};
+    if (G.around_centre) centroid(G, centre);
     // no motion: MUSEN leaves the walls and the velocity they carry as they are
     if (zero3(vel) && zero3(G.cur_w)) continue;
     for (int k = 0; k < 3; k++) {
       G.vel[k] = vel[k];
-      G.rotvel[k] = G.cur_w[k];    // 0: rotations are refused when the file is read
-      G.rotcentre[k] = G.cur_c[k];
+      G.rotvel[k] = G.cur_w[k];
+      G.rotcentre[k] = centre[k];
     }
+    double R[3][3];
+    const bool rotates = !zero3(G.cur_w);
+    if (rotates) rotation_matrix(G.cur_w, dt, R);
     for (int tr : G.tris) {
       double *p = &vert[9 * (size_t) tr];
-      for (int a = 0; a < 3; a++)
-        for (int k = 0; k < 3; k++) p[3 * a + k] += vel[k] * dt;
+      // rotate about the centre first, then translate (MoveWalls)
+      if (rotates)
+        for (int a = 0; a < 3; a++) {
+          const double r[3] = {p[3 * a] - centre[0], p[3 * a + 1] - centre[1], p[3 * a + 2] - centre[2]};
+          for (int k = 0; k < 3; k++) p[3 * a + k] = centre[k] + (R[k][0] * r[0] + R[k][1] * r[1] + R[k][2] * r[2]);
+        }
+      if (!zero3(vel))
+        for (int a = 0; a < 3; a++)
+          for (int k = 0; k < 3; k++) p[3 * a + k] += vel[k] * dt;
+      if (rotates) {    // Normalized((v2 - v1) x (v3 - v1))
+        double u[3], w[3], c[3];
+        for (int k = 0; k < 3; k++) {
+          u[k] = p[3 + k] - p[k];
+          w[k] = p[6 + k] - p[k];
+        }
+        c[0] = u[1] * w[2] - u[2] * w[1];
+        c[1] = u[2] * w[0] - u[0] * w[2];
+        c[2] = u[0] * w[1] - u[1] * w[0];
+        const double len = std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+        for (int k = 0; k < 3; k++) nrm[3 * (size_t) tr + k] = len != 0 ? c[k] / len : 0.0;
+      }
       for (int k = 0; k < 3; k++) {
         tlo[3 * (size_t) tr + k] = std::min(std::min(p[k], p[3 + k]), p[6 + k]);
         thi[3 * (size_t) tr + k] = std::max(std::max(p[k], p[3 + k]), p[6 + k]);

@@ -155,12 +155,6 @@ def _check_motion(model: GranularModel, geom: Geometry, mesh: bool, rows: np.nda
     if geom.motion_type in (2, 3) and not geom.force_motion:
         raise InputError(model.source, None, f"geometry '{geom.name}': force-dependent motion "
                          "without intervals (MUSEN refuses it too)")
-    rotating = [iv for iv in geom.force_motion if np.any(np.asarray(iv.angular_velocity) != 0)]
-    if geom.motion_type == 1:
-        rotating += [iv for iv in geom.motion if np.any(np.asarray(iv.angular_velocity) != 0)]
-    if rotating:
-        raise InputError(model.source, None, f"geometry '{geom.name}': rotation in {what} "
-                         "geometry motion is not supported (only translation)")
     vel = model.triangles.velocity[np.asarray(rows, np.int64)]
     if len(vel) and np.any(vel != vel[:1]):
         # MUSEN starts each wall from its own stored velocity; fibrelmp's geometry has one

@@ -144,6 +144,19 @@ class MotionInterval:
 
 
 @dataclass
+class ForceInterval:
+    """Force-dependent rigid motion (MUSEN 26 types 2 and 3, ``GeometryMotion.h``
+    SForceMotionInterval): the geometry moves with ``velocity`` until the z component of the
+    total force on its walls passes ``limit`` (above it when ``limit_max``, else below it)."""
+
+    limit: float
+    limit_max: bool
+    velocity: np.ndarray           # (3,)
+    centre: np.ndarray             # (3,)
+    angular_velocity: np.ndarray   # (3,)
+
+
+@dataclass
 class Geometry:
     """A named group of triangles that moves as one body (MUSEN 25/26/27)."""
 
@@ -156,6 +169,7 @@ class Geometry:
     motion: list[MotionInterval]
     triangle_rows: np.ndarray                # (k,) rows into GranularModel.triangles
     raw_lines: list[str] = field(default_factory=list)  # 25/26/27 lines as read, for write-back
+    force_motion: list[ForceInterval] = field(default_factory=list)   # motion types 2 and 3
 
 
 @dataclass
@@ -178,9 +192,11 @@ class GranularPlan:
     domain: tuple[np.ndarray, np.ndarray] | None = None   # (lo, hi): particles leaving are removed
     periodic: tuple[bool, bool, bool] = (False, False, False)
     periodic_box: tuple[np.ndarray, np.ndarray] | None = None
+    periodic_velocity: np.ndarray | None = None   # MUSEN's moving periodic box: faces move out at v
     bond_breakage: int = 1                  # MUSEN CONSIDER_BREAKAGE: 0 none, 1 combined, 2 separate
     bond_law: SolidBondLaw = field(default_factory=SolidBondLaw)   # the solid bonds' law
     contacts_between_bonded: bool = True    # MUSEN default
+    velocity_limit: float | None = None     # MUSEN's particle velocity limit (m/s; None: none)
     # the particle-particle law's contact duration (m*, R*, E*, approach speed) when it is not
     # Hertz's (set by its model in translate/granular/models; None: Hertz)
     pp_contact_time: Callable[[float, float, float, float], float] | None = None

@@ -16,7 +16,7 @@ import pytest
 
 from fibrelmp import lammps_styles
 from fibrelmp.errors import InputError
-from fibrelmp.granmodel import ContactLaw, hertz_effective
+from fibrelmp.granmodel import ContactLaw, ForceInterval, hertz_effective
 from fibrelmp.post.lammps_dump.reader import iter_frames
 from fibrelmp.translate.granular_job import describe_walls
 from fibrelmp.translate.granular.geometry import (detect_box, detect_cylinder, detect_oriented_box,
@@ -168,7 +168,8 @@ def test_describe_walls_and_motion_errors():
     assert lines[1].startswith("Funnel: tiled with frozen wall particles")
     assert lines[2].startswith("plane 1: plane z = -0.05") and "wall/gran zplane" in lines[2]
     m.geometries[0].motion_type = 2
-    with pytest.raises(InputError, match="force-dependent geometry motion is not supported yet"):
+    m.geometries[0].force_motion = [ForceInterval(1.0, True, np.zeros(3), np.zeros(3), np.zeros(3))]
+    with pytest.raises(InputError, match="force-dependent geometry motion needs fibrelmp's LAMMPS styles"):
         describe_walls(m)
 
 

@@ -90,6 +90,7 @@ ERRORS = [  # (text, line, words in the message)
     (replace_line(2, "0 1.5 1 1 5 0.001 0.001 23 GLASS 2 0 12 0 0 0.01"), 2, "non-negative integer"),
     (replace_line(8, "26 5 0"), 8, "motion type 5"),
     (replace_line(8, "26 1 1 0 1 0 0"), 8, "`26` needs 13 value(s)"),
+    (replace_line(8, "26 2 1 5 7 0 0 0 0 0 0 0 0 0"), 8, "limit type 7"),
     (replace_line(5, "22 1 -1 -1 -1 1 1"), 5, "min < max"),
     (replace_line(2, "0"), 2, "object id"),
 ]
@@ -135,7 +136,6 @@ WARNINGS = [  # (text, warning kind)
     (BASE.replace(" 24 0 1e+300 2 0 12 0 0 0.01", " 2 0 12 0 0 0.01"), "musen-no-activity"),
     (BASE + "0 4 1 13 5 1 2 0.001 0.002 23 GLASS 24 0 1e+300 2 0\n", "musen-liquid-bonds"),
     (BASE.replace("29 0", "") + "29 1\n", "musen-anisotropy"),
-    (replace_line(8, "26 2 1 5 1 0 0 0 0 0 0 0 0 0"), "musen-force-motion"),
     (replace_line(2, "0 1 1 1 5 0.001 0.001 23 GLASS 24 0 1e+300 2 -1 12 0 0 0.01"),
      "musen-time-mismatch"),
 ]
@@ -210,6 +210,9 @@ SCRIPT_ERRORS = [
     ("SIMULATION_STEP -1e-8\n", 1, "positive"),
     ("END_TIME\n", 1, "needs 1 number"),
     ("EXT_ACCEL 0 0\n", 1, "needs 3 number"),
+    ("GEOMETRY_MOTION_FORCE Plate 1 MAX 0 0 1\n", 1, "needs 9 number"),
+    ("GEOMETRY_MOTION_FORCE Plate\n", 1, "needs GEOMETRY FORCE_LIMIT MIN|MAX"),
+    ("LIMIT_PARTICLE_VELOCITY fast\n", 1, "expected a number, got 'fast'"),
     ("MODEL_SB_PARAMS CONSIDER_BREAKAGE 0\n", 1, "no MODEL_SB line before it"),
     ("MODEL_PARAMS ModelSBElastic CONSIDER_BREAKAGE 0\n", 1, "not selected in this job"),
     ("MODEL ModelSBElastic\nMODEL_SB_PARAMS CONSIDER_BREAKAGE 0\n", 2, "no MODEL_SB line before it"),
@@ -257,7 +260,6 @@ APPLY_ERRORS = [  # script, line, words: parsed fine, refused when the job is ap
     (GOOD + "MODEL_LB ModelLBCapilarViscous\n", 7, "liquid-bond model is not supported"),
     (GOOD + "VARIABLE_TIME_STEP 1\n", 7, "variable time step"),
     (GOOD + "STOP_CRITERION BROKEN_BONDS 5\n", 7, "broken bonds"),
-    (GOOD + "LIMIT_PARTICLE_VELOCITY 3\n", 7, "limiting particle velocities"),
     (GOOD + "MATERIAL_PROPERTY DENSITY Glass 3000\n", 7, "material 'Glass' has key GLASS"),
     (GOOD + "MATERIAL_PROPERTY POISSON_RATIO GLASS 0.6\n", 7, "Poisson ratio"),
     (GOOD + "INTERACTION_PROPERTY SLIDING_FRICTION GLASS WOOD 0.1\n", 7, "no material with key 'WOOD'"),
@@ -267,7 +269,7 @@ APPLY_ERRORS = [  # script, line, words: parsed fine, refused when the job is ap
     (GOOD.replace("ModelSBElastic", "ModelSBKelvin") + "MODEL_SB_PARAMS MAX_DAMP_RATIO -1\n", 7,
      "MAX_DAMP_RATIO must be >= 0"),
     (GOOD + "MODEL_SB_PARAMS CONSIDER_BREAKAGE\n", 3, "expected a number"),
-    (GOOD + "GEOMETRY_MOTION_FORCE Plate 1 MAX 0 0 1 0 0 0 0 0 0\n", 7, "force-dependent"),
+    (GOOD + "GEOMETRY_MOTION_FORCE Lid 1 MAX 0 0 1 0 0 0 0 0 0\n", 7, "no geometry 'Lid'"),
     (GOOD + "GEOMETRY_MOTION_TIME Lid 0 1 0 0 1 0 0 0 0 0 0\n", 7, "no geometry 'Lid'"),
     (GOOD + "COMPONENT EXPORT_TO_TEXT\n", 7, "not a SIMULATOR job"),
 ]

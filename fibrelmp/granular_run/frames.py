@@ -254,6 +254,9 @@ class FrameBuilder:
             fm = next(self.mesh).columns
             k = fm["id"].astype(np.int64) - 1
             tforce[self.job.mesh_rows[k]] = np.column_stack([fm["fx"], fm["fy"], fm["fz"]])
+            if "x1" in fm:
+                # geometries the fix moves step by step: where it moved them, their velocity
+                _stepped_walls(self.job, fm, k, verts, tvel)
         if self.tiles is not None:
             ft = next(self.tiles).columns
             ids = ft["id"].astype(np.int64)
@@ -273,3 +276,17 @@ class FrameBuilder:
         for dump in (self.frames, self.bonds, self.tiles, self.mesh):
             if dump is not None:
                 dump.close()
+
+
+def _stepped_walls(job, fm: dict, k: np.ndarray, verts: np.ndarray, tvel: np.ndarray) -> None:
+    """The vertices and velocity fix musen/wall/mesh reports for triangles of stepped
+    geometries (force-dependent or free motion), into the frame's arrays."""
+    rows = job.mesh_rows[k]
+    stepped = np.zeros(len(verts), bool)
+    for wp in job.wall_plans:
+        if wp.stepped is not None:
+            stepped[wp.triangle_rows] = True
+    sel = stepped[rows]
+    cols = [fm[f"{c}{a}"] for a in (1, 2, 3) for c in "xyz"]
+    verts[rows[sel]] = np.column_stack(cols)[sel].reshape(-1, 3, 3)
+    tvel[rows[sel]] = np.column_stack([fm["vx"], fm["vy"], fm["vz"]])[sel]

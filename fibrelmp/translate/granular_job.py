@@ -263,7 +263,12 @@ def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> 
         parts.warnings.append(("approximate MUSEN physics (particle-particle contact)", STOCK_PAIR_WARNING))
     geometry, styles = parts.geometry, parts.styles
     # the plugin is loaded only for a style of its own (a DEMDF job uses stock styles only)
-    uses_plugin = bool(styles.path) and (parts.musen_hm or geometry is not None or len(parts.mesh) > 0)
+    if plan.velocity_limit is not None and not styles.path:
+        raise InputError(model.source, None, "a particle velocity limit needs fibrelmp's LAMMPS "
+                         "styles (fix musen/velocity/limit)")
+    pbc_velocity = _moving_periodic_box(model, parts.axes, styles)
+    uses_plugin = bool(styles.path) and (parts.musen_hm or geometry is not None or len(parts.mesh) > 0
+                                         or plan.velocity_limit is not None or pbc_velocity is not None)
     return template_environment().get_template("granular.lammps.j2").render(
         model=model, plugin=lammps_path(styles.path, "plugin") if uses_plugin else None,
         packages=granular_packages(uses_plugin, parts.wall_cmds),
@@ -289,6 +294,21 @@ def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> 
         lost=bool(parts.axes.removal_axes.any()),
         walls=[(wp.name, wp.description) for wp in parts.wall_plans],
         mesh_fix=MESH_FIX if len(parts.mesh) else None, mesh_forces_name=MESH_FORCES_NAME,
-        contacts_name=CONTACTS_NAME,
+        contacts_name=CONTACTS_NAME, velocity_limit=plan.velocity_limit, pbc_velocity=pbc_velocity,
         thermo_every=min(saves.period or 0, 2 ** 31 - 1),      # thermo N is a C int
     )
+
+
+def _moving_periodic_box(model: GranularModel, axes: BoxAxes, styles) -> np.ndarray | None:
+    """MUSEN's moving periodic box (a .mdem's ``periodic_conditions_vel``) on the job's periodic
+    axes, or None; it needs fibrelmp's ``fix musen/pbc/move``."""
+    v = model.plan.periodic_velocity
+    if v is None:
+        return None
+    v = np.where([b == "p" for b in axes.bnd], np.asarray(v, float), 0.0)
+    if not v.any():
+        return None
+    if not styles.path:
+        raise InputError(model.source, None, "a moving periodic box needs fibrelmp's LAMMPS styles "
+                         "(fix musen/pbc/move)")
+    return v

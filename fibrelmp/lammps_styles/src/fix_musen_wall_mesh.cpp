@@ -189,6 +189,7 @@ struct Tokens {
     if (pos >= tok.size()) fail(what);
     return tok[pos++];
   }
+  bool next_is(const char *kw) const { return pos < tok.size() && tok[pos] == kw; }
   void expect(const char *kw)
   {
     if (pos >= tok.size() || tok[pos] != kw) fail(std::string("expected '") + kw + "'");
@@ -390,8 +391,46 @@ void FixMusenWallMesh::parse(const std::string &text)
         error->all(FLERR, "Fix musen/wall/mesh: {}: geometry {}: motion intervals are not sorted by their start", file, G.name);
       G.intervals.push_back(I);
     }
-    if (!G.segments.empty()) any_moving = true;
-    for (int k = 0; k < 3; k++) G.vel[k] = G.rotvel[k] = G.rotcentre[k] = 0.0;
+    if (in.next_is("force")) {
+      in.expect("force");
+      G.stepped = true;
+      G.motion_kind = static_cast<int>(in.integer("motion type", 1, 3));
+      const long nf = in.integer("number of force intervals", 0, 1L << 30);
+      for (long s = 0; s < nf; s++) {
+        ForceInterval F{};
+        in.expect("fint");
+        F.limit = in.finite("force limit");
+        F.max = in.integer("force limit type (0 MIN, 1 MAX)", 0, 1) != 0;
+        for (int k = 0; k < 3; k++) F.v[k] = in.finite("force interval velocity");
+        for (int k = 0; k < 3; k++) F.c[k] = in.finite("force interval rotation centre");
+        for (int k = 0; k < 3; k++) F.w[k] = in.finite("force interval rotation velocity");
+        G.fints.push_back(F);
+      }
+      if (G.motion_kind != 1 && G.fints.empty())
+        error->all(FLERR, "Fix musen/wall/mesh: {}: geometry {}: force-dependent motion without intervals", file, G.name);
+    }
+    if (in.next_is("free")) {
+      in.expect("free");
+      G.stepped = true;
+      for (int k = 0; k < 3; k++) G.free_axis[k] = in.integer("free-motion flag", 0, 1) != 0;
+      G.mass = in.finite("geometry mass");
+    }
+    if (G.stepped && in.next_is("velocity")) {
+      in.expect("velocity");
+      for (int k = 0; k < 3; k++) G.start_vel[k] = in.finite("start velocity");
+    }
+    if (G.stepped) {
+      if (!G.segments.empty())
+        error->all(FLERR, "Fix musen/wall/mesh: {}: geometry {}: a stepped geometry has no segments", file, G.name);
+      any_stepped = true;
+    }
+    if (!G.segments.empty() || G.stepped) any_moving = true;
+    for (int k = 0; k < 3; k++) G.rotvel[k] = G.rotcentre[k] = 0.0;
+    for (int k = 0; k < 3; k++) G.vel[k] = G.start_vel[k];    // MUSEN: the walls' stored velocity
+  }
+  if (in.next_is("gravity")) {
+    in.expect("gravity");
+    for (int k = 0; k < 3; k++) gravity[k] = in.finite("gravity");
   }
 
   in.expect("triangles");
@@ -518,6 +557,16 @@ void FixMusenWallMesh::init()
 
 void FixMusenWallMesh::setup(int vflag)
 {
+  if (any_stepped && !started) {
+    // MUSEN's half-step prediction iteration: forces at the start positions, then MoveWalls
+    start_vert = vert;    // a frame before the first step shows them here (MUSEN saves first)
+    dry_run = true;
+    post_force(vflag);
+    dry_run = false;
+    step_walls(current_time());
+    started = true;
+  }
+  if (any_stepped && ftri_step != update->ntimestep) pending = true;
   // a set-up at the step of a time step (run 0 after a checkpoint, a resumed run) adds the
   // wall forces to the atoms again but keeps the triangle forces of that step, which an
   // uninterrupted run writes in its next frame
@@ -595,6 +644,7 @@ void FixMusenWallMesh::place(double t)
 void FixMusenWallMesh::motion_state(double t)
 {
   for (auto &G : geoms) {
+    if (G.stepped) continue;    // step_walls keeps its motion
     const Interval *cur = nullptr;
     for (const auto &I : G.intervals)
       if (I.tb <= t && t <= I.te) {
@@ -753,6 +803,11 @@ void FixMusenWallMesh::build_grid(double rmax)
 
 void FixMusenWallMesh::post_force(int /*vflag*/)
 {
+  // a time step first moves the stepped geometries by the previous step's wall forces
+  if (any_stepped && pending && !update->setupflag) {
+    step_walls(current_time() - update->dt);
+    pending = false;
+  }
   const double t = current_time();
   if (any_moving || !placed) place(t);
   motion_state(t);
@@ -907,8 +962,10 @@ void FixMusenWallMesh::post_force(int /*vflag*/)
       double fo[3], to[3];
       wall_force(i, cd, w.xi, dt, fo, to);
       for (int k = 0; k < 3; k++) {
-        f[i][k] += fo[k];
-        torque[i][k] += to[k];
+        if (!dry_run) {
+          f[i][k] += fo[k];
+          torque[i][k] += to[k];
+        }
         ftri[3 * (size_t) cd.tri + k] -= fo[k];
       }
     }
@@ -923,6 +980,7 @@ void FixMusenWallMesh::post_force(int /*vflag*/)
   if (commit) {
     history->sweep(nlocal);
     ftri_step = update->ntimestep;
+    pending = any_stepped;
   }
 }
 
@@ -1041,10 +1099,22 @@ int FixMusenWallMesh::modify_param(int narg, char **arg)
       fmt::print(fp, "ITEM: TIMESTEP\n{}\nITEM: NUMBER OF ATOMS\n{}\nITEM: BOX BOUNDS ff ff ff\n",
                  update->ntimestep, ntri);
       for (int k = 0; k < 3; k++) fmt::print(fp, "{:.17g} {:.17g}\n", domain->boxlo[k], domain->boxhi[k]);
-      fputs("ITEM: ATOMS id fx fy fz\n", fp);
-      for (int t = 0; t < ntri; t++)
-        fprintf(fp, "%d %.17g %.17g %.17g\n", t + 1, ftri_all[3 * (size_t) t],
+      fputs(any_stepped ? "ITEM: ATOMS id fx fy fz vx vy vz x1 y1 z1 x2 y2 z2 x3 y3 z3\n"
+                        : "ITEM: ATOMS id fx fy fz\n", fp);
+      for (int t = 0; t < ntri; t++) {
+        fprintf(fp, "%d %.17g %.17g %.17g", t + 1, ftri_all[3 * (size_t) t],
                 ftri_all[3 * (size_t) t + 1], ftri_all[3 * (size_t) t + 2]);
+        if (any_stepped) {
+          // before the first time step MUSEN's frame precedes its prediction update: the
+          // walls where and as they started
+          const bool first = ftri_step < 0 && !start_vert.empty();
+          const double *gv = first ? geoms[tgeom[t]].start_vel : geoms[tgeom[t]].vel;
+          const double *p = first ? &start_vert[9 * (size_t) t] : &vert[9 * (size_t) t];
+          fprintf(fp, " %.17g %.17g %.17g", gv[0], gv[1], gv[2]);
+          for (int k = 0; k < 9; k++) fprintf(fp, " %.17g", p[k]);
+        }
+        fputc('\n', fp);
+      }
       if (fclose(fp) != 0) ok = 0;
     }
   }
@@ -1064,6 +1134,8 @@ void FixMusenWallMesh::write_restart(FILE *fp)
   list.push_back(static_cast<double>(ftri_step));
   list.push_back(static_cast<double>(ntri));
   list.insert(list.end(), ftri_all.begin(), ftri_all.end());
+  const std::vector<double> state = stepped_state();    // empty without stepped geometries
+  list.insert(list.end(), state.begin(), state.end());
   const int size = static_cast<int>(list.size() * sizeof(double));
   fwrite(&size, sizeof(int), 1, fp);
   fwrite(list.data(), sizeof(double), list.size(), fp);
@@ -1077,6 +1149,8 @@ void FixMusenWallMesh::restart(char *buf)
   if (comm->me == 0) std::copy(list + 2, list + 2 + 3 * (size_t) ntri, ftri.begin());
   ftri_step = static_cast<bigint>(list[0]);
   reduced_valid = false;
+  // a job with stepped geometries always writes their state after the forces
+  if (any_stepped) restore_stepped(list + 2 + 3 * (size_t) ntri);
 }
 
 double FixMusenWallMesh::memory_usage()

@@ -58,10 +58,26 @@
                     e = (1, tau, cos(w tau), sin(w tau)), tau = t - t0 (w = 0: e = (1, tau, 1, 0));
                     before the first segment R = I, b = 0; after the last, the last one.
        NINT lines:  int t_begin t_end vx vy vz cx cy cz wx wy wz   (MUSEN's intervals, sorted)
+       optional:    force KIND NF   (MUSEN's motion type: 1 time, 2 force-dependent, 3 constant
+                                     force), then NF lines  fint LIMIT MAX vx vy vz cx cy cz wx wy wz
+                                     (MAX 1: the interval ends when the force exceeds LIMIT, 0: when
+                                     it falls below)
+       optional:    free FX FY FZ MASS   (free axes 0/1 and the geometry's mass)
+       optional:    velocity vx vy vz    (a stepped geometry's walls' velocity at the start)
+     gravity gx gy gz            (optional: the external acceleration a free geometry feels)
      triangles T                 then T lines:  GEOMETRY MATERIAL x1 y1 z1 x2 y2 z2 x3 y3 z3
    TYPE is a LAMMPS atom type, MATERIAL any integer >= 0 (a wall material), GEOMETRY the
    0-based index of a geometry line.  The triangle order is MUSEN's wall order (geometries in
    scene order, each in its `27` list order): it decides ties between touched triangles.
+
+   A geometry with a "force" or a "free" line is STEPPED (fix_musen_wall_mesh_motion.cpp):
+   it has no segments and moves as MUSEN's CPUSimulator::MoveWalls moves it, one update per
+   time step from the total force the walls felt in the previous step (the z component of
+   the sum of its triangles' forces switches force-dependent intervals, the whole force plus
+   gravity x MASS accelerates free axes), plus MUSEN's extra update of its half-step
+   prediction before the first step, so at time t its triangles are where MUSEN's are.
+   compute_array's vertices then come from this stepping, and "fix_modify write" adds each
+   triangle's velocity and vertices (vx vy vz x1 .. z3) to its frame.
 
    Only public LAMMPS classes are used (Fix, Atom, Domain, Neighbor, Update, Comm).
 ------------------------------------------------------------------------- */
@@ -114,6 +130,11 @@ class FixMusenWallMesh : public Fix {
     double v[3], c[3], w[3];
     bool moves() const;
   };
+  struct ForceInterval {
+    double limit;
+    bool max;            // MUSEN's ELimitType::MAX (else MIN)
+    double v[3], c[3], w[3];
+  };
   struct Geometry {
     std::string name;
     bool around_centre;
@@ -121,6 +142,15 @@ class FixMusenWallMesh : public Fix {
     std::vector<Segment> segments;
     std::vector<Interval> intervals;
     std::vector<int> tris;          // its triangles (FILE order)
+    // stepped geometries (fix_musen_wall_mesh_motion.cpp)
+    bool stepped = false;
+    int motion_kind = 0;            // MUSEN's EMotionType: 0 none, 1 time, 2 force, 3 constant force
+    std::vector<ForceInterval> fints;
+    long imotion = -1;              // CGeometryMotion::m_iMotion
+    double cur_v[3] = {0, 0, 0}, cur_w[3] = {0, 0, 0}, cur_c[3] = {0, 0, 0};   // m_currentMotion
+    bool free_axis[3] = {false, false, false};
+    double mass = 0.0;
+    double start_vel[3] = {0, 0, 0};   // its walls' velocity at the start (the scene's)
     // the wall motion MUSEN's contact law sees now
     double vel[3], rotvel[3], rotcentre[3];
   };
@@ -149,7 +179,12 @@ class FixMusenWallMesh : public Fix {
   bool any_moving;
   double t_placed;                     // time the triangles were last placed at
   bool placed;
-  bool warned_centre_on_wall = false;    // a sphere centre on a triangle was met (warned once)
+  bool warned_centre_on_wall = false;
+  // stepped geometries: the prediction update done, ftri holds forces not yet used to move,
+  // an evaluation that only measures the wall forces (no atom forces, no history)
+  bool any_stepped = false, started = false, pending = false, dry_run = false;
+  double gravity[3] = {0, 0, 0};
+  std::vector<double> start_vert;      // vertices before the prediction update    // a sphere centre on a triangle was met (warned once)
 
   // per-triangle force on the walls (local sums; reduced on demand)
   std::vector<double> ftri, ftri_all, fgeom_all;
@@ -182,6 +217,12 @@ class FixMusenWallMesh : public Fix {
   void find_adjacent();
   void place(double t);
   void motion_state(double t);
+  void step_walls(double t);
+  static void update_motion(Geometry &G, double value);
+  static void rotation_matrix(const double *w, double dt, double R[3][3]);
+  void centroid(const Geometry &G, double *centre) const;
+  std::vector<double> stepped_state() const;
+  void restore_stepped(const double *list);
   void build_grid(double rmax);
   bool grid_stale(double rmax);
   void reduce_forces();

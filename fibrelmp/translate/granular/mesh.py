@@ -82,6 +82,9 @@ def mesh_text(model: GranularModel, wall_plans, spheres) -> str:
     out += laws
     out.append(f"geometries {len(plans)}")
     for wp in plans:
+        if wp.stepped is not None:
+            out += _stepped_lines(wp, tris)
+            continue
         kin = wp.kinematics
         out.append(f"geometry {_words(wp.name)} {int(kin.around_centre)} {len(kin.segments)} "
                    f"{len(kin.motions)}")
@@ -92,12 +95,38 @@ def mesh_text(model: GranularModel, wall_plans, spheres) -> str:
         for m in kin.motions:
             vals = [m.t_begin, m.t_end, *m.velocity, *m.centre, *m.omega]
             out.append("int " + " ".join(_num(v) for v in vals))
+    if any(wp.stepped is not None for wp in plans):
+        out.append("gravity " + " ".join(_num(g) for g in model.plan.gravity))
     out.append(f"triangles {len(rows)}")
     for gi, wp in enumerate(plans):
         for r in np.asarray(wp.triangle_rows, np.int64):
             v = np.asarray(tris.vertices[r], float).ravel()
             out.append(f"{gi} {int(tris.material[r])} " + " ".join(_num(c) for c in v))
     return "\n".join(out) + "\n"
+
+
+def _stepped_lines(wp, tris) -> list[str]:
+    """A geometry the fix moves step by step: MUSEN's intervals as they are (time intervals
+    in MUSEN's order, force intervals), its free axes and mass."""
+    g = wp.stepped
+    around = bool(g.rotate_around_centre)
+    times = g.motion if g.motion_type == 1 else []
+    out = [f"geometry {_words(wp.name)} {int(around)} 0 {len(times)}"]
+    for m in times:
+        vals = [m.t_begin, m.t_end, *m.velocity, *m.centre, *m.angular_velocity]
+        out.append("int " + " ".join(_num(v) for v in vals))
+    if g.motion_type in (1, 2, 3):
+        forces = g.force_motion if g.motion_type in (2, 3) else []
+        out.append(f"force {g.motion_type} {len(forces)}")
+        for f in forces:
+            vals = [*f.velocity, *f.centre, *f.angular_velocity]
+            out.append(f"fint {_num(f.limit)} {int(f.limit_max)} " + " ".join(_num(v) for v in vals))
+    if any(g.free) and g.mass != 0:
+        out.append("free " + " ".join(str(int(bool(x))) for x in g.free) + f" {_num(g.mass)}")
+    rows = np.asarray(wp.triangle_rows, np.int64)
+    if len(rows) and np.any(tris.velocity[rows[0]] != 0):    # one velocity (walls.py checks)
+        out.append("velocity " + " ".join(_num(v) for v in tris.velocity[rows[0]]))
+    return out
 
 
 def write_mesh(model: GranularModel, wall_plans, spheres, path: Path) -> MeshWalls:

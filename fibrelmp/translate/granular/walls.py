@@ -10,6 +10,7 @@ wall/gran plane, and MUSEN geometries are named in an "approximate MUSEN physics
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -44,6 +45,8 @@ class WallPlan:
     tile_ids: np.ndarray | None = None       # LAMMPS ids of its wall tiles
     tile_owner: np.ndarray | None = None     # triangle row of each tile
     plane_index: int | None = None           # index into model.planes
+    stepped: Geometry | None = None          # moved step by step by fix musen/wall/mesh (force-
+                                             # dependent or free motion): the geometry it follows
 
 
 def use_mesh(model: GranularModel) -> bool:
@@ -63,9 +66,10 @@ def plan_walls(model: GranularModel, dt: float, t_end: float, mesh: bool | None 
     t0 = model.plan.t_start
     for name, geom, rows in geometry_triangle_rows(model):
         v = tris.vertices[rows]
+        stepped = geom is not None and is_stepped(geom)
         if geom is not None:
-            _check_motion(model, geom)
-            kin = geometry_kinematics(geom, v, t0, t_end)
+            _check_motion(model, geom, mesh, rows)
+            kin = stepped_kinematics(geom) if stepped else geometry_kinematics(geom, v, t0, t_end)
         else:
             kin = Kinematics()
         mats, counts = np.unique(tris.material[rows], return_counts=True)
@@ -77,9 +81,13 @@ def plan_walls(model: GranularModel, dt: float, t_end: float, mesh: bool | None 
                 continue
             desc = (f"{len(rows)} exact triangles -> fix musen/wall/mesh (MUSEN's particle-wall "
                     "contact, face/edge/vertex)")
-            if kin.moving:
+            if stepped:
+                desc += (", moving step by step as MUSEN moves it ("
+                         + ("force-dependent" if geom.motion_type in (2, 3) else "free") + " motion)")
+            elif kin.moving:
                 desc += ", moving (time-dependent motion)"
-            plans.append(WallPlan(name, "mesh", desc, rows, kin, material))
+            plans.append(WallPlan(name, "mesh", desc, rows, kin, material,
+                                  stepped=geom if stepped else None))
             continue
         shape = detect_oriented_box(v) or detect_cylinder(v) if len(rows) else None
         if shape is not None and kin.rotating and not _region_can_rotate(shape, kin):
@@ -121,16 +129,37 @@ def _region_can_rotate(shape, kin: Kinematics) -> bool:
     return True
 
 
-def _check_motion(model: GranularModel, geom: Geometry) -> None:
-    if geom.motion_type in (2, 3):
-        raise InputError(model.source, None, f"geometry '{geom.name}': force-dependent geometry "
-                         "motion is not supported yet")
-    if geom.motion_type not in (0, 1):
+def is_stepped(geom: Geometry) -> bool:
+    """The geometry's motion depends on the forces on it: force-dependent intervals (types 2
+    and 3) or free axes with a mass (CPUSimulator::MoveWalls solves Newton's law then)."""
+    return geom.motion_type in (2, 3) or (any(geom.free) and geom.mass != 0)
+
+
+def stepped_kinematics(geom: Geometry) -> Kinematics:
+    """What the job knows in advance of a stepped geometry: only its interval velocities
+    (pacing); fix musen/wall/mesh moves it and reports where it is."""
+    vels = [iv.velocity for iv in geom.force_motion] + [iv.velocity for iv in geom.motion]
+    return Kinematics(intervals=[(-math.inf, math.inf, np.asarray(v, float)) for v in vels])
+
+
+def _check_motion(model: GranularModel, geom: Geometry, mesh: bool, rows: np.ndarray) -> None:
+    if geom.motion_type not in (0, 1, 2, 3):
         raise InputError(model.source, None, f"geometry '{geom.name}': unknown motion type "
                          f"{geom.motion_type}")
-    if any(geom.free) and geom.mass > 0:
-        raise InputError(model.source, None, f"geometry '{geom.name}': free (force-driven) geometry "
-                         "motion is not supported yet")
+    if not is_stepped(geom):
+        return
+    what = "force-dependent" if geom.motion_type in (2, 3) else "free (force-driven)"
+    if not mesh:
+        raise InputError(model.source, None, f"geometry '{geom.name}': {what} geometry motion "
+                         "needs fibrelmp's LAMMPS styles (fix musen/wall/mesh)")
+    if geom.motion_type in (2, 3) and not geom.force_motion:
+        raise InputError(model.source, None, f"geometry '{geom.name}': force-dependent motion "
+                         "without intervals (MUSEN refuses it too)")
+    vel = model.triangles.velocity[np.asarray(rows, np.int64)]
+    if len(vel) and np.any(vel != vel[:1]):
+        # MUSEN starts each wall from its own stored velocity; fibrelmp's geometry has one
+        raise InputError(model.source, None, f"geometry '{geom.name}': its walls start with "
+                         f"different velocities; {what} motion needs one velocity per geometry")
 
 
 def describe_walls(model: GranularModel) -> list[str]:

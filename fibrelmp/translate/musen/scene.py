@@ -16,8 +16,8 @@ import numpy as np
 
 from fibrelmp.errors import InputError
 from fibrelmp.units import SI
-from fibrelmp.granmodel import (ContactLaw, Geometry, GranularModel, GranularPlan, LiquidBond, Material,
-                         MotionInterval, SolidBonds, Spheres, Triangles, hertz_effective)
+from fibrelmp.granmodel import (ContactLaw, ForceInterval, Geometry, GranularModel, GranularPlan, LiquidBond,
+                         Material, MotionInterval, SolidBonds, Spheres, Triangles, hertz_effective)
 from fibrelmp.translate.musen.scene_record import MusenSceneRecord
 from fibrelmp.translate.musen.text import (LIQUID_BOND, SOLID_BOND, SPHERE, TD_SIZE, TYPE_NAMES, WALL,  # noqa: F401
                          TimePoints, _bool, check_duplicate_ids, _fill, _int, _num, scan_text, TextScan,
@@ -367,8 +367,13 @@ def _motion(g: Geometry, tok, path, ln, warn) -> None:
             g.motion.append(MotionInterval(a[0], a[1], np.array(a[2:5]), np.array(a[5:8]),
                                            np.array(a[8:11])))
     else:
-        warn.append(("musen-force-motion", f"{path}:{ln}: geometry {g.name}: force-dependent "
-                     "motion (`26 {mtype}`) is kept for the result file but cannot be simulated"))
+        for j in range(n):
+            a = v[11 * j: 11 * j + 11]      # Flimit limitType(0 MIN, 1 MAX) | velocity | centre | angular velocity
+            if a[1] not in (0.0, 1.0):
+                raise InputError(path, ln, f"force motion interval {j + 1}: limit type {a[1]:g}: "
+                                 "MUSEN knows 0 (MIN) and 1 (MAX)")
+            g.force_motion.append(ForceInterval(a[0], a[1] == 1.0, np.array(a[2:5]), np.array(a[5:8]),
+                                                np.array(a[8:11])))
 
 
 def _wall_list(tok, ids, types, wall_rows, path, ln) -> np.ndarray:

@@ -29,6 +29,9 @@ class MusenSceneRecord(SourceRecord):
     mdem_source: Path | None = None              # the .mdem read (its scene message is copied)
     gravity_set: bool = False                    # the file or job set gravity (no default note)
     file_models: list[MusenModelSpec] = field(default_factory=list)   # a .mdem's stored models
+    # a .mdem's simulator settings fibrelmp cannot simulate: field name -> why (a job script
+    # may switch them off; a SIMULATOR job refuses what remains)
+    refused: dict[str, str] = field(default_factory=dict)
 
 
 def scene_record(model: GranularModel, keep: bool = False) -> MusenSceneRecord:

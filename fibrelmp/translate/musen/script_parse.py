@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from fibrelmp.errors import InputError
-from fibrelmp.granmodel import MotionInterval
+from fibrelmp.granmodel import ForceInterval, MotionInterval
 from fibrelmp.translate.granular import models as physics
 from fibrelmp.translate.musen.text_writer import EXPORT_FLAGS, all_on
 from fibrelmp.textio import read_text
@@ -115,10 +115,12 @@ class MusenJob:
     contact_radius: bool | None = None
     reset_bonds: bool | None = None
     variable_time_step: bool | None = None
+    velocity_limit: float | None = None      # LIMIT_PARTICLE_VELOCITY (<= 0: no limit)
+    stop_none: bool = False                  # STOP_CRITERION NONE (replaces a .mdem's criteria)
     material_properties: list[tuple[int, str, float, int]] = field(default_factory=list)
     interaction_properties: list[tuple[int, str, str, float, int]] = field(default_factory=list)
     geometry_motion_time: list[tuple[str, MotionInterval, int]] = field(default_factory=list)
-    geometry_motion_force: list[tuple[str, int]] = field(default_factory=list)
+    geometry_motion_force: list[tuple[str, ForceInterval, int]] = field(default_factory=list)
     text_export: dict[str, dict[str, bool]] = field(default_factory=all_on)
     precision: int = 6
     time_interval: tuple[float, float] | None = None
@@ -320,6 +322,11 @@ def _variable_step(job: MusenJob, line: _Line) -> None:
         job.refused.append((line.key, line.ln, "a variable time step is not supported"))
 
 
+def _velocity_limit(job: MusenJob, line: _Line) -> None:
+    # cmusen: a value <= 0 removes the limit (CBaseSimulator::SetPartVelocityLimit)
+    job.velocity_limit = line.floats(1)[0]
+
+
 def _stop(job: MusenJob, line: _Line) -> None:
     value = line.tok[0].upper() if line.tok else ""
     if value == "BROKEN_BONDS":
@@ -327,6 +334,8 @@ def _stop(job: MusenJob, line: _Line) -> None:
                             "supported; give END_TIME"))
     elif value != "NONE":
         raise line.error(f"expected NONE or BROKEN_BONDS, got {value!r}")
+    else:
+        job.stop_none = True
 
 
 def _pbc_flags(job: MusenJob, line: _Line) -> None:
@@ -384,7 +393,14 @@ def _motion_time(job: MusenJob, line: _Line) -> None:
 
 
 def _motion_force(job: MusenJob, line: _Line) -> None:
-    job.geometry_motion_force.append((line.tok[0] if line.tok else "", line.ln))
+    if len(line.tok) < 3:
+        raise line.error("needs GEOMETRY FORCE_LIMIT MIN|MAX vx vy vz wx wy wz cx cy cz")
+    limit = _Line(line.path, line.ln, line.key, line.tok[1]).floats(1)[0]
+    # ScriptAnalyzer: "MIN" is MIN, any other word MAX
+    v = _Line(line.path, line.ln, line.key, " ".join(line.tok[3:])).floats(9)
+    # script order: velocity, rotation velocity, rotation centre (the text file has v, c, w)
+    job.geometry_motion_force.append((line.tok[0], ForceInterval(
+        limit, line.tok[2].upper() != "MIN", np.array(v[0:3]), np.array(v[6:9]), np.array(v[3:6])), line.ln))
 
 
 def _set(attr: str):
@@ -416,7 +432,7 @@ _HANDLERS = {
     "EXT_ACCEL": _tuple("ext_accel", 3), "SIMULATION_DOMAIN": _tuple("simulation_domain", 6),
     "PBC_FLAGS": _pbc_flags, "PBC_DOMAIN": _tuple("pbc_domain", 6),
     "VARIABLE_TIME_STEP": _variable_step, "STOP_CRITERION": _stop,
-    "LIMIT_PARTICLE_VELOCITY": _refuse("limiting particle velocities is not supported"),
+    "LIMIT_PARTICLE_VELOCITY": _velocity_limit,
     "MATERIAL_PROPERTY": _material_property, "INTERACTION_PROPERTY": _interaction_property,
     "TEXT_EXPORT_PRECISION": _precision, "TIME_INTERVAL": _time_interval,
     "GEOMETRY_MOTION_TIME": _motion_time, "GEOMETRY_MOTION_FORCE": _motion_force,

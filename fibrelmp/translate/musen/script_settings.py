@@ -127,6 +127,12 @@ def apply_simulator_settings(model: GranularModel, job: MusenJob) -> None:
                                         job.where(f"MODEL_{kind}_PARAMS"))
     if job.connected_pp_contact is not None:
         plan.contacts_between_bonded = job.connected_pp_contact
+    _refuse_file_settings(model, job)
+    if job.velocity_limit is not None:
+        plan.velocity_limit = job.velocity_limit if job.velocity_limit > 0 else None
+        if plan.velocity_limit is not None and not lammps_styles.plugin().available:
+            raise InputError(job.path, job.where("LIMIT_PARTICLE_VELOCITY"), "LIMIT_PARTICLE_VELOCITY "
+                             "needs fibrelmp's LAMMPS styles (fix musen/velocity/limit)")
     _apply_times(model, job)
 
 
@@ -201,14 +207,31 @@ def _apply_motion(model: GranularModel, job: MusenJob) -> None:
     for name, interval, ln in job.geometry_motion_time:
         g = geometry(name, ln)
         if id(g) not in cleared:
-            g.motion, g.motion_type = [], 1
+            g.motion, g.force_motion, g.motion_type = [], [], 1
             g.raw_lines = [r for r in g.raw_lines if not r.startswith("26")]
             cleared.add(id(g))
         g.motion.append(interval)
-    for name, ln in job.geometry_motion_force:
-        geometry(name, ln)
-        raise InputError(job.path, ln, "GEOMETRY_MOTION_FORCE: force-dependent geometry motion "
-                         "is not supported")
+    # ConsoleSimulator: the force intervals replace the motion of the geometries they name
+    cleared = set()
+    for name, interval, ln in job.geometry_motion_force:
+        g = geometry(name, ln)
+        if id(g) not in cleared:
+            g.motion, g.force_motion, g.motion_type = [], [], 2
+            cleared.add(id(g))
+        g.force_motion.append(interval)
+
+
+def _refuse_file_settings(model: GranularModel, job: MusenJob) -> None:
+    """A .mdem's settings fibrelmp cannot simulate (``MusenSceneRecord.refused``), unless the
+    job switches them off as cmusen's ConsoleSimulator would (VARIABLE_TIME_STEP 0,
+    STOP_CRITERION NONE)."""
+    record = scene_record(model)
+    if job.variable_time_step is False:
+        record.refused.pop("flexible_time_step", None)
+    if job.stop_none:
+        record.refused.pop("stop_criteria", None)
+    for name, why in record.refused.items():
+        raise InputError(record.mdem_source or model.source, None, f"{name}: {why}")
 
 
 def _check_models(model: GranularModel, job: MusenJob, models: dict) -> None:

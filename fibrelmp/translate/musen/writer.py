@@ -373,8 +373,8 @@ class MusenResultWriter(Writer):
                 parts.append(" ".join(_g(v) for v in (iv.t_begin, iv.t_end, *iv.velocity,
                                                       *iv.centre, *iv.angular_velocity)))
             return " ".join(parts)
-        for raw in g.raw_lines:                     # force-driven motion: as read
-            tok = raw.split()
-            if tok[0] == "26":
-                return " ".join(tok[1:])
-        return f"{g.motion_type} 0"
+        parts = [f"{g.motion_type} {len(g.force_motion)}"]     # force-driven motion
+        for iv in g.force_motion:
+            parts.append(" ".join(_g(v) for v in (iv.limit, int(iv.limit_max), *iv.velocity,
+                                                  *iv.centre, *iv.angular_velocity)))
+        return " ".join(parts)

@@ -36,6 +36,7 @@ def read_scene(path: str | os.PathLike) -> GranularModel:
             where = f" (its text form, line {exc.line})" if exc.line else ""
             raise InputError(path, None, f"{exc.message}{where}") from None
         _settings(model, mdem.storage.modules_data)
+        _refused_settings(model, mdem.storage)
     model.source = path
     scene_record(model, keep=True).mdem_source = path
     return model
@@ -54,6 +55,8 @@ def _settings(model: GranularModel, modules) -> None:
         plan.save_every_time = sim.saving_step
     if sim.end_time > 0:
         plan.t_end = sim.end_time
+    if sim.part_velocity_limit > 0:        # MUSEN: 0 (the default) is no limit
+        plan.velocity_limit = sim.part_velocity_limit
     if modules.HasField("simulator"):
         g = sim.external_acceleration
         plan.gravity = np.array([g.x, g.y, g.z])
@@ -70,6 +73,20 @@ def _settings(model: GranularModel, modules) -> None:
         specs.append(MusenModelSpec(name=name, params=entry.params, kind=kind, line=0))
     if specs:
         scene_record(model, keep=True).file_models = specs
+
+
+def _refused_settings(model: GranularModel, storage) -> None:
+    """Simulator settings of the file that fibrelmp does not simulate (MUSEN's
+    ``CBaseSimulator::LoadConfiguration``): kept by name, refused when simulated; and the
+    moving periodic box (``SPBC::vVel``), which it does."""
+    refused = scene_record(model, keep=True).refused
+    if storage.modules_data.simulator.flexible_time_step:
+        refused["flexible_time_step"] = "MUSEN's variable time step is not supported"
+    if any(t != 0 for t in storage.info.stop_criteria.types):      # 0 NONE, 1 BROKEN_BONDS
+        refused["stop_criteria"] = "stopping on a number of broken bonds is not supported"
+    v = storage.info.periodic_conditions_vel
+    if storage.info.periodic_conditions_enabled and (v.x, v.y, v.z) != (0.0, 0.0, 0.0):
+        model.plan.periodic_velocity = np.array([v.x, v.y, v.z])    # fix musen/pbc/move
 
 
 class MdemReader(Reader):

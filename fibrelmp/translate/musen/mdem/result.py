@@ -195,6 +195,11 @@ class MdemResultWriter(MusenResultWriter):
                 motion.Clear()
                 set_motion(motion, 1, [(iv.t_begin, iv.t_end, iv.velocity, iv.centre,
                                         iv.angular_velocity) for iv in g.motion])
+            elif g.motion_type in (2, 3):       # a script's GEOMETRY_MOTION_FORCE included
+                motion = geo.base_geometry.motion
+                motion.Clear()
+                set_motion(motion, g.motion_type, [(iv.limit, int(iv.limit_max), iv.velocity, iv.centre,
+                                                    iv.angular_velocity) for iv in g.force_motion])
 
     def _set_settings(self, storage: Any) -> None:
         m, plan = self.model, self.model.plan
@@ -208,6 +213,7 @@ class MdemResultWriter(MusenResultWriter):
         sim.external_acceleration.x, sim.external_acceleration.y, sim.external_acceleration.z = \
             (float(g) for g in plan.gravity)
         sim.simulator_type = sim.simulator_type or 1           # CPU
+        sim.part_velocity_limit = plan.velocity_limit or 0.0   # as MUSEN saves it (0: none)
         models = m.models
         if models:
             manager = storage.modules_data.model_manager

@@ -197,6 +197,19 @@ def _chunk_events(active: list[tuple[int, DynamicGenerator]], last: dict[int, fl
     return out
 
 
+def next_fraction(generated: list[int], targets: list[float]) -> int:
+    """``MixtureFractionIndexToGenerate``: the mixture fraction of the next sphere, given the
+    spheres made so far of each fraction (successes only) and the target number fractions:
+    the first fraction below its target, else the first."""
+    total = sum(generated)
+    if total == 0:
+        return 0
+    for i, (made, target) in enumerate(zip(generated, targets)):
+        if made / total < target:
+            return i
+    return 0
+
+
 def refuse_active(storage: Any, path: Path, dt: float) -> None:
     """Refuse a scene with an active generator that generates anything in its own time window
     (fibrelmp does not insert objects into a running LAMMPS job; the window, not the run's end,

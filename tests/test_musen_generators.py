@@ -159,7 +159,7 @@ def test_run_with_an_active_generator_is_refused(tmp_path):
     with pytest.raises(InputError) as err:
         python_api.run(scene)
     assert str(err.value).startswith(f"{scene}: dynamic generator 'InletA': activity: asks for "
-                                     "198 object(s) from t = 0.001 s")
+                                     "10 object(s) at t = 0.001 s")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["inlet_scene.mdem"]
 
 

@@ -148,12 +148,13 @@ def check_generator(gen: DynamicGenerator, storage: Any, path: Path) -> None:
         raise _field(path, gen, "rate_value", f"gives {gen.rate!r} objects per second")
 
 
-def generation_schedule(generators: list[DynamicGenerator], dt: float,
-                        t_end: float) -> list[GenerationEvent]:
+def generation_schedule(generators: list[DynamicGenerator], dt: float, t_end: float,
+                        first_only: bool = False) -> list[GenerationEvent]:
     """Every generation cmusen attempts in a run of step ``dt`` to ``t_end``, in the order
     cmusen attempts them (by step, then generator order, which is also the order of the new
     ids).  The run's steps are those with t < ``t_end`` before the step (cmusen stops once the
-    accumulated time reaches the end time)."""
+    accumulated time reaches the end time).  ``first_only``: stop at the first chunk of 2^20
+    steps holding an event (a long window of tiny steps is not summed to its end)."""
     events: list[GenerationEvent] = []
     active = [(i, g) for i, g in enumerate(generators) if g.active and g.rate > 0]
     if not active:
@@ -165,6 +166,8 @@ def generation_schedule(generators: list[DynamicGenerator], dt: float,
         # steps first .. first+_CHUNK-1; the last one starts the next chunk
         times = np.cumsum(np.r_[t0, np.full(_CHUNK - 1, dt)])
         events.extend(_chunk_events(active, last, times, first, t_end))
+        if first_only and events:
+            break
         first += _CHUNK - 1
         t0 = float(times[-1])
     events.sort(key=lambda e: (e.step, e.generator))
@@ -221,10 +224,10 @@ def refuse_active(storage: Any, path: Path, dt: float) -> None:
             check_generator(g, storage, path)
     window = max((g.end + g.update_step for g in generators if g.active), default=0.0)
     step = dt if dt > 0 else MUSEN_DEFAULT_STEP           # nan: the file sets no step
-    events = generation_schedule(generators, step, window)
+    events = generation_schedule(generators, step, window, first_only=True)
     if events:
         g = generators[events[0].generator]
-        raise _field(path, g, "activity", f"asks for {sum(e.requested for e in events)} "
-                     f"object(s) from t = {events[0].time:.6g} s (with the file's step); inserting "
+        raise _field(path, g, "activity", f"asks for {events[0].requested} object(s) at "
+                     f"t = {events[0].time:.6g} s (with the file's step), and more later; inserting "
                      "particles during a run is not implemented in fibrelmp: deactivate the "
                      "generator or generate the particles before the run")

@@ -1,0 +1,233 @@
+"""MUSEN's dynamic generators (inlets) stored in a ``.mdem``: the settings, MUSEN's
+generation schedule, and the refusal of a run that needs them.
+
+A dynamic generator (``ProtoObjectsGenerator`` in the modules data; MUSEN's
+``CObjectsGenerator``, ``CGenerationManager``) inserts spheres of a mixture, or agglomerates of
+the agglomerates database, into an analysis volume while the simulation runs.  cmusen asks
+every generator before every step (``PreCalculationStep``, before the step's save):
+
+- it generates at time *t* if it is active, ``start <= t <= end + 0.1 update``,
+  ``t >= last + update`` and the number below is at least 1; *last* (the time of its last
+  generation, attempted or not) starts at 0;
+- the number is ``floor((t - (last - start)) * rate)``: with a start time > 0 the first
+  generation makes ``2 start rate`` objects and each later one ``(update + start) rate``, not
+  ``update rate`` (MUSEN's arithmetic, reproduced: the stored cmusen reference shows it);
+- the rate in objects per second is ``rate_value`` (rate type 0), ``rate_value / update``
+  (type 1: per update step) or ``rate_value / (end - start)`` (type 2: in total);
+- *t* is cmusen's time, accumulated as ``t += dt`` from 0 (the first step runs twice at 0,
+  as MUSEN's prediction step), so the generation steps drift from multiples of the update
+  step by the rounding of that sum (``generation_schedule`` reproduces the sum exactly);
+- each object gets at most ``max_iterations`` random positions (C ``rand()``, seeded with the
+  wall-clock time: not reproducible) and is dropped if none is totally inside the volume,
+  free of the other spheres' contact radii and of the walls; a failure does not move the count
+  of later generations.  New objects get the next free ids (after every object of the scene and
+  those generated before), ``activity_start = t``, and the fixed initial velocity or, with a
+  random velocity, a direction uniform on the sphere times the magnitude.
+
+fibrelmp reads and checks the settings and computes the schedule; inserting the objects into
+a running LAMMPS job is not implemented, so an active generator that would generate during
+the run is refused (``refuse_active``) with the generator's and the field's name.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from fibrelmp.errors import InputError
+
+SPHERES, AGGLOMERATES = 1, 2            # ProtoObjectsGenerator.obj_type
+RATE_PER_SECOND, RATE_PER_UPDATE, RATE_TOTAL = 0, 1, 2
+MUSEN_DEFAULT_STEP = 1e-6              # BaseSimulator.h: a scene's step when none is set
+_CHUNK = 1 << 20                        # time steps accumulated per numpy call
+
+
+@dataclass(frozen=True)
+class DynamicGenerator:
+    """One ``ProtoObjectsGenerator`` as MUSEN's ``LoadConfiguration`` reads it."""
+
+    name: str
+    volume_key: str
+    mixture_key: str
+    objects: int                   # SPHERES (a mixture) or AGGLOMERATES
+    agglomerate_key: str
+    init_velocity: tuple[float, float, float]
+    random_velocity: bool
+    velocity_magnitude: float
+    start: float
+    end: float
+    update_step: float
+    rate_type: int
+    rate_value: float
+    max_iterations: int
+    inside_geometries: bool
+    active: bool
+
+    @property
+    def rate(self) -> float:
+        """Objects per second (``CObjectsGenerator::Initialize``)."""
+        if self.rate_type == RATE_PER_UPDATE:
+            return self.rate_value / self.update_step
+        if self.rate_type == RATE_TOTAL:
+            return self.rate_value / (self.end - self.start)
+        return self.rate_value
+
+    def count_at(self, time: float, last: float) -> int:
+        """``NumberToBeGenerated``: objects asked for at ``time`` after a generation at ``last``."""
+        return int(math.floor((time - (last - self.start)) * self.rate))
+
+
+@dataclass(frozen=True)
+class GenerationEvent:
+    """One generation cmusen attempts: at time step ``step`` (time ``time``, cmusen's
+    accumulated value) the generator ``generator`` (its index) asks for ``requested`` objects."""
+
+    step: int
+    time: float
+    generator: int
+    requested: int
+
+
+def read_generators(storage: Any) -> list[DynamicGenerator]:
+    """The dynamic generators of a ``.mdem`` scene message (version 0 files: a rate in objects
+    per second and 30 iterations, as MUSEN reads them)."""
+    out = []
+    for g in storage.modules_data.objects_generator.generators:
+        old = g.version == 0
+        v = g.init_velocity
+        out.append(DynamicGenerator(
+            name=g.name, volume_key=g.volume_key, mixture_key=g.mixture_key,
+            objects=int(g.obj_type), agglomerate_key=g.aggl_key,
+            init_velocity=(v.x, v.y, v.z), random_velocity=bool(g.random_velocity_flag),
+            velocity_magnitude=g.velocity_magnitude, start=g.start_generation_time,
+            end=g.end_generation_time, update_step=g.update_time_step,
+            rate_type=RATE_PER_SECOND if old else int(g.rate_type),
+            rate_value=g.generation_rate if old else g.rate_value,
+            max_iterations=30 if old else int(g.max_iterations),
+            inside_geometries=bool(g.inside_geometries), active=bool(g.activity)))
+    return out
+
+
+def _field(path: Path, gen: DynamicGenerator, field: str, message: str) -> InputError:
+    return InputError(path, None, f"dynamic generator '{gen.name}': {field}: {message}")
+
+
+def check_generator(gen: DynamicGenerator, storage: Any, path: Path) -> None:
+    """What MUSEN's ``IsDataCorrect`` and ``Initialize`` need of an active generator: its
+    volume, its mixture (fractions summing to 1) or agglomerate, a usable rate."""
+    volumes = {v.base_geometry.key for v in storage.info.analysis_volume}
+    volumes |= {v.key for v in storage.info.analysis_volume_v0}
+    if gen.volume_key not in volumes:
+        raise _field(path, gen, "volume_key", f"no analysis volume '{gen.volume_key}' in the "
+                     "scene (MUSEN: 'No generation volume was specified')")
+    if gen.objects == AGGLOMERATES:
+        raise _field(path, gen, "obj_type", "generating agglomerates (from the agglomerates "
+                     "database) is not supported by fibrelmp; generate spheres of a mixture")
+    if gen.objects != SPHERES:
+        raise _field(path, gen, "obj_type", f"unknown object type {gen.objects} (1: spheres, "
+                     "2: agglomerates)")
+    mixtures = {m.uniqueKey: m for m in storage.modules_data.materials_database.mixture}
+    mixture = mixtures.get(gen.mixture_key)
+    if mixture is None or not len(mixture.fraction):
+        raise _field(path, gen, "mixture_key", f"no mixture '{gen.mixture_key}' with fractions "
+                     "in the scene's materials database")
+    total = sum(f.fraction for f in mixture.fraction)
+    if abs(total - 1.0) > 1e-14:             # CMaterialsDatabase::IsMixtureCorrect
+        raise _field(path, gen, "mixture_key", f"the fractions of mixture '{gen.mixture_key}' "
+                     f"sum to {total:.17g}, not 1 (MUSEN refuses the mixture)")
+    if gen.rate_type not in (RATE_PER_SECOND, RATE_PER_UPDATE, RATE_TOTAL):
+        raise _field(path, gen, "rate_type", f"unknown rate type {gen.rate_type} (0: objects "
+                     "per second, 1: per update step, 2: in total)")
+    if not (gen.update_step > 0 and math.isfinite(gen.update_step)):
+        raise _field(path, gen, "update_time_step", f"must be > 0, got {gen.update_step!r}")
+    if not (math.isfinite(gen.rate) and gen.rate >= 0):
+        raise _field(path, gen, "rate_value", f"gives {gen.rate!r} objects per second")
+
+
+def generation_schedule(generators: list[DynamicGenerator], dt: float, t_end: float,
+                        first_only: bool = False) -> list[GenerationEvent]:
+    """Every generation cmusen attempts in a run of step ``dt`` to ``t_end``, in the order
+    cmusen attempts them (by step, then generator order, which is also the order of the new
+    ids).  The run's steps are those with t < ``t_end`` before the step (cmusen stops once the
+    accumulated time reaches the end time).  ``first_only``: stop at the first chunk of 2^20
+    steps holding an event (a long window of tiny steps is not summed to its end)."""
+    events: list[GenerationEvent] = []
+    active = [(i, g) for i, g in enumerate(generators) if g.active and g.rate > 0]
+    if not active:
+        return events
+    last = {i: 0.0 for i, _ in active}
+    first, t0 = 0, 0.0
+    horizon = max(g.end + 0.1 * g.update_step for _, g in active)
+    while t0 < t_end and t0 <= horizon:
+        # steps first .. first+_CHUNK-1; the last one starts the next chunk
+        times = np.cumsum(np.r_[t0, np.full(_CHUNK - 1, dt)])
+        events.extend(_chunk_events(active, last, times, first, t_end))
+        if first_only and events:
+            break
+        first += _CHUNK - 1
+        t0 = float(times[-1])
+    events.sort(key=lambda e: (e.step, e.generator))
+    return events
+
+
+def _chunk_events(active: list[tuple[int, DynamicGenerator]], last: dict[int, float],
+                  times: np.ndarray, first: int, t_end: float) -> list[GenerationEvent]:
+    """The events among ``times`` (steps ``first ..``; the last entry is the next chunk's
+    first), updating ``last``."""
+    out: list[GenerationEvent] = []
+    stop = int(np.searchsorted(times[:-1], t_end, "left"))    # steps run: t < t_end
+    usable = times[:stop]
+    for i, g in active:
+        limit = g.end + 0.1 * g.update_step
+        k = 0
+        while True:
+            # earliest time the three conditions of IsNeedToBeGenerated can all hold
+            need = max(g.start, last[i] + g.update_step, (last[i] - g.start) + 1.0 / g.rate)
+            k = int(np.searchsorted(usable, need, "left"))
+            while k < len(usable) and (usable[k] < last[i] + g.update_step
+                                       or usable[k] < g.start
+                                       or g.count_at(float(usable[k]), last[i]) < 1):
+                k += 1                       # rounding at the threshold: step on
+            if k >= len(usable) or usable[k] > limit:
+                break
+            t = float(usable[k])
+            out.append(GenerationEvent(first + k, t, i, g.count_at(t, last[i])))
+            last[i] = t
+    return out
+
+
+def next_fraction(generated: list[int], targets: list[float]) -> int:
+    """``MixtureFractionIndexToGenerate``: the mixture fraction of the next sphere, given the
+    spheres made so far of each fraction (successes only) and the target number fractions:
+    the first fraction below its target, else the first."""
+    total = sum(generated)
+    if total == 0:
+        return 0
+    for i, (made, target) in enumerate(zip(generated, targets)):
+        if made / total < target:
+            return i
+    return 0
+
+
+def refuse_active(storage: Any, path: Path, dt: float) -> None:
+    """Refuse a scene with an active generator that generates anything in its own time window
+    (fibrelmp does not insert objects into a running LAMMPS job; the window, not the run's end,
+    because a job script may still change the end time); every active generator's settings
+    are checked first, so the message names the first thing MUSEN itself would stop at."""
+    generators = read_generators(storage)
+    for g in generators:
+        if g.active:
+            check_generator(g, storage, path)
+    window = max((g.end + g.update_step for g in generators if g.active), default=0.0)
+    step = dt if dt > 0 else MUSEN_DEFAULT_STEP           # nan: the file sets no step
+    events = generation_schedule(generators, step, window, first_only=True)
+    if events:
+        g = generators[events[0].generator]
+        raise _field(path, g, "activity", f"asks for {events[0].requested} object(s) at "
+                     f"t = {events[0].time:.6g} s (with the file's step), and more later; inserting "
+                     "particles during a run is not implemented in fibrelmp: deactivate the "
+                     "generator or generate the particles before the run")

@@ -225,3 +225,32 @@ def test_example6_runs_unchanged_and_falls_as_cmusen(tmp_path):
     scale, half_step = 9.81 * 1e-4, 9.81 * 2e-7 / 2
     np.testing.assert_allclose(mean_vz, np.array(ref["mass_mean_vz"]) + np.where(times > 0, half_step, 0),
                                atol=1e-6 * scale, rtol=0)
+
+
+@pytest.mark.skipif(not os.environ.get("FIBRELMP_CMUSEN"), reason="set FIBRELMP_CMUSEN to the real cmusen")
+def test_with_cmusen_a_new_packing_gets_cmusens_bonds(tmp_path):
+    """cmusen makes a new random packing and its bonds (job_generators.txt); fibrelmp's bonds
+    generator on that packing gives the same bonds, and the packing has the stored statistics."""
+    from fibrelmp.translate.musen.generators import bonds
+    from fibrelmp.translate.musen.generators.scene import read_generator_scene
+    from fibrelmp.translate.musen.mdem.objects import SOLID_BOND
+
+    shutil.copy(SCENE, tmp_path / "PackingGeneration.mdem")
+    shutil.copy(DATA / "job_generators.txt", tmp_path / "job.txt")
+    done = subprocess.run([os.environ["FIBRELMP_CMUSEN"], "-t=1", "-s=job.txt"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=300)
+    assert "Error" not in done.stdout, done.stdout
+    cmusen = _statistics(tmp_path / "small_packing.mdem", [0.002, 0.0022, 0.0024, 0.0025])
+    _compare(cmusen, STATS["small_packing"], 1e-7)
+    scene = read_generator_scene(tmp_path / "small_packing.mdem")
+    bonds.generate_bonds(scene, [bonds.BondClass(compound="CG9ZE5YQBM", max_distance=1e-3, diameter=1.5e-3)])
+
+    def listed(objs):
+        b = objs.types == SOLID_BOND
+        return {(min(i, j), max(i, j)): (d, length) for i, j, d, length in
+                zip(objs.left[b].tolist(), objs.right[b].tolist(), objs.diameter[b].tolist(),
+                    objs.length0[b].tolist())}
+    mine, theirs = listed(scene.objects()), listed(read_generator_scene(tmp_path / "small_bonds.mdem").objects())
+    assert set(mine) == set(theirs) and len(theirs) > 50
+    for pair, (d, length) in theirs.items():
+        assert mine[pair][0] == d and mine[pair][1] == pytest.approx(length, rel=4e-16)

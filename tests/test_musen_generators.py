@@ -254,3 +254,13 @@ def test_with_cmusen_a_new_packing_gets_cmusens_bonds(tmp_path):
     assert set(mine) == set(theirs) and len(theirs) > 50
     for pair, (d, length) in theirs.items():
         assert mine[pair][0] == d and mine[pair][1] == pytest.approx(length, rel=4e-16)
+
+
+def test_spheres_too_large_for_the_volume_are_refused(tmp_path):
+    """cmusen's IsDataCorrect: largest contact diameter above 0.95 of the volume's
+    MaxInscribedDiameter (for this cylinder min(r, h) = 0.02 m)."""
+    shutil.copy(SCENE, tmp_path / "PackingGeneration.mdem")
+    (tmp_path / "job.txt").write_text(SMALL + "MIXTURE_PROPERTY 1 4 BWLPWOW76F 0.0191 0.0191 0.2\n")
+    done = _cli(["run", "job.txt"], tmp_path)
+    assert done.returncode == 2 and "job.txt:4: package generator 1 (Generator): particle diameter " \
+        "(0.0191 m) is too large" in done.stderr, done.stderr

@@ -95,11 +95,19 @@ def _generate(scene: Scene, g, k: int, meshes: dict, job, rng, say: Say) -> pack
     tri, described = meshes[g.volume_key]
     normals = mesh.inward_normals(tri)
     vol = volume_to_fill(described["shape"], described["sizes"], tri)
+    largest = float(fr.contact.max())
+    if 0.95 * max_inscribed_diameter(described["shape"], described["sizes"], vol) < largest:
+        raise InputError(job.path, job.where("COMPONENT"), f"package generator {k + 1} "
+                         f"({g.volume_name}): particle diameter ({largest:g} m) is too large for "
+                         "the generation volume (cmusen refuses it too)")
     counts = package.particles_per_fraction(fr, vol, g.porosity)
     contact = (fr.contact if scene.info.contact_radius else fr.diameter) / 2
     t0 = time.perf_counter()
     fixed_x, fixed_r = package.existing_spheres(scene, tri)
-    x, frac = package.place(tri, normals, counts, contact, fixed_x, fixed_r, rng)
+    try:
+        x, frac = package.place(tri, normals, counts, contact, fixed_x, fixed_r, rng)
+    except ValueError as exc:
+        raise InputError(job.path, job.where("COMPONENT"), f"package generator {k + 1}: {exc}") from None
     n = len(x)
     allx = np.concatenate([x, fixed_x])
     rc = np.concatenate([contact[frac], fixed_r])
@@ -124,6 +132,13 @@ def volume_to_fill(shape: int, sizes: list[float], tri: np.ndarray) -> float:
     own = {0: 4.0 * np.pi * r ** 3 / 3.0, 1: w * d * h, 2: np.pi * r * r * h,
            3: 4.0 * np.pi / 3.0 * (r ** 3 - ri ** 3)}
     return float(own[shape]) if shape in own else mesh.volume(tri)
+
+
+def max_inscribed_diameter(shape: int, sizes: list[float], volume: float) -> float:
+    """``CAnalysisVolume::MaxInscribedDiameter`` (MUSEN's own rule, radius for a sphere)."""
+    w, d, h, r, ri = sizes
+    own = {0: r, 3: r - ri, 2: min(r, h), 1: min(w, d, h)}
+    return own.get(shape, (volume / np.pi * 3 / 4) ** (1 / 3) * 2)
 
 
 def _bond_classes(scene: Scene, job) -> list[bonds.BondClass]:

@@ -112,7 +112,8 @@ def place(tri: np.ndarray, normals: np.ndarray, counts: list[int], contact: np.n
         fs.append(frac[ok])
         left = [n - int((frac[ok] == k).sum()) for k, n in enumerate(left)]
     else:
-        raise RuntimeError("the generation volume takes no sphere of this mixture")
+        raise ValueError("the generation volume takes no sphere of this mixture after "
+                         "10000 random drops")
     return np.concatenate(xs), np.concatenate(fs)
 
 

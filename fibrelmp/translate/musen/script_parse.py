@@ -227,7 +227,7 @@ def _keyword(job: MusenJob, line: _Line) -> None:
                              f"({_IGNORED[key]})"))
     elif key in _OTHER_COMPONENT_KEYS:
         pass                            # read by components fibrelmp refuses; no effect here
-    elif not any(ch.isalnum() for ch in key):     # a stray character (MUSEN's Example 6 has one)
+    elif not line.tok and not any(ch.isalnum() for ch in key):   # a lone stray mark (Example 6's ´)
         job.warnings.append(("musen-ignored-keyword", f"{line.path}:{line.ln}: {key!r} skipped "
                              "(not a keyword; cmusen skips it as an unknown key)"))
     else:

@@ -266,19 +266,16 @@ def test_spheres_too_large_for_the_volume_are_refused(tmp_path):
         "(0.0191 m) is too large" in done.stderr, done.stderr
 
 
-def test_only_a_lone_stray_mark_is_skipped():
+def test_only_a_lone_stray_mark_is_skipped(tmp_path):
     """Example 6's `´` line is skipped with a warning (cmusen: unknown key); other
     unknown lines stay errors."""
     from fibrelmp.errors import InputError
     from fibrelmp.translate.musen.script_parse import read_script
 
-    (job,) = read_script(DATA / "example6_as_shipped.txt")[:1]
+    job = read_script(DATA / "example6_as_shipped.txt")[0]
     assert job.component == "PACKAGE_GENERATOR" and "'´' skipped" in job.warnings[0][1]
-    bad = Path(DATA / "example6_as_shipped.txt").read_text(encoding="utf-8").replace("´", "´ x")
-    path = Path(os.environ.get("TMPDIR", "/tmp")) / "fibrelmp-stray-test.txt"
-    path.write_text(bad, encoding="utf-8")
-    try:
-        with pytest.raises(InputError, match="unknown cmusen keyword"):
-            read_script(path)
-    finally:
-        path.unlink()
+    path = tmp_path / "job.txt"
+    path.write_text((DATA / "example6_as_shipped.txt").read_text(encoding="utf-8").replace("´", "´ x"),
+                    encoding="utf-8")
+    with pytest.raises(InputError, match="unknown cmusen keyword"):
+        read_script(path)

@@ -279,3 +279,60 @@ def test_only_a_lone_stray_mark_is_skipped(tmp_path):
                     encoding="utf-8")
     with pytest.raises(InputError, match="unknown cmusen keyword"):
         read_script(path)
+
+
+BOUNCE = data_path("real-outputs/musen/bounce/bounce_result.mdem")
+
+
+@pytest.mark.parametrize("time, reference", [(0.0006, "snap_bounce_saved.mdem"),
+                                             (0.00111, "snap_bounce_between.mdem")])
+def test_snapshot_is_cmusens(tmp_path, time, reference):
+    """SNAPSHOT_GENERATOR of cmusen's bounce result at a saved time and between two: the
+    objects, every value and every field flag of cmusen's snapshot (job_snapshot.txt)."""
+    from fibrelmp.translate.musen.mdem.document import MdemFile
+
+    shutil.copy(BOUNCE, tmp_path / "bounce_result.mdem")
+    (tmp_path / "job.txt").write_text("JOB\nSOURCE_FILE ./bounce_result.mdem\nRESULT_FILE ./snap.mdem\n"
+                                      f"COMPONENT SNAPSHOT_GENERATOR\nSNAPSHOT_TIME {time!r}\n")
+    done = _cli(["run", "job.txt"], tmp_path)
+    assert done.returncode == 0, done.stderr
+    with MdemFile(tmp_path / "snap.mdem") as mine, MdemFile(DATA / reference) as theirs:
+        assert [p.SerializeToString() for p in mine.info.particles] == \
+            [p.SerializeToString() for p in theirs.info.particles]
+        (t1, v1, m1), = list(mine.time_points())
+        (t2, v2, m2), = list(theirs.time_points())
+        assert t1 == t2 == 0.0 and np.array_equal(v1, v2) and np.array_equal(m1, m2)
+
+
+def test_snapshot_after_the_last_saved_time_is_refused(tmp_path):
+    shutil.copy(BOUNCE, tmp_path / "bounce_result.mdem")
+    (tmp_path / "job.txt").write_text("JOB\nSOURCE_FILE ./bounce_result.mdem\nRESULT_FILE ./snap.mdem\n"
+                                      "COMPONENT SNAPSHOT_GENERATOR\nSNAPSHOT_TIME 1\n")
+    done = _cli(["run", "job.txt"], tmp_path)
+    assert done.returncode == 2 and "job.txt:5: SNAPSHOT_TIME 1 is outside the saved times" in done.stderr
+    assert not (tmp_path / "snap.mdem").exists()
+
+
+@pytest.mark.skipif(not os.environ.get("FIBRELMP_CMUSEN"), reason="set FIBRELMP_CMUSEN to the real cmusen")
+def test_with_cmusen_a_bonded_snapshot_is_cmusens(tmp_path):
+    """cmusen: packing + bonds (job_generators.txt), 3e-5 s of simulation and a snapshot
+    between saves (job_snapshot.txt); fibrelmp's snapshot of that result equals cmusen's."""
+    from types import SimpleNamespace
+
+    from fibrelmp.translate.musen.generators.snapshot import snapshot
+    from fibrelmp.translate.musen.mdem.document import MdemFile
+
+    shutil.copy(SCENE, tmp_path / "PackingGeneration.mdem")
+    shutil.copy(BOUNCE, tmp_path / "bounce_result.mdem")
+    for script in ("job_generators.txt", "job_snapshot.txt"):
+        shutil.copy(DATA / script, tmp_path / script)
+        done = subprocess.run([os.environ["FIBRELMP_CMUSEN"], "-t=1", f"-s={script}"], cwd=tmp_path,
+                              capture_output=True, text=True, timeout=300)
+        assert "Error" not in done.stdout, done.stdout
+    scene = snapshot(tmp_path / "bonded_result.mdem",
+                     SimpleNamespace(path=tmp_path / "job.txt", where=lambda key: 1, snapshot_time=1.3e-5))
+    with MdemFile(tmp_path / "snap_bonded_between.mdem") as theirs:
+        (_, values, masks), = list(theirs.time_points())
+        assert [p.SerializeToString() for p in theirs.info.particles] == \
+            [p.SerializeToString() for p in scene.info.particles]
+    assert np.array_equal(values, scene.values) and np.array_equal(masks, scene.masks)

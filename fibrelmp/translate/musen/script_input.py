@@ -316,7 +316,7 @@ class _Planner:
             return self.simulate(job)
         if job.component == "EXPORT_TO_TEXT":
             return self.export(job)
-        if job.component in ("PACKAGE_GENERATOR", "BONDS_GENERATOR"):
+        if job.component in ("PACKAGE_GENERATOR", "BONDS_GENERATOR", "SNAPSHOT_GENERATOR"):
             return self.generate(job)
         raise InputError(job.path, job.where("COMPONENT"), f"COMPONENT {job.component} is "
                          "not supported (fibrelmp runs SIMULATOR, IMPORT_FROM_TEXT and "

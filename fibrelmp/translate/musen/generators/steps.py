@@ -1,4 +1,4 @@
-"""Generator jobs of a cmusen script (PACKAGE_GENERATOR, BONDS_GENERATOR)
+"""Generator jobs of a cmusen script (PACKAGE_GENERATOR, BONDS_GENERATOR, SNAPSHOT_GENERATOR)
 for ``script_input``'s planner.
 
 A generator is pre-processing: it runs while the script is planned (seconds), so that a
@@ -17,7 +17,8 @@ from typing import Callable
 from fibrelmp.errors import InputError
 
 Say = Callable[[str], None]
-KINDS = {"PACKAGE_GENERATOR": "package", "BONDS_GENERATOR": "bonds"}
+KINDS = {"PACKAGE_GENERATOR": "package", "BONDS_GENERATOR": "bonds",
+         "SNAPSHOT_GENERATOR": "snapshot"}
 
 
 class GeneratedFiles:
@@ -66,15 +67,17 @@ def remember_import(handle: Path, text_source: Path, made: GeneratedFiles) -> No
 
 def run_generator(job, source: Path, handle: Path, made: GeneratedFiles, say: Say):
     """Runs the job's generator now; the scene it made (a ``GranularModel``)."""
-    from fibrelmp.translate.musen.generators import jobs
+    from fibrelmp.translate.musen.generators import jobs, snapshot
     from fibrelmp.translate.musen.mdem.model import read_scene
 
     kind = KINDS[job.component]
     lines: list[str] = []
     if kind == "package":
         scene = jobs.run_package_generator(source, job, lines.append)
-    else:
+    elif kind == "bonds":
         scene = jobs.run_bonds_generator(source, job, lines.append)
+    else:
+        scene = snapshot.snapshot(source, job)
     target = made.new(handle)
     with open(target, "w+b") as fh:
         scene.write(fh)

@@ -203,9 +203,9 @@ def test_no_other_exception_escapes(tmp_path):
 
 SCRIPT_ERRORS = [
     ("SIMULATION_STEPP 1e-8\n", 1, "did you mean SIMULATION_STEP?"),
-    ("JOB\nCOMPONENT PACKAGE_GENERATOR\n", 2, "not supported"),
+    ("JOB\nCOMPONENT RESULTS_ANALYZER\n", 2, "not supported"),
     ("JOB\nCOMPONENT SIMULATR\n", 2, "did you mean SIMULATOR?"),
-    ("COMPONENT 4\n", 1, "SNAPSHOT_GENERATOR is not supported"),
+    ("COMPONENT 1\n", 1, "RESULTS_ANALYZER is not supported"),
     ("SIMULATION_STEP abc\n", 1, "expected a number, got 'abc'"),
     ("SIMULATION_STEP -1e-8\n", 1, "positive"),
     ("END_TIME\n", 1, "needs 1 number"),

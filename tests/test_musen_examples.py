@@ -106,7 +106,7 @@ def test_mdem_result_name_gives_an_mdem_result(tmp_path):
     ("JOB\nSOURCE_FILE r.mdem\nRESULT_FILE ./r.txt\nCOMPONENT EXPORT_TO_TEXT\n",
      "no earlier job of this script produced it"),
     ("JOB\nSOURCE_FILE SingelParticle_text.txt\nRESULT_FILE r.mdem\nCOMPONENT PACKAGE_GENERATOR\n",
-     "PACKAGE_GENERATOR"),
+     "IMPORT_FROM_TEXT"),
 ])
 def test_script_errors_exit_2(tmp_path, script, message):
     folder = _example(tmp_path, "SingelParticle_text.txt")

@@ -83,6 +83,8 @@ class ScriptInput(InputFormat):
                 steps.append(Action(partial(_announce, st, say, warn)))
                 steps.append(_simulation(st, work / f"job{st.job.index}", spools,
                                          outputs, settings.also))
+            elif st.kind == "generate":
+                steps.append(Action(partial(_generated, st, say)))
             else:
                 steps.append(Action(partial(_import if st.kind == "import" else _export, st, spools, say)))
 
@@ -137,6 +139,17 @@ def _import(step: "ScriptStep", spools: dict, say: Say, rank0: bool) -> list[Pat
         written = [step.written]
     say(f"job {job.index}: imported {job.source_file} ({step.model.spheres.count} spheres) as "
         f"{step.written.name}")
+    return written
+
+
+def _generated(step: "ScriptStep", say: Say, rank0: bool) -> list[Path]:
+    """PACKAGE_GENERATOR / BONDS_GENERATOR: the scene generated while planning, written."""
+    from fibrelmp.translate.musen.generators.steps import write_generated
+
+    written = [write_generated(step.handle, step.written, step.generated)] if rank0 else []
+    say(f"job {step.job.index}: {step.job.component} wrote {step.written.name} "
+        f"({step.model.spheres.count} spheres, "
+        f"{0 if step.model.bonds is None else step.model.bonds.count} bonds)")
     return written
 
 
@@ -244,7 +257,7 @@ def _path_resolver(script: Path):
 class ScriptStep:
     """One job of a cmusen script, resolved and checked before anything runs."""
     job: object                          # MusenJob
-    kind: str                            # "import" | "simulate" | "export"
+    kind: str                            # "import" | "simulate" | "export" | "generate"
     handle: Path | None = None           # the .mdem name it makes (import/simulate)
     source: Path | None = None           # what it reads (import: the text; export: the handle or file)
     model: GranularModel | None = None   # import: the scene; simulate: scene + settings;
@@ -252,6 +265,7 @@ class ScriptStep:
     written: Path | None = None          # the file it writes, if any
     spool: bool = False                  # simulate: keep the frames for a later export
     notes: list[str] = field(default_factory=list)
+    generated: object = None             # generate: the GeneratedFiles holding its .mdem
 
 
 @dataclass
@@ -292,6 +306,8 @@ class _Planner:
                          if j.component == "EXPORT_TO_TEXT" and j.source_file}
         self.handles: dict[Path, tuple[str, GranularModel]] = {}
         self.inputs: list[Path] = [script]
+        self.generated = None                 # generators.steps.GeneratedFiles, when needed
+        self.imported: dict[Path, Path] = {}  # handle -> text scene it was imported from
 
     def step(self, job) -> ScriptStep:
         if job.component == "IMPORT_FROM_TEXT":
@@ -300,6 +316,8 @@ class _Planner:
             return self.simulate(job)
         if job.component == "EXPORT_TO_TEXT":
             return self.export(job)
+        if job.component in ("PACKAGE_GENERATOR", "BONDS_GENERATOR", "SNAPSHOT_GENERATOR"):
+            return self.generate(job)
         raise InputError(job.path, job.where("COMPONENT"), f"COMPONENT {job.component} is "
                          "not supported (fibrelmp runs SIMULATOR, IMPORT_FROM_TEXT and "
                          "EXPORT_TO_TEXT jobs)")
@@ -310,7 +328,36 @@ class _Planner:
         self.inputs.append(source)
         handle = self.path_of(job.result_file, job, "RESULT_FILE")
         self.handles[handle] = ("scene", model)
+        self.imported[handle] = source
+        if self.generated is not None:
+            from fibrelmp.translate.musen.generators.steps import remember_import
+
+            remember_import(handle, source, self.generated)
         step = ScriptStep(job, "import", handle=handle, source=source, model=model)
+        self.result(step)
+        return step
+
+    def generate(self, job) -> ScriptStep:
+        """A generator job: run now (pre-processing), its scene handed on like an import's."""
+        from fibrelmp.translate.musen.generators import steps
+
+        if self.generated is None:
+            self.generated = steps.GeneratedFiles()
+            for handle, (kind, _) in self.handles.items():
+                if kind == "scene" and handle in self.imported:
+                    steps.remember_import(handle, self.imported[handle], self.generated)
+        source = self.path_of(job.source_file, job, "SOURCE_FILE")
+        mdem = steps.source_mdem(job, source, self.handles, self.generated)
+        if source not in self.handles and source not in self.generated.files:
+            self.inputs.append(source)
+        handle = self.path_of(job.result_file, job, "RESULT_FILE")
+        notes: list[str] = []
+        model = steps.run_generator(job, mdem, handle, self.generated, notes.append)
+        self.handles[handle] = ("scene", model)
+        step = ScriptStep(job, "generate", handle=handle, source=mdem, model=model,
+                          notes=[f"job {job.index} ({job.component}): {n.strip()}" for n in notes]
+                          + [message for _, message in job.warnings])
+        step.generated = self.generated
         self.result(step)
         return step
 
@@ -335,7 +382,9 @@ class _Planner:
 
     def export(self, job) -> ScriptStep:
         source = self.path_of(job.source_file, job, "SOURCE_FILE")
-        if source in self.handles:
+        if self.generated is not None and source in self.generated.files and source not in self.imported:
+            model, source = None, self.generated.files[source]     # MUSEN's exporter on it
+        elif source in self.handles:
             model = self.handles[source][1]
         elif is_mdem(source) and source.exists():
             from fibrelmp.translate.musen.mdem.document import MdemFile

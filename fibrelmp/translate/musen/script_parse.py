@@ -25,9 +25,9 @@ from fibrelmp.translate.musen.text_writer import EXPORT_FLAGS, all_on
 from fibrelmp.textio import read_text
 
 COMPONENTS = {"SIMULATOR": "SIMULATOR", "IMPORT_FROM_TEXT": "IMPORT_FROM_TEXT",
-              "EXPORT_TO_TEXT": "EXPORT_TO_TEXT"}
-OTHER_COMPONENTS = ("PACKAGE_GENERATOR", "RESULTS_ANALYZER", "BONDS_GENERATOR",
-                    "SNAPSHOT_GENERATOR", "COMPARE_FILES")
+              "EXPORT_TO_TEXT": "EXPORT_TO_TEXT", "PACKAGE_GENERATOR": "PACKAGE_GENERATOR",
+              "BONDS_GENERATOR": "BONDS_GENERATOR", "SNAPSHOT_GENERATOR": "SNAPSHOT_GENERATOR"}
+OTHER_COMPONENTS = ("RESULTS_ANALYZER", "COMPARE_FILES")
 _COMPONENT_NUMBERS = ["PACKAGE_GENERATOR", "RESULTS_ANALYZER", "BONDS_GENERATOR", "SIMULATOR",
                       "SNAPSHOT_GENERATOR", "EXPORT_TO_TEXT", "IMPORT_FROM_TEXT", "COMPARE_FILES"]
 MATERIAL_PROPERTIES = {"DENSITY": 0, "HEAT_CAPACITY": 1, "DYNAMIC_VISCOSITY": 2,
@@ -72,11 +72,7 @@ _IGNORED = {
     "MAX_PART_MOVE": "only for a variable time step", "STEP_INC_FACTOR": "only for a variable time step",
 }
 # keywords only the generator / analyser / snapshot components read: accepted, no effect
-_OTHER_COMPONENT_KEYS = ("AGGLOMERATES_DB", "SNAPSHOT_TIME", "MIXTURE_PROPERTY", "PACK_GEN_VOLUME",
-                         "PACK_GEN_MIXTURE", "PACK_GEN_POROSITY", "PACK_GEN_OVERLAP",
-                         "PACK_GEN_ITERATIONS", "PACK_GEN_VELOCITY", "PACK_GEN_INSIDE",
-                         "BOND_GEN_MATERIAL", "BOND_GEN_MINDIST", "BOND_GEN_MAXDIST",
-                         "BOND_GEN_DIAMETER", "BOND_GEN_OVERLAY")
+_OTHER_COMPONENT_KEYS = ("AGGLOMERATES_DB",)
 
 
 @dataclass
@@ -127,6 +123,11 @@ class MusenJob:
     refused: list[tuple[str, int, str]] = field(default_factory=list)   # (keyword, line, why)
     warnings: list[tuple[str, str]] = field(default_factory=list)
     lines: dict[str, int] = field(default_factory=dict)                  # keyword -> last line
+    # generator components (PACK_GEN_* / BOND_GEN_* by 1-based generator index)
+    package_generators: dict[int, dict] = field(default_factory=dict)
+    bond_generators: dict[int, dict] = field(default_factory=dict)
+    mixture_properties: list[tuple[int, int, str, float, float, float, int]] = field(default_factory=list)
+    snapshot_time: float = 0.0
 
     def where(self, keyword: str) -> int:
         return self.lines.get(keyword, self.line)
@@ -228,6 +229,9 @@ def _keyword(job: MusenJob, line: _Line) -> None:
                              f"({_IGNORED[key]})"))
     elif key in _OTHER_COMPONENT_KEYS:
         pass                            # read by components fibrelmp refuses; no effect here
+    elif not line.tok and not any(ch.isalnum() for ch in key):   # a lone stray mark (Example 6's ´)
+        job.warnings.append(("musen-ignored-keyword", f"{line.path}:{line.ln}: {key!r} skipped "
+                             "(not a keyword; cmusen skips it as an unknown key)"))
     else:
         near = difflib.get_close_matches(key, _known_keys(), n=1, cutoff=0.6)
         hint = f"; did you mean {near[0]}?" if near else ""
@@ -241,8 +245,8 @@ def _component(job: MusenJob, line: _Line) -> None:
     if value in COMPONENTS:
         job.component = COMPONENTS[value]
     elif value in OTHER_COMPONENTS:
-        raise line.error(f"{value} is not supported by fibrelmp (only SIMULATOR, "
-                         "IMPORT_FROM_TEXT and EXPORT_TO_TEXT)")
+        raise line.error(f"{value} is not supported by fibrelmp (MUSEN's examples and "
+                         "tutorials use none; fibrelmp runs " + ", ".join(COMPONENTS) + ")")
     else:
         near = difflib.get_close_matches(value, list(COMPONENTS) + list(OTHER_COMPONENTS), n=1)
         raise line.error(f"unknown component {value!r}" + (f"; did you mean {near[0]}?"
@@ -409,7 +413,48 @@ def _set(attr: str):
     return handler
 
 
+# PACK_GEN_<key> / BOND_GEN_<key> INDEX VALUE...: (setting name, how the value reads)
+_GENERATOR_KEYS = {
+    "PACK_GEN_VOLUME": ("volume", "text"), "PACK_GEN_MIXTURE": ("mixture", "text"),
+    "PACK_GEN_POROSITY": ("porosity", 1), "PACK_GEN_OVERLAP": ("overlap", 1),
+    "PACK_GEN_ITERATIONS": ("iterations", 1), "PACK_GEN_VELOCITY": ("velocity", 3),
+    "PACK_GEN_INSIDE": ("inside", "flag"), "BOND_GEN_MATERIAL": ("material", "text"),
+    "BOND_GEN_MINDIST": ("min", 1), "BOND_GEN_MAXDIST": ("max", 1),
+    "BOND_GEN_DIAMETER": ("diameter", 1), "BOND_GEN_OVERLAY": ("overlay", "flag"),
+}
+
+
+def _generator_key(job: MusenJob, line: _Line) -> None:
+    name, kind = _GENERATOR_KEYS[line.key]
+    index = line.tok[0] if line.tok else ""
+    if not index.isdigit() or int(index) < 1:
+        raise line.error(f"needs the generator's number (1, 2, ...) first, got {line.rest!r}")
+    rest = _Line(line.path, line.ln, line.key, line.rest[len(line.tok[0]):].strip())
+    if kind == "text":
+        value = rest.text()
+    elif kind == "flag":
+        value = rest.flag()
+    else:
+        value = rest.floats(kind) if kind > 1 else rest.floats(1)[0]
+    table = job.package_generators if line.key.startswith("PACK") else job.bond_generators
+    table.setdefault(int(index), {})[name] = value
+
+
+def _mixture_property(job: MusenJob, line: _Line) -> None:
+    if len(line.tok) != 6:
+        raise line.error(f"needs 6 values: MIXTURE FRACTION COMPOUND_KEY DIAMETER "
+                         f"CONTACT_DIAMETER FRACTION, got {len(line.tok)} (cmusen reads a missing "
+                         "value as 0)")
+    mix, frac = _Line(line.path, line.ln, line.key, " ".join(line.tok[:2])).floats(2)
+    d, dc, share = _Line(line.path, line.ln, line.key, " ".join(line.tok[3:])).floats(3)
+    if mix != int(mix) or frac != int(frac) or mix < 1 or frac < 1:
+        raise line.error("the mixture and fraction numbers count from 1")
+    job.mixture_properties.append((int(mix), int(frac), line.tok[2], d, dc, share, line.ln))
+
+
 _HANDLERS = {
+    **{key: _generator_key for key in _GENERATOR_KEYS},
+    "MIXTURE_PROPERTY": _mixture_property, "SNAPSHOT_TIME": _number("snapshot_time", False),
     "SOURCE_FILE": _set("source_file"), "RESULT_FILE": _set("result_file"),
     "RESULTS_FILE": _set("result_file"), "COMPONENT": _component,
     "SIMULATOR_TYPE": _simulator_type,

@@ -289,7 +289,9 @@ def relevant_sizes(shape: int, sizes: list[float]) -> list[float]:
 def _volume(vol: Any, tok: list[str], path: Path, ln: int) -> None:
     base = vol.base_geometry
     _base(base, tok[0], tok[1])
-    v = _floats(tok[2:23], path, ln, "38")
+    # shape, colour (4), sizes (5), scaling, rotation (9): 20 numbers (operator<< of
+    # CAnalysisVolume), then the motion
+    v = _floats(tok[2:22], path, ln, "38")
     base.shape = int(v[0])
     base.color.r, base.color.g, base.color.b, base.color.a = v[1:5]
     del base.sizes[:]
@@ -297,7 +299,7 @@ def _volume(vol: Any, tok: list[str], path: Path, ln: int) -> None:
     base.scaling = v[10]
     for row, msg in zip(range(3), (base.rotation.v1, base.rotation.v2, base.rotation.v3)):
         set_vector(msg, v[11 + 3 * row: 14 + 3 * row])
-    rest = tok[23:]
+    rest = tok[22:]
     kind = int(float(rest[0]))
     count = int(float(rest[1])) if kind else 0
     _motion(base.motion, rest[:2 + 11 * count], path, ln)

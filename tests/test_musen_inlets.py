@@ -1,0 +1,200 @@
+"""MUSEN's dynamic generators (inlets) against the real cmusen's inlet-into-a-box run
+(tests/data/real-outputs/musen/inlet/README.md): settings, generation times and counts, ids,
+activity starts, radii per mixture fraction, positions and velocities at generation; and the
+refusal of a run that needs them.  cmusen seeds its random positions with the wall clock, so
+positions are compared as statistics (inside the volume, no overlap), not value by value."""
+
+from __future__ import annotations
+
+import gzip
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fibrelmp import python_api
+from fibrelmp.errors import InputError
+from fibrelmp.translate.musen.mdem import generators as gen
+from fibrelmp.translate.musen.mdem.document import MdemFile
+
+from .conftest import data_path
+from .musen_model_checks import CMUSEN, needs_cmusen
+
+DATA = data_path("real-outputs", "musen", "inlet")
+SCENE = DATA / "inlet_scene.mdem"
+DT, END = 1e-6, 0.02                                   # job_inlet.txt
+VOLUME_LO, VOLUME_HI = np.array([-0.004, -0.004, 0.007]), np.array([0.004, 0.004, 0.011])
+
+
+def _storage():
+    with MdemFile(SCENE) as f:
+        return f.storage
+
+
+_WIDTH = {16: 3, 12: 3, 20: 3, 18: 1, 31: 4, 42: 3, 36: 9, 37: 1, 15: 3}   # sphere tags
+
+
+def _records(tok: list[str]) -> list[tuple[float, dict[int, list[float]]]]:
+    """The time records of an object line from its first ``2``: (time, tag -> values)."""
+    out, k = [], 12
+    while k < len(tok):
+        assert tok[k] == "2"
+        rec: dict[int, list[float]] = {}
+        t, k = float(tok[k + 1]), k + 2
+        while k < len(tok) and tok[k] != "2":
+            tag = int(tok[k])
+            rec[tag] = [float(x) for x in tok[k + 1:k + 1 + _WIDTH[tag]]]
+            k += 1 + _WIDTH[tag]
+        out.append((t, rec))
+    return out
+
+
+def _spheres(text: str) -> dict:
+    """Per sphere of a cmusen text result: id, radius, compound, activity start (6 digits, as
+    MUSEN writes it) and its first saved time point at or after it (time, coord, velocity);
+    ``saves``: every saved time."""
+    out: dict = {"id": [], "r": [], "mat": [], "start": [], "first": [], "saves": None}
+    for line in text.splitlines():
+        tok = line.split()
+        if len(tok) < 12 or tok[0] != "0" or tok[3] != "1":
+            continue
+        records = _records(tok)
+        out["saves"] = np.array([t for t, _ in records])
+        out["id"].append(int(tok[1]))
+        out["r"].append(float(tok[5]))
+        out["mat"].append(tok[8])
+        out["start"].append(tok[10])
+        t, rec = next((t, rec) for t, rec in records if "%g" % t >= tok[10] and t >= float(tok[10]))
+        out["first"].append((t, rec[12], rec[15]))
+    return out
+
+
+@pytest.fixture(scope="module")
+def cmusen_result() -> dict:
+    with gzip.open(DATA / "inlet_result_prec17.txt.gz", "rt") as fh:
+        return _spheres(fh.read())
+
+
+def test_settings_read_as_musen_loads_them():
+    a, b = gen.read_generators(_storage())
+    assert (a.name, a.volume_key, a.mixture_key, a.objects) == ("InletA", "VINLET", "MIXONE", 1)
+    assert a.random_velocity and a.velocity_magnitude == 0.5 and a.rate == 10000.0
+    assert (a.start, a.end, a.update_step, a.max_iterations) == (0.0, 0.015, 1e-3, 30)
+    assert b.init_velocity == (0.0, 0.0, -0.5) and not b.random_velocity
+    assert b.rate_type == gen.RATE_PER_UPDATE and b.rate == pytest.approx(1500.0, rel=1e-15)
+
+
+def test_schedule_gives_cmusens_generation_times(cmusen_result):
+    """Every generation cmusen made happened at a scheduled event, each event made something,
+    in the schedule's order (ids ascending with the events), never more than requested."""
+    events = gen.generation_schedule(gen.read_generators(_storage()), DT, END)
+    assert len(events) == 20
+    starts = cmusen_result["start"]
+    ids = np.array(cmusen_result["id"])
+    assert (ids == np.arange(10, 10 + len(ids))).all()        # after the 10 walls, compact
+    labels = ["%g" % e.time for e in events]
+    made = [starts.count(lab) for lab in labels]
+    assert sum(made) == len(starts) == 183
+    order = [labels.index(s) for s in starts]
+    assert order == sorted(order)
+    assert all(1 <= m <= e.requested for m, e in zip(made, events))
+    # uncrowded at first: exactly the requested numbers; InletB's first 12 (not 2 dt 1500 = 3
+    # per update step) is MUSEN's start-time arithmetic, floor((t - (0 - 0.004)) 1500)
+    assert [e.requested for e in events[:4]] == made[:4] == [10, 10, 10, 12]
+    assert [e.generator for e in events[:4]] == [0, 0, 0, 1]
+    assert events[1].step == 2001 and events[3].step == 4000      # drift of the summed time
+
+
+def test_radii_follow_the_mixture_fractions(cmusen_result):
+    events = gen.generation_schedule(gen.read_generators(_storage()), DT, END)
+    labels = ["%g" % e.time for e in events]
+    radii = np.array(cmusen_result["r"])
+    which = np.array([events[labels.index(s)].generator for s in cmusen_result["start"]])
+    assert (radii[which == 0] == 0.0005).all()
+    made = [0, 0]
+    expected = []
+    for _ in range(int((which == 1).sum())):
+        i = gen.next_fraction(made, [0.5, 0.5])
+        made[i] += 1
+        expected.append([0.0004, 0.0006][i])
+    np.testing.assert_allclose(radii[which == 1], expected, rtol=1e-15)
+    assert set(cmusen_result["mat"]) == {"MGLASS"}
+
+
+def test_objects_at_a_save_of_their_generation_step(cmusen_result):
+    """Spheres generated on a saving step are saved as generated: totally inside the volume,
+    free of each other, with the generator's velocity (|v| = 0.5 for the random one)."""
+    saves = cmusen_result["saves"]
+    events = gen.generation_schedule(gen.read_generators(_storage()), DT, END)
+    on_save = {"%g" % e.time: e for e in events if np.isin(e.time, saves)}
+    assert sorted(on_save) == ["0.001", "0.004", "0.006", "0.008"]
+    for label, event in on_save.items():
+        rows = [k for k, s in enumerate(cmusen_result["start"]) if s == label]
+        pos = np.array([cmusen_result["first"][k][1] for k in rows])
+        vel = np.array([cmusen_result["first"][k][2] for k in rows])
+        r = np.array([cmusen_result["r"][k] for k in rows])
+        assert all(cmusen_result["first"][k][0] == event.time for k in rows)
+        assert ((pos - r[:, None] >= VOLUME_LO) & (pos + r[:, None] <= VOLUME_HI)).all()
+        d = np.linalg.norm(pos[:, None] - pos[None], axis=2) + np.eye(len(r))
+        assert (d >= r[:, None] + r[None] - 1e-15).all()
+        if event.generator == 0:
+            np.testing.assert_allclose(np.linalg.norm(vel, axis=1), 0.5, rtol=1e-14)
+            assert len({tuple(v) for v in vel}) == len(vel)        # one random draw each
+        else:
+            assert (vel == [0.0, 0.0, -0.5]).all()
+
+
+def test_next_fraction_is_musens_rule():
+    assert gen.next_fraction([0, 0, 0], [0.2, 0.3, 0.5]) == 0
+    assert gen.next_fraction([1, 0, 0], [0.2, 0.3, 0.5]) == 1
+    assert gen.next_fraction([1, 1, 0], [0.2, 0.3, 0.5]) == 2
+    assert gen.next_fraction([2, 3, 5], [0.2, 0.3, 0.5]) == 0     # all at target: the first
+
+
+def test_run_with_an_active_generator_is_refused(tmp_path):
+    scene = tmp_path / "inlet_scene.mdem"
+    shutil.copy(SCENE, scene)
+    with pytest.raises(InputError) as err:
+        python_api.run(scene)
+    assert str(err.value).startswith(f"{scene}: dynamic generator 'InletA': activity: asks for "
+                                     "10 object(s) at t = 0.001 s")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["inlet_scene.mdem"]
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda g, s: setattr(g, "obj_type", 2), "obj_type: generating agglomerates"),
+    (lambda g, s: setattr(g, "volume_key", "NOPE"), "volume_key: no analysis volume 'NOPE'"),
+    (lambda g, s: setattr(s.modules_data.materials_database.mixture[1].fraction[0],
+                          "fraction", 0.4), "mixture_key: the fractions of mixture 'MIXTWO' sum"),
+    (lambda g, s: setattr(g, "update_time_step", 0.0), "update_time_step: must be > 0"),
+])
+def test_bad_settings_name_generator_and_field(change, message):
+    storage = _storage()
+    g = storage.modules_data.objects_generator.generators[1]
+    change(g, storage)
+    with pytest.raises(InputError, match=f"dynamic generator 'InletB': {message}"):
+        gen.refuse_active(storage, SCENE, DT)
+
+
+def test_inactive_generators_are_no_obstacle():
+    storage = _storage()
+    for g in storage.modules_data.objects_generator.generators:
+        g.activity = False
+    gen.refuse_active(storage, SCENE, DT)
+    assert gen.generation_schedule(gen.read_generators(storage), DT, END) == []
+
+
+@needs_cmusen
+def test_schedule_holds_for_another_cmusen_seed(tmp_path):
+    """cmusen again (another wall-clock seed, other positions): same generation times."""
+    for name in ("inlet_scene.mdem", "job_inlet.txt"):
+        shutil.copy(DATA / name, tmp_path)
+    done = subprocess.run([CMUSEN, "-t=1", "-s=job_inlet.txt"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0 and "Error:" not in done.stdout, done.stdout + done.stderr
+    starts = _spheres(Path(tmp_path / "inlet_result_prec17.txt").read_text())["start"]
+    events = gen.generation_schedule(gen.read_generators(_storage()), DT, END)
+    labels = ["%g" % e.time for e in events]
+    assert set(starts) <= set(labels) and labels.index(starts[0]) == 0

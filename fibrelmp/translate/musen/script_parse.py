@@ -72,7 +72,7 @@ _IGNORED = {
     "MAX_PART_MOVE": "only for a variable time step", "STEP_INC_FACTOR": "only for a variable time step",
 }
 # keywords only the generator / analyser / snapshot components read: accepted, no effect
-_OTHER_COMPONENT_KEYS = ("AGGLOMERATES_DB", "SNAPSHOT_TIME", "MIXTURE_PROPERTY", "PACK_GEN_VOLUME",
+_OTHER_COMPONENT_KEYS = ("AGGLOMERATES_DB", "SNAPSHOT_TIME", "PACK_GEN_VOLUME",
                          "PACK_GEN_MIXTURE", "PACK_GEN_POROSITY", "PACK_GEN_OVERLAP",
                          "PACK_GEN_ITERATIONS", "PACK_GEN_VELOCITY", "PACK_GEN_INSIDE",
                          "BOND_GEN_MATERIAL", "BOND_GEN_MINDIST", "BOND_GEN_MAXDIST",
@@ -84,6 +84,20 @@ class MusenModelSpec:
     name: str
     params: str
     kind: str          # PP PW SB LB EF, or "" for the generic MODEL keyword
+    line: int
+
+
+@dataclass
+class MixtureProperty:
+    """A MIXTURE_PROPERTY line: fraction ``fraction_index`` of mixture ``mixture_index``
+    (both 1-based, as written)."""
+
+    mixture_index: int
+    fraction_index: int
+    compound_key: str
+    diameter: float
+    contact_diameter: float
+    fraction: float
     line: int
 
 
@@ -117,6 +131,7 @@ class MusenJob:
     variable_time_step: bool | None = None
     material_properties: list[tuple[int, str, float, int]] = field(default_factory=list)
     interaction_properties: list[tuple[int, str, str, float, int]] = field(default_factory=list)
+    mixture_properties: list[MixtureProperty] = field(default_factory=list)
     geometry_motion_time: list[tuple[str, MotionInterval, int]] = field(default_factory=list)
     geometry_motion_force: list[tuple[str, int]] = field(default_factory=list)
     text_export: dict[str, dict[str, bool]] = field(default_factory=all_on)
@@ -362,6 +377,30 @@ def _interaction_property(job: MusenJob, line: _Line) -> None:
     job.interaction_properties.append((pid, key1, key2, value, line.ln))
 
 
+_MIXTURE_USAGE = ("MIXTURE FRACTION COMPOUND_KEY DIAMETER CONTACT_DIAMETER FRACTION_VALUE "
+                  "(6 values)")
+
+
+def _mixture_property(job: MusenJob, line: _Line) -> None:
+    # ScriptAnalyzer reads six values; a missing one is 0, so a line of five (MUSEN's own
+    # Example 5) reads its fraction as the contact diameter and a fraction of 0, and the
+    # package generator then stops ("The total fraction of material ... is not equal to 1")
+    if len(line.tok) != 6:
+        extra = ("; cmusen reads the fifth value as the contact diameter and the fraction "
+                 "as 0, so the mixture's fractions no longer sum to 1 and its package "
+                 "generator stops" if len(line.tok) == 5 else "")
+        raise line.error(f"needs {_MIXTURE_USAGE}, got {len(line.tok)}{extra}")
+    indices = _Line(line.path, line.ln, line.key, " ".join(line.tok[:2])).floats(2)
+    for what, v in zip(("mixture", "fraction"), indices):
+        if v != int(v) or v < 1:
+            raise line.error(f"the {what} number must be a whole number from 1, got {v:g} "
+                             "(cmusen skips the line then)")
+    diameter, contact, fraction = _Line(line.path, line.ln, line.key,
+                                        " ".join(line.tok[3:])).floats(3)
+    job.mixture_properties.append(MixtureProperty(int(indices[0]), int(indices[1]), line.tok[2],
+                                                  diameter, contact, fraction, line.ln))
+
+
 def _precision(job: MusenJob, line: _Line) -> None:
     value = line.floats(1)[0]
     if value != int(value) or not 1 <= value <= 40:
@@ -418,6 +457,7 @@ _HANDLERS = {
     "VARIABLE_TIME_STEP": _variable_step, "STOP_CRITERION": _stop,
     "LIMIT_PARTICLE_VELOCITY": _refuse("limiting particle velocities is not supported"),
     "MATERIAL_PROPERTY": _material_property, "INTERACTION_PROPERTY": _interaction_property,
+    "MIXTURE_PROPERTY": _mixture_property,
     "TEXT_EXPORT_PRECISION": _precision, "TIME_INTERVAL": _time_interval,
     "GEOMETRY_MOTION_TIME": _motion_time, "GEOMETRY_MOTION_FORCE": _motion_force,
 }

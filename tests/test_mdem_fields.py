@@ -139,3 +139,12 @@ def test_refusal_through_the_cli_exits_2_and_writes_nothing(tmp_path):
     assert f"{path}: modules_data.objects_generator.generators[0]" in proc.stderr
     assert "Traceback" not in proc.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["edited.mdem"]
+
+
+def test_contacts_between_bonded_particles_off_in_a_bonded_scene_warns():
+    """CompressionTest.mdem stores 'off' (proto default) and has bonds; the flag is not read
+    yet, so the difference is said, not hidden."""
+    model = read_scene(REPO / "tests" / "data" / "real-inputs" / "musen" / "CompressionTest.mdem")
+    texts = [t for k, t in model.warnings if k == "musen-ignored-setting"]
+    assert len(texts) == 1 and "connected_pp_contact: the file says contacts" in texts[0]
+    assert not [t for k, t in read_scene(SCENE).warnings if "connected_pp_contact" in t]

@@ -199,7 +199,8 @@ FIELDS: dict[str, tuple[str, str]] = {
                                                "overlap / vertex 3"),
     "ProtoTimeDependentProperties.quaternion": (HONOURED, "orientation"),
     "ProtoTimeDependentProperties.force": (HONOURED, "bond force (a bond's state)"),
-    "ProtoTimeDependentProperties.angles": (HONOURED, "wall vertex 2"),
+    "ProtoTimeDependentProperties.angles": (NOT_SIMULATION, "old layout only (refused); walls "
+                                            "keep vertex 2 in the quaternion"),
     "ProtoTimeDependentProperties.angle_accl": (NOT_SIMULATION, "old layout only (refused)"),
     "ProtoTimeDependentProperties.total_torque": (HONOURED, "bond torque (a bond's state)"),
     "ProtoTimeDependentProperties.temperature": (NOT_SIMULATION, "heat transfer is not "

@@ -148,3 +148,26 @@ def test_contacts_between_bonded_particles_off_in_a_bonded_scene_warns():
     texts = [t for k, t in model.warnings if k == "musen-ignored-setting"]
     assert len(texts) == 1 and "connected_pp_contact: the file says contacts" in texts[0]
     assert not [t for k, t in read_scene(SCENE).warnings if "connected_pp_contact" in t]
+
+
+def test_docs_table_has_every_row():
+    section = DOC.read_text().split("## 6. `.mdem` fields", 1)[1]
+    for key, (cls, _) in mdem_fields.FIELDS.items():
+        assert f"| `{key}` | {cls} |" in section, key
+
+
+def test_two_stored_models_of_one_kind_are_refused(tmp_path):
+    """A version-1 model list with two particle-particle models: MUSEN runs both."""
+    from fibrelmp.registry import INPUT, detect
+
+    def edit(s):
+        manager = s.modules_data.model_manager
+        manager.version = 1
+        manager.models.add(key="B18A46C2786D4D44B925A8A04D0D1008", path="ModelPPHertzMindlin")
+        manager.models.add(key="K2", path="ModelPPLinearElastic", params="Kn 1e5 Kt 1e5")
+    path = _edited(tmp_path, edit)
+    with pytest.raises(InputError) as err:
+        detect(path).load(INPUT)().model(path)
+    assert err.value.path == str(path) and err.value.line is None
+    assert err.value.message.startswith("ModelPPLinearElastic (stored in edited.mdem) and "
+                                        "ModelPPHertzMindlin (stored in edited.mdem) are both PP")

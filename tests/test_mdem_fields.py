@@ -39,8 +39,8 @@ def test_every_field_of_every_message_is_classified():
 
 def test_docs_table_lists_every_refused_setting():
     text = DOC.read_text()
-    assert "## 6. `.mdem` fields" in text
-    section = text.split("## 6. `.mdem` fields", 1)[1]
+    assert "## 7. `.mdem` fields" in text
+    section = text.split("## 7. `.mdem` fields", 1)[1]
     for setting in mdem_fields.REFUSALS:
         assert setting in section, setting
 
@@ -62,16 +62,6 @@ def _edited(tmp_path: Path, edit, name: str = "edited.mdem") -> Path:
     return path
 
 
-def _generator(s, active):
-    s.modules_data.objects_generator.generators.add(name="Inlet", activity=active,
-                                                    generation_rate=100.0)
-
-
-def _vel(s, enabled):
-    s.info.periodic_conditions_enabled = enabled
-    s.info.periodic_conditions_vel.x = 0.01
-
-
 def _ht(s, key):
     s.modules_data.model_manager.ht_pp_model.key = key
     s.modules_data.model_manager.ht_pp_model.path = "ModelPPHeatTransfer" if key else ""
@@ -82,15 +72,6 @@ def _keyed_model(s):
 
 
 REFUSED = [  # (edit, words of the message)
-    (lambda s: _generator(s, True), "objects_generator.generators[0] ('Inlet', active): dynamic"),
-    (lambda s: _vel(s, True), "info.periodic_conditions_vel: a moving periodic box"),
-    (lambda s: setattr(s.modules_data.simulator, "flexible_time_step", True),
-     "modules_data.simulator.flexible_time_step: MUSEN's variable time step"),
-    (lambda s: setattr(s.modules_data.simulator, "part_velocity_limit", 2.0),
-     "modules_data.simulator.part_velocity_limit: a particle velocity limit (2 m/s)"),
-    (lambda s: (s.info.stop_criteria.types.append(1),
-                setattr(s.info.stop_criteria, "max_broken_bonds", 5)),
-     "info.stop_criteria.types: additional stop criteria (types [1]"),
     (lambda s: _ht(s, "ABC"), "modules_data.model_manager.ht_pp_model: the old heat-transfer"),
     (lambda s: s.info.multispheres.add(id=[0]), "info.multispheres: 1 multisphere(s)"),
     (_keyed_model, "modules_data.model_manager.pp_model: a model stored by its key only"),
@@ -107,12 +88,8 @@ def test_a_refused_setting_names_the_file_and_the_field(tmp_path, edit, words):
 
 
 @pytest.mark.parametrize("edit", [
-    lambda s: _generator(s, False),                              # inactive: MUSEN skips it
-    lambda s: _vel(s, False),                                    # box off: no box to move
-    lambda s: setattr(s.modules_data.simulator, "part_velocity_limit", -1.0),   # <= 0: none
-    lambda s: s.info.stop_criteria.types.append(0),              # NONE
     lambda s: _ht(s, ""),                                        # empty slot
-    lambda s: setattr(s.modules_data.model_manager, "version", 1),   # slots unread in version 1
+    lambda s: (_ht(s, "ABC"), setattr(s.modules_data.model_manager, "version", 1)),  # unread
 ])
 def test_settings_at_their_inert_values_are_accepted(tmp_path, edit):
     base = read_scene(SCENE)
@@ -131,12 +108,12 @@ def test_output_choices_warn_by_name(tmp_path):
 
 
 def test_refusal_through_the_cli_exits_2_and_writes_nothing(tmp_path):
-    path = _edited(tmp_path, lambda s: _generator(s, True))
+    path = _edited(tmp_path, lambda s: s.info.multispheres.add(id=[0]))
     out = tmp_path / "out"
     proc = subprocess.run([sys.executable, "-m", "fibrelmp.cli", "run", str(path), "-o", str(out)],
                           capture_output=True, text=True, timeout=120)
     assert proc.returncode == 2, proc.stderr
-    assert f"{path}: modules_data.objects_generator.generators[0]" in proc.stderr
+    assert f"{path}: info.multispheres: 1 multisphere(s)" in proc.stderr
     assert "Traceback" not in proc.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["edited.mdem"]
 
@@ -151,7 +128,7 @@ def test_contacts_between_bonded_particles_off_in_a_bonded_scene_warns():
 
 
 def test_docs_table_has_every_row():
-    section = DOC.read_text().split("## 6. `.mdem` fields", 1)[1]
+    section = DOC.read_text().split("## 7. `.mdem` fields", 1)[1]
     for key, (cls, _) in mdem_fields.FIELDS.items():
         assert f"| `{key}` | {cls} |" in section, key
 

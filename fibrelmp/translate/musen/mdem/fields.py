@@ -7,6 +7,9 @@ simulates with them; a setting fibrelmp cannot honour is refused here, naming th
 the field, never dropped.  ``FIELDS`` classifies every field of ``messages._SPEC`` (a test
 checks that none is missing, so a field added to the table of messages must be classified);
 ``REFUSALS`` holds one check per refused setting: an implementation replaces its row.
+Dynamic generators, the variable time step and stop criteria are refused where their own
+items handle them (``generators.refuse_active``, ``model._refused_settings``: a job script
+may switch the latter off); the velocity limit and a moving periodic box are simulated.
 """
 
 from __future__ import annotations
@@ -24,6 +27,11 @@ NOT_SIMULATION = "not simulation data"
 _TEXT = "through the scene's text form (`.mdem` → MUSEN text export → text scene reader)"
 _GUI = "GUI / view data"
 _DB = "materials database, read through the text form (`32`/`33`)"
+# handled where their items put them (issue 26, items 3 and 4), not in REFUSALS below
+_DEFERRED = ("kept by name and refused when simulated, unless the job script switches it off "
+             "as cmusen would (model.py `_refused_settings`)")
+_INLETS = ("an active dynamic generator (inlet) is refused by name and field "
+           "(mdem/generators.py `refuse_active`); an inactive one is inert, as in MUSEN")
 
 # "Message.field" -> (class, why); "Message.*" classifies every field of a message
 FIELDS: dict[str, tuple[str, str]] = {
@@ -81,15 +89,16 @@ FIELDS: dict[str, tuple[str, str]] = {
     "ProtoSimulationInfo.periodic_conditions_y": (HONOURED, "periodic box (`28`), " + _TEXT),
     "ProtoSimulationInfo.periodic_conditions_z": (HONOURED, "periodic box (`28`), " + _TEXT),
     "ProtoSimulationInfo.periodic_conditions_enabled": (HONOURED, "periodic box (`28`), " + _TEXT),
-    "ProtoSimulationInfo.periodic_conditions_vel": (REFUSED, "a moving periodic box is not "
-                                                    "simulated"),
+    "ProtoSimulationInfo.periodic_conditions_vel": (HONOURED, "moving periodic box: "
+                                                    "fix musen/pbc/move (model.py "
+                                                    "`_refused_settings`, item 4)"),
     "ProtoSimulationInfo.anisotripy": (HONOURED, "anisotropy flag (`29`), " + _TEXT),
     "ProtoSimulationInfo.contact_radius": (HONOURED, "contact-radius flag (`30`), " + _TEXT),
     "ProtoSimulationInfo.selective_saving": (WARNED, "fibrelmp saves every field"),
     "ProtoSimulationInfo.selective_saving_flags": (WARNED, "fibrelmp saves every field"),
     "ProtoSelectiveSaving.*": (WARNED, "fibrelmp saves every field"),
-    "ProtoSimulationInfo.stop_criteria": (REFUSED, "additional stop criteria are not simulated"),
-    "ProtoStopCriteria.*": (REFUSED, "additional stop criteria are not simulated"),
+    "ProtoSimulationInfo.stop_criteria": (REFUSED, _DEFERRED),
+    "ProtoStopCriteria.*": (REFUSED, _DEFERRED),
     "ProtoParticleInfo.id": (HONOURED, _TEXT),
     "ProtoParticleInfo.type": (HONOURED, _TEXT + "; liquid bonds are refused by the scene reader"),
     "ProtoParticleInfo.compound": (HONOURED, _TEXT),
@@ -139,7 +148,7 @@ FIELDS: dict[str, tuple[str, str]] = {
                                  "analysers only"),
     # ---- modules
     "ProtoModulesData.simulator": (HONOURED, "simulator settings (rows below)"),
-    "ProtoModulesData.objects_generator": (REFUSED, "dynamic generators (inlets)"),
+    "ProtoModulesData.objects_generator": (REFUSED, _INLETS),
     "ProtoModulesData.bonds_generator": (NOT_SIMULATION, "pre-processing: run only by a "
                                          "script's COMPONENT BONDS_GENERATOR"),
     "ProtoModulesData.package_generator": (NOT_SIMULATION, "pre-processing: run only by a "
@@ -157,15 +166,15 @@ FIELDS: dict[str, tuple[str, str]] = {
     "ProtoModuleSimulator.max_cells_number": (NOT_SIMULATION, "neighbour search: LAMMPS's own"),
     "ProtoModuleSimulator.verlet_dist_coeff": (NOT_SIMULATION, "neighbour search: LAMMPS's own"),
     "ProtoModuleSimulator.verlet_auto_adjust": (NOT_SIMULATION, "neighbour search: LAMMPS's own"),
-    "ProtoModuleSimulator.flexible_time_step": (REFUSED, "MUSEN's variable time step"),
+    "ProtoModuleSimulator.flexible_time_step": (REFUSED, _DEFERRED),
     "ProtoModuleSimulator.part_move_limit": (HONOURED, "read by MUSEN only with a variable time "
                                              "step, which is refused"),
     "ProtoModuleSimulator.time_step_factor": (HONOURED, "read by MUSEN only with a variable "
                                               "time step, which is refused"),
-    "ProtoModuleSimulator.part_velocity_limit": (REFUSED, "particle velocity limit"),
-    "ProtoModuleObjectsGenerator.*": (REFUSED, "dynamic generators (inlets)"),
-    "ProtoObjectsGenerator.*": (REFUSED, "dynamic generators (inlets): an active one is refused; "
-                                "an inactive one does nothing in MUSEN either"),
+    "ProtoModuleSimulator.part_velocity_limit": (HONOURED, "fix musen/velocity/limit (> 0; "
+                                                 "MUSEN: <= 0 is no limit; item 4)"),
+    "ProtoModuleObjectsGenerator.*": (REFUSED, _INLETS),
+    "ProtoObjectsGenerator.*": (REFUSED, _INLETS),
     "ProtoModuleBondsGenerator.*": (NOT_SIMULATION, "pre-processing (COMPONENT BONDS_GENERATOR)"),
     "ProtoBondsGenerator.*": (NOT_SIMULATION, "pre-processing (COMPONENT BONDS_GENERATOR)"),
     "ProtoModulePackageGenerator.*": (NOT_SIMULATION, "pre-processing (COMPONENT "
@@ -217,52 +226,6 @@ def classify(message: str, name: str) -> tuple[str, str] | None:
 
 # ---- refusals: each returns (field, why) when a file sets a setting fibrelmp cannot honour
 
-def _dynamic_generators(storage: Any) -> tuple[str, str] | None:
-    # CGenerationManager runs only active generators; an inactive one is inert
-    for i, gen in enumerate(storage.modules_data.objects_generator.generators):
-        if gen.activity:
-            return (f"modules_data.objects_generator.generators[{i}] ({gen.name!r}, active)",
-                    "dynamic generators (inlets) are not simulated by fibrelmp; deactivate it "
-                    "in MUSEN or remove it")
-    return None
-
-
-def _moving_periodic_box(storage: Any) -> tuple[str, str] | None:
-    info = storage.info
-    v = info.periodic_conditions_vel
-    if info.periodic_conditions_enabled and (v.x, v.y, v.z) != (0.0, 0.0, 0.0):
-        return ("info.periodic_conditions_vel",
-                f"a moving periodic box (velocity {v.x:g} {v.y:g} {v.z:g} m/s) is not simulated "
-                "by fibrelmp")
-    return None
-
-
-def _variable_time_step(storage: Any) -> tuple[str, str] | None:
-    if storage.modules_data.simulator.flexible_time_step:
-        return ("modules_data.simulator.flexible_time_step",
-                "MUSEN's variable time step is not simulated by fibrelmp; switch it off")
-    return None
-
-
-def _velocity_limit(storage: Any) -> tuple[str, str] | None:
-    # CBaseSimulator::SetPartVelocityLimit: a limit <= 0 means none
-    limit = storage.modules_data.simulator.part_velocity_limit
-    if limit > 0:
-        return ("modules_data.simulator.part_velocity_limit",
-                f"a particle velocity limit ({limit:g} m/s) is not simulated by fibrelmp")
-    return None
-
-
-def _stop_criteria(storage: Any) -> tuple[str, str] | None:
-    # EStopCriteria: 0 NONE, 1 BROKEN_BONDS
-    types = [t for t in storage.info.stop_criteria.types if t != 0]
-    if types:
-        return ("info.stop_criteria.types",
-                f"additional stop criteria (types {types}, MUSEN's 1 = broken bonds, at most "
-                f"{storage.info.stop_criteria.max_broken_bonds}) are not simulated by fibrelmp")
-    return None
-
-
 def _heat_model_slot(storage: Any) -> tuple[str, str] | None:
     manager = storage.modules_data.model_manager
     # CModelManager::LoadConfiguration reads the old slots only for version 0
@@ -295,11 +258,6 @@ def _model_without_path(storage: Any) -> tuple[str, str] | None:
 
 # refused setting -> its check; an implementation replaces its row
 REFUSALS: dict[str, Callable[[Any], tuple[str, str] | None]] = {
-    "dynamic generators": _dynamic_generators,
-    "moving periodic box": _moving_periodic_box,
-    "variable time step": _variable_time_step,
-    "particle velocity limit": _velocity_limit,
-    "stop criteria": _stop_criteria,
     "old heat-model slot": _heat_model_slot,
     "multispheres": _multispheres,
     "model without a name": _model_without_path,

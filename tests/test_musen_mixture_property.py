@@ -11,7 +11,7 @@ import sys
 import pytest
 
 from fibrelmp.errors import InputError
-from fibrelmp.translate.musen.script_parse import MixtureProperty, read_script
+from fibrelmp.translate.musen.script_parse import read_script
 
 from .conftest import REPO
 
@@ -42,8 +42,9 @@ def test_example_5_stops_at_its_first_short_mixture_line(tmp_path):
     with pytest.raises(InputError) as err:
         read_script(script)
     assert err.value.path == str(script) and err.value.line == 13
-    assert err.value.message.startswith("MIXTURE_PROPERTY: needs MIXTURE FRACTION COMPOUND_KEY")
-    assert "got 5" in err.value.message and "no longer sum to 1" in err.value.message
+    assert err.value.message == ("MIXTURE_PROPERTY: needs 6 values: MIXTURE FRACTION COMPOUND_KEY "
+                                 "DIAMETER CONTACT_DIAMETER FRACTION, got 5 (cmusen reads a "
+                                 "missing value as 0)")
 
 
 def test_six_values_are_read_in_cmusens_order(tmp_path):
@@ -51,12 +52,12 @@ def test_six_values_are_read_in_cmusens_order(tmp_path):
     script.write_text("COMPONENT SIMULATOR\n"
                       "MIXTURE_PROPERTY 1 2 CG9ZE5YQBM 1.8e-3 1.7e-3 0.3\n")
     (job,) = read_script(script)
-    assert job.mixture_properties == [MixtureProperty(1, 2, "CG9ZE5YQBM", 1.8e-3, 1.7e-3, 0.3, 2)]
+    assert job.mixture_properties == [(1, 2, "CG9ZE5YQBM", 1.8e-3, 1.7e-3, 0.3, 2)]
 
 
 @pytest.mark.parametrize("line, words", [
-    ("0 1 KEY 1e-3 1e-3 1", "mixture number must be a whole number from 1, got 0"),
-    ("1 1.5 KEY 1e-3 1e-3 1", "fraction number must be a whole number from 1, got 1.5"),
+    ("0 1 KEY 1e-3 1e-3 1", "the mixture and fraction numbers count from 1"),
+    ("1 1.5 KEY 1e-3 1e-3 1", "the mixture and fraction numbers count from 1"),
     ("1 1 KEY 1e-3 x 1", "expected a number, got 'x'"),
     ("1 1 KEY 1e-3 1e-3 1 7", "got 7"),
 ])
@@ -77,6 +78,6 @@ def test_example_5_through_the_cli_exits_2_and_writes_nothing(tmp_path):
     proc = subprocess.run([sys.executable, "-m", "fibrelmp.cli", "run", SCRIPT.name],
                           cwd=script.parent, capture_output=True, text=True, timeout=120)
     assert proc.returncode == 2, proc.stderr
-    assert f"{SCRIPT.name}:13: MIXTURE_PROPERTY: needs" in proc.stderr
+    assert f"{SCRIPT.name}:13: MIXTURE_PROPERTY: needs 6 values" in proc.stderr
     assert "Traceback" not in proc.stderr
     assert sorted(p.name for p in script.parent.iterdir()) == [SCRIPT.name]

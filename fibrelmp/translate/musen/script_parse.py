@@ -88,20 +88,6 @@ class MusenModelSpec:
 
 
 @dataclass
-class MixtureProperty:
-    """A MIXTURE_PROPERTY line: fraction ``fraction_index`` of mixture ``mixture_index``
-    (both 1-based, as written)."""
-
-    mixture_index: int
-    fraction_index: int
-    compound_key: str
-    diameter: float
-    contact_diameter: float
-    fraction: float
-    line: int
-
-
-@dataclass
 class MusenJob:
     """One cmusen job.  Numbers left at 0 / None were not given (cmusen keeps what the
     loaded .mdem has, or its defaults)."""
@@ -131,7 +117,7 @@ class MusenJob:
     variable_time_step: bool | None = None
     material_properties: list[tuple[int, str, float, int]] = field(default_factory=list)
     interaction_properties: list[tuple[int, str, str, float, int]] = field(default_factory=list)
-    mixture_properties: list[MixtureProperty] = field(default_factory=list)
+    mixture_properties: list[tuple[int, int, str, float, float, float, int]] = field(default_factory=list)
     geometry_motion_time: list[tuple[str, MotionInterval, int]] = field(default_factory=list)
     geometry_motion_force: list[tuple[str, int]] = field(default_factory=list)
     text_export: dict[str, dict[str, bool]] = field(default_factory=all_on)
@@ -377,28 +363,16 @@ def _interaction_property(job: MusenJob, line: _Line) -> None:
     job.interaction_properties.append((pid, key1, key2, value, line.ln))
 
 
-_MIXTURE_USAGE = ("MIXTURE FRACTION COMPOUND_KEY DIAMETER CONTACT_DIAMETER FRACTION_VALUE "
-                  "(6 values)")
-
-
 def _mixture_property(job: MusenJob, line: _Line) -> None:
-    # ScriptAnalyzer reads six values; a missing one is 0, so a line of five (MUSEN's own
-    # Example 5) reads its fraction as the contact diameter and a fraction of 0, and the
-    # package generator then stops ("The total fraction of material ... is not equal to 1")
     if len(line.tok) != 6:
-        extra = ("; cmusen reads the fifth value as the contact diameter and the fraction "
-                 "as 0, so the mixture's fractions no longer sum to 1 and its package "
-                 "generator stops" if len(line.tok) == 5 else "")
-        raise line.error(f"needs {_MIXTURE_USAGE}, got {len(line.tok)}{extra}")
-    indices = _Line(line.path, line.ln, line.key, " ".join(line.tok[:2])).floats(2)
-    for what, v in zip(("mixture", "fraction"), indices):
-        if v != int(v) or v < 1:
-            raise line.error(f"the {what} number must be a whole number from 1, got {v:g} "
-                             "(cmusen skips the line then)")
-    diameter, contact, fraction = _Line(line.path, line.ln, line.key,
-                                        " ".join(line.tok[3:])).floats(3)
-    job.mixture_properties.append(MixtureProperty(int(indices[0]), int(indices[1]), line.tok[2],
-                                                  diameter, contact, fraction, line.ln))
+        raise line.error(f"needs 6 values: MIXTURE FRACTION COMPOUND_KEY DIAMETER "
+                         f"CONTACT_DIAMETER FRACTION, got {len(line.tok)} (cmusen reads a missing "
+                         "value as 0)")
+    mix, frac = _Line(line.path, line.ln, line.key, " ".join(line.tok[:2])).floats(2)
+    d, dc, share = _Line(line.path, line.ln, line.key, " ".join(line.tok[3:])).floats(3)
+    if mix != int(mix) or frac != int(frac) or mix < 1 or frac < 1:
+        raise line.error("the mixture and fraction numbers count from 1")
+    job.mixture_properties.append((int(mix), int(frac), line.tok[2], d, dc, share, line.ln))
 
 
 def _precision(job: MusenJob, line: _Line) -> None:

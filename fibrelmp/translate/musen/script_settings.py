@@ -5,6 +5,7 @@ materials, scene (domain, PBC, bonds, motion), models and times, in cmusen's ord
 
 from __future__ import annotations
 
+import dataclasses
 import difflib
 import math
 from pathlib import Path
@@ -24,20 +25,60 @@ MUSEN_DEFAULTS = {"dt": 1e-6, "save": 1e-3, "t_end": 1.0, "gravity": (0.0, 0.0, 
 
 
 def _resolve_models(model: GranularModel, job: MusenJob) -> dict[str, ModelChoice]:
-    """The models a SIMULATOR job runs: the scene's (a ``.mdem`` stores its models, as MUSEN
-    loads them with the file; a kind the job names again is replaced), then the job's."""
+    """The models a SIMULATOR job runs, merged as cmusen merges them (ConsoleSimulator: the
+    file's models as loaded, then ``AddActiveModel`` for each of the job's: a model already
+    active keeps its place and takes the job's parameters on top of the file's).  Every
+    active model acts (CPUSimulator runs all models of a kind, in turn), so two of one kind
+    are refused (``_one_per_kind``): fibrelmp applies one model of a kind."""
     chosen: dict[str, ModelChoice] = dict(model.models)
-    given = {model_kind(spec) for spec in job.models}
+    active: list[ModelChoice] = []
+    by_name: dict[str, int] = {}
     for spec in scene_record(model).file_models:
-        if model_kind(spec) not in given:
-            choice = _model_choice(model, spec, model.source, None)
-            chosen[choice.kind] = choice
+        by_name[spec.name] = len(active)
+        active.append(_model_choice(model, spec, model.source, None))
     for spec in job.models:
         if spec.name.startswith(REFUSED_MODEL):    # check's stand-in for a model refused above
             continue
-        choice = _model_choice(model, spec, job.path, spec.line)
+        if spec.name in by_name:
+            stored = next(s for s in scene_record(model).file_models if s.name == spec.name)
+            if spec.params.strip():                # SetParametersStr: "" changes nothing
+                both = dataclasses.replace(spec, params=f"{stored.params} {spec.params}")
+                active[by_name[spec.name]] = _model_choice(model, both, job.path, spec.line)
+            continue
+        by_name[spec.name] = len(active)
+        active.append(_model_choice(model, spec, job.path, spec.line))
+    for choice in _one_per_kind(active, model.source):
         chosen[choice.kind] = choice
     return chosen
+
+
+_ACTS_ON = {"PP": "particle-particle contact", "PW": "particle-wall contact", "SB": "solid bond",
+            "LB": "liquid bond", "EF": "particle"}
+
+
+def _chosen_at(choice: ModelChoice, source) -> str:
+    return f"line {choice.line}" if choice.line is not None else f"stored in {Path(source).name}"
+
+
+def _one_per_kind(active: list[ModelChoice], source) -> list[ModelChoice]:
+    """Refusal (until several models of a kind act together, as in cmusen): two active
+    models of one kind, named where the second was selected."""
+    seen: dict[str, ModelChoice] = {}
+    for choice in active:
+        first = seen.setdefault(choice.kind, choice)
+        if first is choice:
+            continue
+        hint = ("remove one of the two MODEL_ lines" if first.line is not None else
+                "a script cannot drop a file's model: remove it in MUSEN (models tab) and save "
+                "the file, or drop this MODEL_ line to run the file's")
+        raise InputError(choice.source, choice.line,
+                         f"{choice.name} ({_chosen_at(choice, source)}) and {first.name} "
+                         f"({_chosen_at(first, source)}) are both {choice.kind} models: cmusen "
+                         f"runs every selected model, both acting on each "
+                         f"{_ACTS_ON.get(choice.kind, 'object')} in turn (forces add"
+                         f"{', either may break it' if choice.kind == 'SB' else ''}); fibrelmp applies one model of a kind and does not "
+                         f"simulate that: {hint}")
+    return list(seen.values())
 
 
 def accepted_models(kind: str) -> list[str]:

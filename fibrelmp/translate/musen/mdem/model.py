@@ -26,8 +26,11 @@ def read_scene(path: str | os.PathLike) -> GranularModel:
     from fibrelmp.translate.musen.mdem.generators import refuse_active
     from fibrelmp.translate.musen.mdem.text_export import export
 
+    from fibrelmp.translate.musen.mdem.fields import check_settings
+
     path = Path(path)
     with MdemFile(path) as mdem, tempfile.TemporaryDirectory(prefix="fibrelmp-mdem-") as tmp:
+        ignored = check_settings(mdem.storage, path)
         text = Path(tmp) / f"{path.stem}.txt"
         with open(text, "w", newline="\n") as out:
             export(mdem, out, precision=17, spool_dir=Path(tmp), times_limit=1)
@@ -40,6 +43,7 @@ def read_scene(path: str | os.PathLike) -> GranularModel:
         _refused_settings(model, mdem.storage)
         # inlets: checked, and refused while fibrelmp cannot insert objects during a run
         refuse_active(mdem.storage, path, float(model.plan.dt))
+    model.warnings.extend(ignored)
     model.source = path
     scene_record(model, keep=True).mdem_source = path
     return model
@@ -65,12 +69,14 @@ def _settings(model: GranularModel, modules) -> None:
         plan.gravity = np.array([g.x, g.y, g.z])
         scene_record(model, keep=True).gravity_set = True
     manager = modules.model_manager
-    entries = list(manager.models) or [manager.pp_model, manager.pw_model, manager.sb_model,
-                                       manager.lb_model, manager.ef_model]
+    # CModelManager::LoadConfiguration: version 0 keeps the per-kind slots (the heat slot is
+    # refused in fields.py), later versions the list; an entry without a key is empty
+    entries = (list(manager.models) if manager.version else
+               [manager.pp_model, manager.pw_model, manager.sb_model, manager.lb_model, manager.ef_model])
     specs = []
     for entry in entries:
         name = Path(entry.path.replace("\\", "/")).stem          # a custom model's library path
-        if not name:
+        if not entry.key or not name:
             continue
         kind = next((k for k, names in MUSEN_MODELS.items() if name in names), name[5:7])
         specs.append(MusenModelSpec(name=name, params=entry.params, kind=kind, line=0))

@@ -39,8 +39,8 @@ def test_every_field_of_every_message_is_classified():
 
 def test_docs_table_lists_every_refused_setting():
     text = DOC.read_text()
-    assert "## 7. `.mdem` fields" in text
-    section = text.split("## 7. `.mdem` fields", 1)[1]
+    assert "## 8. `.mdem` fields" in text
+    section = text.split("## 8. `.mdem` fields", 1)[1]
     for setting in mdem_fields.REFUSALS:
         assert setting in section, setting
 
@@ -128,7 +128,7 @@ def test_contacts_between_bonded_particles_off_in_a_bonded_scene_warns():
 
 
 def test_docs_table_has_every_row():
-    section = DOC.read_text().split("## 7. `.mdem` fields", 1)[1]
+    section = DOC.read_text().split("## 8. `.mdem` fields", 1)[1]
     for key, (cls, _) in mdem_fields.FIELDS.items():
         assert f"| `{key}` | {cls} |" in section, key
 

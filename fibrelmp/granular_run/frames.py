@@ -120,7 +120,7 @@ class FrameBuilder:
 
     def read(self, step: int) -> GranularFrame:
         job = self.job
-        t = job.t_start + step * job.dt
+        t = job.clock.time(step) if job.clock is not None else job.t_start + step * job.dt
         f = next(self.frames, None)
         if f is None or f.step != step:
             raise wrong_frame(job.frames, step, None if f is None else f.step)

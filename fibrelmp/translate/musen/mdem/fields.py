@@ -171,7 +171,7 @@ FIELDS: dict[str, tuple[str, str]] = {
                                              "step, which is refused"),
     "ProtoModuleSimulator.time_step_factor": (HONOURED, "read by MUSEN only with a variable "
                                               "time step, which is refused"),
-    "ProtoModuleSimulator.part_velocity_limit": (HONOURED, "fix musen/velocity/limit (> 0; "
+    "ProtoModuleSimulator.part_velocity_limit": (HONOURED, "fix musen/leapfrog vlimit (> 0; "
                                                  "MUSEN: <= 0 is no limit; item 4)"),
     "ProtoModuleObjectsGenerator.*": (REFUSED, _INLETS),
     "ProtoObjectsGenerator.*": (REFUSED, _INLETS),

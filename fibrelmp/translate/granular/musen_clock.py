@@ -65,10 +65,22 @@ class SaveList:
 
 
 def musen_run(t_start: float, dt: float, t_end: float, saving_step: float | None,
-              max_saves: int) -> tuple[int, list[int] | int]:
+              max_saves: int) -> tuple[int, list[int] | int, bool]:
     """(steps of the run, the saved steps: a list, or the period k when they are every k
-    steps up to the last) as cmusen runs them.  The saved steps include 0 and the last step.
-    More than ``max_saves`` irregular saves raise ValueError."""
+    steps up to the last, exact) as cmusen runs them.  The saved steps include 0 and the
+    last step.  When there would be more than ``max_saves`` irregular saves (the summed clock
+    drifts by 0.1 dt over a long run), the saves are every round(saving step / dt) steps and
+    ``exact`` is False."""
+    try:
+        total, saves = _musen_run(t_start, dt, t_end, saving_step, max_saves)
+        return total, saves, True
+    except ValueError:
+        total, _ = _musen_run(t_start, dt, t_end, None, max_saves)
+        return total, max(1, round(saving_step / dt)), False
+
+
+def _musen_run(t_start: float, dt: float, t_end: float, saving_step: float | None,
+               max_saves: int) -> tuple[int, list[int] | int]:
     saves = SaveList(max_saves)
     last, t, n = float(t_start), float(t_start), 0
     while True:

@@ -59,16 +59,25 @@ def _musen_run_time(model: GranularModel, dim: int, dt: float, t_start: float) -
     every = float(plan.save_every_time) if plan.save_every_time else None
     if every is not None and not every > 0:
         raise InputError(model.source, None, f"save interval must be > 0, got {every!r}")
-    try:
-        total, saves = musen_run(t_start, dt, float(plan.t_end), every, MAX_IRREGULAR_SAVES)
-    except ValueError:
-        raise InputError(model.source, None, f"the saving step {every:g} s is not a multiple of "
-                         f"the simulation step {dt:g} s and the run saves more than "
-                         f"{MAX_IRREGULAR_SAVES} times: make the saving step a multiple of the "
-                         "simulation step") from None
-    steps = SaveSteps(total, period=saves) if isinstance(saves, int) else SaveSteps(total, explicit=saves)
-    return RunTime(dim, dt, total, t_start, MusenClock(t_start, dt).time(total), steps,
-                   MusenClock(t_start, dt))
+    if plan.save_every_steps:          # not a MUSEN setting (a model built in Python)
+        every = None
+    t_end = float(plan.t_end)
+    if not t_end > t_start:            # nothing to simulate: the scene as it is
+        return RunTime(dim, dt, 0, t_start, t_start)
+    total, saves, exact = musen_run(t_start, dt, t_end, every, MAX_IRREGULAR_SAVES)
+    if not exact:
+        model.warnings.append(("musen-save-drift", f"cmusen's summed clock drifts over this run, so "
+                               f"it saves some of its {every:g} s time points a step earlier or "
+                               f"later than every {saves} steps; fibrelmp saves every {saves} steps "
+                               "(the times written are still cmusen's summed times of those steps)"))
+    if plan.save_every_steps:
+        steps = None                   # save_steps' regular schedule
+    elif isinstance(saves, int):
+        steps = SaveSteps(total, period=saves)
+    else:
+        steps = SaveSteps(total, explicit=saves)
+    clock = MusenClock(t_start, dt)
+    return RunTime(dim, dt, total, t_start, clock.time(total), steps, clock)
 
 
 def schedule(total: int, saves: SaveSteps, deletions: list[tuple[int, np.ndarray]],

@@ -16,7 +16,6 @@ import pytest
 
 from fibrelmp.errors import InputError
 from fibrelmp.granmodel import ContactLaw, hertz_effective
-from fibrelmp.granular_run.frames import quat_multiply
 from fibrelmp.translate.granular_job import law_args, write_granular_job
 
 from . import granular_models as gm

@@ -171,7 +171,6 @@ class FrameBuilder:
     def _bonds(self, frame: GranularFrame, step: int) -> None:
         """Bond states at ``step``: breaks logged since the last frame, bonds of removed
         spheres ended, forces from the bond dump (zero for broken bonds)."""
-        job = self.job
         broken = np.array(self.breaks.upto(step), np.int64).reshape(-1, 3)
         if len(broken):
             broken = broken[np.argsort(broken[:, 0], kind="stable")]

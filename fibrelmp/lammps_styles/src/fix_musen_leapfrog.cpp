@@ -5,6 +5,7 @@
 
 #include "fix_musen_leapfrog.h"
 #include "style_registry.h"
+#include "musen_startup.h"
 
 #include "atom.h"
 #include "domain.h"
@@ -69,6 +70,8 @@ void FixMusenLeapfrog::kick(double fraction)
 
 void FixMusenLeapfrog::initial_integrate(int /*vflag*/)
 {
+  // time steps have begun: later set-ups (checkpoints, deletions) do not advance states
+  musen_startup::advancing_setups() = 0;
   kick(1.0);
   double **x = atom->x, **v = atom->v;
   const int *mask = atom->mask;
@@ -80,12 +83,16 @@ void FixMusenLeapfrog::initial_integrate(int /*vflag*/)
 
 void MusenPredict::command(int narg, char **arg)
 {
-  if (narg != 1) error->all(FLERR, "Illegal musen/predict command: musen/predict <fix ID>");
+  const bool start = narg == 2 && strcmp(arg[1], "start") == 0;
+  if (narg != 1 && !start) error->all(FLERR, "Illegal musen/predict command: musen/predict <fix ID> [start]");
   auto *fix = dynamic_cast<FixMusenLeapfrog *>(modify->get_fix_by_id(arg[0]));
   if (!fix) error->all(FLERR, "musen/predict: {} is not the ID of a fix musen/leapfrog", arg[0]);
   if (!domain->box_exist) error->all(FLERR, "musen/predict before the simulation box exists");
-  // f and torque still hold the forces of the last set-up (run 0): MUSEN's prediction step
-  fix->kick(0.5);
+  // start: the next set-up (run 0) is the evaluation of MUSEN's prediction iteration;
+  // else f and torque hold its forces: the half kick, and the next set-up is MUSEN's
+  // evaluation of its first step, at x(0) with the predicted velocities
+  if (!start) fix->kick(0.5);
+  musen_startup::advancing_setups() = 1;
 }
 
 // registration with LAMMPS when the plugin loads (style_registry.h)

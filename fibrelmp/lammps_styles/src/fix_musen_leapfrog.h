@@ -11,11 +11,13 @@
    time: the one the spheres moved with to x(t).
 
      fix ID group musen/leapfrog [vlimit VMAX]
-     musen/predict ID      (after the set-up's forces: MUSEN's half-step prediction kick)
+     musen/predict ID start   (before the first run 0: its set-up is MUSEN's first evaluation)
+     musen/predict ID         (after it: MUSEN's half-step prediction kick)
 
    MUSEN starts with a "prediction" iteration at t = 0: forces at x(0), v += F/m dt/2,
    w += M/I dt/2, no move; then its first full step computes the forces at x(0) again with
-   those velocities.  The job script does: run 0 (forces at x(0), v(0): the first frame),
+   those velocities; both evaluations advance contact and bond states (musen_startup.h).  The
+   job script does: musen/predict start, run 0 (forces at x(0), v(0): the first frame),
    musen/predict, run 0 (forces again, with the predicted velocities), then the run.
    Quaternions are not integrated: MUSEN turns them only with anisotropy, which fibrelmp
    does not simulate.  VMAX: MUSEN's particle velocity limit (|v| scaled down to VMAX after

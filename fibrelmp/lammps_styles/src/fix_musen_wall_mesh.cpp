@@ -10,7 +10,6 @@
 
 #include "fix_musen_wall_mesh.h"
 #include "style_registry.h"
-#include "musen_startup.h"
 #include "fix_musen_history.h"
 
 #include "atom.h"
@@ -826,8 +825,7 @@ void FixMusenWallMesh::post_force(int /*vflag*/)
   std::fill(ftri.begin(), ftri.end(), 0.0);
   reduced_valid = false;
   const double dt = update->dt;
-  // MUSEN's two evaluations at t = 0 advance the contacts too (musen_startup.h)
-  const bool commit = musen_startup::advances(update) && !dry_run;
+  const bool commit = !update->setupflag;
 
   for (int i = 0; i < nlocal; i++) {
     if (!(mask[i] & groupbit)) continue;

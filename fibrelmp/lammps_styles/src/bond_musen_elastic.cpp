@@ -21,6 +21,7 @@
 
 #include "bond_musen_elastic.h"
 #include "style_registry.h"
+#include "musen_startup.h"
 
 #include "fix_musen_history.h"
 
@@ -312,7 +313,7 @@ void BondMusenElastic::compute(int eflag, int vflag)
   const int newton_bond = force->newton_bond;
   int **bondlist = neighbor->bondlist;
   const int nbondlist = neighbor->nbondlist;
-  const bool advance = !update->setupflag;
+  const bool advance = musen_startup::advances(update);    // musen_startup.h
 
   LawInput in;
   in.dt = update->dt;

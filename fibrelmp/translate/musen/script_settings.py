@@ -173,7 +173,7 @@ def apply_simulator_settings(model: GranularModel, job: MusenJob) -> None:
         plan.velocity_limit = job.velocity_limit if job.velocity_limit > 0 else None
         if plan.velocity_limit is not None and not lammps_styles.plugin().available:
             raise InputError(job.path, job.where("LIMIT_PARTICLE_VELOCITY"), "LIMIT_PARTICLE_VELOCITY "
-                             "needs fibrelmp's LAMMPS styles (fix musen/velocity/limit)")
+                             "needs fibrelmp's LAMMPS styles (fix musen/leapfrog vlimit)")
     _apply_times(model, job)
 
 

@@ -158,7 +158,7 @@ def build_granular_job(model: GranularModel, folder: str | Path):
     saves = save_steps(model, run.total, run.dt, run)
     script = _render_script(model, parts, saves)
     has_bonds = len(bonds.rows) > 0
-    breakage = int(model.plan.bond_breakage) != 0
+    breakage = model.plan.bonds_may_break()
     has_mesh = len(parts.mesh) > 0
     job = GranularJob(
         folder=folder, script=folder / SCRIPT_NAME, data=data_path, total_steps=run.total,
@@ -279,12 +279,12 @@ def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> 
         bonds_name=BONDS_NAME, tiles_name=TILES_NAME, breaks_name=BREAKS_NAME,
         comm_cut=comm_cut, skin=skin, musen_hm=parts.musen_hm, pair_lines=parts.pair_lines,
         has_bonds=len(bonds.rows) > 0,
-        overlay=bool(plan.contacts_between_bonded), breakage=int(plan.bond_breakage) != 0,
+        overlay=bool(plan.contacts_between_bonded), breakage=plan.bonds_may_break(),
         bond_types=bonds.types,
         musen_bonds=geometry is not None, bond_geometry=geometry, bond_partners=PARTNERS,
         bond_values=VALUES, geometry_fix=GEOMETRY_FIX, geometry_name=GEOMETRY_NAME,
         bond_criterion=int(plan.bond_breakage),
-        bond_law=parts.sb_model.bond_law(plan) if geometry is not None else None,
+        bond_law=physics.bond_style_law(plan) if geometry is not None else None,
         pair_style_lines=parts.pp_model.pair_style_lines(parts.pp_params, parts.musen_hm),
         sphere_types=[spheres.type_of_mat[m] for m in mats],
         sphere_type_names=[model.materials[m].name for m in mats],

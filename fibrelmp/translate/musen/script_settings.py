@@ -77,9 +77,9 @@ def _one_per_kind(active: list[ModelChoice], source) -> list[ModelChoice]:
                          f"{choice.name} ({_chosen_at(choice, source)}) and {first.name} "
                          f"({_chosen_at(first, source)}) are both {choice.kind} models: cmusen "
                          f"runs every selected model, both acting on each "
-                         f"{_ACTS_ON.get(choice.kind, 'object')} in turn (forces add"
-                         f"{', either may break it' if choice.kind == 'SB' else ''}); fibrelmp applies one model of a kind and does not "
-                         f"simulate that: {hint}")
+                         f"{_ACTS_ON.get(choice.kind, 'object')} in turn (forces add); fibrelmp "
+                         f"applies one model of a kind (several only for solid bonds) and does "
+                         f"not simulate that: {hint}")
     return list(seen.values())
 
 

@@ -568,6 +568,7 @@ void BondMusenElastic::allocate()
 
 void BondMusenElastic::settings(int narg, char **arg)
 {
+  then_laws.clear();    // a repeated bond_style command (e.g. after read_restart) restates them
   int iarg = 0;
   while (iarg < narg) {
     const std::string key = arg[iarg];

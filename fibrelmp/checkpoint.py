@@ -39,10 +39,11 @@ STATE = "checkpoint.json"             # written last: names the files below
 RESTART = "checkpoint-{n}.restart"     # n: commands done (see runner.run_script)
 FORCES = "checkpoint-{n}.forces.npz"   # the step's forces and torques (see runner.step_state)
 # commands that change the state or write output: done already when resuming
-# (fibrenet/frame: fix fibrenet/output's frame, appended to FibreNet's xyz files)
+# (fibrenet/frame: fix fibrenet/output's frame, appended to FibreNet's xyz files; musen/predict:
+# MUSEN's prediction kick at t = 0)
 ACTIONS = frozenset({"run", "minimize", "velocity", "displace_atoms", "reset_timestep", "write_dump",
                      "write_restart", "write_data", "set", "delete_atoms", "create_atoms",
-                     "delete_bonds", "displace_box", "change_box", "fibrenet/frame"})
+                     "delete_bonds", "displace_box", "change_box", "fibrenet/frame", "musen/predict"})
 
 
 class CheckpointStop(Exception):

@@ -70,6 +70,8 @@ class SolidBondLaw:
     model: str | None = None   # MUSEN's name, e.g. "ModelSBKelvin" (None: no SB model chosen)
     form: str = "elastic"      # "elastic" (ModelSBElastic) | "kelvin" (ModelSBKelvin)
     max_damp_ratio: float = 1.0   # ModelSBKelvin's MAX_DAMP_RATIO (0: no cap)
+    breakage: int = 1          # its CONSIDER_BREAKAGE (a later law's; the first law's is the
+                               # plan's bond_breakage)
 
 
 @dataclass
@@ -195,6 +197,9 @@ class GranularPlan:
     periodic_velocity: np.ndarray | None = None   # MUSEN's moving periodic box: faces move out at v
     bond_breakage: int = 1                  # MUSEN CONSIDER_BREAKAGE: 0 none, 1 combined, 2 separate
     bond_law: SolidBondLaw = field(default_factory=SolidBondLaw)   # the solid bonds' law
+    # further SB models acting on every bond after bond_law, in cmusen's order (cmusen runs
+    # every active model of a kind; each continues the bond's state and may break it)
+    then_bond_laws: list[SolidBondLaw] = field(default_factory=list)
     contacts_between_bonded: bool = True    # MUSEN default
     velocity_limit: float | None = None     # MUSEN's particle velocity limit (m/s; None: none)
     # the particle-particle law's contact duration (m*, R*, E*, approach speed) when it is not
@@ -204,6 +209,14 @@ class GranularPlan:
     pw_contact_time: Callable[[float, float, float, float], float] | None = None   # the same for
     pw_contact_law: str = "Hertz"                                                 # sphere-wall
     dimension: int = 3
+
+    def bonds_may_break(self) -> bool:
+        """Whether any of the solid bonds' laws has a breakage criterion."""
+        return int(self.bond_breakage) != 0 or any(law.breakage for law in self.then_bond_laws)
+
+    def bond_laws_use(self, form: str) -> bool:
+        """Whether any of the solid bonds' laws is ``form`` ("elastic" | "kelvin")."""
+        return any(law.form == form for law in (self.bond_law, *self.then_bond_laws))
 
 
 class SourceRecord:

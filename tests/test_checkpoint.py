@@ -229,5 +229,6 @@ def test_rotating_wall_checkpoints_give_identical_files(tmp_path, styles):
     walls = [ln for ln in reference["result.txt"].decode().splitlines()
              if ln.split()[:1] == ["0"] and int(ln.split()[1]) < 12]        # the plate's triangles
     forces = np.array([[abs(float(part.split()[2])) for part in ln.split(" 20 ")[1:]] for ln in walls])
-    assert forces.shape == (12, 11) and (forces.sum(0) > 0).sum() >= 8, "no lasting wall contact"
+    # 12 saved times: cmusen's clock reaches END_TIME one step late and saves there too
+    assert forces.shape == (12, 12) and (forces.sum(0) > 0).sum() >= 8, "no lasting wall contact"
     assert _result_files(tmp_path / "cut") == reference

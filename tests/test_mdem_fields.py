@@ -118,13 +118,16 @@ def test_refusal_through_the_cli_exits_2_and_writes_nothing(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["edited.mdem"]
 
 
-def test_contacts_between_bonded_particles_off_in_a_bonded_scene_warns():
-    """CompressionTest.mdem stores 'off' (proto default) and has bonds; the flag is not read
-    yet, so the difference is said, not hidden."""
+def test_contacts_between_bonded_particles_are_the_files_setting(tmp_path):
+    """CompressionTest.mdem stores 'off' (cmusen honours it: MUSEN's Example 1); a scene
+    without a model manager keeps MUSEN's default 'on'; a script's CONNECTED_PP_CONTACT wins."""
     model = read_scene(REPO / "tests" / "data" / "real-inputs" / "musen" / "CompressionTest.mdem")
-    texts = [t for k, t in model.warnings if k == "musen-ignored-setting"]
-    assert len(texts) == 1 and "connected_pp_contact: the file says contacts" in texts[0]
-    assert not [t for k, t in read_scene(SCENE).warnings if "connected_pp_contact" in t]
+    assert model.plan.contacts_between_bonded is False
+    assert not [t for k, t in model.warnings if "connected_pp_contact" in t]
+    on = _edited(tmp_path, lambda s: setattr(s.modules_data.model_manager, "connected_pp_contact", True))
+    assert read_scene(on).plan.contacts_between_bonded is True
+    bare = _edited(tmp_path, lambda s: s.modules_data.ClearField("model_manager"), "bare.mdem")
+    assert read_scene(bare).plan.contacts_between_bonded is True
 
 
 def test_docs_table_has_every_row():

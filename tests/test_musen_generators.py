@@ -5,8 +5,8 @@ export of a generated packing.
 The packing is random in both codes: its statistics are compared (count per fraction,
 porosity, size-distribution moments, largest overlap, spheres inside the volume).  The bond
 generator is deterministic: the bond list is compared pair by pair.  Examples 4 and 5
-(5,371 and 11,114 spheres, 15-40 s) are in the slow tier (FIBRELMP_SLOW=1); the normal
-suite runs a 426-sphere packing of the same scene against cmusen's."""
+(5,371 and 11,114 spheres, 10-15 s each) and Example 6 run in the normal suite too, next to
+a 426-sphere packing of the same scene against cmusen's."""
 
 from __future__ import annotations
 
@@ -91,8 +91,6 @@ def test_small_packing_has_cmusens_statistics(tmp_path):
     _compare(mine, STATS["small_packing"], 1e-7)
 
 
-@pytest.mark.slow
-@pytest.mark.skipif(os.environ.get("FIBRELMP_SLOW") != "1", reason="set FIBRELMP_SLOW=1")
 @pytest.mark.parametrize("case, script, diameters", [
     ("example4", "job_example4.txt", [0.002, 0.0022, 0.0024, 0.0025]),
     ("example5_corrected", "job_example5_corrected.txt", [0.0015, 0.0018, 0.0019, 0.0021]),
@@ -195,13 +193,11 @@ def test_results_analyzer_is_refused_by_name(tmp_path):
     assert done.returncode == 2 and "job.txt:2: COMPONENT: RESULTS_ANALYZER is not supported" in done.stderr
 
 
-@pytest.mark.slow
-@pytest.mark.skipif(os.environ.get("FIBRELMP_SLOW") != "1", reason="set FIBRELMP_SLOW=1")
 def test_example6_runs_unchanged_and_falls_as_cmusen(tmp_path):
     """MUSEN's Example 6 as shipped (packing, stray line, simulation; ~30 s).  The packings
     differ (random), so the comparison is the free fall of the whole packing (no walls): the
-    mass-weighted mean vz at every cmusen time point.  cmusen saves it g*dt/2 ahead (its saved
-    velocity is half a step later, docs/musen.md); fibrelmp's is -g t."""
+    mass-weighted mean vz at every cmusen time point: both save MUSEN's leapfrog velocity,
+    -g t - g dt/2 (docs/musen.md)."""
     from fibrelmp.translate.musen.mdem import timepoints
     from fibrelmp.translate.musen.mdem.document import MdemFile
     from fibrelmp.translate.musen.mdem.model import read_scene
@@ -222,9 +218,8 @@ def test_example6_runs_unchanged_and_falls_as_cmusen(tmp_path):
     np.testing.assert_allclose(times, ref["times"], rtol=1e-12, atol=1e-18)
     mean_vz = np.array([(mass * v[m != 0][:, timepoints.columns("vel")][:, 2]).sum() / mass.sum()
                         for _, v, m in points])
-    scale, half_step = 9.81 * 1e-4, 9.81 * 2e-7 / 2
-    np.testing.assert_allclose(mean_vz, np.array(ref["mass_mean_vz"]) + np.where(times > 0, half_step, 0),
-                               atol=1e-6 * scale, rtol=0)
+    scale = 9.81 * 1e-4
+    np.testing.assert_allclose(mean_vz, ref["mass_mean_vz"], atol=1e-6 * scale, rtol=0)
 
 
 @pytest.mark.skipif(not os.environ.get("FIBRELMP_CMUSEN"), reason="set FIBRELMP_CMUSEN to the real cmusen")

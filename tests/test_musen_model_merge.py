@@ -1,8 +1,9 @@
 """Models merged as cmusen merges them (ConsoleSimulator::SetupModelManager: the file's
 models, then the job's added; a model already active takes the job's parameters on top of
-the file's).  Every active model acts, so two of one kind -- MUSEN's Example 3: the file's
-Kelvin bond and the script's Elastic bond, both listed in cmusen's log -- are refused, never
-silently reduced to one."""
+the file's).  Every active model acts: several solid-bond models -- MUSEN's Example 3: the
+file's Kelvin bond and the script's Elastic bond, both listed in cmusen's log -- act on each
+bond in turn (tests/test_musen_several_bond_models.py compares that with cmusen); two models
+of another kind are refused, never silently reduced to one."""
 
 from __future__ import annotations
 
@@ -44,24 +45,41 @@ def test_cmusen_runs_the_files_and_the_scripts_bond_model():
     assert "Elastic bond\n\tCONSIDER_BREAKAGE 1" in log
 
 
-def test_example_3_is_refused_naming_both_bond_models(tmp_path):
-    script = _staged(tmp_path)
-    with pytest.raises(InputError) as err:
-        _model(script)
-    assert err.value.path == str(script) and err.value.line == 9
-    assert err.value.message.startswith(
-        "ModelSBElastic (line 9) and ModelSBKelvin (stored in CompressionTest.mdem) are both "
-        "SB models: cmusen runs every selected model")
+def test_example_3_runs_the_files_kelvin_then_the_scripts_elastic(tmp_path):
+    model = _model(_staged(tmp_path))
+    plan = model.plan
+    # cmusen's model manager order: the file's Kelvin bond, then the script's Elastic bond
+    assert (plan.bond_law.model, plan.bond_law.form, plan.bond_breakage) == (
+        "ModelSBKelvin", "kelvin", 1)
+    assert plan.bond_law.max_damp_ratio == 1.0
+    assert [(law.model, law.form, law.breakage) for law in plan.then_bond_laws] == [
+        ("ModelSBElastic", "elastic", 1)]
+    assert model.models["SB"].name == "ModelSBKelvin"
 
 
-def test_example_3_through_the_cli_exits_2_and_writes_nothing(tmp_path):
-    script = _staged(tmp_path)
+def test_example_3_job_applies_both_laws_in_cmusens_order(tmp_path):
+    from fibrelmp.translate.granular_job import write_granular_job
+
+    job = write_granular_job(_model(_staged(tmp_path)), tmp_path / "job")
+    script = job.script.read_text()
+    assert "bond_style      musen/elastic breakage 1 kelvin 1.0 then elastic 1 geometry" in script
+    assert "MUSEN's Kelvin then elastic solid bond" in script
+
+
+def test_two_particle_particle_models_are_still_refused_through_the_cli(tmp_path):
+    shutil.copy(TEXT_SCENE, tmp_path)
+    script = tmp_path / "job.txt"
+    script.write_text(f"SOURCE_FILE {TEXT_SCENE.name}\nRESULT_FILE ./r.txt\n"
+                      "MODEL_PP ModelPPHertzMindlin\nMODEL_PP ModelPPLinearElastic\n"
+                      "END_TIME 1e-7\n")
+    before = sorted(p.name for p in tmp_path.iterdir())
     proc = subprocess.run([sys.executable, "-m", "fibrelmp.cli", "run", script.name],
-                          cwd=script.parent, capture_output=True, text=True, timeout=120)
+                          cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert proc.returncode == 2, proc.stderr
-    assert f"{script.name}:9: ModelSBElastic (line 9) and ModelSBKelvin" in proc.stderr
+    assert (f"{script.name}:4: ModelPPLinearElastic (line 4) and ModelPPHertzMindlin (line 3) "
+            "are both PP models") in proc.stderr
     assert "Traceback" not in proc.stderr
-    assert sorted(p.name for p in script.parent.iterdir()) == [script.name]
+    assert sorted(p.name for p in tmp_path.iterdir()) == before
 
 
 def test_the_files_model_named_again_takes_the_scripts_parameters_on_top(tmp_path):
@@ -86,15 +104,27 @@ def test_the_files_model_named_again_without_parameters_keeps_the_files(tmp_path
                                                                    "MAX_DAMP_RATIO": 1.0}, None)
 
 
-def test_two_bond_models_in_one_script_are_refused(tmp_path):
+def test_two_bond_models_in_one_script_act_in_script_order(tmp_path):
     shutil.copy(TEXT_SCENE, tmp_path)
     script = tmp_path / "job.txt"
     script.write_text(f"SOURCE_FILE {TEXT_SCENE.name}\nRESULT_FILE ./r.txt\n"
                       "MODEL_PP ModelPPHertzMindlin\nMODEL_SB ModelSBElastic\n"
-                      "MODEL_SB ModelSBKelvin\nEND_TIME 1e-7\n")
+                      "MODEL_SB ModelSBKelvin\nMODEL_PARAMS ModelSBKelvin MAX_DAMP_RATIO 0.25\n"
+                      "SIMULATION_STEP 1e-8\nEND_TIME 1e-7\n")
+    plan = _model(script).plan
+    assert (plan.bond_law.form, plan.bond_breakage) == ("elastic", 1)
+    assert [(law.form, law.breakage, law.max_damp_ratio) for law in plan.then_bond_laws] == [
+        ("kelvin", 1, 0.25)]
+
+
+def test_a_later_bond_models_bad_parameter_names_its_line(tmp_path):
+    shutil.copy(TEXT_SCENE, tmp_path)
+    script = tmp_path / "job.txt"
+    script.write_text(f"SOURCE_FILE {TEXT_SCENE.name}\nRESULT_FILE ./r.txt\n"
+                      "MODEL_PP ModelPPHertzMindlin\nMODEL_SB ModelSBElastic\n"
+                      "MODEL_SB ModelSBKelvin\nMODEL_PARAMS ModelSBKelvin MAX_DAMP_RATIO -1\n"
+                      "SIMULATION_STEP 1e-8\nEND_TIME 1e-7\n")
     with pytest.raises(InputError) as err:
         _model(script)
-    assert err.value.line == 5
-    assert err.value.message.startswith("ModelSBKelvin (line 5) and ModelSBElastic (line 4) are "
-                                        "both SB models")
-    assert "remove one of the two MODEL_ lines" in err.value.message
+    assert (err.value.path, err.value.line) == (str(script), 5)
+    assert "MAX_DAMP_RATIO must be >= 0" in err.value.message

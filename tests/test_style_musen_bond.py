@@ -663,10 +663,14 @@ def _pull_commands(n: int) -> list[str]:
             f"group b id {n}", "fix pa a addforce v_push 0 0", "fix pb b addforce v_pull 0 0"]
 
 
-def test_restart_and_split_runs_continue_exactly(tmp_path):
+@pytest.mark.parametrize("style,dt", [(CLUSTER_STYLE, 1e-7), (CLUSTER_STYLE.replace(
+    " breaks ", " then elastic 2 breaks ", 1), 4e-8)])
+def test_restart_and_split_runs_continue_exactly(tmp_path, style, dt):
     """One run of 300 steps = 150 + 150 = 150, write_restart, read_restart (new LAMMPS), 150:
-    the history (overlaps, moments, previous bond, Kelvin damping) travels in the restart file
-    and set-up computes do not advance it.  Some bonds break on the way."""
+    the history (overlaps, moments, previous bond, Kelvin damping; with a later law, each
+    law's own copy) travels in the restart file and set-up computes do not advance it.  Some
+    bonds break on the way (two laws double the stiffness: a shorter step keeps the
+    explicit scheme stable)."""
     x, v, w, pairs = _cluster(vel=0.1, spin=500.0)
     write_data(tmp_path / "data.bonds", x, [RADIUS] * len(x), pairs, v, w)
     states, breaks = [], []
@@ -674,7 +678,7 @@ def test_restart_and_split_runs_continue_exactly(tmp_path):
         folder = tmp_path / case
         folder.mkdir()
         shutil.copy(tmp_path / "data.bonds", folder)
-        lmp = Lmp(folder, folder / "data.bonds", CLUSTER_STYLE, CLUSTER_COEFF, 1e-7, integrate=True,
+        lmp = Lmp(folder, folder / "data.bonds", style, CLUSTER_COEFF, dt, integrate=True,
                   post=_pull_commands(len(x)))
         try:
             if case == "one":
@@ -688,7 +692,7 @@ def test_restart_and_split_runs_continue_exactly(tmp_path):
                     lmp.lmp = new_lammps(["-log", "none", "-screen", "none", "-nocite"])
                     lmp.folder, lmp.first = folder, True
                     for c in [f"plugin load {plugin_or_skip()}", "read_restart half.restart",
-                              "pair_style zero 0.003", "pair_coeff * *", f"bond_style {CLUSTER_STYLE}",
+                              "pair_style zero 0.003", "pair_coeff * *", f"bond_style {style}",
                               f"bond_coeff {CLUSTER_COEFF}", "fix integ all nve/bpm/sphere",
                               "thermo_style custom step", "thermo 0", *_pull_commands(len(x))]:
                         lmp.command(c)

@@ -1,4 +1,4 @@
-"""MUSEN's particle velocity limit (fix musen/velocity/limit) against the real cmusen
+"""MUSEN's particle velocity limit (fix musen/leapfrog vlimit) against the real cmusen
 (tests/data/real-outputs/musen/velocity_limit/README.md): a force-controlled plate pushes a
 free sphere that may not move faster than 0.01 m/s, from the script's
 LIMIT_PARTICLE_VELOCITY and from a `.mdem`'s stored limit."""
@@ -53,7 +53,7 @@ def test_script_velocity_limit_is_cmusens(tmp_path):
     styles_or_skip()
     python_api.run(_job(tmp_path), work=tmp_path / "work")
     _compare(tmp_path / "vlim_result_prec17.txt")
-    assert "musen/velocity/limit 0.01" in (tmp_path / "work" / "job2" / "in.lammps").read_text()
+    assert "musen/leapfrog vlimit 0.01" in (tmp_path / "work" / "job2" / "in.lammps").read_text()
     assert read_scene(tmp_path / "vlim_result.mdem").plan.velocity_limit == 0.01   # written back
 
 
@@ -74,7 +74,7 @@ def test_zero_removes_the_limit(tmp_path):
     text = (DATA / "job_vlim.txt").read_text().replace("LIMIT_PARTICLE_VELOCITY 0.01",
                                                        "LIMIT_PARTICLE_VELOCITY 0")
     python_api.run(_job(tmp_path, text=text), work=tmp_path / "work")
-    assert "musen/velocity/limit" not in (tmp_path / "work" / "job2" / "in.lammps").read_text()
+    assert "vlimit" not in (tmp_path / "work" / "job2" / "in.lammps").read_text()
     vz = read_time_points(tmp_path / "vlim_result_prec17.txt").fields[VEL][:, 0, 2]
     assert vz.min() < -0.03
 

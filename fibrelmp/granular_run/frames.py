@@ -10,6 +10,7 @@ times in memory.  It is the pipeline's frame source for granular jobs.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +20,7 @@ from fibrelmp.granmodel import GranularFrame, GranularModel, quat_multiply
 from fibrelmp.post.lammps_dump.reader import iter_frames
 from fibrelmp.translate.granular_job import GranularJob
 from fibrelmp.translate.granular.geometry import nearest_triangle
+from fibrelmp.translate.granular.musen_clock import MusenClock
 
 
 class _BreakLog:
@@ -71,10 +73,13 @@ class FrameBuilder:
         self.prev_t = job.t_start
         self.prev_x = np.asarray(sp.position, float).copy()
         self.prev_v = np.asarray(sp.velocity, float).copy()
+        # the time of a step: MUSEN's summed clock (read forwards) or t_start + step dt
+        self.frame_clock, self.break_clock = _clock(job), _clock(job)
         self.deletion_time: dict[int, float] = {}
-        for step, rows in job.deletions:
+        deletion_clock = _clock(job)
+        for step, rows in sorted(job.deletions, key=lambda d: d[0]):
             for r in rows:
-                self.deletion_time[int(r)] = job.t_start + step * job.dt
+                self.deletion_time[int(r)] = deletion_clock(step)
         b = model.bonds
         self.nb = b.count if b is not None else 0
         if self.nb:
@@ -120,7 +125,7 @@ class FrameBuilder:
 
     def read(self, step: int) -> GranularFrame:
         job = self.job
-        t = job.t_start + step * job.dt
+        t = self.frame_clock(step)
         f = next(self.frames, None)
         if f is None or f.step != step:
             raise wrong_frame(job.frames, step, None if f is None else f.step)
@@ -166,7 +171,6 @@ class FrameBuilder:
     def _bonds(self, frame: GranularFrame, step: int) -> None:
         """Bond states at ``step``: breaks logged since the last frame, bonds of removed
         spheres ended, forces from the bond dump (zero for broken bonds)."""
-        job = self.job
         broken = np.array(self.breaks.upto(step), np.int64).reshape(-1, 3)
         if len(broken):
             broken = broken[np.argsort(broken[:, 0], kind="stable")]
@@ -177,7 +181,10 @@ class FrameBuilder:
             bsteps = bsteps[first]                          # ranks may both report it)
             live = self.bond_alive[r]
             self.bond_alive[r[live]] = False
-            self.bond_end[r[live]] = job.t_start + bsteps[live] * job.dt
+            order = np.argsort(bsteps[live], kind="stable")
+            ends = np.empty(len(order))
+            ends[order] = [self.break_clock(int(s)) for s in bsteps[live][order]]
+            self.bond_end[r[live]] = ends
         pair = self.model.bonds.pair
         end = np.minimum(self.sphere_end[pair[:, 0]], self.sphere_end[pair[:, 1]])
         dead = self.bond_alive & np.isfinite(end)
@@ -290,3 +297,10 @@ def _stepped_walls(job, fm: dict, k: np.ndarray, verts: np.ndarray, tvel: np.nda
     cols = [fm[f"{c}{a}"] for a in (1, 2, 3) for c in "xyz"]
     verts[rows[sel]] = np.column_stack(cols)[sel].reshape(-1, 3, 3)
     tvel[rows[sel]] = np.column_stack([fm["vx"], fm["vy"], fm["vz"]])[sel]
+
+
+def _clock(job) -> Callable[[int], float]:
+    """The time at a step, for steps asked in increasing order."""
+    if job.clock is None:
+        return lambda step: job.t_start + step * job.dt
+    return MusenClock(job.clock.t_start, job.clock.dt).time

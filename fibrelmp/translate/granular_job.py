@@ -28,6 +28,7 @@ from fibrelmp.translate.granular.contacts import (STOCK_PAIR_WARNING, law_args, 
                                                   rolling_spring, stock_pair_deviates)
 from fibrelmp.translate.granular.data import write_data
 from fibrelmp.translate.granular.reach import Travel, speed_bound
+from fibrelmp.translate.granular.musen_clock import MusenClock
 from fibrelmp.translate.granular.schedule import RunTime, compress_ids, run_time, save_steps, schedule
 from fibrelmp.translate.granular.spheres import SimulatedSpheres, select_spheres
 from fibrelmp.translate.granular.tiles import TILE_MASS_FACTOR, WallTiles, place_tiles, tile_estimate, tile_types
@@ -66,6 +67,7 @@ class GranularJob:
     walls: list[tuple[str, str]]     # geometry name -> representation
     dt: float
     t_start: float
+    clock: MusenClock | None         # MUSEN: its summed time at a step (else t_start + step dt)
     sphere_rows: np.ndarray          # rows simulated (LAMMPS id = row + 1)
     outside_rows: np.ndarray         # active at t_start but outside the domain: dropped
     late_rows: np.ndarray            # active only after t_start: not simulated
@@ -153,10 +155,10 @@ def build_granular_job(model: GranularModel, folder: str | Path):
             write_mesh(model, parts.wall_plans, spheres, folder / MESH_NAME)
         write_facts(data_path, job_facts(model, spheres, tiles, run.t_start, run.dt))
 
-    saves = save_steps(model, run.total, run.dt)
+    saves = save_steps(model, run.total, run.dt, run)
     script = _render_script(model, parts, saves)
     has_bonds = len(bonds.rows) > 0
-    breakage = int(model.plan.bond_breakage) != 0
+    breakage = model.plan.bonds_may_break()
     has_mesh = len(parts.mesh) > 0
     job = GranularJob(
         folder=folder, script=folder / SCRIPT_NAME, data=data_path, total_steps=run.total,
@@ -165,7 +167,7 @@ def build_granular_job(model: GranularModel, folder: str | Path):
         bond_dump=folder / BONDS_NAME if has_bonds else None,
         tile_dump=folder / TILES_NAME if tiles.total else None,
         breaks=folder / BREAKS_NAME if has_bonds and breakage else None,
-        walls=[(wp.name, wp.description) for wp in parts.wall_plans], dt=run.dt, t_start=run.t_start,
+        walls=[(wp.name, wp.description) for wp in parts.wall_plans], dt=run.dt, t_start=run.t_start, clock=run.clock,
         sphere_rows=spheres.rows, outside_rows=spheres.outside_rows, late_rows=spheres.late_rows,
         bond_rows=bonds.rows, deletions=spheres.deletions, wall_plans=parts.wall_plans,
         domain_lo=parts.dom_lo, domain_hi=parts.dom_hi, removal_axes=parts.axes.removal_axes,
@@ -249,7 +251,8 @@ def _plan_parts(model: GranularModel) -> _JobParts:
 def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> str:
     """in.lammps of the planned job (templates/granular.lammps.j2)."""
     plan, run, spheres, tiles, bonds = model.plan, parts.run, parts.spheres, parts.tiles, parts.bonds
-    acts = schedule(run.total, saves, spheres.deletions)
+    # MUSEN's integrator (with fibrelmp's styles) starts with its half-step prediction
+    acts = schedule(run.total, saves, spheres.deletions, predict=parts.musen_hm)
     skin = 0.5 * tiles.largest_radius(spheres.r_max)
     pair_cut = 2.0 * tiles.largest_radius(spheres.r_max)
     comm_cut = max(pair_cut, 1.5 * bonds.max_length) + skin
@@ -263,9 +266,9 @@ def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> 
         parts.warnings.append(("approximate MUSEN physics (particle-particle contact)", STOCK_PAIR_WARNING))
     geometry, styles = parts.geometry, parts.styles
     # the plugin is loaded only for a style of its own (a DEMDF job uses stock styles only)
-    if plan.velocity_limit is not None and not styles.path:
+    if plan.velocity_limit is not None and not parts.musen_hm:
         raise InputError(model.source, None, "a particle velocity limit needs fibrelmp's LAMMPS "
-                         "styles (fix musen/velocity/limit)")
+                         "styles (fix musen/leapfrog)")
     pbc_velocity = _moving_periodic_box(model, parts.axes, styles)
     uses_plugin = bool(styles.path) and (parts.musen_hm or geometry is not None or len(parts.mesh) > 0
                                          or plan.velocity_limit is not None or pbc_velocity is not None)
@@ -276,12 +279,12 @@ def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> 
         bonds_name=BONDS_NAME, tiles_name=TILES_NAME, breaks_name=BREAKS_NAME,
         comm_cut=comm_cut, skin=skin, musen_hm=parts.musen_hm, pair_lines=parts.pair_lines,
         has_bonds=len(bonds.rows) > 0,
-        overlay=bool(plan.contacts_between_bonded), breakage=int(plan.bond_breakage) != 0,
+        overlay=bool(plan.contacts_between_bonded), breakage=plan.bonds_may_break(),
         bond_types=bonds.types,
         musen_bonds=geometry is not None, bond_geometry=geometry, bond_partners=PARTNERS,
         bond_values=VALUES, geometry_fix=GEOMETRY_FIX, geometry_name=GEOMETRY_NAME,
         bond_criterion=int(plan.bond_breakage),
-        bond_law=parts.sb_model.bond_law(plan) if geometry is not None else None,
+        bond_law=physics.bond_style_law(plan) if geometry is not None else None,
         pair_style_lines=parts.pp_model.pair_style_lines(parts.pp_params, parts.musen_hm),
         sphere_types=[spheres.type_of_mat[m] for m in mats],
         sphere_type_names=[model.materials[m].name for m in mats],
@@ -295,6 +298,7 @@ def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> 
         walls=[(wp.name, wp.description) for wp in parts.wall_plans],
         mesh_fix=MESH_FIX if len(parts.mesh) else None, mesh_forces_name=MESH_FORCES_NAME,
         contacts_name=CONTACTS_NAME, velocity_limit=plan.velocity_limit, pbc_velocity=pbc_velocity,
+        musen_integrator=parts.musen_hm,
         thermo_every=min(saves.period or 0, 2 ** 31 - 1),      # thermo N is a C int
     )
 

@@ -21,6 +21,7 @@
 
 #include "bond_musen_elastic.h"
 #include "style_registry.h"
+#include "musen_startup.h"
 
 #include "fix_musen_history.h"
 
@@ -303,22 +304,12 @@ void BondMusenElastic::compute(int eflag, int vflag)
   ev_init(eflag, vflag);
 
   double **x = atom->x;
-  double **v = atom->v;
-  double **omega = atom->omega;
-  double **f = atom->f;
-  double **torque = atom->torque;
   tagint *tag = atom->tag;
   const int nlocal = atom->nlocal;
   const int newton_bond = force->newton_bond;
   int **bondlist = neighbor->bondlist;
   const int nbondlist = neighbor->nbondlist;
-  const bool advance = !update->setupflag;
-
-  LawInput in;
-  in.dt = update->dt;
-  in.kelvin = kelvin;
-  in.max_damp_ratio = max_damp_ratio;
-  LawOutput out;
+  const bool advance = musen_startup::advances(update);    // musen_startup.h
 
   for (int n = 0; n < nbondlist; n++) {
     const int i1 = bondlist[n][0];    // stores the bond: MUSEN's left sphere
@@ -332,18 +323,9 @@ void BondMusenElastic::compute(int eflag, int vflag)
       h = init_entry(i1, i2, type);
       fresh = true;
     }
-    in.xl = x[i1];
-    in.xr = x[i2];
-    in.vl = v[i1];
-    in.vr = v[i2];
-    in.wl = omega[i1];
-    in.wr = omega[i2];
-    in.E = youngs[type];
-    in.G = shear[type];
-    in.mu = viscosity[type];
-    musen_law(in, h, advance, fresh, out);
-
-    if (musen_breaks(breakage, h, out, sigma_n[type], tau_s[type])) {
+    double total[3] = {0.0, 0.0, 0.0};
+    const bool broke = apply_laws(i1, i2, type, h, advance, fresh, total);
+    if (broke) {
       // MUSEN: Active = false, EndActivity = time; an inactive bond is not consolidated
       bondlist[n][2] = 0;
       for (int m = 0; m < atom->num_bond[i1]; m++)
@@ -355,22 +337,79 @@ void BondMusenElastic::compute(int eflag, int vflag)
       broken.push_back(update->ntimestep);
       broken.push_back(tag[i1]);
       broken.push_back(tag[i2]);
-      continue;
     }
-
-    for (int k = 0; k < 3; k++) {
-      f[i1][k] += out.total[k];
-      torque[i1][k] += out.mleft[k];
-      f[i2][k] -= out.total[k];
-      torque[i2][k] += out.mright[k];
+    if (evflag) {
+      double del[3];
+      sub(x[i1], x[i2], del);
+      ev_tally_xyz(i1, i2, nlocal, newton_bond, 0.0, total[0], total[1], total[2], del[0], del[1],
+                   del[2]);
     }
-    if (evflag)
-      ev_tally_xyz(i1, i2, nlocal, newton_bond, 0.0, out.total[0], out.total[1], out.total[2],
-                   out.bond[0], out.bond[1], out.bond[2]);
   }
 
-  if (breakage) process_breaks();
+  if (any_breakage()) process_breaks();
 }
+
+/* ----------------------------------------------------------------------
+   the laws in turn on one bond (CalculateForcesSB: each model's CalculateSB, then its
+   ConsolidatePart, over the bonds still active): each adds its force and moments to the
+   two spheres unless its own test breaks the bond, which ends the bond for the later laws.
+   Advancing, every law continues the shared state h; every law but the last then keeps its
+   part (H_LAWSTATE values) for set-up evaluations, which take each law's own copy.
+   total: the force on the left sphere summed over the laws applied.  Returns: broken.
+------------------------------------------------------------------------- */
+
+bool BondMusenElastic::apply_laws(int i1, int i2, int type, double *h, bool advance, bool fresh,
+                                  double *total)
+{
+  double **f = atom->f;
+  double **torque = atom->torque;
+  LawInput in;
+  in.xl = atom->x[i1];
+  in.xr = atom->x[i2];
+  in.vl = atom->v[i1];
+  in.vr = atom->v[i2];
+  in.wl = atom->omega[i1];
+  in.wr = atom->omega[i2];
+  in.dt = update->dt;
+  in.E = youngs[type];
+  in.G = shear[type];
+  in.mu = viscosity[type];
+  LawOutput out;
+  const int nlaws = 1 + (int) then_laws.size();
+  double scratch[H_SIZE];
+  for (int k = 0; k < nlaws; k++) {
+    const Law law = k == 0 ? Law{kelvin, max_damp_ratio, breakage} : then_laws[k - 1];
+    in.kelvin = law.kelvin;
+    in.max_damp_ratio = law.max_damp_ratio;
+    double *own = h + H_SIZE + H_LAWSTATE * k;    // law k's copy (k < nlaws - 1)
+    double *state = h;
+    if (!advance && k < nlaws - 1) {    // a set-up evaluation of law k's own state
+      std::copy(h, h + H_SIZE, scratch);
+      std::copy(own, own + H_LAWSTATE, scratch);
+      state = scratch;
+    }
+    musen_law(in, state, advance, fresh, out);
+    if (k < nlaws - 1) std::copy(state, state + H_LAWSTATE, own);
+    if (musen_breaks(law.breakage, state, out, sigma_n[type], tau_s[type])) return true;
+    for (int c = 0; c < 3; c++) {
+      f[i1][c] += out.total[c];
+      torque[i1][c] += out.mleft[c];
+      f[i2][c] -= out.total[c];
+      torque[i2][c] += out.mright[c];
+      total[c] += out.total[c];
+    }
+  }
+  return false;
+}
+
+bool BondMusenElastic::any_breakage() const
+{
+  if (breakage) return true;
+  for (const Law &law : then_laws)
+    if (law.breakage) return true;
+  return false;
+}
+
 
 /* ----------------------------------------------------------------------
    the state of a bond met for the first time: its d and L0 (per-atom arrays or the type's
@@ -420,6 +459,8 @@ double *BondMusenElastic::init_entry(int i1, int i2, int type)
   }
   h[H_DIAMETER] = d;
   h[H_LENGTH0] = L0;
+  for (size_t k = 0; k < then_laws.size(); k++)    // every law's copy starts from it
+    std::copy(h, h + H_LAWSTATE, h + H_SIZE + H_LAWSTATE * k);
   return h;
 }
 
@@ -527,6 +568,7 @@ void BondMusenElastic::allocate()
 
 void BondMusenElastic::settings(int narg, char **arg)
 {
+  then_laws.clear();    // a repeated bond_style command (e.g. after read_restart) restates them
   int iarg = 0;
   while (iarg < narg) {
     const std::string key = arg[iarg];
@@ -545,6 +587,25 @@ void BondMusenElastic::settings(int narg, char **arg)
         error->all(FLERR, "Bond style musen/elastic: kelvin MAX_DAMP_RATIO must be >= 0 "
                           "(0: no cap), got {}", arg[iarg + 1]);
       iarg += 2;
+    } else if (key == "then") {
+      // then elastic BREAKAGE | then kelvin BREAKAGE MAX_DAMP_RATIO: one more law
+      if (iarg + 3 > narg) utils::missing_cmd_args(FLERR, "bond_style musen/elastic then", error);
+      const std::string form = arg[iarg + 1];
+      Law law{form == "kelvin" ? 1 : 0, 0.0, utils::inumeric(FLERR, arg[iarg + 2], false, lmp)};
+      if (form != "kelvin" && form != "elastic")
+        error->all(FLERR, "Bond style musen/elastic: then takes elastic or kelvin, got {}", form);
+      if (law.breakage < 0 || law.breakage > (law.kelvin ? 1 : 2))
+        error->all(FLERR, "Bond style musen/elastic: then {}: breakage must be 0..{}, got {}",
+                   form, law.kelvin ? 1 : 2, arg[iarg + 2]);
+      if (law.kelvin) {
+        if (iarg + 4 > narg) utils::missing_cmd_args(FLERR, "bond_style musen/elastic then kelvin", error);
+        law.max_damp_ratio = utils::numeric(FLERR, arg[iarg + 3], false, lmp);
+        if (law.max_damp_ratio < 0.0 || !std::isfinite(law.max_damp_ratio))
+          error->all(FLERR, "Bond style musen/elastic: then kelvin MAX_DAMP_RATIO must be >= 0 "
+                            "(0: no cap), got {}", arg[iarg + 3]);
+      }
+      then_laws.push_back(law);
+      iarg += law.kelvin ? 4 : 3;
     } else if (key == "geometry") {
       if (iarg + 4 > narg) utils::missing_cmd_args(FLERR, "bond_style musen/elastic geometry", error);
       partners_name = arg[iarg + 1];
@@ -561,7 +622,7 @@ void BondMusenElastic::settings(int narg, char **arg)
       iarg += 2;
     } else {
       error->all(FLERR, "Bond style musen/elastic: unknown keyword {} (known: breakage, kelvin, "
-                        "geometry, breaks)", key);
+                        "then, geometry, breaks)", key);
     }
   }
 }
@@ -663,13 +724,13 @@ void BondMusenElastic::init_style()
   if (!history) {
     Fix *fix = modify->get_fix_by_id(history_id);
     if (!fix)
-      fix = modify->add_fix(fmt::format("{} all MUSEN/HISTORY {}", history_id, (int) H_SIZE));
+      fix = modify->add_fix(fmt::format("{} all MUSEN/HISTORY {}", history_id, entry_size()));
     if (strcmp(fix->style, "MUSEN/HISTORY") != 0)
       error->all(FLERR, "Bond style musen/elastic: fix {} is not its history", history_id);
     history = static_cast<FixMusenHistory *>(fix);
-    if (history->nvalues() != H_SIZE)
+    if (history->nvalues() != entry_size())
       error->all(FLERR, "Bond style musen/elastic: its history fix holds {} values per bond, "
-                        "not {}", history->nvalues(), (int) H_SIZE);
+                        "not {}", history->nvalues(), entry_size());
   }
 
   if (comm->me == 0 && !breaks_file.empty() && !breaks_fp) {
@@ -711,6 +772,13 @@ void BondMusenElastic::write_restart_settings(FILE *fp)
   fwrite(&breakage, sizeof(int), 1, fp);
   fwrite(&kelvin, sizeof(int), 1, fp);
   fwrite(&max_damp_ratio, sizeof(double), 1, fp);
+  const int nthen = (int) then_laws.size();
+  fwrite(&nthen, sizeof(int), 1, fp);
+  for (const Law &law : then_laws) {
+    fwrite(&law.kelvin, sizeof(int), 1, fp);
+    fwrite(&law.max_damp_ratio, sizeof(double), 1, fp);
+    fwrite(&law.breakage, sizeof(int), 1, fp);
+  }
 }
 
 void BondMusenElastic::read_restart_settings(FILE *fp)
@@ -723,6 +791,20 @@ void BondMusenElastic::read_restart_settings(FILE *fp)
   MPI_Bcast(&breakage, 1, MPI_INT, 0, world);
   MPI_Bcast(&kelvin, 1, MPI_INT, 0, world);
   MPI_Bcast(&max_damp_ratio, 1, MPI_DOUBLE, 0, world);
+  int nthen = 0;
+  if (comm->me == 0) utils::sfread(FLERR, &nthen, sizeof(int), 1, fp, nullptr, error);
+  MPI_Bcast(&nthen, 1, MPI_INT, 0, world);
+  then_laws.assign(nthen, Law{0, 0.0, 0});
+  for (Law &law : then_laws) {
+    if (comm->me == 0) {
+      utils::sfread(FLERR, &law.kelvin, sizeof(int), 1, fp, nullptr, error);
+      utils::sfread(FLERR, &law.max_damp_ratio, sizeof(double), 1, fp, nullptr, error);
+      utils::sfread(FLERR, &law.breakage, sizeof(int), 1, fp, nullptr, error);
+    }
+    MPI_Bcast(&law.kelvin, 1, MPI_INT, 0, world);
+    MPI_Bcast(&law.max_damp_ratio, 1, MPI_DOUBLE, 0, world);
+    MPI_Bcast(&law.breakage, 1, MPI_INT, 0, world);
+  }
 }
 
 /* ----------------------------------------------------------------------
@@ -767,8 +849,10 @@ double BondMusenElastic::single(int type, double /*rsq*/, int i, int j, double &
   in.E = youngs[type];
   in.G = shear[type];
   in.mu = viscosity[type];
-  in.kelvin = kelvin;
-  in.max_damp_ratio = max_damp_ratio;
+  // several laws: the last one's force, which is what MUSEN keeps as the bond's TotalForce
+  const Law last = then_laws.empty() ? Law{kelvin, max_damp_ratio, breakage} : then_laws.back();
+  in.kelvin = last.kelvin;
+  in.max_damp_ratio = last.max_damp_ratio;
   double copy[H_SIZE];    // evaluating must not touch the state
   std::copy(h, h + H_SIZE, copy);
   LawOutput out;

@@ -8,6 +8,7 @@
    MUSEN is BSD-3-Clause, (c) MUSEN Development Team.
 
      bond_style musen/elastic [breakage 0|1|2] [kelvin MAX_DAMP_RATIO]
+                              [then elastic 0|1|2] [then kelvin 0|1 MAX_DAMP_RATIO] ...
                               [geometry PARTNER VALUES K] [breaks FILE]
      bond_coeff N E G sigma_n tau_s mu [d L0]
 
@@ -20,6 +21,13 @@
    overlap] of the bond to it; one slot per line of a read_data section, whose lines LAMMPS
    limits to 256 characters) or, without the geometry keyword, from the bond type's d and L0.
    L0 <= 0 means "the distance at the first use" (MUSEN's RESET_INITIAL_BOND_LENGTH).
+
+   Several laws (cmusen runs every active SB model: CCPUSimulator::CalculateForcesSB): the
+   first law is given by breakage/kelvin, each "then" adds one after it.  Every step each law
+   in turn advances the bond's one shared state from where the previous law left it, adds its
+   own force and applies its own breakage test; a bond one law breaks gets no later law.
+   A set-up (non-advancing) evaluation needs each law's state, so every law but the last keeps
+   a copy of its part of the state (H_LAWSTATE values) after the H_SIZE values of the entry.
 ------------------------------------------------------------------------- */
 
 #ifdef BOND_CLASS
@@ -65,7 +73,14 @@ class BondMusenElastic : public Bond {
     H_DAMPT = 15,       // Kelvin tangential damping force of the last update, 3
     H_DIAMETER = 18,    // the bond's diameter d
     H_LENGTH0 = 19,     // its initial length L0
-    H_SIZE = 20
+    H_SIZE = 20,
+    H_LAWSTATE = 18     // the per-law part: overlap, moments, prev. bond, damping (offsets 0..17)
+  };
+
+  struct Law {
+    int kelvin;              // 1: ModelSBKelvin's damping
+    double max_damp_ratio;   // its MAX_DAMP_RATIO (0: no cap)
+    int breakage;            // the law's CONSIDER_BREAKAGE
   };
 
  protected:
@@ -74,6 +89,7 @@ class BondMusenElastic : public Bond {
   int breakage;              // MUSEN CONSIDER_BREAKAGE: 0 none, 1 sums, 2 each term
   int kelvin;                // 1: ModelSBKelvin's damping
   double max_damp_ratio;     // its MAX_DAMP_RATIO (0: no cap)
+  std::vector<Law> then_laws;   // laws acting after the first one, in cmusen's order
   std::string partners_name, values_name;    // per-atom geometry slots (empty: coefficients)
   std::string breaks_file;   // "step id1 id2" per broken bond (rank 0 appends)
   FILE *breaks_fp;
@@ -87,6 +103,9 @@ class BondMusenElastic : public Bond {
 
   std::vector<bigint> broken;    // (step, tag left, tag right) found on this rank this call
 
+  int entry_size() const { return H_SIZE + H_LAWSTATE * (int) then_laws.size(); }
+  bool apply_laws(int i1, int i2, int type, double *h, bool advance, bool fresh, double *total);
+  bool any_breakage() const;
   void allocate();
   double *init_entry(int i1, int i2, int type);
   void process_breaks();

@@ -28,6 +28,7 @@
 
 #include "pair_musen_hm.h"
 #include "style_registry.h"
+#include "musen_startup.h"
 
 #include "atom.h"
 #include "comm.h"
@@ -124,7 +125,7 @@ void PairMusenHM::compute(int eflag, int vflag)
 
   // LAMMPS recomputes forces at the start of every run (setup) and for `run 0`: those
   // evaluations must not advance the tangential overlap (MUSEN advances it once per step)
-  const bool advance = !update->setupflag;
+  const bool advance = musen_startup::advances(update);    // musen_startup.h
   const double dt = update->dt;
 
   double **x = atom->x;

@@ -84,8 +84,9 @@ def select_bonds(model: GranularModel, run: RunTime, spheres, periodic: np.ndarr
             out.type = btype.reshape(-1)
             out.types = [_musen_coeffs(model, int(m), int((bm == m).sum())) for m in mats]
             return out
-        if model.plan.bond_law.form != "elastic":
-            raise InputError(model.source, None, f"MUSEN's {model.plan.bond_law.form} solid bond "
+        if model.plan.bond_law.form != "elastic" or model.plan.then_bond_laws:
+            form = "kelvin" if model.plan.bond_laws_use("kelvin") else "several-model"
+            raise InputError(model.source, None, f"MUSEN's {form} solid bond "
                              "needs fibrelmp's LAMMPS styles (bond_style musen/elastic), which "
                              "are not used here; stock LAMMPS has no equivalent")
         breaking = ("LAMMPS bpm/rotational breaks on the sum of four load ratios, not MUSEN's "
@@ -178,7 +179,7 @@ def _musen_coeffs(model: GranularModel, mat: int, count: int) -> dict:
         raise InputError(model.source, None, f"material '{m.name}' of solid bonds needs Young's "
                          "modulus > 0 and a Poisson ratio in (-1, 0.5]")
     mu = 0.0
-    if model.plan.bond_law.form == "kelvin":
+    if model.plan.bond_laws_use("kelvin"):
         mu = m.props.get(2, float("nan"))
         if not (math.isfinite(mu) and mu >= 0):
             raise InputError(model.source, None, f"material '{m.name}' of solid bonds needs a "

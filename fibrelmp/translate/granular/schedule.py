@@ -10,6 +10,7 @@ import numpy as np
 
 from fibrelmp.errors import InputError
 from fibrelmp.granmodel import GranularModel
+from fibrelmp.translate.granular.musen_clock import MusenClock, musen_run
 from fibrelmp.translate.steps import SaveSteps, run_piece
 
 MAX_STEPS = 2.0 ** 63 - 1   # LAMMPS counts time steps in a 64-bit integer
@@ -23,7 +24,9 @@ class RunTime:
     dt: float
     total: int               # time steps of the run
     t_start: float
-    t_end: float             # t_start + total * dt
+    t_end: float             # t_start + total * dt (MUSEN: its summed time)
+    saves: SaveSteps | None = None       # MUSEN: cmusen's saved steps
+    clock: MusenClock | None = None      # MUSEN: its summed time at a step (else t_start + step dt)
 
 
 def run_time(model: GranularModel) -> RunTime:
@@ -42,18 +45,48 @@ def run_time(model: GranularModel) -> RunTime:
     if not steps <= MAX_STEPS:
         raise InputError(model.source, None, f"time step {dt:g} is too small: {span:g} time units "
                          f"take {steps:.3g} steps, more than LAMMPS can count ({MAX_STEPS:.3g})")
-    total = int(round(steps))
     t_start = float(plan.t_start)
+    if model.kind == "musen":
+        # cmusen's loop: summed time, saves by its rule, the step that reaches END_TIME last
+        return _musen_run_time(model, dim, dt, t_start)
+    total = int(round(steps))
     t_end = t_start + total * dt
     return RunTime(dim, dt, total, t_start, t_end)
 
 
-def schedule(total: int, saves: SaveSteps, deletions: list[tuple[int, np.ndarray]]):
+def _musen_run_time(model: GranularModel, dim: int, dt: float, t_start: float) -> RunTime:
+    plan = model.plan
+    every = float(plan.save_every_time) if plan.save_every_time else None
+    if every is not None and not every > 0:
+        raise InputError(model.source, None, f"save interval must be > 0, got {every!r}")
+    if plan.save_every_steps:          # not a MUSEN setting (a model built in Python)
+        every = None
+    t_end = float(plan.t_end)
+    if not t_end > t_start:            # nothing to simulate: the scene as it is
+        return RunTime(dim, dt, 0, t_start, t_start)
+    total, saves, exact = musen_run(t_start, dt, t_end, every, MAX_IRREGULAR_SAVES)
+    if not exact:
+        model.warnings.append(("musen-save-drift", f"cmusen's summed clock drifts over this run, so "
+                               f"it saves some of its {every:g} s time points a step earlier or "
+                               f"later than every {saves} steps; fibrelmp saves every {saves} steps "
+                               "(the times written are still cmusen's summed times of those steps)"))
+    if plan.save_every_steps:
+        steps = None                   # save_steps' regular schedule
+    elif isinstance(saves, int):
+        steps = SaveSteps(total, period=saves)
+    else:
+        steps = SaveSteps(total, explicit=saves)
+    clock = MusenClock(t_start, dt)
+    return RunTime(dim, dt, total, t_start, clock.time(total), steps, clock)
+
+
+def schedule(total: int, saves: SaveSteps, deletions: list[tuple[int, np.ndarray]],
+             predict: bool = False):
     """Actions of the script: runs (in pieces of 1/50 of the run: ``steps.run_piece``),
     activity-end deletions and frames.  A stretch of regular saves with no deletion in it is
     one LAMMPS loop ("loop" ... "end"), so the script does not grow with the number of frames."""
     piece = run_piece(total)                  # progress pieces (translate.steps)
-    acts: list[tuple] = [("run0",), ("frame", 0)]
+    acts: list[tuple] = [("run0",), ("frame", 0)] + ([("predict",)] if predict else [])
     dels = {s: rows for s, rows in deletions}
     step, pre = 0, False
 
@@ -103,8 +136,10 @@ def schedule(total: int, saves: SaveSteps, deletions: list[tuple[int, np.ndarray
     return acts
 
 
-def save_steps(model: GranularModel, total: int, dt: float) -> SaveSteps:
+def save_steps(model: GranularModel, total: int, dt: float, run: RunTime | None = None) -> SaveSteps:
     plan = model.plan
+    if run is not None and run.saves is not None:
+        return run.saves
     if plan.save_every_steps:
         k = int(plan.save_every_steps)
         if k <= 0:

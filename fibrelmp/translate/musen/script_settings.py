@@ -24,12 +24,13 @@ from fibrelmp.translate.musen.script_parse import MUSEN_MODELS, REFUSED_MODEL, M
 MUSEN_DEFAULTS = {"dt": 1e-6, "save": 1e-3, "t_end": 1.0, "gravity": (0.0, 0.0, -9.81)}
 
 
-def _resolve_models(model: GranularModel, job: MusenJob) -> dict[str, ModelChoice]:
+def _resolve_models(model: GranularModel, job: MusenJob) -> tuple[dict[str, ModelChoice],
+                                                                  list[ModelChoice]]:
     """The models a SIMULATOR job runs, merged as cmusen merges them (ConsoleSimulator: the
     file's models as loaded, then ``AddActiveModel`` for each of the job's: a model already
     active keeps its place and takes the job's parameters on top of the file's).  Every
-    active model acts (CPUSimulator runs all models of a kind, in turn), so two of one kind
-    are refused (``_one_per_kind``): fibrelmp applies one model of a kind."""
+    active model acts (CPUSimulator runs all models of a kind, in turn): the first of each
+    kind, and the later SB models (in order), which act after it (``_one_per_kind``)."""
     chosen: dict[str, ModelChoice] = dict(model.models)
     active: list[ModelChoice] = []
     by_name: dict[str, int] = {}
@@ -49,7 +50,7 @@ def _resolve_models(model: GranularModel, job: MusenJob) -> dict[str, ModelChoic
         active.append(_model_choice(model, spec, job.path, spec.line))
     for choice in _one_per_kind(active, model.source):
         chosen[choice.kind] = choice
-    return chosen
+    return chosen, [c for c in active if c.kind == "SB" and c is not chosen.get("SB")]
 
 
 _ACTS_ON = {"PP": "particle-particle contact", "PW": "particle-wall contact", "SB": "solid bond",
@@ -61,12 +62,13 @@ def _chosen_at(choice: ModelChoice, source) -> str:
 
 
 def _one_per_kind(active: list[ModelChoice], source) -> list[ModelChoice]:
-    """Refusal (until several models of a kind act together, as in cmusen): two active
-    models of one kind, named where the second was selected."""
+    """The first active model of each kind.  Several SB models act together (the later ones
+    become the plan's ``then_bond_laws``); two of another kind are refused, named where the
+    second was selected: cmusen adds their forces, which fibrelmp does not simulate."""
     seen: dict[str, ModelChoice] = {}
     for choice in active:
         first = seen.setdefault(choice.kind, choice)
-        if first is choice:
+        if first is choice or choice.kind == "SB":
             continue
         hint = ("remove one of the two MODEL_ lines" if first.line is not None else
                 "a script cannot drop a file's model: remove it in MUSEN (models tab) and save "
@@ -75,9 +77,9 @@ def _one_per_kind(active: list[ModelChoice], source) -> list[ModelChoice]:
                          f"{choice.name} ({_chosen_at(choice, source)}) and {first.name} "
                          f"({_chosen_at(first, source)}) are both {choice.kind} models: cmusen "
                          f"runs every selected model, both acting on each "
-                         f"{_ACTS_ON.get(choice.kind, 'object')} in turn (forces add"
-                         f"{', either may break it' if choice.kind == 'SB' else ''}); fibrelmp applies one model of a kind and does not "
-                         f"simulate that: {hint}")
+                         f"{_ACTS_ON.get(choice.kind, 'object')} in turn (forces add); fibrelmp "
+                         f"applies one model of a kind (several only for solid bonds) and does "
+                         f"not simulate that: {hint}")
     return list(seen.values())
 
 
@@ -156,7 +158,7 @@ def apply_simulator_settings(model: GranularModel, job: MusenJob) -> None:
     if job.reset_bonds:
         reset_bond_lengths(model)
     _apply_motion(model, job)
-    models = _resolve_models(model, job)
+    models, later_bond_models = _resolve_models(model, job)
     model.models = models
     _check_models(model, job, models)
     if "PP" in models:                            # the laws stand for the PP model chosen
@@ -166,6 +168,10 @@ def apply_simulator_settings(model: GranularModel, job: MusenJob) -> None:
         # a kind's parameter errors point at its PARAMS line (cmusen reads them there)
         physics.find(choice.name).apply(plan, choice.parameters, job.path,
                                         job.where(f"MODEL_{kind}_PARAMS"))
+    plan.then_bond_laws = []
+    for choice in later_bond_models:    # in cmusen's order, after the first SB model
+        physics.add_later_bond_law(plan, choice.name, choice.parameters, choice.source,
+                                   choice.line)
     if job.connected_pp_contact is not None:
         plan.contacts_between_bonded = job.connected_pp_contact
     _refuse_file_settings(model, job)
@@ -173,7 +179,7 @@ def apply_simulator_settings(model: GranularModel, job: MusenJob) -> None:
         plan.velocity_limit = job.velocity_limit if job.velocity_limit > 0 else None
         if plan.velocity_limit is not None and not lammps_styles.plugin().available:
             raise InputError(job.path, job.where("LIMIT_PARTICLE_VELOCITY"), "LIMIT_PARTICLE_VELOCITY "
-                             "needs fibrelmp's LAMMPS styles (fix musen/velocity/limit)")
+                             "needs fibrelmp's LAMMPS styles (fix musen/leapfrog vlimit)")
     _apply_times(model, job)
 
 

@@ -7,13 +7,14 @@ styles, checks its parameters (``path:line`` errors) and applies them to a ``Gra
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 import pkgutil
 from pathlib import Path
 from typing import ClassVar
 
 from fibrelmp.errors import InputError
-from fibrelmp.granmodel import GranularModel, GranularPlan
+from fibrelmp.granmodel import GranularModel, GranularPlan, SolidBondLaw
 
 KIND_WORDS = {"PP": "particle-particle", "PW": "particle-wall", "SB": "solid-bond",
               "LB": "liquid-bond", "EF": "external-force"}
@@ -82,6 +83,11 @@ class PhysicsModel:
         raise NotImplementedError(f"{cls.name} is not a solid-bond model of musen/elastic")
 
     @classmethod
+    def then_words(cls, law: SolidBondLaw) -> str:
+        """SB models acting after another one: the style's ``then`` words of ``law``."""
+        raise NotImplementedError(f"{cls.name} is not a solid-bond model of musen/elastic")
+
+    @classmethod
     def apply(cls, plan: GranularPlan, params: dict[str, float], path: Path | str | None,
               line: int | None) -> None:
         """Check ``params`` and set what the model changes in ``plan`` (nothing by default)."""
@@ -136,6 +142,26 @@ def chosen(model: GranularModel, kind: str) -> tuple[type[PhysicsModel], dict[st
 def solid_bond_model(plan: GranularPlan) -> type[PhysicsModel]:
     """The SB model of ``plan.bond_law`` (the form's model when no SB model chose it)."""
     return next(m for m in of_kind("SB") if m.plan_bond_model == plan.bond_law.form)
+
+
+def add_later_bond_law(plan: GranularPlan, name: str, params: dict[str, float],
+                       path: Path | str | None, line: int | None) -> None:
+    """An SB model acting after ``plan``'s bond law(s) (cmusen runs every active SB model on
+    each bond in turn): checked as its model checks it, appended to ``plan.then_bond_laws``."""
+    own = GranularPlan(dt=plan.dt, t_start=plan.t_start, t_end=plan.t_end)
+    find(name).apply(own, params, path, line)
+    plan.then_bond_laws.append(dataclasses.replace(own.bond_law, breakage=int(own.bond_breakage)))
+
+
+def bond_style_law(plan: GranularPlan) -> tuple[str, str]:
+    """(the laws' names for the script's comment, ``bond_style musen/elastic``'s law words)
+    of the first SB law and every later one."""
+    name, words = solid_bond_model(plan).bond_law(plan)
+    for law in plan.then_bond_laws:
+        model = next(m for m in of_kind("SB") if m.plan_bond_model == law.form)
+        name += f" then {model.bond_law(plan)[0].lower()}"
+        words += f" {model.then_words(law)}"
+    return name, words
 
 
 def mdem_key(name: str) -> str:

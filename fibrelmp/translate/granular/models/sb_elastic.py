@@ -37,3 +37,7 @@ class SBElastic(PhysicsModel):
     @classmethod
     def bond_law(cls, plan: GranularPlan) -> tuple[str, str]:
         return "elastic", f"breakage {int(plan.bond_breakage)}"
+
+    @classmethod
+    def then_words(cls, law: SolidBondLaw) -> str:
+        return f"then elastic {int(law.breakage)}"

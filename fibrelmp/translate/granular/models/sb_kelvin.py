@@ -37,3 +37,7 @@ class SBKelvin(PhysicsModel):
     def bond_law(cls, plan: GranularPlan) -> tuple[str, str]:
         return ("Kelvin", f"breakage {int(plan.bond_breakage)} kelvin "
                 f"{float_text(plan.bond_law.max_damp_ratio)}")
+
+    @classmethod
+    def then_words(cls, law: SolidBondLaw) -> str:
+        return f"then kelvin {int(law.breakage)} {float_text(law.max_damp_ratio)}"

@@ -171,7 +171,7 @@ FIELDS: dict[str, tuple[str, str]] = {
                                              "step, which is refused"),
     "ProtoModuleSimulator.time_step_factor": (HONOURED, "read by MUSEN only with a variable "
                                               "time step, which is refused"),
-    "ProtoModuleSimulator.part_velocity_limit": (HONOURED, "fix musen/velocity/limit (> 0; "
+    "ProtoModuleSimulator.part_velocity_limit": (HONOURED, "fix musen/leapfrog vlimit (> 0; "
                                                  "MUSEN: <= 0 is no limit; item 4)"),
     "ProtoModuleObjectsGenerator.*": (REFUSED, _INLETS),
     "ProtoObjectsGenerator.*": (REFUSED, _INLETS),
@@ -190,11 +190,10 @@ FIELDS: dict[str, tuple[str, str]] = {
     "ProtoModuleModelManager.ef_model": (HONOURED, "version 0 slot"),
     "ProtoModuleModelManager.ht_pp_model": (REFUSED, "the old heat-transfer model slot "
                                             "(version 0): heat transfer is not simulated"),
-    "ProtoModuleModelManager.connected_pp_contact": (WARNED, "contacts between bonded "
-                                                     "particles: not read yet (a parallel item "
-                                                     "honours it); off in a scene with bonds "
-                                                     "warns, since fibrelmp computes them unless "
-                                                     "a script says CONNECTED_PP_CONTACT 0"),
+    "ProtoModuleModelManager.connected_pp_contact": (HONOURED, "contacts between bonded "
+                                                     "particles (plan.contacts_between_bonded; "
+                                                     "a script's CONNECTED_PP_CONTACT overrides "
+                                                     "it, as in cmusen)"),
     "ProtoMusenModel.key": (HONOURED, "a model without a library path is refused (MUSEN finds "
                             "it by this key; fibrelmp by its name)"),
     "ProtoMusenModel.path": (HONOURED, "the model's name (its library path's stem)"),
@@ -271,11 +270,6 @@ def _warnings(storage: Any) -> list[str]:
                    "saves every field")
     if storage.modules_data.simulator.save_collisions:
         out.append("modules_data.simulator.save_collisions: fibrelmp writes no collisions file")
-    bonds = any(p.type == 9 for p in storage.info.particles)
-    if bonds and not storage.modules_data.model_manager.connected_pp_contact:
-        out.append("modules_data.model_manager.connected_pp_contact: the file says contacts "
-                   "between bonded particles are off; fibrelmp does not read this flag yet and "
-                   "computes them unless the job script says CONNECTED_PP_CONTACT 0")
     return out
 
 

@@ -64,6 +64,8 @@ def _settings(model: GranularModel, modules) -> None:
         plan.t_end = sim.end_time
     if sim.part_velocity_limit > 0:        # MUSEN: 0 (the default) is no limit
         plan.velocity_limit = sim.part_velocity_limit
+    if modules.HasField("model_manager"):  # CModelManager::LoadConfiguration (else its true)
+        plan.contacts_between_bonded = bool(modules.model_manager.connected_pp_contact)
     if modules.HasField("simulator"):
         g = sim.external_acceleration
         plan.gravity = np.array([g.x, g.y, g.z])

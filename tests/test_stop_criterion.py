@@ -5,6 +5,7 @@ and writes it."""
 
 from __future__ import annotations
 
+import json
 import shutil
 import subprocess
 from pathlib import Path
@@ -65,6 +66,8 @@ def test_script_stop_criterion_is_cmusens(tmp_path):
     _compare(tmp_path / "stop_result_prec17.txt", DATA / "cmusen_stop_result_prec17.txt")
     script = (tmp_path / "work" / "job2" / "in.lammps").read_text()
     assert 'if              "${fl_broken} > 1" then "jump SELF fl_stopped"' in script
+    summary = json.loads((tmp_path / "work" / "job2" / "summary.json").read_text())
+    assert summary["frames"] == 14 and summary["steps"]["total"] == 241
 
 
 def test_mdem_stop_criteria_field_is_cmusens(tmp_path):

@@ -154,6 +154,8 @@ def simulate(request: RunRequest, options: RunOptions, rank: int = 0, size: int 
     tally = getattr(source, "tally", None)
     summary = record.summary(rendered, time.monotonic() - started, request.model.warnings,
                              tally() if tally is not None else None)
+    if schedule.stopped:          # the frames written, not the scheduled ones
+        summary["frames"] = schedule.given
     write_summary(rendered.folder, summary)
     if size > 1:
         mpi_barrier()
@@ -236,16 +238,18 @@ class _FrameSteps:
 
     def __init__(self, steps: Iterable[int]):
         self._steps, self._last = iter(steps), 0
+        self.given, self.stopped = 0, False
 
     def __iter__(self) -> "_FrameSteps":
         return self
 
     def __next__(self) -> int:
         self._last = next(self._steps)
+        self.given += 1
         return self._last
 
     def stop(self) -> None:
-        self._steps = iter([self._last + 1])
+        self._steps, self.stopped = iter([self._last + 1]), True
 
 
 def _count(schedule) -> str:

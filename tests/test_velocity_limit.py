@@ -114,7 +114,9 @@ def test_mdem_variable_step_is_refused_by_name(tmp_path):
     mdem = tmp_path / "cmusen_flex_result.mdem"
     with pytest.raises(InputError) as err:
         python_api.run(job, work=tmp_path / "work")
-    assert str(err.value) == f"{mdem}: flexible_time_step: MUSEN's variable time step is not supported"
+    assert str(err.value) == (f"{mdem}: flexible_time_step: MUSEN's variable time step is not "
+                              "supported: its step changes every step with the forces; a job "
+                              "script's VARIABLE_TIME_STEP 0 runs it with its fixed step")
     assert not (tmp_path / "again.mdem").exists()
     job.write_text(FLEX_JOB + "VARIABLE_TIME_STEP 0\n")
     python_api.run(job, work=tmp_path / "work")

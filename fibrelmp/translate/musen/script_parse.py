@@ -322,7 +322,10 @@ def _refuse(why: str):
 def _variable_step(job: MusenJob, line: _Line) -> None:
     job.variable_time_step = line.flag()
     if job.variable_time_step:
-        job.refused.append((line.key, line.ln, "a variable time step is not supported"))
+        job.refused.append((line.key, line.ln, "MUSEN's variable time step is not supported: "
+                            "its step changes every step with the forces and its saves fall "
+                            "between steps; give VARIABLE_TIME_STEP 0 to run with the fixed "
+                            "SIMULATION_STEP"))
 
 
 def _velocity_limit(job: MusenJob, line: _Line) -> None:

@@ -80,6 +80,18 @@ def test_mdem_stop_criteria_field_is_cmusens(tmp_path):
     _compare(tmp_path / "stop_mdem_result_prec17.txt", DATA / "cmusen_stop_mdem_result_prec17.txt")
 
 
+def test_result_mdem_keeps_the_criterion(tmp_path):
+    """fibrelmp's result .mdem stores the script's criterion as cmusen's does: simulated
+    again with no STOP_CRITERION line, it stops where cmusen stops."""
+    styles_or_skip()
+    for name in ("stop_scene.txt", "job_stop.txt", "job_stop_mdem.txt"):
+        shutil.copy(DATA / name, tmp_path)
+    python_api.run(tmp_path / "job_stop.txt", work=tmp_path / "work")
+    shutil.copy(tmp_path / "stop_result.mdem", tmp_path / "stop_cmusen.mdem")
+    python_api.run(tmp_path / "job_stop_mdem.txt", work=tmp_path / "work2")
+    _compare(tmp_path / "stop_mdem_result_prec17.txt", DATA / "cmusen_stop_mdem_result_prec17.txt")
+
+
 def test_script_none_replaces_the_files_criterion(tmp_path):
     """STOP_CRITERION NONE replaces the file's criteria (cmusen's ConsoleSimulator): the run
     goes on to END_TIME, breaking the same two bonds."""

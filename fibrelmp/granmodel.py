@@ -202,6 +202,9 @@ class GranularPlan:
     then_bond_laws: list[SolidBondLaw] = field(default_factory=list)
     contacts_between_bonded: bool = True    # MUSEN default
     velocity_limit: float | None = None     # MUSEN's particle velocity limit (m/s; None: none)
+    # MUSEN's stop criterion BROKEN_BONDS N: at a save with more than N bonds broken since the
+    # start, one more step, its frame, the end (None: no criterion)
+    stop_broken_bonds: int | None = None
     # the particle-particle law's contact duration (m*, R*, E*, approach speed) when it is not
     # Hertz's (set by its model in translate/granular/models; None: Hertz)
     pp_contact_time: Callable[[float, float, float, float], float] | None = None

@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING, Callable, Iterator
 
 from fibrelmp._lammps import new_lammps
 from fibrelmp.errors import RunError
+from fibrelmp.lammps_flow import condition_holds, execute, jump_target
 from fibrelmp.lammps_text import input_lines, read_script
 
 if TYPE_CHECKING:
@@ -217,48 +218,6 @@ def parse_commands(text: str, where: str = "in.lammps") -> tuple[list[Command], 
     return commands, labels
 
 
-def execute(commands: list[Command], labels: dict[str, int], where: str = "in.lammps") -> Iterator[Command]:
-    """The commands in the order LAMMPS executes them, following loops the way ``lmp -in``
-    does: ``variable V loop N`` counts, ``next V`` advances (and past N the next ``jump`` is
-    skipped), ``jump SELF L`` continues after ``label L``.  Yields every command (the caller
-    sends all but ``label``/``jump`` to LAMMPS, whose ``next`` keeps its own copy in step)."""
-    loops: dict[str, list[int]] = {}
-    files: set[str] = set()          # atomfile variables: 'next' reads their next block
-    skip_jump = False
-    pc = 0
-    while pc < len(commands):
-        cmd = commands[pc]
-        pc += 1
-        w = cmd.words
-        if w[0] == "variable" and len(w) >= 4 and w[2] == "loop":
-            lo, hi = (1, int(w[3])) if len(w) == 4 or not w[4].isdigit() else (int(w[3]), int(w[4]))
-            loops[w[1]] = [lo, hi]
-        elif w[0] == "variable" and len(w) >= 4 and w[2] == "atomfile":
-            files.add(w[1])
-        elif w[0] == "next" and all(name in files for name in w[1:]):
-            pass                     # LAMMPS's own: no loop to follow
-        elif w[0] == "next":
-            for name in w[1:]:
-                state = loops.get(name)
-                if state is None:
-                    raise RunError(f"{where}:{cmd.number}: 'next {name}' without a loop variable")
-                state[0] += 1
-                if state[0] > state[1]:
-                    del loops[name]
-                    skip_jump = True
-        elif w[0] == "jump":
-            yield cmd
-            if skip_jump:
-                skip_jump = False
-                continue
-            if len(w) != 3 or w[1] != "SELF" or w[2] not in labels:
-                raise RunError(f"{where}:{cmd.number}: only 'jump SELF label' with a label of "
-                               "this script is supported")
-            pc = labels[w[2]] + 1
-            continue
-        yield cmd
-
-
 def run_script(script: Path, total_steps: int, progress: bool = True, log: bool = True,
                on_command: Callable[[list[str]], None] | None = None, text: str | None = None,
                checkpoints: "Checkpointing | None" = None,
@@ -293,7 +252,7 @@ def run_script(script: Path, total_steps: int, progress: bool = True, log: bool 
                      resumed_state=checkpoints.load_step_state() if resume else None)
     try:
         run.start(args, folder, log)
-        for cmd in execute(commands, labels, str(script)):
+        for cmd in execute(commands, labels, str(script), taken=lambda: run.jumped):
             run.command(cmd)
         if record is not None:
             record.end(run.lmp, run.steps, steps)
@@ -334,6 +293,7 @@ class _ScriptRun:
     deferred: list[str] = field(default_factory=list)   # per-atom fixes: defined after read_restart
     atomfiles: set[str] = field(default_factory=set)    # atomfile variables skipped while replaying
     lmp: object = None
+    jumped: bool = False             # the last conditional 'jump SELF' was taken
 
     def start(self, args: list[str], folder: ExitStack, log: bool) -> None:
         """Start LAMMPS and enter the job folder (every rank must see it)."""
@@ -361,11 +321,15 @@ class _ScriptRun:
         if words[0] in ("label", "jump"):
             return                       # followed by execute(); LAMMPS's own jump needs a file
         replaying = self.done <= self.skip_to
+        if words[0] == "if" and jump_target(text) is not None:
+            # taken only to end the run (MUSEN's stop criterion): never before a checkpoint
+            self.jumped = not replaying and condition_holds(self.lmp, text, f"{self.script}:{cmd.number}")
+            return
         if replaying:
             text = self._replayed(words, text)
             if text is None:
                 return
-        if self.due is not None and words[0] == "run":
+        if self.due is not None and words[0] == "run" and not self.jumped:
             self._checkpoint(cmd)
         counts, before = self._execute(cmd, text, replaying)
         if words[0] == "write_dump":

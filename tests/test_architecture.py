@@ -242,7 +242,7 @@ def test_the_cycle_check_sees_function_level_imports_and_skips_type_checking_one
 LAYERS = [
     ("base", ["errors", "textio", "units", "registry", "formatbase", "lammps_text", "_lammps",
               "lammps_log", "numtext/", "lammps_styles/"]),
-    ("core", ["particles", "model", "granmodel", "sanity", "record", "runner", "checkpoint",
+    ("core", ["particles", "model", "granmodel", "sanity", "record", "runner", "lammps_flow", "checkpoint",
               "outputs", "inputformat", "runplan", "also", "finite"]),
     ("mesh", ["mesh/"]),
     ("translate", ["translate/"]),

@@ -15,10 +15,11 @@ from __future__ import annotations
 import os
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, Callable, Iterator
+from typing import Any, Callable, Iterable, Iterator
 
 from fibrelmp.errors import InputError, RunError
 from fibrelmp.checkpoint import has_checkpoint
+from fibrelmp.lammps_flow import is_stop_print
 from fibrelmp.runplan import (Action, Consumer, Outcome, Rendered, RunOptions, RunPlan,
                               RunRequest)
 
@@ -126,9 +127,11 @@ def simulate(request: RunRequest, options: RunOptions, rank: int = 0, size: int 
     source = request.frames(rendered)
     try:
         consume = request.results(rendered)
-        schedule = iter(rendered.schedule)
+        schedule = _FrameSteps(rendered.schedule)
 
         def token(words: list[str]) -> Any:
+            if is_stop_print(words):
+                schedule.stop()
             return next(schedule, _EXTRA) if source.is_frame(words) else None
 
         def convert(tokens: Iterator[Any]) -> list[Path]:
@@ -151,6 +154,8 @@ def simulate(request: RunRequest, options: RunOptions, rank: int = 0, size: int 
     tally = getattr(source, "tally", None)
     summary = record.summary(rendered, time.monotonic() - started, request.model.warnings,
                              tally() if tally is not None else None)
+    if schedule.stopped:          # the frames written, not the scheduled ones
+        summary["frames"] = schedule.given
     write_summary(rendered.folder, summary)
     if size > 1:
         mpi_barrier()
@@ -225,6 +230,26 @@ def _scheduled(tokens: Iterator[Any], source, schedule: Iterator[int], rendered:
     if missing is not None:
         raise RunError(f"{rendered.script}: the run ended without the frame of step {missing} "
                        f"({_count(rendered.schedule)} were scheduled)")
+
+
+class _FrameSteps:
+    """The steps of the frames: the schedule's, until the script stops early (its
+    ``lammps_flow.STOP_PRINT``); then one frame, one step after the last, and no more."""
+
+    def __init__(self, steps: Iterable[int]):
+        self._steps, self._last = iter(steps), 0
+        self.given, self.stopped = 0, False
+
+    def __iter__(self) -> "_FrameSteps":
+        return self
+
+    def __next__(self) -> int:
+        self._last = next(self._steps)
+        self.given += 1
+        return self._last
+
+    def stop(self) -> None:
+        self._steps, self.stopped = iter([self._last + 1]), True
 
 
 def _count(schedule) -> str:

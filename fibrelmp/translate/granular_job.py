@@ -29,7 +29,8 @@ from fibrelmp.translate.granular.contacts import (STOCK_PAIR_WARNING, law_args, 
 from fibrelmp.translate.granular.data import write_data
 from fibrelmp.translate.granular.reach import Travel, speed_bound
 from fibrelmp.translate.granular.musen_clock import MusenClock
-from fibrelmp.translate.granular.schedule import RunTime, compress_ids, run_time, save_steps, schedule
+from fibrelmp.translate.granular.schedule import (STOP_LABEL, RunTime, compress_ids, run_time, save_steps,
+                                                  schedule, with_stop_criterion)
 from fibrelmp.translate.granular.spheres import SimulatedSpheres, select_spheres
 from fibrelmp.translate.granular.tiles import TILE_MASS_FACTOR, WallTiles, place_tiles, tile_estimate, tile_types
 from fibrelmp.translate.granular import models as physics
@@ -252,7 +253,7 @@ def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> 
     """in.lammps of the planned job (templates/granular.lammps.j2)."""
     plan, run, spheres, tiles, bonds = model.plan, parts.run, parts.spheres, parts.tiles, parts.bonds
     # MUSEN's integrator (with fibrelmp's styles) starts with its half-step prediction
-    acts = schedule(run.total, saves, spheres.deletions, predict=parts.musen_hm)
+    acts = _stop_criterion(model, parts, schedule(run.total, saves, spheres.deletions, predict=parts.musen_hm))
     skin = 0.5 * tiles.largest_radius(spheres.r_max)
     pair_cut = 2.0 * tiles.largest_radius(spheres.r_max)
     comm_cut = max(pair_cut, 1.5 * bonds.max_length) + skin
@@ -300,7 +301,24 @@ def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> 
         contacts_name=CONTACTS_NAME, velocity_limit=plan.velocity_limit, pbc_velocity=pbc_velocity,
         musen_integrator=parts.musen_hm,
         thermo_every=min(saves.period or 0, 2 ** 31 - 1),      # thermo N is a C int
+        stop_label=STOP_LABEL,
     )
+
+
+def _stop_criterion(model: GranularModel, parts: _JobParts, acts: list[tuple]) -> list[tuple]:
+    """The actions with MUSEN's stop criterion BROKEN_BONDS checked at every save (none
+    without bonds: none can break)."""
+    limit, bonds = model.plan.stop_broken_bonds, parts.bonds
+    if limit is None or not len(bonds.rows):
+        return acts
+    if parts.geometry is None:
+        raise InputError(model.source, None, "a stop criterion on broken bonds needs fibrelmp's "
+                         "LAMMPS styles (bond style musen/elastic counts the breaks)")
+    bonded = model.bonds.pair[bonds.rows]
+    if any(np.isin(bonded, rows).any() for _, rows in parts.spheres.deletions):
+        raise InputError(model.source, None, "a stop criterion on broken bonds with bonded spheres "
+                         "whose activity ends is not supported (their bonds would count as broken)")
+    return with_stop_criterion(acts, limit, len(bonds.rows))
 
 
 def _moving_periodic_box(model: GranularModel, axes: BoxAxes, styles) -> np.ndarray | None:

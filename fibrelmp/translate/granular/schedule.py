@@ -10,6 +10,7 @@ import numpy as np
 
 from fibrelmp.errors import InputError
 from fibrelmp.granmodel import GranularModel
+from fibrelmp.lammps_flow import STOP_PRINT
 from fibrelmp.translate.granular.musen_clock import MusenClock, musen_run
 from fibrelmp.translate.steps import SaveSteps, run_piece
 
@@ -175,3 +176,22 @@ def compress_ids(ids: np.ndarray) -> str:
     starts = np.r_[ids[0], ids[breaks + 1]]
     ends = np.r_[ids[breaks], ids[-1]]
     return " ".join(str(a) if a == b else f"{a}:{b}" for a, b in zip(starts, ends))
+
+
+STOP_LABEL, END_LABEL = "fl_stopped", "fl_finish"
+
+
+def with_stop_criterion(acts: list[tuple], max_broken: int, bonds0: int) -> list[tuple]:
+    """MUSEN's stop criterion BROKEN_BONDS (BaseSimulator::PreCalculationStep): at every save
+    after the first, more than ``max_broken`` bonds broken since the start (``bonds0`` at the
+    start) stop the run; cmusen then still makes that step and saves once more
+    (FinalizeSimulation), so the stop block is one step and its frame."""
+    out: list[tuple] = [("stopvar", bonds0)]
+    for act in acts:
+        out.append(act)
+        if act[0] == "frame" and act[1] != 0:
+            out.append(("stopcheck", max_broken))
+    said = (f"{STOP_PRINT}: more than {max_broken} bonds broken (MUSEN BROKEN_BONDS): one more "
+            "step, its frame, the end")
+    return out + [("jump", END_LABEL), ("label", STOP_LABEL), ("stopped", said),
+                  ("run", 1, False), ("frame", None), ("label", END_LABEL)]

@@ -112,7 +112,10 @@ class MusenJob:
     reset_bonds: bool | None = None
     variable_time_step: bool | None = None
     velocity_limit: float | None = None      # LIMIT_PARTICLE_VELOCITY (<= 0: no limit)
-    stop_none: bool = False                  # STOP_CRITERION NONE (replaces a .mdem's criteria)
+    # STOP_CRITERION lines in order (NONE / BROKEN_BONDS; any replaces a .mdem's criteria) and
+    # the last BROKEN_BONDS number (cmusen keeps one value)
+    stop_criteria: list[str] = field(default_factory=list)
+    stop_max_broken: int = 0
     material_properties: list[tuple[int, str, float, int]] = field(default_factory=list)
     interaction_properties: list[tuple[int, str, str, float, int]] = field(default_factory=list)
     geometry_motion_time: list[tuple[str, MotionInterval, int]] = field(default_factory=list)
@@ -323,7 +326,10 @@ def _refuse(why: str):
 def _variable_step(job: MusenJob, line: _Line) -> None:
     job.variable_time_step = line.flag()
     if job.variable_time_step:
-        job.refused.append((line.key, line.ln, "a variable time step is not supported"))
+        job.refused.append((line.key, line.ln, "MUSEN's variable time step is not supported: "
+                            "its step changes every step with the forces and its saves fall "
+                            "between steps; give VARIABLE_TIME_STEP 0 to run with the fixed "
+                            "SIMULATION_STEP"))
 
 
 def _velocity_limit(job: MusenJob, line: _Line) -> None:
@@ -333,13 +339,16 @@ def _velocity_limit(job: MusenJob, line: _Line) -> None:
 
 def _stop(job: MusenJob, line: _Line) -> None:
     value = line.tok[0].upper() if line.tok else ""
-    if value == "BROKEN_BONDS":
-        job.refused.append((line.key, line.ln, "stopping on a number of broken bonds is not "
-                            "supported; give END_TIME"))
-    elif value != "NONE":
+    if value not in ("NONE", "BROKEN_BONDS"):
         raise line.error(f"expected NONE or BROKEN_BONDS, got {value!r}")
-    else:
-        job.stop_none = True
+    if value == "BROKEN_BONDS":
+        # cmusen reads a size_t: a count of bonds, >= 0
+        count = line.tok[1] if len(line.tok) > 1 else ""
+        if not count.isdigit():
+            raise line.error(f"BROKEN_BONDS needs the number of broken bonds (an integer >= 0) "
+                             f"after which the simulation stops, got {count!r}")
+        job.stop_max_broken = int(count)
+    job.stop_criteria.append(value)
 
 
 def _pbc_flags(job: MusenJob, line: _Line) -> None:

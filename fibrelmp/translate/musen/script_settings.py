@@ -275,8 +275,10 @@ def _refuse_file_settings(model: GranularModel, job: MusenJob) -> None:
     record = scene_record(model)
     if job.variable_time_step is False:
         record.refused.pop("flexible_time_step", None)
-    if job.stop_none:
+    if job.stop_criteria:       # cmusen: the script's criteria replace the file's
         record.refused.pop("stop_criteria", None)
+        model.plan.stop_broken_bonds = (job.stop_max_broken if "BROKEN_BONDS" in job.stop_criteria
+                                        else None)
     for name, why in record.refused.items():
         raise InputError(record.mdem_source or model.source, None, f"{name}: {why}")
 

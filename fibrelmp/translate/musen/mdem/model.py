@@ -92,9 +92,15 @@ def _refused_settings(model: GranularModel, storage) -> None:
     moving periodic box (``SPBC::vVel``), which it does."""
     refused = scene_record(model, keep=True).refused
     if storage.modules_data.simulator.flexible_time_step:
-        refused["flexible_time_step"] = "MUSEN's variable time step is not supported"
-    if any(t != 0 for t in storage.info.stop_criteria.types):      # 0 NONE, 1 BROKEN_BONDS
-        refused["stop_criteria"] = "stopping on a number of broken bonds is not supported"
+        refused["flexible_time_step"] = ("MUSEN's variable time step is not supported: its step "
+                                         "changes every step with the forces; a job script's "
+                                         "VARIABLE_TIME_STEP 0 runs it with its fixed step")
+    criteria = storage.info.stop_criteria
+    if any(t not in (0, 1) for t in criteria.types):                # 0 NONE, 1 BROKEN_BONDS
+        refused["stop_criteria"] = (f"stop criterion types {sorted(set(criteria.types))}: MUSEN "
+                                    "knows 0 (NONE) and 1 (BROKEN_BONDS) only")
+    elif 1 in criteria.types:
+        model.plan.stop_broken_bonds = int(criteria.max_broken_bonds)
     v = storage.info.periodic_conditions_vel
     if storage.info.periodic_conditions_enabled and (v.x, v.y, v.z) != (0.0, 0.0, 0.0):
         model.plan.periodic_velocity = np.array([v.x, v.y, v.z])    # fix musen/pbc/move

@@ -214,6 +214,9 @@ class MdemResultWriter(MusenResultWriter):
             (float(g) for g in plan.gravity)
         sim.simulator_type = sim.simulator_type or 1           # CPU
         sim.part_velocity_limit = plan.velocity_limit or 0.0   # as MUSEN saves it (0: none)
+        if plan.stop_broken_bonds is not None:                 # MUSEN's SaveConfiguration
+            storage.info.stop_criteria.types[:] = [1]
+            storage.info.stop_criteria.max_broken_bonds = plan.stop_broken_bonds
         models = m.models
         if models:
             manager = storage.modules_data.model_manager

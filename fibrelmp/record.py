@@ -156,6 +156,11 @@ class Recorder:
             "energy": {"start": _energies(start), "end": _energies(self.last)},
         }
         out.update(model.summary_figures(job, self.final, self.last, tally))
+        clock = getattr(job, "clock", None)
+        if clock is not None and start is not None and self.last is not None:
+            # MUSEN's summed time, as its results write it (LAMMPS's Time is step * dt)
+            out["time"] = {"start": clock.time(thermo_int(start, "Step")),
+                           "end": clock.time(thermo_int(self.last, "Step"))}
         out["final_step"] = self.final["step"]
         scale = time_step_scale(model)
         if scale is not None:

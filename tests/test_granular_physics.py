@@ -74,7 +74,8 @@ def _tangential_case(tmp_path, shift_velocity, steps, mu=0.45, name="t"):
 
 
 def test_tangential_stiffness_8_G_a(tmp_path):
-    """Small tangential displacement xi: F_t = 8 G* a xi with a = sqrt(R* delta)."""
+    """Small tangential displacement xi: F_t = 8 G* a xi with a = sqrt(R* delta) (MUSEN's
+    tangential spring, with MUSEN's integrator)."""
     v, n = 1e-4, 20
     frames, es, gs, r, dt = _tangential_case(tmp_path, v, n, mu=10.0)
     f0, f1 = frames[0], frames[-1]
@@ -83,7 +84,11 @@ def test_tangential_stiffness_8_G_a(tmp_path):
     nrm = dx / dist
     delta = 2 * r - dist
     a = math.sqrt(r / 2 * delta)
-    xi = v * n * dt                                   # sphere 2 moved by v t tangentially
+    # MUSEN's spring grows by v dt at every force evaluation: the two at t = 0 (its prediction,
+    # then the real one: both advance contact states) and one per step, so n + 2 by step n,
+    # while sphere 2 moved by v n dt
+    xi = v * (n + 2) * dt
+    assert f1.position[1][1] - f0.position[1][1] == pytest.approx(v * n * dt, rel=1e-9)
     ft = f1.force[1] - (f1.force[1] @ nrm) * nrm      # tangential part on sphere 2
     expect = 8 * gs * a * xi
     print(f"\ntangential: |F_t| {np.linalg.norm(ft)!r} N, 8 G* a xi = {expect!r} N "

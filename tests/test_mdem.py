@@ -150,7 +150,9 @@ def test_result_mdem_equals_the_text_result(tmp_path):
     assert (tmp_path / "init.mdem").exists() and (tmp_path / "result.mdem").exists()
     python_api.convert_file(tmp_path / "result.mdem", tmp_path / "export.txt", precision=17)
     ours, text = read_time_points(tmp_path / "export.txt"), read_time_points(tmp_path / "result.txt")
-    assert np.array_equal(ours.times, text.times) and len(ours.times) == 25
+    # cmusen's summed clock reaches END_TIME one step late: 24 saves, then 0.0120001 s
+    # (tests/test_musen_clock.py: cmusen's loop)
+    assert np.array_equal(ours.times, text.times) and len(ours.times) == 26
     assert np.array_equal(ours.ids, text.ids)
     assert set(ours.fields) - set(text.fields) == {36, 42}
     for tag in text.fields:

@@ -955,7 +955,10 @@ def test_pipeline_break_time_is_musens(tmp_path, model_name, criterion):
     assert _criterion_value(b, b.trace[-2], criterion) < 1 - 1e-6
     last = frames[-1]
     assert last.bond_alive.tolist() == [False]
-    assert last.bond_end_time[0] == model.plan.t_start + k * dt
+    musen_time = model.plan.t_start       # cmusen's clock: t += dt, step by step
+    for _ in range(k):
+        musen_time += dt
+    assert last.bond_end_time[0] == musen_time
     assert [f.bond_alive[0] for f in frames] == [f.step < k for f in frames]
 
 

@@ -120,7 +120,8 @@ def granular_packages(uses_plugin: bool, wall_cmds: list[str]) -> list[str]:
     return packages
 
 
-def job_facts(model: GranularModel, spheres, tiles, t_start: float, dt: float) -> WorkFacts:
+def job_facts(model: GranularModel, spheres, tiles, t_start: float, dt: float,
+              musen_clock: bool = False) -> WorkFacts:
     """What ``fibrelmp post --data`` needs beyond the data file and dump to write the spheres
     as the run does (translate.work_facts): names, MUSEN keys and ids, initial orientations,
     the DEMDF document."""
@@ -136,7 +137,7 @@ def job_facts(model: GranularModel, spheres, tiles, t_start: float, dt: float) -
         object_ids=np.asarray(sp.ids, np.int64) if model.kind == "musen" else None,
         orientation=None if identity else q,
         radius=None if np.array_equal(spheres.crad, sp.radius) else np.asarray(sp.radius, float),
-        demdf=demdf)
+        demdf=demdf, clock="musen" if musen_clock else "product")
 
 
 def build_granular_job(model: GranularModel, folder: str | Path):
@@ -154,7 +155,7 @@ def build_granular_job(model: GranularModel, folder: str | Path):
                    bonds.rows, bonds.type, len(bonds.types), parts.geometry)
         if len(parts.mesh):
             write_mesh(model, parts.wall_plans, spheres, folder / MESH_NAME)
-        write_facts(data_path, job_facts(model, spheres, tiles, run.t_start, run.dt))
+        write_facts(data_path, job_facts(model, spheres, tiles, run.t_start, run.dt, run.clock is not None))
 
     saves = save_steps(model, run.total, run.dt, run)
     script = _render_script(model, parts, saves)

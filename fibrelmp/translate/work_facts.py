@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -51,9 +51,17 @@ class WorkFacts:
     output_fields: list[str] | None = None       # FibreNet output_data (position velocity force)
     demdf: dict[str, Any] | None = None          # what DEMDF snapshots repeat (the document, ...)
     path: Path | None = None
+    clock: str = "product"                       # "musen": cmusen's summed time (t += dt)
+    _musen: Any = field(default=None, repr=False, compare=False)
 
     def time(self, step: int) -> float:
         """The simulated time of ``step``, computed as the run computes it."""
+        if self.clock == "musen":
+            if self._musen is None:
+                from fibrelmp.translate.granular.musen_clock import MusenClock
+
+                self._musen = MusenClock(self.time_start, self.time_step)
+            return self._musen.time(step)
         return self.time_start + step * self.time_step
 
 
@@ -61,7 +69,7 @@ def write_facts(data: str | Path, facts: WorkFacts) -> Path:
     """Write ``facts`` beside the data file ``data``; returns the path."""
     doc: dict[str, Any] = {
         "fibrelmp_work_facts": VERSION, "kind": facts.kind, "source": facts.source,
-        "time": {"start": float(facts.time_start), "step": float(facts.time_step)},
+        "time": {"start": float(facts.time_start), "step": float(facts.time_step), "clock": facts.clock},
         "type_names": {str(t): name for t, name in sorted(facts.type_names.items())},
     }
     if facts.material_keys is not None:
@@ -111,7 +119,9 @@ def read_facts(data: str | Path) -> WorkFacts | None:
             box_lengths=_array(doc, "box_lengths", np.float64),
             output_types=[str(t) for t in doc["output_types"]] if "output_types" in doc else None,
             output_fields=[str(t) for t in doc["output_fields"]] if "output_fields" in doc else None,
-            demdf=doc.get("demdf"), path=path)
+            demdf=doc.get("demdf"), path=path, clock=str(time.get("clock", "product")))
+        if facts.clock not in ("product", "musen"):
+            raise ValueError(f"unknown clock {facts.clock!r}")
         if not (math.isfinite(facts.time_start) and math.isfinite(facts.time_step)):
             raise ValueError("non-finite time")
         if facts.orientation is not None and facts.orientation.shape[1:] != (4,):

@@ -149,7 +149,7 @@ MUSEN_SCRIPT = _c("cmusen script", "musen_script", [
     ("huge_end_time", "END_TIME 1e400"),
     ("component", "unsupported component"),
     ("model_typo", "misspelt model name"),
-    ("irregular_saves", "saving step not a multiple of the step, a million saves"),
+    ("irregular_saves", "saving step not a multiple of the step, 833,334 saves (every 4 steps, as cmusen)", "accept"),
     ("missing_scene", "SOURCE_FILE that does not exist"),
     ("bad_scene", "SOURCE_FILE scene with a bad material"),
     ("step_longer_than_run", "simulation step longer than the run"),

@@ -56,7 +56,7 @@ class SaveList:
         else:
             self.steps.append(step)
             if len(self.steps) > self.limit:
-                k = regular(self.steps + [step])
+                k = regular(self.steps)
                 if k is None:
                     raise ValueError("irregular")
                 self.period, self.steps = k, None
@@ -88,6 +88,8 @@ def _musen_run(t_start: float, dt: float, t_end: float, saving_step: float | Non
         reached = np.flatnonzero(times >= t_end)
         stop = int(reached[0]) if len(reached) else CHUNK       # index of the final step
         j = 0
+        if saving_step is not None and saves.period is not None:
+            j, last = _regular_saves(saves, times, j, stop, last, n, dt, saving_step)
         while saving_step is not None and j < stop:               # saves before the final step
             # the first k with |t_k - last| + 0.1 dt > saving step (times increase)
             k = j + int(np.searchsorted(times[j:stop], last + saving_step - 0.1 * dt, "left"))
@@ -111,6 +113,27 @@ def _musen_run(t_start: float, dt: float, t_end: float, saving_step: float | Non
         steps.append(total)
     k = regular(steps)
     return total, (k if k is not None and len(steps) > 2 else steps)
+
+
+def _regular_saves(saves: SaveList, times: np.ndarray, j: int, stop: int, last: float, n: int,
+                   dt: float, saving_step: float) -> tuple[int, float]:
+    """Once the saves are every k steps: take, at once, every further save of this chunk that
+    MUSEN's rule puts exactly k steps after the one before (the step before it not yet due);
+    the per-save search goes on from the first that is not."""
+    k = saves.period
+    idx = np.arange(j + k - 1, stop, k)
+    if not len(idx):
+        return j, last
+    prev = np.concatenate(([last], times[idx[:-1]]))
+    due = np.abs(times[idx] - prev) + 0.1 * dt > saving_step
+    if k > 1:
+        due &= ~(np.abs(times[idx - 1] - prev) + 0.1 * dt > saving_step)
+    good = len(idx) if due.all() else int(np.argmin(due))
+    if good == 0:
+        return j, last
+    saves.count += good
+    saves.last = n + int(idx[good - 1]) + 1
+    return int(idx[good - 1]) + 1, float(times[idx[good - 1]])
 
 
 def regular(saves: list[int]) -> int | None:

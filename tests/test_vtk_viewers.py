@@ -21,6 +21,7 @@ import pytest
 from fibrelmp.post.lammps_data.reader import read_data
 from fibrelmp.post.lammps_dump import iter_frames
 from fibrelmp.post.vtk import ViewerFrame, VtkWriter, bond_segments, read_frame, read_piece, read_pvd
+from fibrelmp.post.vtk.writer import time_text
 
 from .conftest import REPO
 
@@ -322,7 +323,7 @@ def test_demdf_run_frames_equal_the_snapshots(tmp_path):
 
 @pytest.fixture(scope="module")
 def agglomerate_run(tmp_path_factory):
-    """The agglomerate cmusen script (5696 spheres, 18800 bonds, 5 frames; about 3 s)."""
+    """The agglomerate cmusen script (5696 spheres, 18800 bonds, 6 frames; about 3 s)."""
     import fibrelmp
 
     folder = tmp_path_factory.mktemp("agglo")
@@ -338,8 +339,9 @@ def test_musen_script_bonds_are_the_alive_bonds(agglomerate_run):
     lines as LAMMPS dumped alive bonds, each from the centre of its id1 sphere to that of
     its id2 sphere (no periodic box)."""
     folder, entries, alive = agglomerate_run
-    assert [t for t, _ in entries] == pytest.approx([k * 5e-7 for k in range(5)], rel=1e-9)
-    assert len(alive) == 5 and alive[0] > 18000
+    # cmusen's save times: every 5e-7 s, then the step whose summed time reaches END_TIME
+    assert [t for t, _ in entries] == pytest.approx([k * 5e-7 for k in range(5)] + [2.01e-6], rel=1e-9)
+    assert len(alive) == 6 and alive[0] > 18000
     for (_, vtm), count in zip(entries, alive):
         assert vtm.name.startswith("agglomerate_short_result_")
         blocks = read_frame(vtm)
@@ -366,8 +368,8 @@ def test_musen_script_files_open_in_vtk(agglomerate_run):
 def test_musen_script_files_open_in_ovito(agglomerate_run):
     folder, entries, alive = agglomerate_run
     pipeline = ovito_import(folder / "agglomerate_short_result.pvd")
-    assert pipeline.num_frames == 5
-    data = pipeline.compute(4)
+    assert pipeline.num_frames == 6
+    data = pipeline.compute(5)
     v = read_frame(entries[-1][1])["Particles"]
     assert data.particles.count == len(v.points)
     np.testing.assert_array_equal(np.asarray(data.particles.identifiers), v.point_data["id"])
@@ -450,7 +452,8 @@ def test_musen_walls_are_a_polydata_series_vtk_and_ovito_open(tmp_path):
     python_api.run(scene, end_time=2e-3, step=1e-7, save_step=1e-3, also=["vtk"])
     series = read_pvd(tmp_path / "SingelParticle_result_walls.pvd")
     frames = list(MdemReader(tmp_path / "SingelParticle_result.mdem"))
-    assert [t for t, _ in series] == [f.time for f in frames]
+    # the .pvd writes times to 15 digits (post/vtk/writer.py time_text)
+    assert [t for t, _ in series] == [float(time_text(f.time)) for f in frames]
     for (time, path), frame in zip(series, frames):
         assert path.name.endswith("_walls.vtp")
         piece = read_piece(path)

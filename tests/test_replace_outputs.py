@@ -3,6 +3,7 @@ at the end leaves the earlier run's whole set of results as it was, and no stagi
 
 from __future__ import annotations
 
+import re
 import shutil
 import subprocess
 import sys
@@ -36,12 +37,16 @@ def test_force_rerun_failing_at_the_end_keeps_the_earlier_results(tmp_path):
     result = tmp_path / "SingelParticle_result.mdem"
     assert result in first.outputs and tmp_path / "SingelParticle_result.pvd" in first.outputs
     before = _contents(tmp_path)
-    (tmp_path / "SingelParticle_result_000003.vtp").mkdir()      # the rerun's 4th frame
+    # the rerun's first frame beyond the first run's (the first has cmusen's 4: 0, 1e-3, 2e-3
+    # and 2.001e-3 s, its summed clock's last step; the rerun goes on to 4e-3 s)
+    n = len([p for p in before if re.fullmatch(r"SingelParticle_result_\d{6}\.vtp", p)])
+    blocked = f"SingelParticle_result_{n:06d}.vtp"
+    (tmp_path / blocked).mkdir()
     proc = subprocess.run([sys.executable, "-m", "fibrelmp.cli", "run", str(scene), "--force",
-                           "--also", "vtk", "--end-time", "3e-3", "--step", "1e-6", "--save-step", "1e-3"],
+                           "--also", "vtk", "--end-time", "4e-3", "--step", "1e-6", "--save-step", "1e-3"],
                           cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert proc.returncode != 0, proc.stderr
-    assert "SingelParticle_result_000003.vtp" in proc.stderr and "Traceback" not in proc.stderr
+    assert blocked in proc.stderr and "Traceback" not in proc.stderr
     assert _contents(tmp_path) == before            # same files, same bytes: nothing replaced
     assert not [p for p in tmp_path.iterdir() if ".tmp" in p.name]   # no staging files left
 

@@ -159,7 +159,7 @@ def test_musen_script_scene_and_material_names_replay_like_run(tmp_path):
         assert replay.returncode == 0, replay.stdout + replay.stderr
         assert ran.returncode == 0, ran.stdout + ran.stderr
         a = (tmp_path / "work" / "job2" / "frames.dump").read_bytes()
-        assert a.count(b"ITEM: TIMESTEP") == 3          # t = 0, 1e-4, 2e-4
+        assert a.count(b"ITEM: TIMESTEP") == 4          # t = 0, 1e-4, 2e-4 and cmusen's last, 2.01e-4
         assert (tmp_path / "job" / "frames.dump").exists(), "lmp -in replayed nothing"
         assert (tmp_path / "job" / "frames.dump").read_bytes() == a, "lmp -in replay differs from run"
         _assert_safe_job(tmp_path / "job")

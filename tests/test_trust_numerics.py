@@ -61,11 +61,15 @@ def test_musen_scene_with_default_2m_domain_runs_small_and_fast(tmp_path):
     frames = list(iter_frames(work / "frames.dump"))
     assert frames[-1].count == 2
     assert (frames[-1].hi - frames[-1].lo).max() < 0.01          # a few mm, not 2 m
-    # free fall: no contact (the plate is 9 mm below), z = z0 - g t^2 / 2, vz = -g t
-    t = 1e-4
+    # free fall: no contact (the plate is 9 mm below), in MUSEN's leapfrog (prediction half
+    # kick, then kick and move): z = z0 - g dt^2 (n^2/2 + n), vz = -g dt (n + 1/2) at step n;
+    # the last is cmusen's, step 101, whose summed time first reaches END_TIME
+    n, dt = frames[-1].step, 1e-6
+    assert n == 101
+    drop = G * dt * dt * (n * n / 2 + n)
     z = frames[-1].column("z")
-    assert z == pytest.approx([0.01 - 0.5 * G * t * t, 0.012 - 0.5 * G * t * t], rel=0, abs=1e-15)
-    assert frames[-1].column("vz") == pytest.approx([-G * t] * 2, rel=1e-9)
+    assert z == pytest.approx([0.01 - drop, 0.012 - drop], rel=0, abs=1e-15)
+    assert frames[-1].column("vz") == pytest.approx([-G * dt * (n + 0.5)] * 2, rel=1e-9)
 
 
 def _pair_leaving(domain_half: float):
@@ -148,7 +152,8 @@ def test_one_far_sphere_uses_neighbour_lists_without_bins(tmp_path):
                  mats, contacts, dt=1e-6, t_end=1e-4, save_every_time=5e-5)
     job, frames = run(m, tmp_path)
     assert "neighbor        0.00025 nsq" in job.script.read_text()
-    assert frames[-1].position[0, 2] == pytest.approx(-1e-4, rel=1e-9)
+    assert frames[-1].step == 101          # cmusen's last step: its summed time reaches 1e-4 s
+    assert frames[-1].position[0, 2] == pytest.approx(-101e-6, rel=1e-9)
 
 
 def test_clipped_tiling_is_the_full_tiling_inside_the_box():

@@ -52,3 +52,22 @@ def check_refused_without_styles(job: Path, model: str, line: int, init: Path) -
         python_api.run(job)
     assert str(err.value).startswith(f"{job}:{line}: ")
     assert not init.exists()
+
+
+def run_cut_and_resumed(monkeypatch: pytest.MonkeyPatch, job: Path, work: Path, every: int) -> None:
+    """Run ``job`` with a checkpoint every ``every`` steps, stopped after its first checkpoint
+    (as if SIGTERM came), then resumed to the end."""
+    import signal
+
+    from fibrelmp import checkpoint
+
+    write = checkpoint.Checkpointing.write
+
+    def write_then_stop(self, *args, **kwargs):
+        write(self, *args, **kwargs)
+        self._stop = signal.SIGTERM
+    monkeypatch.setattr(checkpoint.Checkpointing, "write", write_then_stop)
+    with pytest.raises(checkpoint.CheckpointStop):
+        python_api.run(job, work=work, checkpoint_every=every)
+    monkeypatch.setattr(checkpoint.Checkpointing, "write", write)
+    python_api.run(job, work=work, resume=True)

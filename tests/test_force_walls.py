@@ -18,7 +18,8 @@ from fibrelmp.translate.musen.scene import read
 from fibrelmp.translate.musen.text import read_time_points
 
 from .conftest import data_path
-from .musen_model_checks import check_reference_is_cmusens_output, needs_cmusen, styles_or_skip
+from .musen_model_checks import (check_reference_is_cmusens_output, needs_cmusen, run_cut_and_resumed,
+                                 styles_or_skip)
 
 DATA = data_path("real-outputs/musen/force_walls")
 COORD, VEL, FORCE, WALL = 12, 15, 20, 44       # MUSEN text tags
@@ -159,26 +160,14 @@ def test_checkpoint_and_resume_give_the_uninterrupted_run(tmp_path, monkeypatch)
     """The stepped state (interval, velocities, vertices) goes through LAMMPS's restart file:
     a run stopped after a checkpoint taken while the plate presses, then resumed, writes the
     uninterrupted run's result byte for byte."""
-    import signal
-
-    from fibrelmp import checkpoint
     styles_or_skip()
     (tmp_path / "whole").mkdir()
     _run(tmp_path / "whole", "press")
     cut = tmp_path / "cut"
     cut.mkdir()
-    write = checkpoint.Checkpointing.write
-
-    def write_then_stop(self, *args, **kwargs):
-        write(self, *args, **kwargs)
-        self._stop = signal.SIGTERM          # as if SIGTERM came: stop after this checkpoint
-    monkeypatch.setattr(checkpoint.Checkpointing, "write", write_then_stop)
     shutil.copy(DATA / "press_scene.txt", cut)
     shutil.copy(DATA / "job_press.txt", cut)
-    with pytest.raises(checkpoint.CheckpointStop):
-        python_api.run(cut / "job_press.txt", work=cut / "work", checkpoint_every=2290)
-    monkeypatch.setattr(checkpoint.Checkpointing, "write", write)
-    python_api.run(cut / "job_press.txt", work=cut / "work", resume=True)
+    run_cut_and_resumed(monkeypatch, cut / "job_press.txt", cut / "work", 2290)
     assert _result_bytes(cut) == _result_bytes(tmp_path / "whole")
 
 

@@ -16,7 +16,7 @@ from fibrelmp.translate.musen.mdem.model import read_scene
 from fibrelmp.translate.musen.text import read_time_points
 
 from .conftest import data_path
-from .musen_model_checks import CMUSEN, needs_cmusen, styles_or_skip
+from .musen_model_checks import CMUSEN, needs_cmusen, run_cut_and_resumed, styles_or_skip
 
 DATA = data_path("real-outputs/musen/moving_pbc")
 COORD, VEL, ANGVEL = 12, 15, 16
@@ -83,23 +83,11 @@ def test_reference_is_cmusens_output(tmp_path):
 
 def test_checkpoint_and_resume_give_the_uninterrupted_run(tmp_path, monkeypatch):
     """The box of the checkpoint's time and the box at t = 0 go through the restart file."""
-    import signal
-
-    from fibrelmp import checkpoint
     styles_or_skip()
     (tmp_path / "whole").mkdir()
     python_api.run(_job(tmp_path / "whole"), work=tmp_path / "whole" / "work")
     cut = tmp_path / "cut"
     cut.mkdir()
-    write = checkpoint.Checkpointing.write
-
-    def write_then_stop(self, *args, **kwargs):
-        write(self, *args, **kwargs)
-        self._stop = signal.SIGTERM          # as if SIGTERM came: stop after this checkpoint
-    monkeypatch.setattr(checkpoint.Checkpointing, "write", write_then_stop)
-    with pytest.raises(checkpoint.CheckpointStop):
-        python_api.run(_job(cut), work=cut / "work", checkpoint_every=1700)
-    monkeypatch.setattr(checkpoint.Checkpointing, "write", write)
-    python_api.run(cut / "job_pbc.txt", work=cut / "work", resume=True)
+    run_cut_and_resumed(monkeypatch, _job(cut), cut / "work", 1700)
     assert (cut / "pbc_result_prec17.txt").read_bytes() == \
         (tmp_path / "whole" / "pbc_result_prec17.txt").read_bytes()

@@ -18,7 +18,8 @@ from fibrelmp.errors import InputError
 from fibrelmp.translate.musen.text import read_time_points
 
 from .conftest import data_path
-from .musen_model_checks import CMUSEN, check_reference_is_cmusens_output, needs_cmusen, styles_or_skip
+from .musen_model_checks import (CMUSEN, check_reference_is_cmusens_output, needs_cmusen, run_cut_and_resumed,
+                                 styles_or_skip)
 
 DATA = data_path("real-outputs/musen/stop_criterion")
 COORD, VEL, FORCE = 12, 15, 20        # MUSEN text tags
@@ -149,23 +150,11 @@ def _copy_case(folder: Path) -> Path:
 def test_checkpoint_and_resume_give_the_uninterrupted_run(tmp_path, monkeypatch, every):
     """A checkpoint before the first break (100) and between the breaks (200): the resumed
     run counts the breaks from the start and stops at the same save."""
-    import signal
-
-    from fibrelmp import checkpoint
     styles_or_skip()
     whole = _copy_case(tmp_path / "whole")
     python_api.run(whole, work=tmp_path / "whole" / "work")
     cut = _copy_case(tmp_path / "cut")
-    write = checkpoint.Checkpointing.write
-
-    def write_then_stop(self, *args, **kwargs):
-        write(self, *args, **kwargs)
-        self._stop = signal.SIGTERM          # as if SIGTERM came: stop after this checkpoint
-    monkeypatch.setattr(checkpoint.Checkpointing, "write", write_then_stop)
-    with pytest.raises(checkpoint.CheckpointStop):
-        python_api.run(cut, work=cut.parent / "work", checkpoint_every=every)
-    monkeypatch.setattr(checkpoint.Checkpointing, "write", write)
-    python_api.run(cut, work=cut.parent / "work", resume=True)
+    run_cut_and_resumed(monkeypatch, cut, cut.parent / "work", every)
     assert (cut.parent / "stop_result_prec17.txt").read_bytes() == \
         (whole.parent / "stop_result_prec17.txt").read_bytes()
 

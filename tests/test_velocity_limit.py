@@ -1,4 +1,4 @@
-"""MUSEN's particle velocity limit (fix musen/velocity/limit) against the real cmusen
+"""MUSEN's particle velocity limit (fix musen/leapfrog vlimit) against the real cmusen
 (tests/data/real-outputs/musen/velocity_limit/README.md): a force-controlled plate pushes a
 free sphere that may not move faster than 0.01 m/s, from the script's
 LIMIT_PARTICLE_VELOCITY and from a `.mdem`'s stored limit."""

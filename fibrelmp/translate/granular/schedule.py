@@ -67,10 +67,10 @@ def _musen_run_time(model: GranularModel, dim: int, dt: float, t_start: float) -
         return RunTime(dim, dt, 0, t_start, t_start)
     total, saves, exact = musen_run(t_start, dt, t_end, every, MAX_IRREGULAR_SAVES)
     if not exact:
-        model.warnings.append(("musen-save-drift", f"cmusen's summed clock drifts over this run, so "
-                               f"it saves some of its {every:g} s time points a step earlier or "
-                               f"later than every {saves} steps; fibrelmp saves every {saves} steps "
-                               "(the times written are still cmusen's summed times of those steps)"))
+        model.warnings.append(("musen-save-drift", f"over this long run cmusen's summed clock "
+                               "drifts, so it may save some time points (and end) a step earlier "
+                               "or later than fibrelmp's regular schedule; the times written are "
+                               "cmusen's summed times of fibrelmp's steps"))
     if plan.save_every_steps:
         steps = None                   # save_steps' regular schedule
     elif isinstance(saves, int):
@@ -78,7 +78,8 @@ def _musen_run_time(model: GranularModel, dim: int, dt: float, t_start: float) -
     else:
         steps = SaveSteps(total, explicit=saves)
     clock = MusenClock(t_start, dt)
-    return RunTime(dim, dt, total, t_start, clock.time(total), steps, clock)
+    end = clock.time(total) if exact else t_start + total * dt     # (not summed: too long)
+    return RunTime(dim, dt, total, t_start, end, steps, clock)
 
 
 def schedule(total: int, saves: SaveSteps, deletions: list[tuple[int, np.ndarray]],

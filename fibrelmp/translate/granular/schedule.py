@@ -67,7 +67,7 @@ def _musen_run_time(model: GranularModel, dim: int, dt: float, t_start: float) -
         return RunTime(dim, dt, 0, t_start, t_start)
     total, saves, exact = musen_run(t_start, dt, t_end, every, MAX_IRREGULAR_SAVES)
     if not exact:
-        model.warnings.append(("musen-save-drift", f"over this long run cmusen's summed clock "
+        model.warnings.append(("musen-save-drift", "over this long run cmusen's summed clock "
                                "drifts, so it may save some time points (and end) a step earlier "
                                "or later than fibrelmp's regular schedule; the times written are "
                                "cmusen's summed times of fibrelmp's steps"))

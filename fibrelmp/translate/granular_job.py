@@ -157,7 +157,7 @@ def build_granular_job(model: GranularModel, folder: str | Path):
             write_mesh(model, parts.wall_plans, spheres, folder / MESH_NAME)
         write_facts(data_path, job_facts(model, spheres, tiles, run.t_start, run.dt, run.clock is not None))
 
-    saves = save_steps(model, run.total, run.dt, run)
+    saves = save_steps(model, run)
     script = _render_script(model, parts, saves)
     has_bonds = len(bonds.rows) > 0
     breakage = model.plan.bonds_may_break()

@@ -138,10 +138,13 @@ def schedule(total: int, saves: SaveSteps, deletions: list[tuple[int, np.ndarray
     return acts
 
 
-def save_steps(model: GranularModel, total: int, dt: float, run: RunTime | None = None) -> SaveSteps:
+def save_steps(model: GranularModel, run: RunTime) -> SaveSteps:
+    """The run's saved steps: MUSEN's (its clock, ``run.saves``), else every k steps or every
+    time interval."""
     plan = model.plan
-    if run is not None and run.saves is not None:
+    if run.saves is not None:
         return run.saves
+    total, dt = run.total, run.dt
     if plan.save_every_steps:
         k = int(plan.save_every_steps)
         if k <= 0:

@@ -71,7 +71,7 @@ double triangle_distance2(const double *p, const double *a, const double *b, con
 }    // namespace
 
 FixMusenInlet::FixMusenInlet(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), wall_id(nullptr), inserted(0)
+    Fix(lmp, narg, arg), wall_id(nullptr), inserted(0), first_id(1), last_id(0), log(nullptr)
 {
   const std::string usage = "fix ID group musen/inlet SEED box XLO XHI YLO YHI ZLO ZHI tries N "
       "walls WALLFIX|none velocity fixed VX VY VZ|random MAG fractions K ... events M ...";
@@ -130,10 +130,27 @@ FixMusenInlet::FixMusenInlet(LAMMPS *lmp, int narg, char **arg) :
       error->all(FLERR, "Fix musen/inlet: event steps must be >= 1 and ascending");
     events.push_back(e);
   }
-  if (at != narg) error->all(FLERR, "Illegal fix musen/inlet command: {} unused argument(s)", narg - at);
+  while (at < narg) {
+    need(at, 2, nullptr);
+    if (strcmp(arg[at], "first_id") == 0) {
+      first_id = utils::tnumeric(FLERR, arg[at + 1], false, lmp);
+    } else if (strcmp(arg[at], "log") == 0) {
+      if (comm->me == 0) {
+        log = fopen(arg[at + 1], "a");
+        if (!log) error->one(FLERR, "Fix musen/inlet: cannot open log file {}", arg[at + 1]);
+      }
+    } else {
+      error->all(FLERR, "Illegal fix musen/inlet command: unknown keyword {}", arg[at]);
+    }
+    at += 2;
+  }
   if (!atom->radius_flag || !atom->rmass_flag || !atom->omega_flag)
     error->all(FLERR, "Fix musen/inlet needs an atom style with radius, rmass and omega");
   if (domain->triclinic) error->all(FLERR, "Fix musen/inlet needs an orthogonal box");
+  const int periodic[3] = {domain->xperiodic, domain->yperiodic, domain->zperiodic};
+  for (int k = 0; k < 3; k++)    // a sphere created outside the box would be lost unseen
+    if (!periodic[k] && (lo[k] < domain->boxlo[k] || hi[k] > domain->boxhi[k]))
+      error->all(FLERR, "Fix musen/inlet: the generation box is not inside the simulation box on axis {}", k);
   force_reneighbor = 1;
   next_reneighbor = -1;
   scalar_flag = 1;
@@ -144,6 +161,7 @@ FixMusenInlet::FixMusenInlet(LAMMPS *lmp, int narg, char **arg) :
 FixMusenInlet::~FixMusenInlet()
 {
   delete[] wall_id;
+  if (log) fclose(log);
 }
 
 int FixMusenInlet::setmask()
@@ -289,6 +307,9 @@ void FixMusenInlet::create(const std::vector<Sphere> &made_now, const std::vecto
   tagint maxtag = 0;
   for (int i = 0; i < atom->nlocal; i++) maxtag = std::max(maxtag, atom->tag[i]);
   MPI_Allreduce(MPI_IN_PLACE, &maxtag, 1, MPI_LMP_TAGINT, MPI_MAX, world);
+  maxtag = std::max(maxtag, first_id - 1);
+  for (Fix *other : modify->get_fix_by_style("^musen/inlet$"))
+    maxtag = std::max(maxtag, static_cast<FixMusenInlet *>(other)->last_given());
   std::string lines;
   for (size_t j = 0; j < made_now.size(); j++) {
     const Fraction &f = fractions[which[j]];
@@ -309,6 +330,12 @@ void FixMusenInlet::create(const std::vector<Sphere> &made_now, const std::vecto
     modify->create_attribute(i);
   }
   atom->natoms += static_cast<bigint>(made_now.size());
+  last_id = maxtag + static_cast<tagint>(made_now.size());
+  if (log) {
+    for (size_t j = 0; j < made_now.size(); j++)
+      fmt::print(log, "{} {}\n", update->ntimestep, maxtag + 1 + static_cast<tagint>(j));
+    fflush(log);
+  }
   inserted += static_cast<bigint>(made_now.size());
   if (atom->map_style != Atom::MAP_NONE) {
     atom->nghost = 0;
@@ -326,7 +353,8 @@ double FixMusenInlet::compute_scalar()
 void FixMusenInlet::write_restart(FILE *fp)
 {
   if (comm->me != 0) return;
-  std::vector<double> list{static_cast<double>(made.size()), static_cast<double>(inserted)};
+  std::vector<double> list{static_cast<double>(made.size()), static_cast<double>(inserted),
+                           static_cast<double>(last_id)};
   for (int m : made) list.push_back(m);
   const int size = static_cast<int>(list.size() * sizeof(double));
   fwrite(&size, sizeof(int), 1, fp);
@@ -340,7 +368,8 @@ void FixMusenInlet::restart(char *buf)
     error->all(FLERR, "Fix musen/inlet: the restart file has {} fractions, the command {}",
                static_cast<int>(list[0]), made.size());
   inserted = static_cast<bigint>(list[1]);
-  for (size_t i = 0; i < made.size(); i++) made[i] = static_cast<int>(list[2 + i]);
+  last_id = static_cast<tagint>(list[2]);
+  for (size_t i = 0; i < made.size(); i++) made[i] = static_cast<int>(list[3 + i]);
 }
 
 // registration with LAMMPS when the plugin loads (style_registry.h)

@@ -8,6 +8,7 @@
          velocity fixed VX VY VZ | velocity random MAGNITUDE
          fractions K  TYPE DIAMETER DENSITY SHARE  (K times)
          events M  STEP COUNT  (M times, steps ascending)
+         [first_id ID] [log FILE]
 
    At each listed STEP (MUSEN's generation times, computed by fibrelmp from cmusen's summed
    clock: the fix does not recompute it) it tries to make COUNT spheres.  Per sphere: the
@@ -25,8 +26,10 @@
    random numbers and takes the same decisions; each rank keeps the new atoms it owns.  The
    random numbers of one generation come from SEED and STEP alone (no state carried from step
    to step), so a restarted or replayed run and any number of ranks insert the same spheres.
-   New atom IDs are the next ones after the largest existing ID, in order of success (fixes
-   at the same step: in the order they were defined).
+   New atom IDs are the next ones after the largest existing ID, the largest any musen/inlet
+   fix gave and ID - 1, in order of success (fixes at the same step: in the order they were
+   defined): a removed sphere's ID is never given again.  FILE: rank 0 appends a line
+   "STEP ID" per new atom (fibrelmp's result writers take the activity start from it).
 ------------------------------------------------------------------------- */
 
 #ifndef FIBRELMP_FIX_MUSEN_INLET_H
@@ -48,7 +51,8 @@ class FixMusenInlet : public Fix {
   void init() override;
   void setup_pre_exchange() override;
   void pre_exchange() override;
-  double compute_scalar() override;    // spheres this fix has inserted (all runs)
+  double compute_scalar() override;
+  tagint last_given() const { return last_id; }    // spheres this fix has inserted (all runs)
   void write_restart(FILE *) override;
   void restart(char *) override;
 
@@ -74,6 +78,8 @@ class FixMusenInlet : public Fix {
   std::vector<int> made;        // successes per fraction (MUSEN's generated mixture particles)
   std::vector<Event> events;
   bigint inserted;
+  tagint first_id, last_id;     // the ID floor; the last ID this fix gave (0: none)
+  FILE *log;
 
   void schedule_next();
   std::vector<Sphere> spheres_near(double reach);

@@ -276,23 +276,3 @@ def read_inlets(storage: Any, path: Path) -> list[Inlet]:
             fractions.append((f.compoundKey, float(f.diameter), float(f.fraction)))
         out.append(Inlet(g, lo, hi, tuple(fractions)))
     return out
-
-
-def refuse_active(storage: Any, path: Path, dt: float) -> None:
-    """Refuse a scene with an active generator that generates anything in its own time window
-    (fibrelmp does not insert objects into a running LAMMPS job; the window, not the run's end,
-    because a job script may still change the end time); every active generator's settings
-    are checked first, so the message names the first thing MUSEN itself would stop at."""
-    generators = read_generators(storage)
-    for g in generators:
-        if g.active:
-            check_generator(g, storage, path)
-    window = max((g.end + g.update_step for g in generators if g.active), default=0.0)
-    step = dt if dt > 0 else MUSEN_DEFAULT_STEP           # nan: the file sets no step
-    events = generation_schedule(generators, step, window, first_only=True)
-    if events:
-        g = generators[events[0].generator]
-        raise _field(path, g, "activity", f"asks for {events[0].requested} object(s) at "
-                     f"t = {events[0].time:.6g} s (with the file's step), and more later; inserting "
-                     "particles during a run is not implemented in fibrelmp: deactivate the "
-                     "generator or generate the particles before the run")

@@ -144,8 +144,8 @@ FixMusenInlet::FixMusenInlet(LAMMPS *lmp, int narg, char **arg) :
     }
     at += 2;
   }
-  if (!atom->radius_flag || !atom->rmass_flag || !atom->omega_flag)
-    error->all(FLERR, "Fix musen/inlet needs an atom style with radius, rmass and omega");
+  if (strcmp(atom->atom_style, "sphere") != 0 && strcmp(atom->atom_style, "bpm/sphere") != 0)
+    error->all(FLERR, "Fix musen/inlet needs atom style sphere or bpm/sphere, not {}", atom->atom_style);
   if (domain->triclinic) error->all(FLERR, "Fix musen/inlet needs an orthogonal box");
   const int periodic[3] = {domain->xperiodic, domain->yperiodic, domain->zperiodic};
   for (int k = 0; k < 3; k++)    // a sphere created outside the box would be lost unseen
@@ -313,8 +313,10 @@ void FixMusenInlet::create(const std::vector<Sphere> &made_now, const std::vecto
   std::string lines;
   for (size_t j = 0; j < made_now.size(); j++) {
     const Fraction &f = fractions[which[j]];
-    lines += fmt::format("{} 0 {} {:.17g} {:.17g} {:.17g} {:.17g} {:.17g}\n", maxtag + 1 + (tagint) j,
-                         f.type, 2.0 * f.radius, f.density, made_now[j].x[0], made_now[j].x[1], made_now[j].x[2]);
+    // the Atoms line of atom styles sphere (id type d rho x y z) and bpm/sphere (id mol ...)
+    lines += fmt::format("{}{} {} {:.17g} {:.17g} {:.17g} {:.17g} {:.17g}\n", maxtag + 1 + (tagint) j,
+                         atom->molecule_flag ? " 0" : "", f.type, 2.0 * f.radius, f.density,
+                         made_now[j].x[0], made_now[j].x[1], made_now[j].x[2]);
   }
   const int first = atom->nlocal;
   std::vector<char> buf(lines.begin(), lines.end());

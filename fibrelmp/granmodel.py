@@ -215,6 +215,8 @@ class GranularPlan:
     # MUSEN's active dynamic generators (translate/musen/mdem/generators.py Inlet): fix musen/inlet
     inlets: list = field(default_factory=list)
     inlet_rows: int | None = None   # the first sphere row reserved for them (inlets.reserve_rows)
+    # (dt, t_end) -> their GenerationEvents on cmusen's summed clock (generation_schedule)
+    inlet_schedule: Callable[[float, float], list] | None = None
 
     def bonds_may_break(self) -> bool:
         """Whether any of the solid bonds' laws has a breakage criterion."""

@@ -70,7 +70,6 @@ def inlet_commands(model: GranularModel, type_of_mat: dict[int, int], dt: float,
                    t_end: float, wall_fix: str | None) -> list[str]:
     """One ``fix musen/inlet`` per active generator (in MUSEN's order: the new ids follow it);
     reserves the model's rows for what they may make (``reserve_rows``)."""
-    from fibrelmp.translate.musen.mdem.generators import generation_schedule
     from fibrelmp.translate.lammps_format import float_text
 
     inlets = model.plan.inlets
@@ -79,7 +78,7 @@ def inlet_commands(model: GranularModel, type_of_mat: dict[int, int], dt: float,
     if t_start != 0.0:
         raise InputError(model.source, None, "dynamic generators with a start time > 0 (a "
                          "continued run) are not supported: cmusen's generation clock starts at 0")
-    events = generation_schedule([i.generator for i in inlets], dt, t_end)
+    events = model.plan.inlet_schedule(dt, t_end)     # cmusen's clock (mdem/generators.py)
     first = reserve_rows(model, sum(e.requested for e in events))
     out = []
     for k, inlet in enumerate(inlets):

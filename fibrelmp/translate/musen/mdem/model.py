@@ -23,7 +23,7 @@ def read_scene(path: str | os.PathLike) -> GranularModel:
     so both forms of a scene give the same model."""
     from fibrelmp.translate.musen import scene
     from fibrelmp.translate.musen.mdem.document import MdemFile
-    from fibrelmp.translate.musen.mdem.generators import read_inlets
+    from fibrelmp.translate.musen.mdem.generators import generation_schedule, read_inlets
     from fibrelmp.translate.musen.mdem.text_export import export
 
     from fibrelmp.translate.musen.mdem.fields import check_settings
@@ -42,7 +42,9 @@ def read_scene(path: str | os.PathLike) -> GranularModel:
         _settings(model, mdem.storage.modules_data)
         _refused_settings(model, mdem.storage)
         # inlets: checked here, scheduled for the job's step and end time by the translation
-        model.plan.inlets = read_inlets(mdem.storage, path)
+        inlets = model.plan.inlets = read_inlets(mdem.storage, path)
+        model.plan.inlet_schedule = (lambda dt, t_end: generation_schedule(
+            [i.generator for i in inlets], dt, t_end))
     model.warnings.extend(ignored)
     model.source = path
     scene_record(model, keep=True).mdem_source = path

@@ -281,3 +281,24 @@ def test_schedule_holds_for_another_cmusen_seed(tmp_path):
     events = gen.generation_schedule(gen.read_generators(_storage()), DT, END)
     labels = ["%g" % e.time for e in events]
     assert set(starts) <= set(labels) and labels.index(starts[0]) == 0
+    # the new run is one more sample of cmusen's spread: the stored four cover it loosely
+    _spread_check(len(starts), CMUSEN_COUNTS)
+
+
+def test_two_ranks_write_the_serial_results(tmp_path):
+    """``mpiexec -n 2 fibrelmp run`` of the inlet job: the same result files, byte for byte
+    (every rank takes the same insertions; each keeps those it owns)."""
+    from .test_mpi import MPIEXEC, assert_ran, serial_and_mpi
+
+    if not MPIEXEC:
+        pytest.skip("mpiexec not found (pip install mpich)")
+
+    def populate(case: Path) -> None:
+        for name in ("inlet_scene.mdem", "job_inlet.txt"):
+            shutil.copy(DATA / name, case)
+
+    runs = serial_and_mpi(tmp_path, populate, ["-q", "run", "job_inlet.txt"])
+    assert_ran(runs)
+    ser, mpi = runs["serial"][0], runs["mpi"][0]
+    for name in ("inlet_result_prec17.txt", "inlet_result.mdem", "job_inlet_work/job1/inlets.log"):
+        assert (mpi / name).read_bytes() == (ser / name).read_bytes(), name

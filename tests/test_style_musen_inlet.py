@@ -33,7 +33,20 @@ def plugin_path() -> str:
     return str(found.path)
 
 
-def _script(plugin: str, seed: int, restart_in: str | None = None, restart_out: str | None = None) -> str:
+PLATE = """musen/wall/mesh 1
+laws 2
+1 0 1e8 1e7 0.8 0.2 0.01
+2 0 1e8 1e7 0.8 0.2 0.01
+geometries 1
+geometry Plate 0 0 0
+triangles 2
+0 0 -0.05 -0.05 0.0 0.05 -0.05 0.0 0.05 0.05 0.0
+0 0 -0.05 -0.05 0.0 0.05 0.05 0.0 -0.05 0.05 0.0
+"""
+
+
+def _script(plugin: str, seed: int, restart_in: str | None = None, restart_out: str | None = None,
+            walls: str = "none") -> str:
     fractions = " ".join(f"{t} {d} {rho} {s}" for t, d, rho, s in FRACTIONS)
     box = " ".join(f"{a} {b}" for a, b in zip(LO, HI))
     head = ([f"plugin load {plugin}", f"read_restart {restart_in}"] if restart_in else
@@ -42,8 +55,11 @@ def _script(plugin: str, seed: int, restart_in: str | None = None, restart_out: 
              "create_box 2 b"])
     lines = head + [
         "pair_style zero 0.01", "pair_coeff * *", "comm_modify vel yes", "neighbor 0.001 bin",
-        "timestep 1e-6", "group spheres empty",
-        f"fix in spheres musen/inlet {seed} box {box} tries 30 walls none velocity random 0.5 "
+        "timestep 1e-6", "group spheres empty"]
+    if walls != "none":
+        lines.append(f"fix {walls} spheres musen/wall/mesh plate.mesh")
+    lines += [
+        f"fix in spheres musen/inlet {seed} box {box} tries 30 walls {walls} velocity random 0.5 "
         f"fractions 2 {fractions} events 3 1 300 3 200 5 100 first_id 1 log inlets.log"]
     if restart_out:
         lines += ["run 3", f"write_restart {restart_out}"]
@@ -54,9 +70,10 @@ def _script(plugin: str, seed: int, restart_in: str | None = None, restart_out: 
     return "\n".join(lines) + "\n"
 
 
-def _run(plugin: str, folder: Path, seed: int = 7, ranks: int = 1) -> dict:
+def _run(plugin: str, folder: Path, seed: int = 7, ranks: int = 1, walls: str = "none") -> dict:
     folder.mkdir(parents=True)
-    _run_lmp_script(folder, _script(plugin, seed), ranks)
+    (folder / "plate.mesh").write_text(PLATE)
+    _run_lmp_script(folder, _script(plugin, seed, walls=walls), ranks)
     return next(iter_frames(folder / "out.dump")).columns
 
 
@@ -147,3 +164,14 @@ def test_restart_continues_the_mixture_and_ids(plugin_path, inserted, tmp_path):
     d = next(iter_frames(second / "out.dump")).columns
     for col in ("id", "type", "x", "y", "z", "vx", "vy", "vz", "radius", "mass"):
         np.testing.assert_array_equal(d[col], c[col])
+
+
+def test_no_sphere_touches_a_wall_triangle(plugin_path, inserted, tmp_path):
+    """A plate of two triangles (fix musen/wall/mesh) across the middle of the box: no new
+    sphere reaches it (MUSEN's IsOverlapped with the walls), where without it some do."""
+    c, _ = inserted
+    crossing = np.abs(c["z"]) < c["radius"]
+    assert crossing.sum() >= 10
+    w = _run(plugin_path, tmp_path / "plate", walls="plate")
+    assert len(w["id"]) == 600
+    assert (np.abs(w["z"]) >= w["radius"]).all()

@@ -55,16 +55,19 @@ def _script(plugin: str, seed: int, restart_in: str | None = None, restart_out: 
              "create_box 2 b"])
     lines = head + [
         "pair_style zero 0.01", "pair_coeff * *", "comm_modify vel yes", "neighbor 0.001 bin",
-        "timestep 1e-6", "group spheres empty"]
+        "timestep 1e-6", "group spheres empty", "group small type 1", "group large type 2"]
     if walls != "none":
         lines.append(f"fix {walls} spheres musen/wall/mesh plate.mesh")
     lines += [
         f"fix in spheres musen/inlet {seed} box {box} tries 30 walls {walls} velocity random 0.5 "
-        f"fractions 2 {fractions} events 3 1 300 3 200 5 100 first_id 1 log inlets.log"]
+        f"fractions 2 {fractions} events 3 1 300 3 200 5 100 first_id 1 log inlets.log "
+        "groups small large"]
     if restart_out:
         lines += ["run 3", f"write_restart {restart_out}"]
     else:
         lines += ["run 3" if not restart_in else "run 0", "run 3"]
+    lines += ["variable small equal count(small)", "variable large equal count(large)",
+              'print "groups ${small} ${large}" file groups.txt']
     lines.append("write_dump all custom out.dump id type x y z vx vy vz radius mass "
                  "modify sort id format float %.17g")
     return "\n".join(lines) + "\n"
@@ -103,6 +106,8 @@ def test_spheres_follow_musens_rule(inserted):
         want.append(k)
     frac = [FRACTIONS[k] for k in want]
     assert (c["type"] == [f[0] for f in frac]).all()
+    small = int((c["type"] == 1).sum())
+    assert (folder / "groups.txt").read_text().split() == ["groups", str(small), str(n - small)]
     r = np.array([0.5 * f[1] for f in frac])
     np.testing.assert_array_equal(c["radius"], r)
     np.testing.assert_array_equal(c["mass"], [4.0 / 3.0 * math.pi * ri ** 3 * f[2] for ri, f in zip(r, frac)])

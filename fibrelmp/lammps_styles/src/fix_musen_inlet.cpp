@@ -11,6 +11,7 @@
 #include "comm.h"
 #include "domain.h"
 #include "error.h"
+#include "group.h"
 #include "memory.h"
 #include "modify.h"
 #include "update.h"
@@ -113,7 +114,7 @@ FixMusenInlet::FixMusenInlet(LAMMPS *lmp, int narg, char **arg) :
     Fraction f{utils::inumeric(FLERR, arg[at], false, lmp),
                0.5 * utils::numeric(FLERR, arg[at + 1], false, lmp),
                utils::numeric(FLERR, arg[at + 2], false, lmp),
-               utils::numeric(FLERR, arg[at + 3], false, lmp)};
+               utils::numeric(FLERR, arg[at + 3], false, lmp), 0};
     if (f.type < 1 || f.type > atom->ntypes) error->all(FLERR, "Fix musen/inlet: invalid atom type {}", f.type);
     if (!(f.radius > 0 && f.density > 0)) error->all(FLERR, "Fix musen/inlet: diameter and density must be > 0");
     fractions.push_back(f);
@@ -134,6 +135,14 @@ FixMusenInlet::FixMusenInlet(LAMMPS *lmp, int narg, char **arg) :
     need(at, 2, nullptr);
     if (strcmp(arg[at], "first_id") == 0) {
       first_id = utils::tnumeric(FLERR, arg[at + 1], false, lmp);
+    } else if (strcmp(arg[at], "groups") == 0) {    // one more group per fraction
+      need(at, 1 + static_cast<int>(fractions.size()), nullptr);
+      for (size_t i = 0; i < fractions.size(); i++) {
+        const int g = group->find(arg[at + 1 + i]);
+        if (g < 0) error->all(FLERR, "Fix musen/inlet: no group {}", arg[at + 1 + i]);
+        fractions[i].groupbit = group->bitmask[g];
+      }
+      at += static_cast<int>(fractions.size()) - 1;
     } else if (strcmp(arg[at], "log") == 0) {
       if (comm->me == 0) {
         log = fopen(arg[at + 1], "a");
@@ -326,7 +335,7 @@ void FixMusenInlet::create(const std::vector<Sphere> &made_now, const std::vecto
   for (int i = first; i < atom->nlocal; i++) {
     const size_t j = static_cast<size_t>(atom->tag[i] - maxtag - 1);
     const Fraction &f = fractions[which[j]];
-    atom->mask[i] |= groupbit;
+    atom->mask[i] |= groupbit | f.groupbit;
     atom->rmass[i] = 4.0 / 3.0 * M_PI * std::pow(f.radius, 3) * f.density;    // MUSEN's mass
     for (int k = 0; k < 3; k++) atom->v[i][k] = vel[3 * j + k], atom->omega[i][k] = 0.0;
     modify->create_attribute(i);

@@ -8,7 +8,7 @@
          velocity fixed VX VY VZ | velocity random MAGNITUDE
          fractions K  TYPE DIAMETER DENSITY SHARE  (K times)
          events M  STEP COUNT  (M times, steps ascending)
-         [first_id ID] [log FILE]
+         [first_id ID] [log FILE] [groups NAME1 .. NAMEK]   (a further group per fraction)
 
    At each listed STEP (MUSEN's generation times, computed by fibrelmp from cmusen's summed
    clock: the fix does not recompute it) it tries to make COUNT spheres.  Per sphere: the
@@ -60,6 +60,7 @@ class FixMusenInlet : public Fix {
   struct Fraction {
     int type;
     double radius, density, share;
+    int groupbit;    // "groups": a further group of its spheres (0: none)
   };
   struct Event {
     bigint step;

@@ -92,8 +92,10 @@ def inlet_commands(model: GranularModel, type_of_mat: dict[int, int], dt: float,
             f"{float_text(model.materials[_material(model, key, g.name)].density)} {float_text(share)}"
             for key, d, share in inlet.fractions)
         steps = " ".join(f"{e.step} {e.requested}" for e in mine)
+        # the per-type groups m<type> of the script (stock walls act on them)
+        groups = " ".join(f"m{type_of_mat[_material(model, key, g.name)]}" for key, _, _ in inlet.fractions)
         out.append(f"fix             fl_inlet{k + 1} spheres musen/inlet {INLET_SEED + k} box {box} "
                    f"tries {g.max_iterations} walls {wall_fix or 'none'} velocity {vel} "
                    f"fractions {len(inlet.fractions)} {fractions} events {len(mine)} {steps} "
-                   f"first_id {first + 1} log {LOG_NAME}")
+                   f"first_id {first + 1} log {LOG_NAME} groups {groups}")
     return out

@@ -78,6 +78,9 @@ def inlet_commands(model: GranularModel, type_of_mat: dict[int, int], dt: float,
     if t_start != 0.0:
         raise InputError(model.source, None, "dynamic generators with a start time > 0 (a "
                          "continued run) are not supported: cmusen's generation clock starts at 0")
+    if any(model.plan.periodic):       # fix musen/inlet does not look across periodic faces
+        raise InputError(model.source, None, f"dynamic generator '{inlets[0].generator.name}': "
+                         "generating in a periodic box is not supported by fibrelmp")
     events = model.plan.inlet_schedule(dt, t_end)     # cmusen's clock (mdem/generators.py)
     first = reserve_rows(model, sum(e.requested for e in events))
     out = []

@@ -229,12 +229,25 @@ def test_summary_counts_the_generated_spheres(fibrelmp_run, fibrelmp_result):
     assert (p["start"], p["generated"], p["end"]) == (0, len(fibrelmp_result["id"]), len(fibrelmp_result["id"]))
 
 
-def test_unsupported_generator_setting_refuses_the_run(tmp_path):
+def _periodic_x(storage) -> None:
+    info = storage.info
+    info.periodic_conditions_enabled = info.periodic_conditions_x = True
+    info.periodic_conditions_min.x, info.periodic_conditions_max.x = -0.005, 0.005
+    info.periodic_conditions_min.y, info.periodic_conditions_max.y = -0.005, 0.005
+    info.periodic_conditions_min.z, info.periodic_conditions_max.z = 0.0, 0.012
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda s: setattr(s.modules_data.objects_generator.generators[0], "inside_geometries", False),
+     "dynamic generator 'InletA': inside_geometries: off"),
+    (_periodic_x, "dynamic generator 'InletA': generating in a periodic box is not supported"),
+])
+def test_unsupported_generator_setting_refuses_the_run(tmp_path, change, message):
     scene = tmp_path / "inlet_scene.mdem"
     with MdemFile(SCENE) as f:
         storage = f.storage
         points = list(f.time_points())
-    storage.modules_data.objects_generator.generators[0].inside_geometries = False
+    change(storage)
     with open(scene, "wb") as fh:
         writer = MdemWriter(fh)
         for t, values, masks in points:
@@ -242,7 +255,7 @@ def test_unsupported_generator_setting_refuses_the_run(tmp_path):
         writer.finish(storage)
     with pytest.raises(InputError) as err:
         python_api.run(scene)
-    assert str(err.value).startswith(f"{scene}: dynamic generator 'InletA': inside_geometries: off")
+    assert str(err.value).startswith(f"{scene}: {message}"), str(err.value)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["inlet_scene.mdem"]
 
 

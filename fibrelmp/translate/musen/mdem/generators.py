@@ -261,6 +261,11 @@ def read_inlets(storage: Any, path: Path) -> list[Inlet]:
                          "is not supported by fibrelmp; switch it on")
         if not (g.max_iterations >= 1):
             raise _field(path, g, "max_iterations", f"must be >= 1, got {g.max_iterations}")
+        info = storage.info
+        if info.periodic_conditions_enabled and (info.periodic_conditions_x or info.periodic_conditions_y
+                                                 or info.periodic_conditions_z):
+            raise InputError(path, None, f"dynamic generator '{g.name}': generating in a periodic "
+                             "box is not supported by fibrelmp")
         lo, hi = _box_volume(storage, g, path)
         mixture = next(m for m in storage.modules_data.materials_database.mixture
                        if m.uniqueKey == g.mixture_key)

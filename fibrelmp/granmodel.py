@@ -212,6 +212,11 @@ class GranularPlan:
     pw_contact_time: Callable[[float, float, float, float], float] | None = None   # the same for
     pw_contact_law: str = "Hertz"                                                 # sphere-wall
     dimension: int = 3
+    # MUSEN's active dynamic generators (translate/musen/mdem/generators.py Inlet): fix musen/inlet
+    inlets: list = field(default_factory=list)
+    inlet_rows: int | None = None   # the first sphere row reserved for them (inlets.reserve_rows)
+    # (dt, t_end) -> their GenerationEvents on cmusen's summed clock (generation_schedule)
+    inlet_schedule: Callable[[float, float], list] | None = None
 
     def bonds_may_break(self) -> bool:
         """Whether any of the solid bonds' laws has a breakage criterion."""
@@ -347,6 +352,7 @@ class GranularModel(ParticleModel):
         tally = tally or {}
         out: dict[str, Any] = {
             "particles": {"kind": "spheres", "start": len(job.sphere_rows), "end": tally.get("spheres"),
+                          "generated": tally.get("generated", 0),
                           "removed_at_activity_end": tally.get("activity_end"),
                           "left_domain": tally.get("left_domain")},
             "contacts": thermo_int(last, "Contacts"),

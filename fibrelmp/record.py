@@ -344,8 +344,10 @@ def summary_lines(s: dict) -> list[str]:
                      f"{g((e1 or {}).get('step'), 'd')})")
     p = s["particles"]
     if p["kind"] == "spheres":
-        removed = p["start"] - p["end"]
-        lines.append(f"  spheres    {p['start']} -> {p['end']} ({removed} removed: "
+        made = p.get("generated") or 0           # MUSEN's dynamic generators (inlets)
+        removed = p["start"] + made - p["end"]
+        lines.append(f"  spheres    {p['start']}{f' + {made} generated' if made else ''} -> {p['end']} "
+                     f"({removed} removed: "
                      f"{p['removed_at_activity_end']} at their activity end, "
                      f"{p['left_domain']} left the domain)")
         ov = s.get("max_overlap")

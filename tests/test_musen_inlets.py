@@ -1,8 +1,10 @@
 """MUSEN's dynamic generators (inlets) against the real cmusen's inlet-into-a-box run
 (tests/data/real-outputs/musen/inlet/README.md): settings, generation times and counts, ids,
-activity starts, radii per mixture fraction, positions and velocities at generation; and the
-refusal of a run that needs them.  cmusen seeds its random positions with the wall clock, so
-positions are compared as statistics (inside the volume, no overlap), not value by value."""
+activity starts, radii per mixture fraction, positions and velocities at generation, for
+cmusen's stored result and for fibrelmp's run of the same job (fix musen/inlet); the heap at
+the end against cmusen's spread over four runs; the fix's own statistics, seeding and ranks.
+cmusen seeds its random positions with the wall clock, so positions are compared as
+statistics (inside the volume, no overlap), not value by value."""
 
 from __future__ import annotations
 
@@ -17,7 +19,7 @@ import pytest
 from fibrelmp import python_api
 from fibrelmp.errors import InputError
 from fibrelmp.translate.musen.mdem import generators as gen
-from fibrelmp.translate.musen.mdem.document import MdemFile
+from fibrelmp.translate.musen.mdem.document import MdemFile, MdemWriter
 
 from .conftest import data_path
 from .musen_model_checks import CMUSEN, needs_cmusen
@@ -77,6 +79,26 @@ def cmusen_result() -> dict:
         return _spheres(fh.read())
 
 
+@pytest.fixture(scope="module")
+def fibrelmp_run(tmp_path_factory) -> Path:
+    """fibrelmp's run of cmusen's job (the .mdem scene, its generators, END_TIME 0.02 s)."""
+    folder = tmp_path_factory.mktemp("inlet")
+    for name in ("inlet_scene.mdem", "job_inlet.txt"):
+        shutil.copy(DATA / name, folder)
+    python_api.run(folder / "job_inlet.txt")
+    return folder
+
+
+@pytest.fixture(scope="module")
+def fibrelmp_result(fibrelmp_run) -> dict:
+    return _spheres((fibrelmp_run / "inlet_result_prec17.txt").read_text())
+
+
+@pytest.fixture(params=["cmusen", "fibrelmp"])
+def result(request) -> dict:
+    return request.getfixturevalue(f"{request.param}_result")
+
+
 def test_settings_read_as_musen_loads_them():
     a, b = gen.read_generators(_storage())
     assert (a.name, a.volume_key, a.mixture_key, a.objects) == ("InletA", "VINLET", "MIXONE", 1)
@@ -107,7 +129,8 @@ def test_schedule_gives_cmusens_generation_times(cmusen_result):
     assert events[1].step == 2001 and events[3].step == 4000      # drift of the summed time
 
 
-def test_radii_follow_the_mixture_fractions(cmusen_result):
+def test_radii_follow_the_mixture_fractions(result):
+    cmusen_result = result
     events = gen.generation_schedule(gen.read_generators(_storage()), DT, END)
     labels = ["%g" % e.time for e in events]
     radii = np.array(cmusen_result["r"])
@@ -123,7 +146,8 @@ def test_radii_follow_the_mixture_fractions(cmusen_result):
     assert set(cmusen_result["mat"]) == {"MGLASS"}
 
 
-def test_objects_at_a_save_of_their_generation_step(cmusen_result):
+def test_objects_at_a_save_of_their_generation_step(result):
+    cmusen_result = result
     """Spheres generated on a saving step are saved as generated: totally inside the volume,
     free of each other, with the generator's velocity (|v| = 0.5 for the random one)."""
     saves = cmusen_result["saves"]
@@ -153,13 +177,85 @@ def test_next_fraction_is_musens_rule():
     assert gen.next_fraction([2, 3, 5], [0.2, 0.3, 0.5]) == 0     # all at target: the first
 
 
-def test_run_with_an_active_generator_is_refused(tmp_path):
+def test_fibrelmp_generates_at_cmusens_times_and_ids(fibrelmp_run, fibrelmp_result, cmusen_result):
+    """fibrelmp's run: generation events, counts and ids as cmusen's (exact while the volume
+    is uncrowded), every activity start bit-identical to cmusen's summed time of its event."""
+    events = gen.generation_schedule(gen.read_generators(_storage()), DT, END)
+    labels = ["%g" % e.time for e in events]
+    starts = fibrelmp_result["start"]
+    made = [starts.count(lab) for lab in labels]
+    assert fibrelmp_result["id"] == list(range(10, 10 + len(starts)))
+    assert sum(made) == len(starts)
+    assert [labels.index(s) for s in starts] == sorted(labels.index(s) for s in starts)
+    assert all(1 <= m <= e.requested for m, e in zip(made, events))
+    cm = [cmusen_result["start"].count(lab) for lab in labels]
+    assert made[:4] == cm[:4] == [10, 10, 10, 12]
+    with MdemFile(fibrelmp_run / "inlet_result.mdem") as f:
+        info = f.storage.info.particles
+    exact = [info[i].activity_start for i in fibrelmp_result["id"]]
+    assert exact == [events[labels.index(s)].time for s in starts]
+    assert exact[0] == 0.0010000000000000152 and exact[30] == 0.0040000000000002065   # README
+
+
+# cmusen's own spread: four runs of job_inlet.txt (README: the stored one and three reruns)
+CMUSEN_COUNTS = (183, 178, 187, 186)
+CMUSEN_Z_CENTRE = (0.006769615662088993, 0.00701519015460296, 0.006947915411370733,
+                   0.006895959351739143)
+
+
+def _spread_check(value: float, runs: tuple) -> None:
+    mean, half = float(np.mean(runs)), 0.5 * (max(runs) - min(runs))
+    assert abs(value - mean) <= 3 * half, (value, mean, half)
+
+
+def test_heap_at_the_end_within_three_cmusen_spreads(fibrelmp_run):
+    """At 0.02 s: the sphere count and the z centre of mass of the heap (volume-weighted: one
+    material) against cmusen's four runs, within 3x their half range."""
+    with MdemFile(fibrelmp_run / "inlet_result.mdem") as f:
+        info = f.storage.info.particles
+        t, values, masks = list(f.time_points())[-1]
+    ids = [i for i, p in enumerate(info) if p.type == 1]
+    r = np.array([np.frombuffer(info[i].encoded_properties, "<f8")[0] for i in ids])
+    z = values[ids, 2]
+    assert t == pytest.approx(0.020001, abs=1e-12) and (masks[ids] != 0).all()
+    _spread_check(len(ids), CMUSEN_COUNTS)
+    _spread_check(float((z * r ** 3).sum() / (r ** 3).sum()), CMUSEN_Z_CENTRE)
+
+
+def test_summary_counts_the_generated_spheres(fibrelmp_run, fibrelmp_result):
+    import json
+    summary = json.loads((fibrelmp_run / "job_inlet_work" / "job1" / "summary.json").read_text())
+    p = summary["particles"]
+    assert (p["start"], p["generated"], p["end"]) == (0, len(fibrelmp_result["id"]), len(fibrelmp_result["id"]))
+
+
+def _periodic_x(storage) -> None:
+    info = storage.info
+    info.periodic_conditions_enabled = info.periodic_conditions_x = True
+    info.periodic_conditions_min.x, info.periodic_conditions_max.x = -0.005, 0.005
+    info.periodic_conditions_min.y, info.periodic_conditions_max.y = -0.005, 0.005
+    info.periodic_conditions_min.z, info.periodic_conditions_max.z = 0.0, 0.012
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda s: setattr(s.modules_data.objects_generator.generators[0], "inside_geometries", False),
+     "dynamic generator 'InletA': inside_geometries: off"),
+    (_periodic_x, "dynamic generator 'InletA': generating in a periodic box is not supported"),
+])
+def test_unsupported_generator_setting_refuses_the_run(tmp_path, change, message):
     scene = tmp_path / "inlet_scene.mdem"
-    shutil.copy(SCENE, scene)
+    with MdemFile(SCENE) as f:
+        storage = f.storage
+        points = list(f.time_points())
+    change(storage)
+    with open(scene, "wb") as fh:
+        writer = MdemWriter(fh)
+        for t, values, masks in points:
+            writer.add(t, values, masks)
+        writer.finish(storage)
     with pytest.raises(InputError) as err:
         python_api.run(scene)
-    assert str(err.value).startswith(f"{scene}: dynamic generator 'InletA': activity: asks for "
-                                     "10 object(s) at t = 0.001 s")
+    assert str(err.value).startswith(f"{scene}: {message}"), str(err.value)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["inlet_scene.mdem"]
 
 
@@ -175,14 +271,14 @@ def test_bad_settings_name_generator_and_field(change, message):
     g = storage.modules_data.objects_generator.generators[1]
     change(g, storage)
     with pytest.raises(InputError, match=f"dynamic generator 'InletB': {message}"):
-        gen.refuse_active(storage, SCENE, DT)
+        gen.read_inlets(storage, SCENE)
 
 
 def test_inactive_generators_are_no_obstacle():
     storage = _storage()
     for g in storage.modules_data.objects_generator.generators:
         g.activity = False
-    gen.refuse_active(storage, SCENE, DT)
+    assert gen.read_inlets(storage, SCENE) == []
     assert gen.generation_schedule(gen.read_generators(storage), DT, END) == []
 
 
@@ -198,3 +294,24 @@ def test_schedule_holds_for_another_cmusen_seed(tmp_path):
     events = gen.generation_schedule(gen.read_generators(_storage()), DT, END)
     labels = ["%g" % e.time for e in events]
     assert set(starts) <= set(labels) and labels.index(starts[0]) == 0
+    # the new run is one more sample of cmusen's spread: the stored four cover it loosely
+    _spread_check(len(starts), CMUSEN_COUNTS)
+
+
+def test_two_ranks_write_the_serial_results(tmp_path):
+    """``mpiexec -n 2 fibrelmp run`` of the inlet job: the same result files, byte for byte
+    (every rank takes the same insertions; each keeps those it owns)."""
+    from .test_mpi import MPIEXEC, assert_ran, serial_and_mpi
+
+    if not MPIEXEC:
+        pytest.skip("mpiexec not found (pip install mpich)")
+
+    def populate(case: Path) -> None:
+        for name in ("inlet_scene.mdem", "job_inlet.txt"):
+            shutil.copy(DATA / name, case)
+
+    runs = serial_and_mpi(tmp_path, populate, ["-q", "run", "job_inlet.txt"])
+    assert_ran(runs)
+    ser, mpi = runs["serial"][0], runs["mpi"][0]
+    for name in ("inlet_result_prec17.txt", "inlet_result.mdem", "job_inlet_work/job1/inlets.log"):
+        assert (mpi / name).read_bytes() == (ser / name).read_bytes(), name

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fibrelmp.errors import wrong_frame
+from fibrelmp.errors import RunError, wrong_frame
 from fibrelmp.granmodel import GranularFrame, GranularModel, quat_multiply
 from fibrelmp.post.lammps_dump.reader import iter_frames
 from fibrelmp.translate.granular_job import GranularJob
@@ -75,6 +75,7 @@ class FrameBuilder:
         self.prev_v = np.asarray(sp.velocity, float).copy()
         # the time of a step: MUSEN's summed clock (read forwards) or t_start + step dt
         self.frame_clock, self.break_clock = _clock(job), _clock(job)
+        self.inlet_clock = _clock(job)
         self.deletion_time: dict[int, float] = {}
         deletion_clock = _clock(job)
         for step, rows in sorted(job.deletions, key=lambda d: d[0]):
@@ -107,7 +108,9 @@ class FrameBuilder:
         removed = np.flatnonzero(self.removed)
         at_end = sum(1 for r in removed.tolist()
                      if self.deletion_time.get(r) == self.sphere_end[r])
-        return {"spheres": int(self.present.sum()), "activity_end": at_end,
+        first = self.model.plan.inlet_rows
+        made = 0 if first is None else int(np.isfinite(self.model.spheres.active_start[first:]).sum())
+        return {"spheres": int(self.present.sum()), "activity_end": at_end, "generated": made,
                 "left_domain": len(removed) - at_end,
                 "bonds": int(self.bond_alive.sum()) if self.nb else 0}
 
@@ -141,6 +144,8 @@ class FrameBuilder:
         if not keep.all():
             c = {k: col[keep] for k, col in c.items()}
             rows, pos = rows[keep], pos[keep]
+        if job.inlet_log is not None:
+            self._generated(rows, c)
         vel = np.column_stack([c["vx"], c["vy"], c["vz"]])
         omega = np.column_stack([c["omegax"], c["omegay"], c["omegaz"]])
         force = np.column_stack([c["fx"], c["fy"], c["fz"]])
@@ -167,6 +172,32 @@ class FrameBuilder:
             self._triangles(frame, t, c)
         self.prev_t, self.prev_x[rows], self.prev_v[rows] = t, pos, vel
         return frame
+
+    def _generated(self, rows: np.ndarray, c: dict) -> None:
+        """Spheres fix musen/inlet made since the last frame fill their reserved rows:
+        activity start (cmusen's clock at the step of the inlet log), radius, mass and
+        material of the dump."""
+        sp = self.model.spheres
+        new = np.flatnonzero(~np.isfinite(sp.active_start[rows]))
+        if not len(new):
+            return
+        made: dict[int, int] = {}
+        with open(self.job.inlet_log) as fh:          # "STEP ID"; a resumed run repeats lines
+            for line in fh:
+                step, tag = line.split()
+                made[int(tag)] = int(step)
+        steps = [made.get(int(rows[k]) + 1) for k in new]
+        if None in steps:
+            raise RunError(f"{self.job.inlet_log}: no line for the new atom "
+                           f"{int(rows[new[steps.index(None)]]) + 1} of the dump")
+        for k in np.argsort(steps, kind="stable"):   # the clock is read forwards
+            r, i = int(rows[new[k]]), new[k]
+            sp.active_start[r] = self.inlet_clock(steps[k])
+            sp.radius[r] = sp.contact_radius[r] = c["radius"][i]
+            sp.mass[r] = c["mass"][i]
+            sp.material[r] = self.job.type_materials[int(c["type"][i])]
+            if sp.compound_key is not None:
+                sp.compound_key[r] = self.model.materials[int(sp.material[r])].key
 
     def _bonds(self, frame: GranularFrame, step: int) -> None:
         """Bond states at ``step``: breaks logged since the last frame, bonds of removed

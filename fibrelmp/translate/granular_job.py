@@ -31,6 +31,8 @@ from fibrelmp.translate.granular.reach import Travel, speed_bound
 from fibrelmp.translate.granular.musen_clock import MusenClock
 from fibrelmp.translate.granular.schedule import (STOP_LABEL, RunTime, compress_ids, run_time, save_steps,
                                                   schedule, with_stop_criterion)
+from fibrelmp.translate.granular.inlets import LOG_NAME as INLET_LOG
+from fibrelmp.translate.granular.inlets import inlet_commands
 from fibrelmp.translate.granular.spheres import SimulatedSpheres, select_spheres
 from fibrelmp.translate.granular.tiles import TILE_MASS_FACTOR, WallTiles, place_tiles, tile_estimate, tile_types
 from fibrelmp.translate.granular import models as physics
@@ -84,6 +86,8 @@ class GranularJob:
     mesh_rows: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))   # model row of each
     geometry: Path | None = None     # per-atom bond geometry (musen/elastic), beside the data file
     contacts: Path | None = None     # sphere-sphere contacts per frame (compute pair/local)
+    inlet_log: Path | None = None    # fix musen/inlet: "STEP ID" per inserted sphere
+    type_materials: dict[int, int] | None = None   # LAMMPS sphere type -> material
 
     @property
     def inputs(self) -> list[Path]:
@@ -176,7 +180,9 @@ def build_granular_job(model: GranularModel, folder: str | Path):
         frame_columns=parts.frame_columns, warnings=parts.warnings,
         wall_forces=folder / MESH_FORCES_NAME if has_mesh else None, mesh_rows=parts.mesh,
         geometry=folder / GEOMETRY_NAME if parts.geometry is not None else None,
-        contacts=folder / CONTACTS_NAME)
+        contacts=folder / CONTACTS_NAME,
+        inlet_log=folder / INLET_LOG if model.plan.inlets else None,
+        type_materials={t: m for m, t in spheres.type_of_mat.items()})
     return job, script, write_data_file
 
 
@@ -242,6 +248,11 @@ def _plan_parts(model: GranularModel) -> _JobParts:
     pp_model, pp_params = physics.chosen(model, "PP")
     sb_model = physics.solid_bond_model(plan)
     wall_cmds, var_cmds, frame_columns = wall_commands(model, wall_plans, spheres, dt)
+    if model.plan.inlets and not musen_hm:
+        raise InputError(model.source, None, "MUSEN's dynamic generators need fibrelmp's LAMMPS "
+                         f"styles (fix musen/inlet): {styles.how}")
+    wall_cmds += inlet_commands(model, spheres.type_of_mat, dt, t_start, run.t_end,
+                                MESH_FIX if len(mesh) else None)
     # musen/elastic: each bond's d, L0 (and initial tangential overlap) on its first sphere
     geometry = (bond_geometry(model, bonds, spheres.rows, len(spheres.rows) + len(tiles.x))
                 if bonds.exact and len(bonds.rows) else None)

@@ -115,6 +115,8 @@ class FixMusenWallMesh : public Fix {
   void write_restart(FILE *) override;
   void restart(char *) override;
   double memory_usage() override;
+  // the triangles where they are now (9 numbers each: V1 V2 V3), as fix musen/inlet checks them
+  const std::vector<double> &vertices_now() const { return vert; }
 
   // contact kinds of MUSEN's EIntersectionType
   enum { NO_CONTACT = 0, FACE_CONTACT = 1, EDGE_CONTACT = 2, VERTEX_CONTACT = 3 };

@@ -10,6 +10,7 @@ import numpy as np
 from fibrelmp.errors import InputError
 from fibrelmp.granmodel import GranularModel
 from fibrelmp.translate.granular.contacts import rolling_spring
+from fibrelmp.translate.granular.inlets import inlet_spheres
 from fibrelmp.translate.granular.schedule import RunTime
 
 
@@ -45,6 +46,8 @@ def select_spheres(model: GranularModel, run: RunTime, periodic: np.ndarray, dom
     eps = 0.5 * dt
     active_now = (sp.active_start <= t_start + eps) & (sp.active_end > t_start + eps)
     late = sp.active_start > t_start + eps
+    if model.plan.inlet_rows is not None:          # reserved for generated spheres (inlets.py)
+        late[model.plan.inlet_rows:] = False
     x = np.asarray(sp.position, float)
     inside = np.ones(sp.count, bool)
     if dom_lo is not None:
@@ -79,13 +82,18 @@ def select_spheres(model: GranularModel, run: RunTime, periodic: np.ndarray, dom
 
     # LAMMPS types: one per sphere material (wall-tile materials follow, see tiles.py)
     smat = sp.material[rows].astype(np.int64)
-    mats = [int(m) for m in np.unique(smat)] if len(rows) else []
+    # and the materials of the spheres MUSEN's generators will insert (inlets.py)
+    made = inlet_spheres(model)
+    mats = sorted({int(m) for m in smat} | {m for m, _, _ in made})
     type_of_mat = {m: i + 1 for i, m in enumerate(mats)}
     mass = sp.mass[rows]
-    m_min = {m: float(mass[smat == m].min()) for m in mats}
-    r_mean = {m: float(crad[rows][smat == m].mean()) for m in mats}
-    r_min = float(crad[rows].min()) if len(rows) else 1.0
-    r_max = float(crad[rows].max()) if len(rows) else 1.0
+    m_min = {m: min([float(x) for x in mass[smat == m]] + [w for k, _, w in made if k == m])
+             for m in mats}
+    r_mean = {m: float(np.mean([*crad[rows][smat == m], *(r for k, r, _ in made if k == m)]))
+              for m in mats}
+    radii = [*crad[rows], *(r for _, r, _ in made)]
+    r_min = float(min(radii)) if radii else 1.0
+    r_max = float(max(radii)) if radii else 1.0
     if m_min:                       # the rolling spring of the heaviest sphere is the stiffest
         rolling_spring(max(m_min.values()), dt, model.source)
     return SimulatedSpheres(keep, rows, outside_rows, late_rows, deletions, x, crad, smat, mats,

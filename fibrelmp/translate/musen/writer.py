@@ -190,6 +190,9 @@ class MusenResultWriter(Writer):
         types = np.concatenate([np.full(len(p[0]), p[1]) for p in parts])
         rows = np.concatenate([np.arange(len(p[0])) for p in parts])
         keep = self._filter(types, rows)
+        # rows reserved for generated spheres that were never made (translate/granular/inlets.py)
+        keep &= ~((types == 1) & ~np.isfinite(np.r_[m.spheres.active_start, np.zeros(len(rows))][
+            np.where(types == 1, rows, len(m.spheres.active_start))]))
         order = np.argsort(ids[keep], kind="stable")
         return ids[keep][order], types[keep][order], rows[keep][order]
 

@@ -7,8 +7,8 @@ simulates with them; a setting fibrelmp cannot honour is refused here, naming th
 the field, never dropped.  ``FIELDS`` classifies every field of ``messages._SPEC`` (a test
 checks that none is missing, so a field added to the table of messages must be classified);
 ``REFUSALS`` holds one check per refused setting: an implementation replaces its row.
-Dynamic generators, the variable time step and stop criteria are refused where their own
-items handle them (``generators.refuse_active``, ``model._refused_settings``: a job script
+Unsupported generator settings, the variable time step and stop criteria are refused where their own
+items handle them (``generators.read_inlets``, ``model._refused_settings``: a job script
 may switch the latter off); the velocity limit and a moving periodic box are simulated.
 """
 
@@ -30,8 +30,10 @@ _DB = "materials database, read through the text form (`32`/`33`)"
 # handled where their items put them (issue 26, items 3 and 4), not in REFUSALS below
 _DEFERRED = ("kept by name and refused when simulated, unless the job script switches it off "
              "as cmusen would (model.py `_refused_settings`)")
-_INLETS = ("an active dynamic generator (inlet) is refused by name and field "
-           "(mdem/generators.py `refuse_active`); an inactive one is inert, as in MUSEN")
+_INLETS = ("an active dynamic generator (inlet) of spheres into a box volume inserts "
+           "them during the run (mdem/generators.py `read_inlets`, fix musen/inlet); "
+           "agglomerates, other volume shapes and inside_geometries off are refused by name "
+           "and field; an inactive one is inert, as in MUSEN")
 
 # "Message.field" -> (class, why); "Message.*" classifies every field of a message
 FIELDS: dict[str, tuple[str, str]] = {
@@ -148,7 +150,7 @@ FIELDS: dict[str, tuple[str, str]] = {
                                  "analysers only"),
     # ---- modules
     "ProtoModulesData.simulator": (HONOURED, "simulator settings (rows below)"),
-    "ProtoModulesData.objects_generator": (REFUSED, _INLETS),
+    "ProtoModulesData.objects_generator": (HONOURED, _INLETS),
     "ProtoModulesData.bonds_generator": (NOT_SIMULATION, "pre-processing: run only by a "
                                          "script's COMPONENT BONDS_GENERATOR"),
     "ProtoModulesData.package_generator": (NOT_SIMULATION, "pre-processing: run only by a "
@@ -173,8 +175,8 @@ FIELDS: dict[str, tuple[str, str]] = {
                                               "time step, which is refused"),
     "ProtoModuleSimulator.part_velocity_limit": (HONOURED, "fix musen/leapfrog vlimit (> 0; "
                                                  "MUSEN: <= 0 is no limit; item 4)"),
-    "ProtoModuleObjectsGenerator.*": (REFUSED, _INLETS),
-    "ProtoObjectsGenerator.*": (REFUSED, _INLETS),
+    "ProtoModuleObjectsGenerator.*": (HONOURED, _INLETS),
+    "ProtoObjectsGenerator.*": (HONOURED, _INLETS),
     "ProtoModuleBondsGenerator.*": (NOT_SIMULATION, "pre-processing (COMPONENT BONDS_GENERATOR)"),
     "ProtoBondsGenerator.*": (NOT_SIMULATION, "pre-processing (COMPONENT BONDS_GENERATOR)"),
     "ProtoModulePackageGenerator.*": (NOT_SIMULATION, "pre-processing (COMPONENT "

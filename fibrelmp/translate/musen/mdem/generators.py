@@ -24,9 +24,11 @@ every generator before every step (``PreCalculationStep``, before the step's sav
   those generated before), ``activity_start = t``, and the fixed initial velocity or, with a
   random velocity, a direction uniform on the sphere times the magnitude.
 
-fibrelmp reads and checks the settings and computes the schedule; inserting the objects into
-a running LAMMPS job is not implemented, so an active generator that would generate during
-the run is refused (``refuse_active``) with the generator's and the field's name.
+fibrelmp reads and checks the settings (``read_inlets``: spheres of a mixture into a box
+volume), computes the schedule for the job's own step and end time, and inserts the spheres
+with fibrelmp's ``fix musen/inlet`` (one per generator, the schedule's steps and counts
+passed to it).  Agglomerates, other volume shapes, moving volumes and ``inside_geometries``
+off are refused with the generator's and the field's name.
 """
 
 from __future__ import annotations
@@ -213,21 +215,69 @@ def next_fraction(generated: list[int], targets: list[float]) -> int:
     return 0
 
 
-def refuse_active(storage: Any, path: Path, dt: float) -> None:
-    """Refuse a scene with an active generator that generates anything in its own time window
-    (fibrelmp does not insert objects into a running LAMMPS job; the window, not the run's end,
-    because a job script may still change the end time); every active generator's settings
-    are checked first, so the message names the first thing MUSEN itself would stop at."""
-    generators = read_generators(storage)
-    for g in generators:
-        if g.active:
-            check_generator(g, storage, path)
-    window = max((g.end + g.update_step for g in generators if g.active), default=0.0)
-    step = dt if dt > 0 else MUSEN_DEFAULT_STEP           # nan: the file sets no step
-    events = generation_schedule(generators, step, window, first_only=True)
-    if events:
-        g = generators[events[0].generator]
-        raise _field(path, g, "activity", f"asks for {events[0].requested} object(s) at "
-                     f"t = {events[0].time:.6g} s (with the file's step), and more later; inserting "
-                     "particles during a run is not implemented in fibrelmp: deactivate the "
-                     "generator or generate the particles before the run")
+@dataclass(frozen=True)
+class Inlet:
+    """An active generator of spheres as fibrelmp runs it: its box volume (``lo``/``hi``) and
+    its mixture's fractions (compound key, diameter, number share)."""
+
+    generator: DynamicGenerator
+    lo: tuple[float, float, float]
+    hi: tuple[float, float, float]
+    fractions: tuple[tuple[str, float, float], ...]
+
+
+def _box_volume(storage: Any, gen: DynamicGenerator, path: Path) -> tuple[tuple, tuple]:
+    """The generator's analysis volume as an axis-aligned box: every vertex of its triangles on
+    a corner of their bounding box (MUSEN's box volume); other shapes and motion are refused."""
+    volume = next((v for v in storage.info.analysis_volume if v.base_geometry.key == gen.volume_key),
+                  None)
+    if volume is None:
+        raise _field(path, gen, "volume_key", f"analysis volume '{gen.volume_key}' is stored in "
+                     "the old (version 0) form, which fibrelmp does not generate into")
+    if volume.base_geometry.motion.ByteSize():
+        raise _field(path, gen, "volume_key", f"analysis volume '{gen.volume_key}' moves; "
+                     "generating into a moving volume is not supported by fibrelmp")
+    tri = np.array([[[t.vert1.x, t.vert1.y, t.vert1.z], [t.vert2.x, t.vert2.y, t.vert2.z],
+                     [t.vert3.x, t.vert3.y, t.vert3.z]] for t in volume.triangles]).reshape(-1, 3)
+    if not len(tri):
+        raise _field(path, gen, "volume_key", f"analysis volume '{gen.volume_key}' has no triangles")
+    lo, hi = tri.min(axis=0), tri.max(axis=0)
+    if not ((tri == lo) | (tri == hi)).all() or not (hi > lo).all():
+        raise _field(path, gen, "volume_key", f"analysis volume '{gen.volume_key}' is not an "
+                     "axis-aligned box; fibrelmp generates into box volumes only")
+    return tuple(map(float, lo)), tuple(map(float, hi))
+
+
+def read_inlets(storage: Any, path: Path) -> list[Inlet]:
+    """Every active generator of spheres of a scene, checked (``check_generator``) and with
+    what fibrelmp's ``fix musen/inlet`` needs."""
+    out = []
+    for g in read_generators(storage):
+        if not g.active:
+            continue
+        check_generator(g, storage, path)
+        if not g.inside_geometries:
+            raise _field(path, g, "inside_geometries", "off (no objects inside real geometries) "
+                         "is not supported by fibrelmp; switch it on")
+        if not (g.max_iterations >= 1):
+            raise _field(path, g, "max_iterations", f"must be >= 1, got {g.max_iterations}")
+        info = storage.info
+        if info.periodic_conditions_enabled and (info.periodic_conditions_x or info.periodic_conditions_y
+                                                 or info.periodic_conditions_z):
+            raise InputError(path, None, f"dynamic generator '{g.name}': generating in a periodic "
+                             "box is not supported by fibrelmp")
+        lo, hi = _box_volume(storage, g, path)
+        mixture = next(m for m in storage.modules_data.materials_database.mixture
+                       if m.uniqueKey == g.mixture_key)
+        fractions = []
+        for f in mixture.fraction:
+            if f.contact_diameter > 0 and f.contact_diameter != f.diameter:
+                raise _field(path, g, "mixture_key", f"fraction '{f.fractionName}' of mixture "
+                             f"'{g.mixture_key}' has a contact diameter != its diameter, which "
+                             "fibrelmp's generator does not support")
+            if not f.diameter > 0:
+                raise _field(path, g, "mixture_key", f"fraction '{f.fractionName}' has diameter "
+                             f"{f.diameter!r}")
+            fractions.append((f.compoundKey, float(f.diameter), float(f.fraction)))
+        out.append(Inlet(g, lo, hi, tuple(fractions)))
+    return out

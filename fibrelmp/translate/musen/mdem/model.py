@@ -23,7 +23,7 @@ def read_scene(path: str | os.PathLike) -> GranularModel:
     so both forms of a scene give the same model."""
     from fibrelmp.translate.musen import scene
     from fibrelmp.translate.musen.mdem.document import MdemFile
-    from fibrelmp.translate.musen.mdem.generators import refuse_active
+    from fibrelmp.translate.musen.mdem.generators import generation_schedule, read_inlets
     from fibrelmp.translate.musen.mdem.text_export import export
 
     from fibrelmp.translate.musen.mdem.fields import check_settings
@@ -41,8 +41,10 @@ def read_scene(path: str | os.PathLike) -> GranularModel:
             raise InputError(path, None, f"{exc.message}{where}") from None
         _settings(model, mdem.storage.modules_data)
         _refused_settings(model, mdem.storage)
-        # inlets: checked, and refused while fibrelmp cannot insert objects during a run
-        refuse_active(mdem.storage, path, float(model.plan.dt))
+        # inlets: checked here, scheduled for the job's step and end time by the translation
+        inlets = model.plan.inlets = read_inlets(mdem.storage, path)
+        model.plan.inlet_schedule = (lambda dt, t_end: generation_schedule(
+            [i.generator for i in inlets], dt, t_end))
     model.warnings.extend(ignored)
     model.source = path
     scene_record(model, keep=True).mdem_source = path

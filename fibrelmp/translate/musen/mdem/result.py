@@ -46,7 +46,13 @@ class MdemResultWriter(MusenResultWriter):
         self.fh = self.open(self.path, "w+b")
         self.mdem = MdemWriter(self.fh)
         m = model
-        self.n = 1 + max(int(np.max(ids)) if len(ids) else -1 for ids in self._id_sets())
+        # rows reserved for generated spheres count once made (a time point holds the objects
+        # that exist then, as MUSEN's grows with its generators)
+        first = model.plan.inlet_rows
+        sets = self._id_sets()
+        if first is not None:
+            sets[0] = sets[0][:first]
+        self.n = 1 + max(int(np.max(ids)) if len(ids) else -1 for ids in sets)
         self.sphere_ids = np.asarray(m.spheres.ids, np.int64)
         self.bond_ids = None if m.bonds is None else np.asarray(m.bonds.ids, np.int64)
         self.wall_ids = None if m.triangles is None else np.asarray(m.triangles.ids, np.int64)
@@ -66,10 +72,11 @@ class MdemResultWriter(MusenResultWriter):
     def write(self, frame: GranularFrame) -> None:
         if not self.track_activity(frame):
             return
-        values = np.zeros((self.n, tp.NCOLS))
-        masks = np.zeros(self.n, np.uint32)
         rows = np.asarray(frame.sphere_rows, np.int64)
         ids = self.sphere_ids[rows]
+        self.n = max(self.n, 1 + int(ids.max()) if len(ids) else 0)
+        values = np.zeros((self.n, tp.NCOLS))
+        masks = np.zeros(self.n, np.uint32)
         values[ids, 0:3] = frame.position
         values[ids, 6:9] = frame.velocity
         values[ids, 9:12] = frame.omega
@@ -138,11 +145,29 @@ class MdemResultWriter(MusenResultWriter):
 
     def _set_activity(self, storage: Any) -> None:
         particles = storage.info.particles
+        self._add_generated(particles)
         for ids, end in ((self.sphere_ids, self.sphere_end), (self.bond_ids, self.bond_end)):
             if ids is None or end is None:
                 continue
             for i in np.flatnonzero(np.isfinite(end)).tolist():
                 particles[int(ids[i])].activity_end = float(end[i])
+
+    def _add_generated(self, particles: Any) -> None:
+        """The spheres MUSEN's generators made (rows reserved by translate/granular/inlets.py)
+        as sphere objects of the scene: compound, radius and contact radius, activity start."""
+        sp, first = self.model.spheres, self.model.plan.inlet_rows
+        if first is None:
+            return
+        for r in np.flatnonzero(np.isfinite(sp.active_start[first:])) + first:
+            i = int(sp.ids[r])
+            while len(particles) <= i:
+                particles.add()
+            entry = particles[i]
+            entry.type = 1
+            entry.compound = self.model.materials[int(sp.material[r])].key
+            entry.encoded_properties = np.array([sp.radius[r], sp.contact_radius[r]], "<f8").tobytes()
+            entry.activity_start = float(sp.active_start[r])
+            entry.activity_end = 1e300
 
     def _set_scene(self, storage: Any) -> None:
         """What the run changed in a ``.mdem`` source's scene, as the text result writes it:

@@ -1,0 +1,394 @@
+/* ----------------------------------------------------------------------
+   fibrelmp's LAMMPS styles; GPL-2.0-or-later like LAMMPS (see ../LICENSE).
+   FixMusenInlet: see fix_musen_inlet.h.
+------------------------------------------------------------------------- */
+
+#include "fix_musen_inlet.h"
+#include "fix_musen_wall_mesh.h"
+#include "style_registry.h"
+
+#include "atom.h"
+#include "comm.h"
+#include "domain.h"
+#include "error.h"
+#include "group.h"
+#include "memory.h"
+#include "modify.h"
+#include "update.h"
+#include "utils.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <string>
+
+using namespace LAMMPS_NS;
+using namespace FixConst;
+
+namespace {
+
+// splitmix64: a small portable generator; one stream per (seed, step)
+struct Stream {
+  std::uint64_t s;
+  std::uint64_t next()
+  {
+    std::uint64_t z = (s += 0x9E3779B97F4A7C15ULL);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+    return z ^ (z >> 31);
+  }
+  double uniform() { return (static_cast<double>(next() >> 11) + 0.5) * 0x1.0p-53; }    // (0, 1)
+};
+
+double dot(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+// squared distance from p to the triangle a b c (closest point by Voronoi regions)
+double triangle_distance2(const double *p, const double *a, const double *b, const double *c)
+{
+  double ab[3], ac[3], ap[3], q[3];
+  for (int k = 0; k < 3; k++) ab[k] = b[k] - a[k], ac[k] = c[k] - a[k], ap[k] = p[k] - a[k];
+  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+  double bp[3], cp[3];
+  for (int k = 0; k < 3; k++) bp[k] = p[k] - b[k], cp[k] = p[k] - c[k];
+  const double d3 = dot(ab, bp), d4 = dot(ac, bp), d5 = dot(ab, cp), d6 = dot(ac, cp);
+  const double va = d3 * d6 - d5 * d4, vb = d5 * d2 - d1 * d6, vc = d1 * d4 - d3 * d2;
+  double u, v;    // q = a + u ab + v ac
+  if (d1 <= 0 && d2 <= 0) u = 0, v = 0;
+  else if (d3 >= 0 && d4 <= d3) u = 1, v = 0;
+  else if (d6 >= 0 && d5 <= d6) u = 0, v = 1;
+  else if (vc <= 0 && d1 >= 0 && d3 <= 0) u = d1 / (d1 - d3), v = 0;
+  else if (vb <= 0 && d2 >= 0 && d6 <= 0) u = 0, v = d2 / (d2 - d6);
+  else if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) {
+    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    u = 1 - w, v = w;
+  } else {
+    const double den = 1.0 / (va + vb + vc);
+    u = vb * den, v = vc * den;
+  }
+  for (int k = 0; k < 3; k++) q[k] = a[k] + u * ab[k] + v * ac[k] - p[k];
+  return dot(q, q);
+}
+
+}    // namespace
+
+FixMusenInlet::FixMusenInlet(LAMMPS *lmp, int narg, char **arg) :
+    Fix(lmp, narg, arg), wall_id(nullptr), inserted(0), first_id(1), last_id(0), log(nullptr)
+{
+  const std::string usage = "fix ID group musen/inlet SEED box XLO XHI YLO YHI ZLO ZHI tries N "
+      "walls WALLFIX|none velocity fixed VX VY VZ|random MAG fractions K ... events M ...";
+  auto need = [&](int at, int n, const char *word) {
+    if (at + n > narg || (word && strcmp(arg[at], word) != 0))
+      error->all(FLERR, "Illegal fix musen/inlet command (expected '{}' at argument {}): {}",
+                 word ? word : "more values", at + 1, usage);
+  };
+  need(3, 1, nullptr);
+  seed = static_cast<std::uint64_t>(utils::bnumeric(FLERR, arg[3], false, lmp));
+  need(4, 7, "box");
+  for (int k = 0; k < 3; k++) {
+    lo[k] = utils::numeric(FLERR, arg[5 + 2 * k], false, lmp);
+    hi[k] = utils::numeric(FLERR, arg[6 + 2 * k], false, lmp);
+    if (!(hi[k] > lo[k])) error->all(FLERR, "Fix musen/inlet: box needs lo < hi on every axis");
+  }
+  need(11, 2, "tries");
+  tries = utils::inumeric(FLERR, arg[12], false, lmp);
+  need(13, 2, "walls");
+  if (strcmp(arg[14], "none") != 0) wall_id = utils::strdup(arg[14]);
+  int at = 15;
+  need(at, 2, "velocity");
+  random_velocity = strcmp(arg[at + 1], "random") == 0;
+  if (random_velocity) {
+    need(at, 3, "velocity");
+    magnitude = utils::numeric(FLERR, arg[at + 2], false, lmp);
+    at += 3;
+  } else {
+    need(at, 5, "velocity");
+    if (strcmp(arg[at + 1], "fixed") != 0) error->all(FLERR, "Fix musen/inlet: velocity fixed|random");
+    for (int k = 0; k < 3; k++) velocity[k] = utils::numeric(FLERR, arg[at + 2 + k], false, lmp);
+    at += 5;
+  }
+  need(at, 2, "fractions");
+  const int nfrac = utils::inumeric(FLERR, arg[at + 1], false, lmp);
+  at += 2;
+  need(at, 4 * nfrac, nullptr);
+  for (int i = 0; i < nfrac; i++, at += 4) {
+    Fraction f{utils::inumeric(FLERR, arg[at], false, lmp),
+               0.5 * utils::numeric(FLERR, arg[at + 1], false, lmp),
+               utils::numeric(FLERR, arg[at + 2], false, lmp),
+               utils::numeric(FLERR, arg[at + 3], false, lmp), 0};
+    if (f.type < 1 || f.type > atom->ntypes) error->all(FLERR, "Fix musen/inlet: invalid atom type {}", f.type);
+    if (!(f.radius > 0 && f.density > 0)) error->all(FLERR, "Fix musen/inlet: diameter and density must be > 0");
+    fractions.push_back(f);
+  }
+  if (fractions.empty()) error->all(FLERR, "Fix musen/inlet needs at least one fraction");
+  made.assign(fractions.size(), 0);
+  need(at, 2, "events");
+  const int nev = utils::inumeric(FLERR, arg[at + 1], false, lmp);
+  at += 2;
+  need(at, 2 * nev, nullptr);
+  for (int i = 0; i < nev; i++, at += 2) {
+    Event e{utils::bnumeric(FLERR, arg[at], false, lmp), utils::inumeric(FLERR, arg[at + 1], false, lmp)};
+    if (e.step < 1 || (!events.empty() && e.step <= events.back().step))
+      error->all(FLERR, "Fix musen/inlet: event steps must be >= 1 and ascending");
+    events.push_back(e);
+  }
+  while (at < narg) {
+    need(at, 2, nullptr);
+    if (strcmp(arg[at], "first_id") == 0) {
+      first_id = utils::tnumeric(FLERR, arg[at + 1], false, lmp);
+    } else if (strcmp(arg[at], "groups") == 0) {    // one more group per fraction
+      need(at, 1 + static_cast<int>(fractions.size()), nullptr);
+      for (size_t i = 0; i < fractions.size(); i++) {
+        const int g = group->find(arg[at + 1 + i]);
+        if (g < 0) error->all(FLERR, "Fix musen/inlet: no group {}", arg[at + 1 + i]);
+        fractions[i].groupbit = group->bitmask[g];
+      }
+      at += static_cast<int>(fractions.size()) - 1;
+    } else if (strcmp(arg[at], "log") == 0) {
+      if (comm->me == 0) {
+        log = fopen(arg[at + 1], "a");
+        if (!log) error->one(FLERR, "Fix musen/inlet: cannot open log file {}", arg[at + 1]);
+      }
+    } else {
+      error->all(FLERR, "Illegal fix musen/inlet command: unknown keyword {}", arg[at]);
+    }
+    at += 2;
+  }
+  if (strcmp(atom->atom_style, "sphere") != 0 && strcmp(atom->atom_style, "bpm/sphere") != 0)
+    error->all(FLERR, "Fix musen/inlet needs atom style sphere or bpm/sphere, not {}", atom->atom_style);
+  if (domain->triclinic) error->all(FLERR, "Fix musen/inlet needs an orthogonal box");
+  const int periodic[3] = {domain->xperiodic, domain->yperiodic, domain->zperiodic};
+  for (int k = 0; k < 3; k++)    // a sphere created outside the box would be lost unseen
+    if (!periodic[k] && (lo[k] < domain->boxlo[k] || hi[k] > domain->boxhi[k]))
+      error->all(FLERR, "Fix musen/inlet: the generation box is not inside the simulation box on axis {}", k);
+  force_reneighbor = 1;
+  next_reneighbor = -1;
+  scalar_flag = 1;
+  extscalar = 0;
+  restart_global = 1;
+}
+
+FixMusenInlet::~FixMusenInlet()
+{
+  delete[] wall_id;
+  if (log) fclose(log);
+}
+
+int FixMusenInlet::setmask()
+{
+  return PRE_EXCHANGE;
+}
+
+void FixMusenInlet::init()
+{
+  if (wall_id && !dynamic_cast<FixMusenWallMesh *>(modify->get_fix_by_id(wall_id)))
+    error->all(FLERR, "Fix musen/inlet: no fix musen/wall/mesh with ID {}", wall_id);
+  schedule_next();
+}
+
+void FixMusenInlet::setup_pre_exchange()
+{
+  schedule_next();
+}
+
+void FixMusenInlet::schedule_next()
+{
+  next_reneighbor = -1;
+  for (const Event &e : events)
+    if (e.step > update->ntimestep) {
+      next_reneighbor = e.step;
+      break;
+    }
+}
+
+void FixMusenInlet::pre_exchange()
+{
+  if (next_reneighbor != update->ntimestep) return;
+  for (const Event &e : events)
+    if (e.step == update->ntimestep) insert(e);
+  schedule_next();
+}
+
+/* every sphere (owned by any rank) whose centre lies within reach of the box */
+std::vector<FixMusenInlet::Sphere> FixMusenInlet::spheres_near(double reach)
+{
+  std::vector<double> mine;
+  for (int i = 0; i < atom->nlocal; i++) {
+    const double *x = atom->x[i];
+    bool near = true;
+    for (int k = 0; k < 3; k++) near = near && x[k] >= lo[k] - reach && x[k] <= hi[k] + reach;
+    if (near) mine.insert(mine.end(), {x[0], x[1], x[2], atom->radius[i]});
+  }
+  int n = static_cast<int>(mine.size());
+  std::vector<int> counts(comm->nprocs), displs(comm->nprocs, 0);
+  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, world);
+  for (int p = 1; p < comm->nprocs; p++) displs[p] = displs[p - 1] + counts[p - 1];
+  std::vector<double> all(displs.back() + counts.back());
+  MPI_Allgatherv(mine.data(), n, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, world);
+  std::vector<Sphere> out(all.size() / 4);
+  for (size_t j = 0; j < out.size(); j++)
+    out[j] = Sphere{{all[4 * j], all[4 * j + 1], all[4 * j + 2]}, all[4 * j + 3]};
+  return out;
+}
+
+/* the wall fix's triangles now (9 numbers each), the same on every rank */
+std::vector<double> FixMusenInlet::wall_triangles()
+{
+  if (!wall_id) return {};
+  auto *walls = dynamic_cast<FixMusenWallMesh *>(modify->get_fix_by_id(wall_id));
+  if (!walls) error->all(FLERR, "Fix musen/inlet: no fix musen/wall/mesh with ID {}", wall_id);
+  return walls->vertices_now();
+}
+
+int FixMusenInlet::next_fraction() const
+{
+  int total = 0;
+  for (int m : made) total += m;
+  if (total == 0) return 0;
+  for (size_t i = 0; i < fractions.size(); i++)
+    if (static_cast<double>(made[i]) / total < fractions[i].share) return static_cast<int>(i);
+  return 0;
+}
+
+void FixMusenInlet::insert(const Event &event)
+{
+  double rmax = 0.0;
+  for (int i = 0; i < atom->nlocal; i++) rmax = std::max(rmax, atom->radius[i]);
+  MPI_Allreduce(MPI_IN_PLACE, &rmax, 1, MPI_DOUBLE, MPI_MAX, world);
+  std::vector<Sphere> near = spheres_near(rmax);
+  const std::vector<double> tri = wall_triangles();
+  // the triangles that can touch a sphere inside the box
+  std::vector<int> close;
+  for (size_t t = 0; t < tri.size() / 9; t++) {
+    bool apart = false;
+    for (int k = 0; k < 3 && !apart; k++) {
+      const double *v = &tri[9 * t];
+      const double tlo = std::min({v[k], v[3 + k], v[6 + k]}), thi = std::max({v[k], v[3 + k], v[6 + k]});
+      apart = thi < lo[k] || tlo > hi[k];
+    }
+    if (!apart) close.push_back(static_cast<int>(t));
+  }
+  Stream rng{seed * 0x9E3779B97F4A7C15ULL ^ static_cast<std::uint64_t>(event.step)};
+  std::vector<Sphere> created;
+  std::vector<int> types;
+  std::vector<double> vel;
+  for (int obj = 0; obj < event.count; obj++) {
+    const int f = next_fraction();
+    const double r = fractions[f].radius;
+    bool placed = false;
+    Sphere s{{0, 0, 0}, r};
+    for (int attempt = 0; attempt < tries && !placed; attempt++) {
+      for (int k = 0; k < 3; k++) s.x[k] = lo[k] + rng.uniform() * (hi[k] - lo[k]);
+      placed = true;
+      for (int k = 0; k < 3; k++) placed = placed && s.x[k] - r >= lo[k] && s.x[k] + r <= hi[k];
+      for (size_t j = 0; placed && j < near.size(); j++) {
+        double d[3] = {s.x[0] - near[j].x[0], s.x[1] - near[j].x[1], s.x[2] - near[j].x[2]};
+        const double reach = r + near[j].r;
+        placed = dot(d, d) >= reach * reach;
+      }
+      for (size_t c = 0; placed && c < close.size(); c++) {
+        const double *v = &tri[9 * close[c]];
+        placed = triangle_distance2(s.x, v, v + 3, v + 6) >= r * r;
+      }
+    }
+    if (!placed) continue;
+    double u[3] = {velocity[0], velocity[1], velocity[2]};
+    if (random_velocity) {
+      double len;
+      do {
+        for (int k = 0; k < 3; k++) u[k] = 2.0 * rng.uniform() - 1.0;
+        len = std::sqrt(dot(u, u));
+      } while (len == 0.0 || len > 1.0);
+      for (int k = 0; k < 3; k++) u[k] = u[k] / len * magnitude;
+    }
+    made[f]++;
+    near.push_back(s);
+    created.push_back(s);
+    types.push_back(f);
+    vel.insert(vel.end(), {u[0], u[1], u[2]});
+  }
+  if (!created.empty()) create(created, types, vel);
+}
+
+/* the new atoms, through Atom::data_atoms (each rank keeps those in its sub-domain) */
+void FixMusenInlet::create(const std::vector<Sphere> &made_now, const std::vector<int> &which,
+                           const std::vector<double> &vel)
+{
+  tagint maxtag = 0;
+  for (int i = 0; i < atom->nlocal; i++) maxtag = std::max(maxtag, atom->tag[i]);
+  MPI_Allreduce(MPI_IN_PLACE, &maxtag, 1, MPI_LMP_TAGINT, MPI_MAX, world);
+  maxtag = std::max(maxtag, first_id - 1);
+  for (Fix *other : modify->get_fix_by_style("^musen/inlet$"))
+    maxtag = std::max(maxtag, static_cast<FixMusenInlet *>(other)->last_given());
+  std::string lines;
+  for (size_t j = 0; j < made_now.size(); j++) {
+    const Fraction &f = fractions[which[j]];
+    // the Atoms line of atom styles sphere (id type d rho x y z) and bpm/sphere (id mol ...)
+    lines += fmt::format("{}{} {} {:.17g} {:.17g} {:.17g} {:.17g} {:.17g}\n", maxtag + 1 + (tagint) j,
+                         atom->molecule_flag ? " 0" : "", f.type, 2.0 * f.radius, f.density,
+                         made_now[j].x[0], made_now[j].x[1], made_now[j].x[2]);
+  }
+  const int first = atom->nlocal;
+  std::vector<char> buf(lines.begin(), lines.end());
+  buf.push_back('\0');
+  double shift[3] = {0.0, 0.0, 0.0};
+  atom->data_atoms(static_cast<int>(made_now.size()), buf.data(), 0, 0, 0, 0, shift, 0, nullptr, 0);
+  for (int i = first; i < atom->nlocal; i++) {
+    const size_t j = static_cast<size_t>(atom->tag[i] - maxtag - 1);
+    const Fraction &f = fractions[which[j]];
+    atom->mask[i] |= groupbit | f.groupbit;
+    atom->rmass[i] = 4.0 / 3.0 * M_PI * std::pow(f.radius, 3) * f.density;    // MUSEN's mass
+    for (int k = 0; k < 3; k++) atom->v[i][k] = vel[3 * j + k], atom->omega[i][k] = 0.0;
+    modify->create_attribute(i);
+  }
+  atom->natoms += static_cast<bigint>(made_now.size());
+  last_id = maxtag + static_cast<tagint>(made_now.size());
+  if (log) {
+    for (size_t j = 0; j < made_now.size(); j++)
+      fmt::print(log, "{} {}\n", update->ntimestep, maxtag + 1 + static_cast<tagint>(j));
+    fflush(log);
+  }
+  inserted += static_cast<bigint>(made_now.size());
+  if (atom->map_style != Atom::MAP_NONE) {
+    atom->nghost = 0;
+    atom->map_init();
+    atom->map_set();
+  }
+}
+
+double FixMusenInlet::compute_scalar()
+{
+  return static_cast<double>(inserted);
+}
+
+/* the mixture history (successes per fraction) and the count: a restarted run continues them */
+void FixMusenInlet::write_restart(FILE *fp)
+{
+  if (comm->me != 0) return;
+  std::vector<double> list{static_cast<double>(made.size()), static_cast<double>(inserted),
+                           static_cast<double>(last_id)};
+  for (int m : made) list.push_back(m);
+  const int size = static_cast<int>(list.size() * sizeof(double));
+  fwrite(&size, sizeof(int), 1, fp);
+  fwrite(list.data(), sizeof(double), list.size(), fp);
+}
+
+void FixMusenInlet::restart(char *buf)
+{
+  const auto *list = reinterpret_cast<const double *>(buf);
+  if (static_cast<size_t>(list[0]) != made.size())
+    error->all(FLERR, "Fix musen/inlet: the restart file has {} fractions, the command {}",
+               static_cast<int>(list[0]), made.size());
+  inserted = static_cast<bigint>(list[1]);
+  last_id = static_cast<tagint>(list[2]);
+  for (size_t i = 0; i < made.size(); i++) made[i] = static_cast<int>(list[3 + i]);
+}
+
+// registration with LAMMPS when the plugin loads (style_registry.h)
+namespace {
+Fix *create(LAMMPS *lmp, int narg, char **arg)
+{
+  return new FixMusenInlet(lmp, narg, arg);
+}
+const style_registry::Registration registered(
+    110, "musen/inlet", "MUSEN dynamic generator (inlet) of spheres", &create);
+}    // namespace

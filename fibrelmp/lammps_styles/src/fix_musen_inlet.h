@@ -1,0 +1,96 @@
+/* -*- c++ -*- ----------------------------------------------------------
+   fibrelmp's LAMMPS styles; GPL-2.0-or-later like LAMMPS (see ../LICENSE).
+
+   FixMusenInlet (fix style musen/inlet): one of MUSEN's dynamic generators of spheres
+   (CObjectsGenerator::Generate, MUSEN 1.74.2 e0ff360) inserting spheres during a run.
+
+     fix ID group musen/inlet SEED box XLO XHI YLO YHI ZLO ZHI tries N walls WALLFIX|none
+         velocity fixed VX VY VZ | velocity random MAGNITUDE
+         fractions K  TYPE DIAMETER DENSITY SHARE  (K times)
+         events M  STEP COUNT  (M times, steps ascending)
+         [first_id ID] [log FILE] [groups NAME1 .. NAMEK]   (a further group per fraction)
+
+   At each listed STEP (MUSEN's generation times, computed by fibrelmp from cmusen's summed
+   clock: the fix does not recompute it) it tries to make COUNT spheres.  Per sphere: the
+   fraction is MUSEN's next_fraction (the first whose number share among the spheres made so
+   far is below its SHARE, else the first), then at most N random centres uniform in the box;
+   a centre is accepted when the sphere lies totally inside the box, overlaps no sphere (sum of
+   radii) and touches no triangle of fix musen/wall/mesh WALLFIX.  A sphere that finds no place
+   is dropped.  Velocity: the fixed one, or a direction uniform on the unit sphere (rejection
+   from the cube, as MUSEN) times MAGNITUDE, one draw per sphere.  Mass 4/3 pi r^3 rho (MUSEN's
+   expression), orientation the identity (fibrelmp does not turn quaternions).
+
+   Insertion happens in pre_exchange of STEP: LAMMPS has moved the atoms to their positions of
+   that step and computes the step's forces afterwards, which is where MUSEN's
+   PreCalculationStep generates.  Every rank gathers the spheres near the box, draws the same
+   random numbers and takes the same decisions; each rank keeps the new atoms it owns.  The
+   random numbers of one generation come from SEED and STEP alone (no state carried from step
+   to step), so a restarted or replayed run and any number of ranks insert the same spheres.
+   New atom IDs are the next ones after the largest existing ID, the largest any musen/inlet
+   fix gave and ID - 1, in order of success (fixes at the same step: in the order they were
+   defined): a removed sphere's ID is never given again.  FILE: rank 0 appends a line
+   "STEP ID" per new atom (fibrelmp's result writers take the activity start from it).
+------------------------------------------------------------------------- */
+
+#ifndef FIBRELMP_FIX_MUSEN_INLET_H
+#define FIBRELMP_FIX_MUSEN_INLET_H
+
+#include "fix.h"
+
+#include <cstdint>
+#include <cstdio>
+#include <vector>
+
+namespace LAMMPS_NS {
+
+class FixMusenInlet : public Fix {
+ public:
+  FixMusenInlet(class LAMMPS *, int, char **);
+  ~FixMusenInlet() override;
+  int setmask() override;
+  void init() override;
+  void setup_pre_exchange() override;
+  void pre_exchange() override;
+  double compute_scalar() override;
+  tagint last_given() const { return last_id; }    // spheres this fix has inserted (all runs)
+  void write_restart(FILE *) override;
+  void restart(char *) override;
+
+ private:
+  struct Fraction {
+    int type;
+    double radius, density, share;
+    int groupbit;    // "groups": a further group of its spheres (0: none)
+  };
+  struct Event {
+    bigint step;
+    int count;
+  };
+  struct Sphere {
+    double x[3], r;
+  };
+  std::uint64_t seed;
+  double lo[3], hi[3];
+  int tries;
+  char *wall_id;
+  bool random_velocity;
+  double velocity[3], magnitude;
+  std::vector<Fraction> fractions;
+  std::vector<int> made;        // successes per fraction (MUSEN's generated mixture particles)
+  std::vector<Event> events;
+  bigint inserted;
+  tagint first_id, last_id;     // the ID floor; the last ID this fix gave (0: none)
+  FILE *log;
+
+  void schedule_next();
+  std::vector<Sphere> spheres_near(double reach);
+  std::vector<double> wall_triangles();
+  int next_fraction() const;
+  void insert(const Event &event);
+  void create(const std::vector<Sphere> &made_now, const std::vector<int> &types,
+              const std::vector<double> &vel);
+};
+
+}    // namespace LAMMPS_NS
+
+#endif

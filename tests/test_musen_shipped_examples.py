@@ -35,14 +35,15 @@ class Reference:
     def __init__(self, path: Path):
         self.spheres: dict[float, dict[int, np.ndarray]] = {}
         self.walls: dict[float, dict[int, np.ndarray]] = {}
+        self.forces: dict[float, dict[int, np.ndarray]] = {}
         self.broken = -1
         with gzip.open(path, "rt") as f:
             for line in f:
                 w = line.split()
                 if line.startswith("# broken_bonds"):
                     self.broken = int(w[2])
-                elif w and w[0] in ("S", "W"):
-                    into = self.spheres if w[0] == "S" else self.walls
+                elif w and w[0] in ("S", "W", "F"):
+                    into = {"S": self.spheres, "W": self.walls, "F": self.forces}[w[0]]
                     into.setdefault(float(w[1]), {})[int(w[2])] = np.array(w[3:], float)
         self.times = sorted(self.spheres)
 
@@ -116,6 +117,35 @@ def test_reference_spreads_are_cmusens_own():
         t = real.times[-1]
         ids = sorted(real.spheres[t])
         assert np.abs(real.field(t, ids, 12) - other.field(t, ids, 12)).max() > 0
+
+
+def test_example1_every_step_equals_cmusen_saved_forces_included(tmp_path):
+    """Example 1 with a save every step (SAVING_STEP = the scene's 3e-8 s step, END_TIME 3e-7 s):
+    positions, velocities and spins of the sampled spheres (sphere 1913, touching the moving
+    plate at t = 0, among them) are cmusen's to 1e-12 of scale, the plate is where cmusen has
+    it, and the saved force is cmusen's: the previous evaluation's (docs/musen.md), to 1e-12 of
+    the largest force."""
+    real = Reference(CASE / "example1_steps_cmusen.txt.gz")
+    ours_path = _run("example1_steps", tmp_path)
+    ours = read_time_points(ours_path, tags=(12, 15, 16, 20, 44))
+    assert ours.times.tolist()[1:] == real.times and len(real.times) == 11
+    ids = sorted(real.spheres[real.times[0]])
+    assert 1913 in ids
+    rows = [{int(i): r for r, i in enumerate(ours.ids.tolist())}[i] for i in ids]
+    x0 = ours.fields[12][0][rows]
+    for tag, _ in QUANTITIES:
+        ref = [real.field(t, ids, tag) - (x0 if tag == 12 else 0) for t in real.times]
+        got = [ours.fields[tag][k][rows] - (x0 if tag == 12 else 0) for k in range(1, len(real.times) + 1)]
+        scale = max(np.abs(r).max() for r in ref)
+        assert max(np.abs(g - r).max() for g, r in zip(got, ref)) <= 1e-12 * scale
+    ref_f = [np.array([real.forces[t][i] for i in ids]) for t in real.times]
+    scale = max(np.abs(r).max() for r in ref_f)
+    for k, r in enumerate(ref_f, start=1):
+        assert np.abs(ours.fields[20][k][rows] - r).max() <= 1e-12 * scale, f"saved force at {real.times[k - 1]!r}"
+    assert np.abs(ours.fields[20][0][rows]).max() == 0.0      # cmusen keeps the scene's 0 at t = 0
+    for k, t in enumerate(real.times, start=1):
+        for wid, vertices in real.walls[t].items():
+            assert np.abs(ours.fields[44][k][list(ours.ids).index(wid)] - vertices).max() <= 1e-15
 
 
 @pytest.mark.skipif(not os.environ.get("FIBRELMP_SLOW"), reason="set FIBRELMP_SLOW=1: runs "

@@ -1,11 +1,12 @@
 """Make the stored references of MUSEN's Examples 1, 2, 3, 7 from cmusen's 17-digit text exports
 (README.md says how those were made).  Usage:
-    python make_reference.py OUT.txt.gz EXPORT_prec17.txt
+    python make_reference.py OUT.txt.gz EXPORT_prec17.txt [forces [STRIDE]]
 
 Writes, for every saved time point after t = 0: a sample of the spheres (ids that are multiples
-of 8, and every sphere touching the moving upper plate at t = 0) as
+of 8 or STRIDE, and every sphere touching the moving upper plate at t = 0) as
 ``S time id x y z vx vy vz wx wy wz``, every wall as ``W time id`` and its 9 vertex coordinates,
-and the number of solid bonds broken by the last time point as ``# broken_bonds N``; 17 significant digits."""
+the number of solid bonds broken by the last time point as ``# broken_bonds N``, and with
+``forces`` the sampled spheres' saved forces as ``F time id fx fy fz``; 17 significant digits."""
 
 from __future__ import annotations
 
@@ -21,15 +22,15 @@ SPHERE, WALL = 1, 14
 PLATE_TOP_CONTACTS = (1913,)    # row of the sphere touching UpperWall at t = 0 (docs/musen.md)
 
 
-def sampled_rows(ids: np.ndarray, types: np.ndarray) -> np.ndarray:
+def sampled_rows(ids: np.ndarray, types: np.ndarray, stride: int = 8) -> np.ndarray:
     spheres = types == SPHERE
-    rows = set(np.flatnonzero(spheres & (ids % 8 == 0)).tolist()) | set(PLATE_TOP_CONTACTS)
+    rows = set(np.flatnonzero(spheres & (ids % stride == 0)).tolist()) | set(PLATE_TOP_CONTACTS)
     return np.array(sorted(rows), np.int64)
 
 
-def main(out: str, export: str) -> None:
-    tp = read_time_points(export, tags=(12, 15, 16, 44))
-    rows = sampled_rows(tp.ids, tp.types)
+def main(out: str, export: str, forces: bool = False, stride: int = 8) -> None:
+    tp = read_time_points(export, tags=(12, 15, 16, 20, 44))
+    rows = sampled_rows(tp.ids, tp.types, stride)
     walls = np.flatnonzero(tp.types == WALL)
     model = read(export)
     # the scene's bonds carry activity ends from an earlier run, far in the future: not breaks
@@ -42,9 +43,13 @@ def main(out: str, export: str) -> None:
             for r in rows:
                 vals = np.concatenate([tp.fields[12][k][r], tp.fields[15][k][r], tp.fields[16][k][r]])
                 f.write(f"S {t} {int(tp.ids[r])} " + " ".join(f"{v:.17g}" for v in vals) + "\n")
+            if forces:
+                for r in rows:
+                    f.write(f"F {t} {int(tp.ids[r])} " + " ".join(f"{v:.17g}" for v in tp.fields[20][k][r]) + "\n")
             for r in walls:
                 f.write(f"W {t} {int(tp.ids[r])} " + " ".join(f"{v:.17g}" for v in tp.fields[44][k][r]) + "\n")
 
 
 if __name__ == "__main__":
-    main(sys.argv[1], sys.argv[2])
+    main(sys.argv[1], sys.argv[2], len(sys.argv) > 3 and sys.argv[3] == "forces",
+         int(sys.argv[4]) if len(sys.argv) > 4 else 8)

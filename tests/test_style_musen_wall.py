@@ -965,3 +965,28 @@ def test_bad_mesh_files_are_clear_errors(plugin_path, tmp_path):
                 L.command("run 0")
         finally:
             L.close()
+
+
+def test_time_driven_walls_with_different_start_velocities_are_warned(plugin_path, tmp_path):
+    """A time-driven geometry moves step by step as cmusen moves it (one step ahead of x0 + v t)
+    only when its walls start with one stored velocity; otherwise it keeps the exact motion and
+    the translation says so."""
+    from fibrelmp.translate.granular_job import build_granular_job
+
+    from . import granular_models as gm
+    mats, contacts = gm.two_materials()
+    m = gm.model(gm.spheres([[0.0, 0.0, 0.0006]], 0.0005, [0], mats), mats, contacts, dt=1e-6,
+                 t_end=0.001, save_every_time=0.001, gravity=np.array([0, 0, -G]))
+    floor = np.array([[[-0.004, -0.004, 0.0], [0.004, -0.004, 0.0], [0.004, 0.004, 0.0]],
+                      [[-0.004, -0.004, 0.0], [0.004, 0.004, 0.0], [-0.004, 0.004, 0.0]]])
+    gm.add_geometry(m, "lift", floor, 1, motion=[gm.interval(0.0, 0.002, v=(0, 0, 0.01))])
+    previous = lammps_styles.request_stock(False)
+    try:
+        job, _, _ = build_granular_job(m, tmp_path / "same")
+        assert not any("one step ahead" in msg for _, msg in job.warnings)
+        m.triangles.velocity[-1] = [0.0, 0.0, 0.01]
+        job, _, _ = build_granular_job(m, tmp_path / "different")
+        assert any(kind == "approximate MUSEN physics" and "'lift'" in msg and "one step ahead" in msg
+                   for kind, msg in job.warnings)
+    finally:
+        lammps_styles.request_stock(previous)

@@ -269,6 +269,11 @@ def wall_warnings(model: GranularModel, wall_plans: list[WallPlan], t_start: flo
             out.append(("approximate MUSEN physics", f"wall geometry '{wp.name}' represented as "
                         f"{wp.description}: LAMMPS's granular wall law stands in for MUSEN's "
                         "particle-wall contact (docs/granular.md, Walls)"))
+        elif wp.kind == "mesh" and wp.stepped is None and wp.kinematics.moving:
+            # steps_by_time refused it: its walls start with different stored velocities
+            out.append(("approximate MUSEN physics", f"geometry '{wp.name}': its walls start with "
+                        "different velocities, so it follows its exact motion x0 + v t; MUSEN's "
+                        "walls are one step ahead of that (docs/musen.md, Walls one step ahead)"))
         elif wp.kind == "ignored":
             out.append(("walls in no geometry", f"{len(wp.triangle_rows)} triangular wall(s) belong "
                         "to no geometry: MUSEN's simulator does not use them, so they are not "

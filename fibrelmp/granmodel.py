@@ -470,3 +470,5 @@ class GranularFrame:
     triangle_vertices: np.ndarray | None = None # (k,3,3)
     triangle_velocity: np.ndarray | None = None # (k,3)
     triangle_force: np.ndarray | None = None    # (k,3) force the particles exert on each triangle
+    saved_force: np.ndarray | None = None      # (n',3) the force cmusen saves now (MUSEN's
+                                               # integrator: the previous evaluation's)

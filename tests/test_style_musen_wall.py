@@ -886,6 +886,21 @@ def test_wall_keeps_velocity_after_its_interval(plugin_path, tmp_path):
     assert abs((R - gap) - d0) > 0.02 * d0
 
 
+def musen_wall_travel(v: float, t_begin: float, t_end: float, dt: float, end_time: float) -> float:
+    """How far cmusen moves a wall with one time interval (velocity v from t_begin to t_end),
+    written from its loop (CBaseSimulator::StartSimulation, CCPUSimulator::MoveWalls): the
+    prediction iteration moves it by v dt at t = 0 without advancing the time, then each step
+    moves it by v dt when t_begin <= t <= t_end at the step's summed time t, then t += dt."""
+    z, t = 0.0, 0.0
+    if t_begin <= t <= t_end:
+        z += v * dt
+    while t < end_time:
+        if t_begin <= t <= t_end:
+            z += v * dt
+        t += dt
+    return z
+
+
 def test_kept_velocity_is_reported_and_warned(plugin_path, tmp_path):
     """Through fibrelmp: the frames report MUSEN's kept wall velocity and the translation says
     so; without the plugin the same job names the stock representation."""
@@ -909,7 +924,10 @@ def test_kept_velocity_is_reported_and_warned(plugin_path, tmp_path):
         job = run_granular(m, tmp_path / "run", frames.append, progress=False)
         assert "musen/wall/mesh" in job.walls[0][1]
         assert frames[-1].triangle_velocity[0].tolist() == [0.0, 0.0, 0.01]
-        assert frames[-1].triangle_vertices[0, 0, 2] == pytest.approx(0.01 * 0.002, rel=1e-12)
+        # MUSEN's walls travel by MoveWalls' steps (one more in the prediction iteration), not
+        # by v (t_end - t_begin)
+        assert frames[-1].triangle_vertices[0, 0, 2] == pytest.approx(
+            musen_wall_travel(0.01, 0.0, 0.002, 1e-6, 0.004), rel=1e-12)
         lammps_styles.request_stock(True)
         job, _, _ = build_granular_job(m, tmp_path / "stock")
         kinds = [kind for kind, _ in job.warnings]
@@ -947,3 +965,28 @@ def test_bad_mesh_files_are_clear_errors(plugin_path, tmp_path):
                 L.command("run 0")
         finally:
             L.close()
+
+
+def test_time_driven_walls_with_different_start_velocities_are_warned(plugin_path, tmp_path):
+    """A time-driven geometry moves step by step as cmusen moves it (one step ahead of x0 + v t)
+    only when its walls start with one stored velocity; otherwise it keeps the exact motion and
+    the translation says so."""
+    from fibrelmp.translate.granular_job import build_granular_job
+
+    from . import granular_models as gm
+    mats, contacts = gm.two_materials()
+    m = gm.model(gm.spheres([[0.0, 0.0, 0.0006]], 0.0005, [0], mats), mats, contacts, dt=1e-6,
+                 t_end=0.001, save_every_time=0.001, gravity=np.array([0, 0, -G]))
+    floor = np.array([[[-0.004, -0.004, 0.0], [0.004, -0.004, 0.0], [0.004, 0.004, 0.0]],
+                      [[-0.004, -0.004, 0.0], [0.004, 0.004, 0.0], [-0.004, 0.004, 0.0]]])
+    gm.add_geometry(m, "lift", floor, 1, motion=[gm.interval(0.0, 0.002, v=(0, 0, 0.01))])
+    previous = lammps_styles.request_stock(False)
+    try:
+        job, _, _ = build_granular_job(m, tmp_path / "same")
+        assert not any("one step ahead" in msg for _, msg in job.warnings)
+        m.triangles.velocity[-1] = [0.0, 0.0, 0.01]
+        job, _, _ = build_granular_job(m, tmp_path / "different")
+        assert any(kind == "approximate MUSEN physics" and "'lift'" in msg and "one step ahead" in msg
+                   for kind, msg in job.warnings)
+    finally:
+        lammps_styles.request_stock(previous)

@@ -166,6 +166,8 @@ class FrameBuilder:
 
         frame = GranularFrame(time=t, step=step, sphere_rows=rows, position=pos, velocity=vel,
                               omega=omega, force=force, quaternion=quat)
+        if "sfx" in c:      # fix musen/leapfrog: the force cmusen saves (the previous evaluation's)
+            frame.saved_force = np.column_stack([c["sfx"], c["sfy"], c["sfz"]])
         if self.nb:
             self._bonds(frame, step)
         if self.v0 is not None:

@@ -11,6 +11,7 @@
 #include "domain.h"
 #include "error.h"
 #include "force.h"
+#include "memory.h"
 #include "modify.h"
 #include "update.h"
 #include "utils.h"
@@ -32,6 +33,77 @@ FixMusenLeapfrog::FixMusenLeapfrog(LAMMPS *lmp, int narg, char **arg) :
       error->all(FLERR, "Fix musen/leapfrog: vlimit must be a positive finite speed");
   }
   time_integrate = 1;
+  peratom_flag = 1;
+  size_peratom_cols = 3;
+  peratom_freq = 1;
+  restart_peratom = 1;
+  saved_force = nullptr;
+  FixMusenLeapfrog::grow_arrays(atom->nmax);
+  atom->add_callback(Atom::GROW);
+  atom->add_callback(Atom::RESTART);
+  for (int i = 0; i < atom->nlocal; i++) saved_force[i][0] = saved_force[i][1] = saved_force[i][2] = 0.0;
+}
+
+FixMusenLeapfrog::~FixMusenLeapfrog()
+{
+  if (copymode) return;
+  atom->delete_callback(id, Atom::GROW);
+  atom->delete_callback(id, Atom::RESTART);
+  memory->destroy(saved_force);
+}
+
+void FixMusenLeapfrog::grow_arrays(int nmax)
+{
+  memory->grow(saved_force, nmax, 3, "musen/leapfrog:saved_force");
+  array_atom = saved_force;
+}
+
+void FixMusenLeapfrog::copy_arrays(int i, int j, int /*delflag*/)
+{
+  for (int k = 0; k < 3; k++) saved_force[j][k] = saved_force[i][k];
+}
+
+int FixMusenLeapfrog::pack_exchange(int i, double *buf)
+{
+  for (int k = 0; k < 3; k++) buf[k] = saved_force[i][k];
+  return 3;
+}
+
+int FixMusenLeapfrog::unpack_exchange(int nlocal, double *buf)
+{
+  for (int k = 0; k < 3; k++) saved_force[nlocal][k] = buf[k];
+  return 3;
+}
+
+int FixMusenLeapfrog::pack_restart(int i, double *buf)
+{
+  buf[0] = 4;    // this fix's values and their count (LAMMPS's per-atom restart layout)
+  for (int k = 0; k < 3; k++) buf[k + 1] = saved_force[i][k];
+  return 4;
+}
+
+void FixMusenLeapfrog::unpack_restart(int nlocal, int nth)
+{
+  double **extra = atom->extra;
+  int m = 0;
+  for (int i = 0; i < nth; i++) m += static_cast<int>(extra[nlocal][m]);
+  m++;
+  for (int k = 0; k < 3; k++) saved_force[nlocal][k] = extra[nlocal][m++];
+}
+
+int FixMusenLeapfrog::size_restart(int /*nlocal*/)
+{
+  return 4;
+}
+
+int FixMusenLeapfrog::maxsize_restart()
+{
+  return 4;
+}
+
+double FixMusenLeapfrog::memory_usage()
+{
+  return 3.0 * atom->nmax * sizeof(double);
 }
 
 int FixMusenLeapfrog::setmask()
@@ -72,6 +144,11 @@ void FixMusenLeapfrog::initial_integrate(int /*vflag*/)
 {
   // time steps have begun: later set-ups (checkpoints, deletions) do not advance states
   musen_startup::advancing_setups() = 0;
+  // cmusen saves before its force evaluation: the force of the previous one, still in f
+  const double *const *f = atom->f;
+  for (int i = 0; i < atom->nlocal; i++)
+    if (atom->mask[i] & groupbit)
+      for (int k = 0; k < 3; k++) saved_force[i][k] = f[i][k];
   kick(1.0);
   double **x = atom->x, **v = atom->v;
   const int *mask = atom->mask;

@@ -22,6 +22,10 @@
    Quaternions are not integrated: MUSEN turns them only with anisotropy, which fibrelmp
    does not simulate.  VMAX: MUSEN's particle velocity limit (|v| scaled down to VMAX after
    the kick, before the move; angular velocities are not limited).
+
+   Per-atom array (f_ID[1..3]): the force MUSEN's SaveData stores at this time, the total force
+   of the previous evaluation (its SaveData runs before the step's force evaluation): f as
+   initial_integrate finds it; zero before the first step.
 ------------------------------------------------------------------------- */
 
 #ifndef FIBRELMP_FIX_MUSEN_LEAPFROG_H
@@ -35,13 +39,25 @@ namespace LAMMPS_NS {
 class FixMusenLeapfrog : public Fix {
  public:
   FixMusenLeapfrog(class LAMMPS *, int, char **);
+  ~FixMusenLeapfrog() override;
   int setmask() override;
   void init() override;
   void initial_integrate(int) override;
   void kick(double fraction);    // v += F/m fraction dt, w += M/I fraction dt (group atoms)
 
+  void grow_arrays(int) override;
+  void copy_arrays(int, int, int) override;
+  int pack_exchange(int, double *) override;
+  int unpack_exchange(int, double *) override;
+  int pack_restart(int, double *) override;
+  void unpack_restart(int, int) override;
+  int size_restart(int) override;
+  int maxsize_restart() override;
+  double memory_usage() override;
+
  private:
-  double vmax;    // 0: no limit
+  double vmax;             // 0: no limit
+  double **saved_force;    // per atom: the force cmusen saves now (previous evaluation's)
 };
 
 class MusenPredict : public Command {

@@ -11,6 +11,7 @@
 #include "fix_musen_wall_mesh.h"
 #include "style_registry.h"
 #include "fix_musen_history.h"
+#include "musen_startup.h"
 
 #include "atom.h"
 #include "comm.h"
@@ -558,19 +559,22 @@ void FixMusenWallMesh::init()
 void FixMusenWallMesh::setup(int vflag)
 {
   if (any_stepped && !started) {
-    // MUSEN's half-step prediction iteration: forces at the start positions, then MoveWalls
+    // MUSEN's prediction iteration: its forces with the walls where and as they start, then
+    // MoveWalls from those wall forces (CBaseSimulator::StartSimulation)
     start_vert = vert;    // a frame before the first step shows them here (MUSEN saves first)
-    dry_run = true;
     post_force(vflag);
-    dry_run = false;
     step_walls(current_time());
     started = true;
+    pending = false;
+    at_start = true;
+    return;
   }
-  if (any_stepped && ftri_step != update->ntimestep) pending = true;
-  // a set-up at the step of a time step (run 0 after a checkpoint, a resumed run) adds the
-  // wall forces to the atoms again but keeps the triangle forces of that step, which an
+  // a set-up that is MUSEN's first step (musen_startup.h) counts as a time step; another
+  // set-up at the step of a time step (run 0 after a checkpoint, a resumed run) adds the wall
+  // forces to the atoms again but keeps the triangle forces of that step, which an
   // uninterrupted run writes in its next frame
-  if (ftri_step != update->ntimestep) {
+  if (musen_startup::advances(update) || ftri_step != update->ntimestep) {
+    if (any_stepped && ftri_step != update->ntimestep) pending = true;
     post_force(vflag);
     return;
   }
@@ -808,6 +812,7 @@ void FixMusenWallMesh::post_force(int /*vflag*/)
     step_walls(current_time() - update->dt);
     pending = false;
   }
+  at_start = false;
   const double t = current_time();
   if (any_moving || !placed) place(t);
   motion_state(t);
@@ -825,7 +830,9 @@ void FixMusenWallMesh::post_force(int /*vflag*/)
   std::fill(ftri.begin(), ftri.end(), 0.0);
   reduced_valid = false;
   const double dt = update->dt;
-  const bool commit = !update->setupflag;
+  // time steps and MUSEN's two evaluations at t = 0 (musen_startup.h) advance the contacts;
+  // other set-ups (run, run 0) leave them as they were
+  const bool commit = musen_startup::advances(update);
 
   for (int i = 0; i < nlocal; i++) {
     if (!(mask[i] & groupbit)) continue;
@@ -962,10 +969,8 @@ void FixMusenWallMesh::post_force(int /*vflag*/)
       double fo[3], to[3];
       wall_force(i, cd, w.xi, dt, fo, to);
       for (int k = 0; k < 3; k++) {
-        if (!dry_run) {
-          f[i][k] += fo[k];
-          torque[i][k] += to[k];
-        }
+        f[i][k] += fo[k];
+        torque[i][k] += to[k];
         ftri[3 * (size_t) cd.tri + k] -= fo[k];
       }
     }
@@ -1107,7 +1112,7 @@ int FixMusenWallMesh::modify_param(int narg, char **arg)
         if (any_stepped) {
           // before the first time step MUSEN's frame precedes its prediction update: the
           // walls where and as they started
-          const bool first = ftri_step < 0 && !start_vert.empty();
+          const bool first = at_start && !start_vert.empty();
           const double *gv = first ? geoms[tgeom[t]].start_vel : geoms[tgeom[t]].vel;
           const double *p = first ? &start_vert[9 * (size_t) t] : &vert[9 * (size_t) t];
           fprintf(fp, " %.17g %.17g %.17g", gv[0], gv[1], gv[2]);

@@ -183,8 +183,8 @@ class FixMusenWallMesh : public Fix {
   bool placed;
   bool warned_centre_on_wall = false;
   // stepped geometries: the prediction update done, ftri holds forces not yet used to move,
-  // an evaluation that only measures the wall forces (no atom forces, no history)
-  bool any_stepped = false, started = false, pending = false, dry_run = false;
+  // frames still show the walls as they started (between the prediction and its first step)
+  bool any_stepped = false, started = false, pending = false, at_start = false;
   double gravity[3] = {0, 0, 0};
   std::vector<double> start_vert;      // vertices before the prediction update    // a sphere centre on a triangle was met (warned once)
 

@@ -66,10 +66,11 @@ def plan_walls(model: GranularModel, dt: float, t_end: float, mesh: bool | None 
     t0 = model.plan.t_start
     for name, geom, rows in geometry_triangle_rows(model):
         v = tris.vertices[rows]
-        stepped = geom is not None and is_stepped(geom)
+        stepped = geom is not None and (is_stepped(geom) or (mesh and steps_by_time(geom, tris.velocity[rows])))
         if geom is not None:
             _check_motion(model, geom, mesh, rows)
-            kin = stepped_kinematics(geom) if stepped else geometry_kinematics(geom, v, t0, t_end)
+            kin = (stepped_kinematics(geom) if is_stepped(geom)
+                   else geometry_kinematics(geom, v, t0, t_end))
         else:
             kin = Kinematics()
         mats, counts = np.unique(tris.material[rows], return_counts=True)
@@ -133,6 +134,21 @@ def is_stepped(geom: Geometry) -> bool:
     """The geometry's motion depends on the forces on it: force-dependent intervals (types 2
     and 3) or free axes with a mass (CPUSimulator::MoveWalls solves Newton's law then)."""
     return geom.motion_type in (2, 3) or (any(geom.free) and geom.mass != 0)
+
+
+def steps_by_time(geom: Geometry, wall_velocities: np.ndarray) -> bool:
+    """A time-dependent motion that fix musen/wall/mesh moves step by step as
+    CPUSimulator::MoveWalls does: v(t) dt per step, and once more in MUSEN's prediction
+    iteration at t = 0, so MUSEN's walls (in its contacts and its result file) are one step
+    ahead of the exact motion x0 + v t (docs/musen.md, "Walls one step ahead").  Walls that
+    start with different stored velocities keep the exact motion (the fix starts a geometry
+    from one velocity); ``wall_warnings`` names them."""
+    if geom.motion_type != 1 or not any(np.any(np.asarray(iv.velocity, float) != 0)
+                                        or np.any(np.asarray(iv.angular_velocity, float) != 0)
+                                        for iv in geom.motion):
+        return False
+    vel = np.asarray(wall_velocities, float)
+    return not len(vel) or bool(np.all(vel == vel[:1]))
 
 
 def stepped_kinematics(geom: Geometry) -> Kinematics:
@@ -253,6 +269,11 @@ def wall_warnings(model: GranularModel, wall_plans: list[WallPlan], t_start: flo
             out.append(("approximate MUSEN physics", f"wall geometry '{wp.name}' represented as "
                         f"{wp.description}: LAMMPS's granular wall law stands in for MUSEN's "
                         "particle-wall contact (docs/granular.md, Walls)"))
+        elif wp.kind == "mesh" and wp.stepped is None and wp.kinematics.moving:
+            # steps_by_time refused it: its walls start with different stored velocities
+            out.append(("approximate MUSEN physics", f"geometry '{wp.name}': its walls start with "
+                        "different velocities, so it follows its exact motion x0 + v t; MUSEN's "
+                        "walls are one step ahead of that (docs/musen.md, Walls one step ahead)"))
         elif wp.kind == "ignored":
             out.append(("walls in no geometry", f"{len(wp.triangle_rows)} triangular wall(s) belong "
                         "to no geometry: MUSEN's simulator does not use them, so they are not "

@@ -127,7 +127,9 @@ class MusenResultWriter(Writer):
         # spheres not in the frame are written as zeros, as MUSEN stores nothing for them
         n = self.model.spheres.count
         b = np.zeros((n, 18))
-        force = np.asarray(f.force, np.float64).reshape(-1, 3)
+        # MUSEN saves the previous evaluation's force (docs/musen.md, saved time points)
+        saved = f.force if f.saved_force is None else f.saved_force
+        force = np.asarray(saved, np.float64).reshape(-1, 3)
         b[rows, 0:3] = f.omega
         b[rows, 3:6] = f.position
         b[rows, 6:9] = force

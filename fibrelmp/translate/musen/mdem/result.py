@@ -80,7 +80,8 @@ class MdemResultWriter(MusenResultWriter):
         values[ids, 0:3] = frame.position
         values[ids, 6:9] = frame.velocity
         values[ids, 9:12] = frame.omega
-        values[ids, 18:21] = np.asarray(frame.force, np.float64).reshape(-1, 3)
+        saved = frame.force if frame.saved_force is None else frame.saved_force    # MUSEN's saved force
+        values[ids, 18:21] = np.asarray(saved, np.float64).reshape(-1, 3)
         values[ids, _Q:_Q + 4] = frame.quaternion
         masks[ids] = SPHERE_FIELDS
         if self.bond_ids is not None:

@@ -37,6 +37,7 @@ FixMusenLeapfrog::FixMusenLeapfrog(LAMMPS *lmp, int narg, char **arg) :
   size_peratom_cols = 3;
   peratom_freq = 1;
   restart_peratom = 1;
+  create_attribute = 1;      // spheres an inlet makes mid-run: MUSEN saves them with zero force
   saved_force = nullptr;
   FixMusenLeapfrog::grow_arrays(atom->nmax);
   atom->add_callback(Atom::GROW);
@@ -56,6 +57,11 @@ void FixMusenLeapfrog::grow_arrays(int nmax)
 {
   memory->grow(saved_force, nmax, 3, "musen/leapfrog:saved_force");
   array_atom = saved_force;
+}
+
+void FixMusenLeapfrog::set_arrays(int i)
+{
+  saved_force[i][0] = saved_force[i][1] = saved_force[i][2] = 0.0;
 }
 
 void FixMusenLeapfrog::copy_arrays(int i, int j, int /*delflag*/)

@@ -69,7 +69,7 @@ def _spheres(text: str) -> dict:
         out["mat"].append(tok[8])
         out["start"].append(tok[10])
         t, rec = next((t, rec) for t, rec in records if "%g" % t >= tok[10] and t >= float(tok[10]))
-        out["first"].append((t, rec[12], rec[15]))
+        out["first"].append((t, rec[12], rec[15], rec[20]))
     return out
 
 
@@ -149,7 +149,8 @@ def test_radii_follow_the_mixture_fractions(result):
 def test_objects_at_a_save_of_their_generation_step(result):
     cmusen_result = result
     """Spheres generated on a saving step are saved as generated: totally inside the volume,
-    free of each other, with the generator's velocity (|v| = 0.5 for the random one)."""
+    free of each other, with the generator's velocity (|v| = 0.5 for the random one) and a
+    zero force."""
     saves = cmusen_result["saves"]
     events = gen.generation_schedule(gen.read_generators(_storage()), DT, END)
     on_save = {"%g" % e.time: e for e in events if np.isin(e.time, saves)}
@@ -163,6 +164,8 @@ def test_objects_at_a_save_of_their_generation_step(result):
         assert ((pos - r[:, None] >= VOLUME_LO) & (pos + r[:, None] <= VOLUME_HI)).all()
         d = np.linalg.norm(pos[:, None] - pos[None], axis=2) + np.eye(len(r))
         assert (d >= r[:, None] + r[None] - 1e-15).all()
+        # MUSEN saves the previous step's force: none yet for a sphere made on this step
+        assert all(cmusen_result["first"][k][3] == [0.0, 0.0, 0.0] for k in rows)
         if event.generator == 0:
             np.testing.assert_allclose(np.linalg.norm(vel, axis=1), 0.5, rtol=1e-14)
             assert len({tuple(v) for v in vel}) == len(vel)        # one random draw each

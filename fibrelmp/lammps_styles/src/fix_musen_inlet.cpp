@@ -72,7 +72,7 @@ double triangle_distance2(const double *p, const double *a, const double *b, con
 }    // namespace
 
 FixMusenInlet::FixMusenInlet(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), wall_id(nullptr), inserted(0), first_id(1), last_id(0), log(nullptr)
+    Fix(lmp, narg, arg), wall_id(nullptr), inserted(0), first_id(1), last_id(0), log(nullptr), type_radius(0.0)
 {
   const std::string usage = "fix ID group musen/inlet SEED box XLO XHI YLO YHI ZLO ZHI tries N "
       "walls WALLFIX|none velocity fixed VX VY VZ|random MAG fractions K ... events M ...";
@@ -353,6 +353,15 @@ void FixMusenInlet::create(const std::vector<Sphere> &made_now, const std::vecto
     atom->map_init();
     atom->map_set();
   }
+}
+
+void *FixMusenInlet::extract(const char *name, int &itype)
+{
+  if (strcmp(name, "radius") != 0) return nullptr;
+  type_radius = 0.0;
+  for (const Fraction &f : fractions)
+    if (f.type == itype) type_radius = std::max(type_radius, f.radius);
+  return &type_radius;
 }
 
 double FixMusenInlet::compute_scalar()

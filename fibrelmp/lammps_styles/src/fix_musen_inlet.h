@@ -55,6 +55,9 @@ class FixMusenInlet : public Fix {
   tagint last_given() const { return last_id; }    // spheres this fix has inserted (all runs)
   void write_restart(FILE *) override;
   void restart(char *) override;
+  // "radius" of type T: the largest radius this fix gives type T (0: none), as fix pour
+  // tells granular pair styles, which size their neighbour cutoffs with it
+  void *extract(const char *, int &) override;
 
  private:
   struct Fraction {
@@ -81,6 +84,7 @@ class FixMusenInlet : public Fix {
   bigint inserted;
   tagint first_id, last_id;     // the ID floor; the last ID this fix gave (0: none)
   FILE *log;
+  double type_radius;           // extract()'s answer
 
   void schedule_next();
   std::vector<Sphere> spheres_near(double reach);

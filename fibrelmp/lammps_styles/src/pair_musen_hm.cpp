@@ -33,6 +33,7 @@
 #include "atom.h"
 #include "comm.h"
 #include "error.h"
+#include "fix.h"
 #include "fix_musen_history.h"
 #include "force.h"
 #include "memory.h"
@@ -359,6 +360,14 @@ void PairMusenHM::init_style()
   for (int t = 0; t <= ntypes; t++) local[t] = 0.0;
   for (int i = 0; i < atom->nlocal; i++)
     local[atom->type[i]] = std::max(local[atom->type[i]], atom->radius[i]);
+  // and the spheres an inlet will insert (fix musen/inlet, as fix pour for LAMMPS's granular
+  // styles): without them a run that starts before they exist would miss their contacts
+  for (Fix *inlet : modify->get_fix_by_style("^musen/inlet$"))
+    for (int t = 1; t <= ntypes; t++) {
+      int asked = t;
+      if (const auto *r = static_cast<const double *>(inlet->extract("radius", asked)))
+        local[t] = std::max(local[t], *r);
+    }
   MPI_Allreduce(local, maxrad, ntypes + 1, MPI_DOUBLE, MPI_MAX, world);
   delete[] local;
 }

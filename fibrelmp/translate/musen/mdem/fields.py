@@ -7,7 +7,7 @@ simulates with them; a setting fibrelmp cannot honour is refused here, naming th
 the field, never dropped.  ``FIELDS`` classifies every field of ``messages._SPEC`` (a test
 checks that none is missing, so a field added to the table of messages must be classified);
 ``REFUSALS`` holds one check per refused setting: an implementation replaces its row.
-Unsupported generator settings, the variable time step and stop criteria are refused where their own
+Unsupported generator settings, the variable time step and unknown stop criteria are refused where their own
 items handle them (``generators.read_inlets``, ``model._refused_settings``: a job script
 may switch the latter off); the velocity limit and a moving periodic box are simulated.
 """
@@ -28,8 +28,12 @@ _TEXT = "through the scene's text form (`.mdem` → MUSEN text export → text s
 _GUI = "GUI / view data"
 _DB = "materials database, read through the text form (`32`/`33`)"
 # handled where their items put them (issue 26, items 3 and 4), not in REFUSALS below
-_DEFERRED = ("kept by name and refused when simulated, unless the job script switches it off "
-             "as cmusen would (model.py `_refused_settings`)")
+_STOP = ("BROKEN_BONDS (type 1, max_broken_bonds) stops the run as cmusen does, checked at every "
+         "save (model.py `_refused_settings`, lammps_flow.py); an unknown type is refused by name; "
+         "a job script's STOP_CRITERION replaces it")
+_VARIABLE_STEP = ("MUSEN's variable time step is not simulated (its rule and a cmusen reference are "
+                  "in tests/data/real-outputs/musen/variable_time_step/); refused unless the job "
+                  "script switches it off (VARIABLE_TIME_STEP 0)")
 _INLETS = ("an active dynamic generator (inlet) of spheres into a box volume inserts "
            "them during the run (mdem/generators.py `read_inlets`, fix musen/inlet); "
            "agglomerates, other volume shapes and inside_geometries off are refused by name "
@@ -99,8 +103,8 @@ FIELDS: dict[str, tuple[str, str]] = {
     "ProtoSimulationInfo.selective_saving": (WARNED, "fibrelmp saves every field"),
     "ProtoSimulationInfo.selective_saving_flags": (WARNED, "fibrelmp saves every field"),
     "ProtoSelectiveSaving.*": (WARNED, "fibrelmp saves every field"),
-    "ProtoSimulationInfo.stop_criteria": (REFUSED, _DEFERRED),
-    "ProtoStopCriteria.*": (REFUSED, _DEFERRED),
+    "ProtoSimulationInfo.stop_criteria": (HONOURED, _STOP),
+    "ProtoStopCriteria.*": (HONOURED, _STOP),
     "ProtoParticleInfo.id": (HONOURED, _TEXT),
     "ProtoParticleInfo.type": (HONOURED, _TEXT + "; liquid bonds are refused by the scene reader"),
     "ProtoParticleInfo.compound": (HONOURED, _TEXT),
@@ -168,7 +172,7 @@ FIELDS: dict[str, tuple[str, str]] = {
     "ProtoModuleSimulator.max_cells_number": (NOT_SIMULATION, "neighbour search: LAMMPS's own"),
     "ProtoModuleSimulator.verlet_dist_coeff": (NOT_SIMULATION, "neighbour search: LAMMPS's own"),
     "ProtoModuleSimulator.verlet_auto_adjust": (NOT_SIMULATION, "neighbour search: LAMMPS's own"),
-    "ProtoModuleSimulator.flexible_time_step": (REFUSED, _DEFERRED),
+    "ProtoModuleSimulator.flexible_time_step": (REFUSED, _VARIABLE_STEP),
     "ProtoModuleSimulator.part_move_limit": (HONOURED, "read by MUSEN only with a variable time "
                                              "step, which is refused"),
     "ProtoModuleSimulator.time_step_factor": (HONOURED, "read by MUSEN only with a variable "

@@ -258,7 +258,7 @@ def test_musen_single_particle_summary(tmp_path):
         assert "total" not in got
         assert got["kinetic_plus_gravity"] == pytest.approx(ke + rot + pe, rel=rel)
     assert s["particles"] == {"kind": "spheres", "start": 1, "end": 1, "removed_at_activity_end": 0,
-                              "left_domain": 0}
+                              "left_domain": 0, "generated": 0}
     assert s["contacts"] == 0 and s["max_overlap"] is None and "bonds" not in s
     assert s["frames"] == len(saved) and s["time"]["end"] == times[-1]
 
@@ -341,7 +341,7 @@ def test_breaks_removals_and_losses_are_counted(tmp_path):
     assert broken == [0] and ended.tolist() == [0, 1]
     assert s["bonds"] == {"start": 2, "end": 0, "broken": len(broken)}
     assert s["particles"] == {"kind": "spheres", "start": 5, "end": 2, "removed_at_activity_end": 1,
-                              "left_domain": 2}
+                              "left_domain": 2, "generated": 0}
 
     # the same run stopped at a checkpoint after the deletion and the losses, then resumed
     calls = {"n": 0}

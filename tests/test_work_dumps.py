@@ -247,8 +247,9 @@ def test_musen_work_dump_times_columns(musen_run):
     folder, _ = musen_run
     dump = folder / "single_particle_job_work" / "job2" / "frames.dump"
     header = re.search(r"ITEM: ATOMS (.*)\n", dump.read_text()).group(1).split()
+    # sfx sfy sfz: the force cmusen saves (the previous evaluation's, fix musen/leapfrog)
     assert header == ("id type x y z vx vy vz omegax omegay omegaz fx fy fz quatw quati quatj quatk "
-                      "radius mass").split()
+                      "radius mass sfx sfy sfz").split()
     times = _dump_times(dump)
     assert [s for s, _ in times] == list(range(0, 200001, 1000)) + [200001]     # cmusen's last point
     for step, t in times:            # LAMMPS's running sum: within rounding of step * dt

@@ -125,11 +125,14 @@ def granular_frame(frame: Frame, time: float, model: GranularModel,
         raise InputError(frame.source, frame.line, f"atom {new} appears after the first frame: "
                          "MUSEN/DEMDF results need every object present from the start")
     n = frame.count
-    return GranularFrame(time=time, step=frame.step, sphere_rows=rows, position=frame.wrapped(),
-                         velocity=_vector(frame, ("vx", "vy", "vz"), n),
-                         omega=_vector(frame, ("omegax", "omegay", "omegaz"), n),
-                         force=_vector(frame, ("fx", "fy", "fz"), n),
-                         quaternion=_orientation(frame, facts))
+    out = GranularFrame(time=time, step=frame.step, sphere_rows=rows, position=frame.wrapped(),
+                        velocity=_vector(frame, ("vx", "vy", "vz"), n),
+                        omega=_vector(frame, ("omegax", "omegay", "omegaz"), n),
+                        force=_vector(frame, ("fx", "fy", "fz"), n),
+                        quaternion=_orientation(frame, facts))
+    if "sfx" in frame.columns:       # fix musen/leapfrog: the force cmusen saves, as the run writes
+        out.saved_force = _vector(frame, ("sfx", "sfy", "sfz"), n)
+    return out
 
 
 def spheres_only(work: Path, frame: Frame) -> str:
@@ -154,7 +157,7 @@ class GranularTarget(DumpTarget):
     lookahead = 2                 # the save interval comes from the first two frames
     # what model_from_frame and granular_frame take from a dump
     finite_columns = frozenset({"vx", "vy", "vz", "omegax", "omegay", "omegaz", "fx", "fy", "fz",
-                                "quatw", "quati", "quatj", "quatk", "radius", "diameter", "mass"})
+                                "sfx", "sfy", "sfz", "quatw", "quati", "quatj", "quatk", "radius", "diameter", "mass"})
     kind: ClassVar[str]
     keeps_ids: ClassVar[bool]
 

@@ -987,6 +987,9 @@ def test_broken_bond_lets_contact_act(tmp_path, bonded_contacts):
     assert frames[0].force[1, 0] == (pytest.approx(hertz, rel=1e-6) if bonded_contacts else 0.0)
     for f in frames[1:]:
         assert f.force[1, 0] == pytest.approx(hertz, rel=1e-6)
+    # the build that lets the pair in is not MUSEN's contact-list update: said once
+    log = (job.script.parent / "log.lammps").read_text()
+    assert ("broken bonds' spheres join the contact pairs" in log) == (not bonded_contacts)
 
 
 # --------------------------------------------------------------------------------------------

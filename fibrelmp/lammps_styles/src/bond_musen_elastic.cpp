@@ -268,7 +268,7 @@ BondMusenElastic::BondMusenElastic(LAMMPS *lmp) :
     Bond(lmp), youngs(nullptr), shear(nullptr), sigma_n(nullptr), tau_s(nullptr),
     viscosity(nullptr), diam0(nullptr), len0(nullptr), breakage(1), kelvin(0),
     max_damp_ratio(1.0), breaks_fp(nullptr), per_atom_geometry(0), nslots(0), nvalues_per(0),
-    update_special(0), max_length0(0.0), history(nullptr),
+    update_special(0), pairs_waiting(0), warned_build(0), max_length0(0.0), history(nullptr),
     history_id(HISTORY_ID)
 {
   partial_flag = 1;    // broken bonds get type 0 (the neighbor lists then skip them)
@@ -310,6 +310,7 @@ void BondMusenElastic::compute(int eflag, int vflag)
   int **bondlist = neighbor->bondlist;
   const int nbondlist = neighbor->nbondlist;
   const bool advance = musen_startup::advances(update);    // musen_startup.h
+  note_list_build();
 
   for (int n = 0; n < nbondlist; n++) {
     const int i1 = bondlist[n][0];    // stores the bond: MUSEN's left sphere
@@ -500,8 +501,26 @@ void BondMusenElastic::process_breaks()
     for (const auto &r : rec) utils::print(breaks_fp, "{} {} {}\n", r[0], r[1], r[2]);
     fflush(breaks_fp);
   }
-  if (update_special)
+  if (update_special) {
     for (const auto &r : rec) forget_special((tagint) r[1], (tagint) r[2]);
+    pairs_waiting += nbroken;
+  }
+}
+
+/* broken pairs join the contacts at this LAMMPS neighbor-list build; MUSEN adds them at its
+   own contact-list update, which its Verlet-distance rule may place at another step: said
+   once, when it happens (a run without builds after breaks is cmusen's, Example 3) */
+
+void BondMusenElastic::note_list_build()
+{
+  if (!pairs_waiting || neighbor->ago != 0) return;
+  if (!warned_build && comm->me == 0)
+    error->warning(FLERR, "Bond style musen/elastic: {} broken bonds' spheres join the contact "
+                   "pairs at LAMMPS's neighbor-list build of step {}; MUSEN adds them at its own "
+                   "contact-list update, which may come at another step", pairs_waiting,
+                   update->ntimestep);
+  warned_build = 1;
+  pairs_waiting = 0;
 }
 
 /* a broken bond's spheres are no longer 1-2 neighbours: drop each from the other's special

@@ -967,7 +967,9 @@ def test_broken_bond_lets_contact_act(tmp_path, bonded_contacts):
     """Overlapping bonded spheres whose bond breaks at once (stretched 0.2 % > sigma_n/E):
     with MUSEN's default (contacts between bonded spheres) the Hertz contact acts from the
     start; with CONNECTED_PP_CONTACT off it is excluded while the bond lives and acts from
-    the step after the break (MUSEN: from its next contact-list update)."""
+    the next neighbour-list build on (MUSEN: its next contact-list update), here the one
+    LAMMPS makes when the run proper starts, after the start-up evaluation broke the bond.
+    (Mid-run breaks wait for the next build: Example 3, test_musen_shipped_examples.)"""
     plugin_or_skip()
     from tests.granular_models import run
 
@@ -985,6 +987,9 @@ def test_broken_bond_lets_contact_act(tmp_path, bonded_contacts):
     assert frames[0].force[1, 0] == (pytest.approx(hertz, rel=1e-6) if bonded_contacts else 0.0)
     for f in frames[1:]:
         assert f.force[1, 0] == pytest.approx(hertz, rel=1e-6)
+    # the build that lets the pair in is not MUSEN's contact-list update: said once
+    log = (job.script.parent / "log.lammps").read_text()
+    assert ("broken bonds' spheres join the contact pairs" in log) == (not bonded_contacts)
 
 
 # --------------------------------------------------------------------------------------------

@@ -97,6 +97,8 @@ class BondMusenElastic : public Bond {
   int nslots, nvalues_per;                     // K slots of nvalues_per values
   std::vector<int> ipartners, ivalues;         // their custom-property indices (init_style)
   int update_special;        // 1-2 weights not 1: a broken bond's pair must become a contact
+  bigint pairs_waiting;      // broken pairs not yet through a neighbor-list build
+  int warned_build;          // the build-schedule warning was printed
   double max_length0;        // longest L0 seen (equilibrium_distance)
   class FixMusenHistory *history;
   std::string history_id;
@@ -109,6 +111,7 @@ class BondMusenElastic : public Bond {
   void allocate();
   double *init_entry(int i1, int i2, int type);
   void process_breaks();
+  void note_list_build();
   void forget_special(tagint, tagint);
 };
 

@@ -57,3 +57,14 @@ def copy_example(folder: str | Path, dest: Path) -> Path:
         target.parent.mkdir(parents=True, exist_ok=True)
         shutil.copy2(path, target)
     return dest
+
+
+@pytest.fixture(scope="module")
+def plugin_path() -> str:
+    """fibrelmp's compiled LAMMPS styles (the plugin library), else the test is skipped."""
+    from fibrelmp import lammps_styles
+
+    found = lammps_styles.plugin()
+    if not found.available:
+        pytest.skip(f"fibrelmp's LAMMPS styles are not available: {found.how}")
+    return str(found.path)

@@ -10,6 +10,7 @@ from __future__ import annotations
 import shutil
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -104,26 +105,26 @@ def test_the_files_model_named_again_without_parameters_keeps_the_files(tmp_path
                                                                    "MAX_DAMP_RATIO": 1.0}, None)
 
 
-def test_two_bond_models_in_one_script_act_in_script_order(tmp_path):
+def _elastic_then_kelvin_job(tmp_path: Path, max_damp_ratio: str) -> Path:
+    """A script with MODEL_SB Elastic, then Kelvin with this MAX_DAMP_RATIO."""
     shutil.copy(TEXT_SCENE, tmp_path)
     script = tmp_path / "job.txt"
     script.write_text(f"SOURCE_FILE {TEXT_SCENE.name}\nRESULT_FILE ./r.txt\n"
                       "MODEL_PP ModelPPHertzMindlin\nMODEL_SB ModelSBElastic\n"
-                      "MODEL_SB ModelSBKelvin\nMODEL_PARAMS ModelSBKelvin MAX_DAMP_RATIO 0.25\n"
+                      f"MODEL_SB ModelSBKelvin\nMODEL_PARAMS ModelSBKelvin MAX_DAMP_RATIO {max_damp_ratio}\n"
                       "SIMULATION_STEP 1e-8\nEND_TIME 1e-7\n")
-    plan = _model(script).plan
+    return script
+
+
+def test_two_bond_models_in_one_script_act_in_script_order(tmp_path):
+    plan = _model(_elastic_then_kelvin_job(tmp_path, "0.25")).plan
     assert (plan.bond_law.form, plan.bond_breakage) == ("elastic", 1)
     assert [(law.form, law.breakage, law.max_damp_ratio) for law in plan.then_bond_laws] == [
         ("kelvin", 1, 0.25)]
 
 
 def test_a_later_bond_models_bad_parameter_names_its_line(tmp_path):
-    shutil.copy(TEXT_SCENE, tmp_path)
-    script = tmp_path / "job.txt"
-    script.write_text(f"SOURCE_FILE {TEXT_SCENE.name}\nRESULT_FILE ./r.txt\n"
-                      "MODEL_PP ModelPPHertzMindlin\nMODEL_SB ModelSBElastic\n"
-                      "MODEL_SB ModelSBKelvin\nMODEL_PARAMS ModelSBKelvin MAX_DAMP_RATIO -1\n"
-                      "SIMULATION_STEP 1e-8\nEND_TIME 1e-7\n")
+    script = _elastic_then_kelvin_job(tmp_path, "-1")
     with pytest.raises(InputError) as err:
         _model(script)
     assert (err.value.path, err.value.line) == (str(script), 5)

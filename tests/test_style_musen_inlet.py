@@ -15,7 +15,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from fibrelmp import lammps_styles
 from fibrelmp.post.lammps_dump.reader import iter_frames
 from fibrelmp.translate.musen.mdem.generators import next_fraction
 
@@ -23,14 +22,6 @@ from .test_style_musen_wall import _run_lmp_script
 
 LO, HI = np.array([-0.04, -0.04, -0.02]), np.array([0.04, 0.04, 0.02])
 FRACTIONS = [(1, 0.002, 2500.0, 0.3), (2, 0.004, 1000.0, 0.7)]     # type, diameter, density, share
-
-
-@pytest.fixture(scope="module")
-def plugin_path() -> str:
-    found = lammps_styles.plugin()
-    if not found.available:
-        pytest.skip(f"fibrelmp's LAMMPS styles are not available: {found.how}")
-    return str(found.path)
 
 
 PLATE = """musen/wall/mesh 1

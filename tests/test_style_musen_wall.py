@@ -41,14 +41,6 @@ G = 9.81
 NO, FACE, EDGE, VERTEX = 0, 1, 2, 3
 
 
-@pytest.fixture(scope="module")
-def plugin_path() -> str:
-    found = lammps_styles.plugin()
-    if not found.available:
-        pytest.skip(f"fibrelmp's LAMMPS styles are not available: {found.how}")
-    return str(found.path)
-
-
 # =======================================================================================
 # the reference: MUSEN's formulas in numpy / python floats, operation by operation
 def dot(a, b):
@@ -901,20 +893,26 @@ def musen_wall_travel(v: float, t_begin: float, t_end: float, dt: float, end_tim
     return z
 
 
+def _sphere_on_lifting_floor(radius: float, t_end: float):
+    """One sphere above a floor of two triangles ("lift") rising at 0.01 m/s until 0.002 s."""
+    from . import granular_models as gm
+    mats, contacts = gm.two_materials()
+    m = gm.model(gm.spheres([[0.0, 0.0, 0.0006]], radius, [0], mats), mats, contacts, dt=1e-6,
+                 t_end=t_end, save_every_time=0.001, gravity=np.array([0, 0, -G]))
+    floor = np.array([[[-0.004, -0.004, 0.0], [0.004, -0.004, 0.0], [0.004, 0.004, 0.0]],
+                      [[-0.004, -0.004, 0.0], [0.004, 0.004, 0.0], [-0.004, 0.004, 0.0]]])
+    gm.add_geometry(m, "lift", floor, 1, motion=[gm.interval(0.0, 0.002, v=(0, 0, 0.01))])
+    return m
+
+
 def test_kept_velocity_is_reported_and_warned(plugin_path, tmp_path):
     """Through fibrelmp: the frames report MUSEN's kept wall velocity and the translation says
     so; without the plugin the same job names the stock representation."""
     from fibrelmp.pipeline.run_model import run_granular
     from fibrelmp.translate.granular_job import build_granular_job
 
-    from . import granular_models as gm
-    mats, contacts = gm.two_materials()
     Rs = 0.0005
-    m = gm.model(gm.spheres([[0.0, 0.0, 0.0006]], Rs, [0], mats), mats, contacts, dt=1e-6, t_end=0.004,
-                 save_every_time=0.001, gravity=np.array([0, 0, -G]))
-    floor = np.array([[[-0.004, -0.004, 0.0], [0.004, -0.004, 0.0], [0.004, 0.004, 0.0]],
-                      [[-0.004, -0.004, 0.0], [0.004, 0.004, 0.0], [-0.004, 0.004, 0.0]]])
-    gm.add_geometry(m, "lift", floor, 1, motion=[gm.interval(0.0, 0.002, v=(0, 0, 0.01))])
+    m = _sphere_on_lifting_floor(Rs, 0.004)
     previous = lammps_styles.request_stock(False)
     try:
         job, _, _ = build_granular_job(m, tmp_path / "dry")
@@ -973,13 +971,7 @@ def test_time_driven_walls_with_different_start_velocities_are_warned(plugin_pat
     the translation says so."""
     from fibrelmp.translate.granular_job import build_granular_job
 
-    from . import granular_models as gm
-    mats, contacts = gm.two_materials()
-    m = gm.model(gm.spheres([[0.0, 0.0, 0.0006]], 0.0005, [0], mats), mats, contacts, dt=1e-6,
-                 t_end=0.001, save_every_time=0.001, gravity=np.array([0, 0, -G]))
-    floor = np.array([[[-0.004, -0.004, 0.0], [0.004, -0.004, 0.0], [0.004, 0.004, 0.0]],
-                      [[-0.004, -0.004, 0.0], [0.004, 0.004, 0.0], [-0.004, 0.004, 0.0]]])
-    gm.add_geometry(m, "lift", floor, 1, motion=[gm.interval(0.0, 0.002, v=(0, 0, 0.01))])
+    m = _sphere_on_lifting_floor(0.0005, 0.001)
     previous = lammps_styles.request_stock(False)
     try:
         job, _, _ = build_granular_job(m, tmp_path / "same")

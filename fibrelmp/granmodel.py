@@ -281,6 +281,9 @@ class GranularModel(ParticleModel):
     origin: SourceRecord | None = None
     liquid_bonds: list[LiquidBond] = field(default_factory=list)
     models: dict[str, ModelChoice] = field(default_factory=dict)   # kind -> chosen model
+    # further PP and PW models acting on each contact after models[kind], in cmusen's order
+    # (cmusen runs every selected model of a kind in turn; forces add)
+    later_models: list[ModelChoice] = field(default_factory=list)
     # post: the dump's atom ids of the spheres and their sort order (post.to_granular)
     atom_ids: np.ndarray | None = None
     atom_order: np.ndarray | None = None

@@ -648,7 +648,10 @@ def test_restart_round_trip(tmp_path):
     (("pair_coeff 1 1", "pair_coeff 1 1 5e10 2e10 0.9 0.3 -1e-3"), "mu_r must be >= 0"),
     (("pair_coeff 1 1", "pair_coeff 1 1 5e10 2e10 0.9 0.3"), "pair_coeff I J Estar Gstar e mu mu_r"),
     (("comm_modify", "comm_modify vel no"), "comm_modify vel yes"),
-    (("pair_style", "pair_style musen/hm 1.0"), "it takes no arguments"),
+    (("pair_style", "pair_style musen/hm 1.0"), "law hertz/mindlin takes no parameters"),
+    (("pair_style", "pair_style musen/hm then"), "'then' needs a law name"),
+    (("pair_style", "pair_style musen/hm then linear/elastic 1e3"), "linear/elastic needs Kn > 0 and Kt > 0"),
+    (("pair_style", "pair_style musen/hm then nosuch"), "unknown particle-particle law nosuch"),
 ])
 def test_bad_input_is_a_clear_error(change, message):
     plugin = plugin_or_skip()

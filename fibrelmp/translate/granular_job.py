@@ -298,7 +298,7 @@ def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> 
         bond_values=VALUES, geometry_fix=GEOMETRY_FIX, geometry_name=GEOMETRY_NAME,
         bond_criterion=int(plan.bond_breakage),
         bond_law=physics.bond_style_law(plan) if geometry is not None else None,
-        pair_style_lines=parts.pp_model.pair_style_lines(parts.pp_params, parts.musen_hm),
+        pair_style_lines=physics.pair_style_lines(model, parts.musen_hm),
         sphere_types=[spheres.type_of_mat[m] for m in mats],
         sphere_type_names=[model.materials[m].name for m in mats],
         tile_types=[tiles.type_of_mat[m] for m in tile_mats],

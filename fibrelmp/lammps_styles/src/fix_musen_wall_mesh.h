@@ -4,7 +4,9 @@
    FixMusenWallMesh (fix style musen/wall/mesh): MUSEN's particle-wall contact against walls
    made of triangles, moving rigidly by time-dependent motion intervals.
 
-     fix ID group musen/wall/mesh FILE [law NAME [parameters]]   (default law hertz/mindlin)
+     fix ID group musen/wall/mesh FILE [law NAME [parameters]] ...   (default law hertz/mindlin)
+   (several laws act on each contact in the order given, as cmusen runs several PW models:
+   their forces and torques add, each continues the contact's history the previous left)
 
    What it reproduces (MUSEN 1.74.2, github.com/msolids/musen e0ff360; file/function named
    where each part is implemented below):
@@ -156,7 +158,8 @@ class FixMusenWallMesh : public Fix {
     // the wall motion MUSEN's contact law sees now
     double vel[3], rotvel[3], rotcentre[3];
   };
-  std::unique_ptr<musen_pw::Law> pw_law;    // the particle-wall law (musen_pw_law.h)
+  // the particle-wall laws, in the order they act (musen_pw_law.h)
+  std::vector<std::unique_ptr<musen_pw::Law>> pw_laws;
   struct Law {
     bool set;
     double estar, gstar, alpha, mu, mur;

@@ -302,9 +302,8 @@ def wall_commands(model: GranularModel, wall_plans: list[WallPlan], spheres, dt:
     if any(wp.kind == "mesh" for wp in wall_plans):
         wall_cmds.append(LammpsText("# " + comment_text(f"the exact triangles of every wall geometry "
                                                          f"({MESH_NAME}), MUSEN's particle-wall contact")))
-        pw_model, pw_params = physics.chosen(model, "PW")
         wall_cmds.append(f"fix             {MESH_FIX} spheres musen/wall/mesh {MESH_NAME}"
-                         f"{pw_model.mesh_law_args(pw_params)}")
+                         f"{physics.mesh_law_args(model)}")
     for gi, wp in enumerate(wall_plans):
         tag = f"w{gi + 1}"
         if wp.kind == "mesh":

@@ -14,7 +14,7 @@ import numpy as np
 
 from fibrelmp import lammps_styles
 from fibrelmp.errors import InputError
-from fibrelmp.granmodel import GranularModel, ModelChoice
+from fibrelmp.granmodel import GranularModel, GranularPlan, ModelChoice
 from fibrelmp.translate.musen.scene import (INTERACTION_DEFAULTS, _check_material, check_simulable, contact_law,
                     domain_warning)
 from fibrelmp.translate.granular import models as physics
@@ -30,7 +30,7 @@ def _resolve_models(model: GranularModel, job: MusenJob) -> tuple[dict[str, Mode
     file's models as loaded, then ``AddActiveModel`` for each of the job's: a model already
     active keeps its place and takes the job's parameters on top of the file's).  Every
     active model acts (CPUSimulator runs all models of a kind, in turn): the first of each
-    kind, and the later SB models (in order), which act after it (``_one_per_kind``)."""
+    kind, and the later ones (in order), which act after it (``_first_and_later``)."""
     chosen: dict[str, ModelChoice] = dict(model.models)
     active: list[ModelChoice] = []
     by_name: dict[str, int] = {}
@@ -48,27 +48,35 @@ def _resolve_models(model: GranularModel, job: MusenJob) -> tuple[dict[str, Mode
             continue
         by_name[spec.name] = len(active)
         active.append(_model_choice(model, spec, job.path, spec.line))
-    for choice in _one_per_kind(active, model.source):
-        chosen[choice.kind] = choice
-    return chosen, [c for c in active if c.kind == "SB" and c is not chosen.get("SB")]
+    first, later = _first_and_later(active, model.source)
+    chosen.update(first)
+    return chosen, later
 
 
 _ACTS_ON = {"PP": "particle-particle contact", "PW": "particle-wall contact", "SB": "solid bond",
             "LB": "liquid bond", "EF": "particle"}
+# kinds of which fibrelmp runs several models together, as cmusen does (each in turn on every
+# contact or bond: PP and PW forces add, SB laws continue the bond's state)
+SEVERAL_OF_A_KIND = ("PP", "PW", "SB")
 
 
 def _chosen_at(choice: ModelChoice, source) -> str:
     return f"line {choice.line}" if choice.line is not None else f"stored in {Path(source).name}"
 
 
-def _one_per_kind(active: list[ModelChoice], source) -> list[ModelChoice]:
-    """The first active model of each kind.  Several SB models act together (the later ones
-    become the plan's ``then_bond_laws``); two of another kind are refused, named where the
-    second was selected: cmusen adds their forces, which fibrelmp does not simulate."""
+def _first_and_later(active: list[ModelChoice], source) -> tuple[dict[str, ModelChoice],
+                                                                    list[ModelChoice]]:
+    """The first active model of each kind, and the later ones of the kinds that act together
+    (``SEVERAL_OF_A_KIND``), in cmusen's order.  Two of another kind (LB, EF) are refused,
+    named where the second was selected."""
     seen: dict[str, ModelChoice] = {}
+    later: list[ModelChoice] = []
     for choice in active:
         first = seen.setdefault(choice.kind, choice)
-        if first is choice or choice.kind == "SB":
+        if first is choice:
+            continue
+        if choice.kind in SEVERAL_OF_A_KIND:
+            later.append(choice)
             continue
         hint = ("remove one of the two MODEL_ lines" if first.line is not None else
                 "a script cannot drop a file's model: remove it in MUSEN (models tab) and save "
@@ -77,10 +85,30 @@ def _one_per_kind(active: list[ModelChoice], source) -> list[ModelChoice]:
                          f"{choice.name} ({_chosen_at(choice, source)}) and {first.name} "
                          f"({_chosen_at(first, source)}) are both {choice.kind} models: cmusen "
                          f"runs every selected model, both acting on each "
-                         f"{_ACTS_ON.get(choice.kind, 'object')} in turn (forces add); fibrelmp "
-                         f"applies one model of a kind (several only for solid bonds) and does "
-                         f"not simulate that: {hint}")
-    return list(seen.values())
+                         f"{_ACTS_ON.get(choice.kind, 'object')} in turn; fibrelmp runs several "
+                         f"models of a kind only for {', '.join(SEVERAL_OF_A_KIND)} and not two "
+                         f"{physics.KIND_WORDS[choice.kind]} models together: {hint}")
+    return seen, later
+
+
+def _apply_later_contact_models(model: GranularModel, plan) -> None:
+    """The later PP / PW models: checked as each model checks its parameters (at its MODEL_
+    line), only with fibrelmp's LAMMPS styles (pair musen/hm's and fix musen/wall/mesh's law
+    lists), and their contact durations joined to the first's for ``fibrelmp check``."""
+    for kind in ("PP", "PW"):
+        own_plans = []
+        for choice in (c for c in model.later_models if c.kind == kind):
+            styles = lammps_styles.plugin()
+            if not styles.available:
+                raise InputError(choice.source, choice.line, f"{choice.name} after "
+                                 f"{model.models[kind].name}: several {kind} models acting "
+                                 "together need fibrelmp's LAMMPS styles, which are not "
+                                 f"available here ({styles.how})")
+            own = GranularPlan(dt=plan.dt, t_start=plan.t_start, t_end=plan.t_end)
+            physics.find(choice.name).apply(own, choice.parameters, choice.source, choice.line)
+            own_plans.append(own)
+        if own_plans:
+            physics.combine_contact_times(plan, kind, own_plans)
 
 
 def accepted_models(kind: str) -> list[str]:
@@ -158,7 +186,7 @@ def apply_simulator_settings(model: GranularModel, job: MusenJob) -> None:
     if job.reset_bonds:
         reset_bond_lengths(model)
     _apply_motion(model, job)
-    models, later_bond_models = _resolve_models(model, job)
+    models, later = _resolve_models(model, job)
     model.models = models
     _check_models(model, job, models)
     if "PP" in models:                            # the laws stand for the PP model chosen
@@ -169,9 +197,12 @@ def apply_simulator_settings(model: GranularModel, job: MusenJob) -> None:
         physics.find(choice.name).apply(plan, choice.parameters, job.path,
                                         job.where(f"MODEL_{kind}_PARAMS"))
     plan.then_bond_laws = []
-    for choice in later_bond_models:    # in cmusen's order, after the first SB model
-        physics.add_later_bond_law(plan, choice.name, choice.parameters, choice.source,
-                                   choice.line)
+    for choice in later:                # in cmusen's order, after the first of their kind
+        if choice.kind == "SB":
+            physics.add_later_bond_law(plan, choice.name, choice.parameters, choice.source,
+                                       choice.line)
+    model.later_models = [c for c in later if c.kind != "SB"]
+    _apply_later_contact_models(model, plan)
     if job.connected_pp_contact is not None:
         plan.contacts_between_bonded = job.connected_pp_contact
     _refuse_file_settings(model, job)

@@ -256,6 +256,10 @@ class MdemResultWriter(MusenResultWriter):
                 entry.key = mdem_key(choice.name)
                 entry.path = choice.name
                 entry.params = "".join(f"{k} {v:g} " for k, v in choice.parameters.items())
+                for later in (c for c in m.later_models if c.kind == kind):   # act after it
+                    entry = manager.models.add()
+                    entry.key, entry.path = mdem_key(later.name), later.name
+                    entry.params = "".join(f"{k} {v:g} " for k, v in later.parameters.items())
                 if kind == "SB":    # the later SB models, which act after it (cmusen's order)
                     for law in plan.then_bond_laws:
                         entry = manager.models.add()

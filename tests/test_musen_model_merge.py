@@ -9,8 +9,6 @@ models of another kind are refused, never silently reduced to one."""
 from __future__ import annotations
 
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest

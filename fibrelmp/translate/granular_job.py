@@ -205,8 +205,6 @@ class _JobParts:
     bonds: SimulatedBonds
     musen_hm: bool
     pair_lines: list[str]
-    pp_model: type[physics.PhysicsModel]
-    pp_params: dict[str, float]
     sb_model: type[physics.PhysicsModel]
     wall_cmds: list[str]
     var_cmds: list[str]
@@ -245,7 +243,6 @@ def _plan_parts(model: GranularModel) -> _JobParts:
     # style, which is exact for it
     musen_hm = styles.available and model.kind == "musen"
     pair_lines = pair_coeff_lines(model, spheres, tiles.materials, tiles.radius, dt, musen_hm)
-    pp_model, pp_params = physics.chosen(model, "PP")
     sb_model = physics.solid_bond_model(plan)
     wall_cmds, var_cmds, frame_columns = wall_commands(model, wall_plans, spheres, dt)
     if model.plan.inlets and not musen_hm:
@@ -257,7 +254,7 @@ def _plan_parts(model: GranularModel) -> _JobParts:
     geometry = (bond_geometry(model, bonds, spheres.rows, len(spheres.rows) + len(tiles.x))
                 if bonds.exact and len(bonds.rows) else None)
     return _JobParts(run, warnings, dom_lo, dom_hi, spheres, wall_plans, mesh, tiles, ntypes, axes,
-                     styles, bonds, musen_hm, pair_lines, pp_model, pp_params, sb_model, box_cmds + wall_cmds, var_cmds,
+                     styles, bonds, musen_hm, pair_lines, sb_model, box_cmds + wall_cmds, var_cmds,
                      frame_columns, geometry)
 
 

@@ -3,9 +3,11 @@
 collision, its force and moments added; a Hertz-Mindlin-shaped model reads the collision's
 tangential overlap the previous model of the step left and writes its own).  References: the
 real cmusen 1.74.2 on an oblique spinning two-sphere impact under ModelPPHertzMindlin then
-ModelPPLinearElastic, the same the other way round, Hertz-Mindlin named twice (cmusen keeps
-one), and a spinning sphere on a plate under ModelPWHertzMindlin then
-ModelPWSimpleViscoElastic (tests/data/real-outputs/musen/several_models/README.md)."""
+ModelPPLinearElastic, the same the other way round, Hertz-Mindlin named twice in the script
+(cmusen keeps one) and twice in a .mdem's model list (cmusen runs both), Hertz-Mindlin and
+linear elastic twice in a .mdem with a script's MODEL_PARAMS (the first takes them), and a
+spinning sphere on a plate under ModelPWHertzMindlin then ModelPWSimpleViscoElastic
+(tests/data/real-outputs/musen/several_models/README.md)."""
 
 from __future__ import annotations
 
@@ -29,8 +31,11 @@ from .musen_model_checks import (ANGVEL, COORD, VEL, check_refused_without_style
                                  run_cut_and_resumed, styles_or_skip)
 
 DATA = data_path("real-outputs/musen/several_models")
+# each case's source: a text scene, or a .mdem whose model list names a model twice (MUSEN
+# loads both; a job's MODEL_PARAMS go to the first)
 SCENES = {"hm_le": "pp_scene.txt", "le_hm": "pp_scene.txt", "hm_hm": "pp_scene.txt",
-          "pw_hm_sve": "pw_scene.txt"}
+          "pw_hm_sve": "pw_scene.txt", "hm_twice": "hm_twice_init.mdem",
+          "le_twice": "le_twice_init.mdem"}
 # what fibrelmp's LAMMPS script says for each case
 LAMMPS_LINES = {
     "hm_le": "pair_style      musen/hm then linear/elastic 500000.0 400000.0",
@@ -38,7 +43,12 @@ LAMMPS_LINES = {
     "hm_hm": "pair_style      musen/hm\n",   # cmusen keeps one model of a name: musen/hm alone
     "pw_hm_sve": "musen/wall/mesh walls.mesh law hertz/mindlin law simple/viscoelastic "
                  "500000.0 0.02\n",
+    "hm_twice": "pair_style      musen/hm then hertz/mindlin\n",
+    "le_twice": "pair_style      musen/hm then linear/elastic 200000.0 400000.0 then "
+                "linear/elastic 500000.0 400000.0\n",
 }
+# the job of a case with a .mdem source is job 1 (no import)
+JOB_FOLDER = {"hm_twice": "job1", "le_twice": "job1"}
 TOLERANCE = 1e-9    # of each quantity's scale (measured: < 2e-16)
 
 
@@ -69,7 +79,7 @@ def test_several_models_act_as_in_cmusen(tmp_path, case):
     styles_or_skip()
     job = _staged(tmp_path, case)
     python_api.run(job, work=tmp_path / "work")
-    script = (tmp_path / "work" / "job2" / "in.lammps").read_text()
+    script = (tmp_path / "work" / JOB_FOLDER.get(case, "job2") / "in.lammps").read_text()
     assert LAMMPS_LINES[case] in script
     diffs = _scaled_differences(tmp_path / f"{case}_result_prec17.txt",
                                 DATA / f"cmusen_{case}_result_prec17.txt")
@@ -96,7 +106,8 @@ def test_the_references_tell_the_laws_and_their_order_apart():
     def ref(case):
         return DATA / f"cmusen_{case}_result_prec17.txt"
     hm_alone = ref("hm_hm")
-    for a, b in ((ref("hm_le"), hm_alone), (ref("hm_le"), ref("le_hm"))):
+    for a, b in ((ref("hm_le"), hm_alone), (ref("hm_le"), ref("le_hm")),
+                 (ref("hm_twice"), hm_alone), (ref("le_twice"), ref("hm_le"))):
         diffs = _scaled_differences(a, b)
         assert diffs[VEL] > 1e-5 and diffs[ANGVEL] > 1e-5, diffs
     # the wall case: the sphere bounced (velocity reversed) and Hertz-Mindlin's friction
@@ -111,6 +122,10 @@ def test_cmusen_lists_both_models_and_one_of_a_name_given_twice():
     assert ("Particle-particle:                     Hertz-Mindlin\n"
             "Particle-particle:                     Linear Elastic\n") in log
     assert (DATA / "cmusen_hm_hm.log").read_text().count("Particle-particle:") == 1
+    # a .mdem's list is loaded as it is; the script's parameters go to the first of a name
+    assert (DATA / "cmusen_hm_twice.log").read_text().count("Hertz-Mindlin") == 2
+    assert ("Linear Elastic\n\tKn 200000 Kt 400000 \nParticle-particle:                     "
+            "Linear Elastic\n\tKn 500000 Kt 400000") in (DATA / "cmusen_le_twice.log").read_text()
 
 
 def test_the_result_keeps_both_models_in_order(tmp_path):

@@ -35,7 +35,9 @@ def _resolve_models(model: GranularModel, job: MusenJob) -> tuple[dict[str, Mode
     active: list[ModelChoice] = []
     by_name: dict[str, int] = {}
     for spec in scene_record(model).file_models:
-        by_name[spec.name] = len(active)
+        # a file may list a model twice (MUSEN loads both); a job's parameters go to the
+        # first (CModelManager::SetModelParameters)
+        by_name.setdefault(spec.name, len(active))
         active.append(_model_choice(model, spec, model.source, None))
     for spec in job.models:
         if spec.name.startswith(REFUSED_MODEL):    # check's stand-in for a model refused above

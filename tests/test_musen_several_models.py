@@ -163,6 +163,18 @@ def test_refused_without_fibrelmps_styles(tmp_path):
                                  tmp_path / "pw_hm_sve_init.mdem")
 
 
+def test_a_files_model_twice_is_refused_without_fibrelmps_styles(tmp_path):
+    """Hertz-Mindlin alone runs on stock LAMMPS; twice it needs pair musen/hm's law list."""
+    from fibrelmp import lammps_styles
+    job = _staged(tmp_path, "hm_twice")
+    with lammps_styles.stock(True), pytest.raises(InputError) as err:
+        python_api.run(job)
+    assert err.value.line is None and err.value.path.endswith("hm_twice_init.mdem")
+    assert err.value.message.startswith("ModelPPHertzMindlin after ModelPPHertzMindlin: several "
+                                        "PP models acting together need fibrelmp's LAMMPS styles")
+    assert not (tmp_path / "hm_twice_result.mdem").exists()
+
+
 def test_two_models_of_a_kind_fibrelmp_does_not_combine_are_refused_at_the_second():
     from fibrelmp.translate.musen.script_settings import _first_and_later
     script = Path("job.txt")

@@ -35,7 +35,7 @@ DATA = data_path("real-outputs/musen/several_models")
 # loads both; a job's MODEL_PARAMS go to the first)
 SCENES = {"hm_le": "pp_scene.txt", "le_hm": "pp_scene.txt", "hm_hm": "pp_scene.txt",
           "pw_hm_sve": "pw_scene.txt", "hm_twice": "hm_twice_init.mdem",
-          "le_twice": "le_twice_init.mdem"}
+          "le_twice": "le_twice_init.mdem", "pw_twice": "pw_twice_init.mdem"}
 # what fibrelmp's LAMMPS script says for each case
 LAMMPS_LINES = {
     "hm_le": "pair_style      musen/hm then linear/elastic 500000.0 400000.0",
@@ -46,9 +46,10 @@ LAMMPS_LINES = {
     "hm_twice": "pair_style      musen/hm then hertz/mindlin\n",
     "le_twice": "pair_style      musen/hm then linear/elastic 200000.0 400000.0 then "
                 "linear/elastic 500000.0 400000.0\n",
+    "pw_twice": "musen/wall/mesh walls.mesh law hertz/mindlin law hertz/mindlin\n",
 }
 # the job of a case with a .mdem source is job 1 (no import)
-JOB_FOLDER = {"hm_twice": "job1", "le_twice": "job1"}
+JOB_FOLDER = {"hm_twice": "job1", "le_twice": "job1", "pw_twice": "job1"}
 TOLERANCE = 1e-9    # of each quantity's scale (measured: < 2e-16)
 
 
@@ -107,7 +108,8 @@ def test_the_references_tell_the_laws_and_their_order_apart():
         return DATA / f"cmusen_{case}_result_prec17.txt"
     hm_alone = ref("hm_hm")
     for a, b in ((ref("hm_le"), hm_alone), (ref("hm_le"), ref("le_hm")),
-                 (ref("hm_twice"), hm_alone), (ref("le_twice"), ref("hm_le"))):
+                 (ref("hm_twice"), hm_alone), (ref("le_twice"), ref("hm_le")),
+                 (ref("pw_twice"), ref("pw_hm_sve"))):
         diffs = _scaled_differences(a, b)
         assert diffs[VEL] > 1e-5 and diffs[ANGVEL] > 1e-5, diffs
     # the wall case: the sphere bounced (velocity reversed) and Hertz-Mindlin's friction

@@ -74,12 +74,13 @@ template <class Derived> class MindlinShaped : public Law {
  public:
   void force(const Contact &c, const Materials &m, double *xi, Result &r) const override
   {
-    law(c, m, xi, r);
+    calculate_pp(c, m, xi, r);
   }
 
-  // the law itself, inlined where a caller knows the law (pair musen/hm alone)
-  [[gnu::always_inline]] inline void law(const Contact &c, const Materials &m, double *xi,
-                                         Result &r) const
+  // the law itself (MUSEN's CalculatePP), inlined where a caller knows the law (pair
+  // musen/hm alone)
+  [[gnu::always_inline]] inline void calculate_pp(const Contact &c, const Materials &m,
+                                                  double *xi, Result &r) const
   {
     constexpr double TWO_SQRT_5_6 = 1.825741858350553711523232609336;    // _2_SQRT_5_6
     const double *n = c.n, *vt = c.vt;

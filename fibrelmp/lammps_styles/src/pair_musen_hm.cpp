@@ -124,7 +124,7 @@ void PairMusenHM::compute(int eflag, int vflag)
     // MUSEN's default, alone: its law called directly (inlined), not through the list
     const musen_pp::HertzMindlin &law = *only_hertz;
     contacts([&law](const musen_pp::Contact &c, const musen_pp::Materials &m, double *xi,
-                    musen_pp::Result &r) { law.law(c, m, xi, r); });
+                    musen_pp::Result &r) { law.calculate_pp(c, m, xi, r); });
   } else {
     contacts([this](const musen_pp::Contact &c, const musen_pp::Materials &m, double *xi,
                     musen_pp::Result &r) { apply_laws(c, m, xi, r); });

@@ -2,15 +2,24 @@
    fibrelmp's LAMMPS styles; GPL-2.0-or-later like LAMMPS (see ../LICENSE).
 
    bond_style musen/elastic: MUSEN's elastic solid bond (and, with the kelvin keyword, its
-   Kelvin bond) with MUSEN's breakage criteria.  Re-implemented from MUSEN's
-   Models/SolidBonds/BondModelElastic/ModelSBElastic.cpp and
-   Models/SolidBonds/BondModelKelvin/ModelSBKelvin.cpp (CalculateSB, ConsolidatePart);
+   Kelvin bond; with plastic, linear/plastic or creep its elastic-perfectly-plastic, linear
+   plastic or creep bond) with MUSEN's breakage criteria.  Re-implemented from MUSEN's
+   Models/SolidBonds/BondModel{Elastic,Kelvin,ElasticPerfectlyPlastic,LinearPlastic,Creep}/
+   ModelSB*.cpp (CalculateSB, ConsolidatePart);
    MUSEN is BSD-3-Clause, (c) MUSEN Development Team.
 
-     bond_style musen/elastic [breakage 0|1|2] [kelvin MAX_DAMP_RATIO]
-                              [then elastic 0|1|2] [then kelvin 0|1 MAX_DAMP_RATIO] ...
+     bond_style musen/elastic [breakage B] [LAW]  [then elastic B | then kelvin B R |
+                              then plastic B FT FC TY RC | then linear/plastic B KL KU |
+                              then creep B FT FC TY RC A m] ...
                               [geometry PARTNER VALUES K] [breaks FILE]
-     bond_coeff N E G sigma_n tau_s mu [d L0]
+       LAW: kelvin MAX_DAMP_RATIO | plastic FT FC TY RC | linear/plastic KL KU |
+            creep FT FC TY RC A m
+       B: the stress criterion (CONSIDER_BREAKAGE; creep: FRACTURE_BY_STRESS; plastic: 0);
+       FT FC: fracture strains in tension / compression (0: none); TY: tangential yield 0|1;
+       RC: ratio compressive / tensile yield; KL KU: loading / unloading stiffness;
+       A m: creep parameters
+     bond_coeff N E G sigma_n tau_s mu [d L0] [yield Y]
+       Y: the yield strength (MUSEN's material property 15) the plastic and creep laws need
 
    The law is incremental: every bond keeps MUSEN's state (tangential overlap, twisting and
    bending moments, the previous bond vector; see the H_* offsets) in a FixMusenHistory
@@ -71,24 +80,30 @@ class BondMusenElastic : public Bond {
     H_PREVBOND = 9,     // bond vector left - right of the last update (MUSEN PrevBond), 3
     H_DAMPN = 12,       // Kelvin normal damping force of the last update, 3
     H_DAMPT = 15,       // Kelvin tangential damping force of the last update, 3
-    H_DIAMETER = 18,    // the bond's diameter d
-    H_LENGTH0 = 19,     // its initial length L0
-    H_SIZE = 20,
-    H_LAWSTATE = 18     // the per-law part: overlap, moments, prev. bond, damping (offsets 0..17)
+    H_PLASTIC = 18,     // normal plastic strain (MUSEN NormalPlasticStrain)
+    H_NFORCE = 19,      // plastic laws: the normal stress last applied (linear/plastic: force)
+    H_DIAMETER = 20,    // the bond's diameter d
+    H_LENGTH0 = 21,     // its initial length L0
+    H_SIZE = 22,
+    H_LAWSTATE = 20     // the per-law part: offsets 0..19
   };
 
+  // MUSEN's SB models this style runs
+  enum Form { ELASTIC = 0, KELVIN = 1, PLASTIC = 2, LINEAR_PLASTIC = 3, CREEP = 4 };
+  // parameters of the plastic laws (Law::p)
+  enum { P_FT = 0, P_FC, P_TY, P_RC, P_A, P_M, P_KL = 0, P_KU = 1, NPARAM = 6 };
+
   struct Law {
-    int kelvin;              // 1: ModelSBKelvin's damping
-    double max_damp_ratio;   // its MAX_DAMP_RATIO (0: no cap)
-    int breakage;            // the law's CONSIDER_BREAKAGE
+    int form;                // Form
+    double max_damp_ratio;   // Kelvin: its MAX_DAMP_RATIO (0: no cap)
+    int breakage;            // the stress criterion: CONSIDER_BREAKAGE (creep: FRACTURE_BY_STRESS)
+    double p[NPARAM];        // plastic, creep: FT FC TY RC [A m]; linear/plastic: KL KU
   };
 
  protected:
   // per bond type: material constants
-  double *youngs, *shear, *sigma_n, *tau_s, *viscosity, *diam0, *len0;
-  int breakage;              // MUSEN CONSIDER_BREAKAGE: 0 none, 1 sums, 2 each term
-  int kelvin;                // 1: ModelSBKelvin's damping
-  double max_damp_ratio;     // its MAX_DAMP_RATIO (0: no cap)
+  double *youngs, *shear, *sigma_n, *tau_s, *viscosity, *diam0, *len0, *yield;
+  Law first_law;             // the first law (breakage: 0 none, 1 sums, 2 each term)
   std::vector<Law> then_laws;   // laws acting after the first one, in cmusen's order
   std::string partners_name, values_name;    // per-atom geometry slots (empty: coefficients)
   std::string breaks_file;   // "step id1 id2" per broken bond (rank 0 appends)
@@ -108,6 +123,8 @@ class BondMusenElastic : public Bond {
   int entry_size() const { return H_SIZE + H_LAWSTATE * (int) then_laws.size(); }
   bool apply_laws(int i1, int i2, int type, double *h, bool advance, bool fresh, double *total);
   bool any_breakage() const;
+  bool uses_yield() const;
+  int parse_law(const std::string &form, int narg, char **arg, Law &law);
   void allocate();
   double *init_entry(int i1, int i2, int type);
   void process_breaks();

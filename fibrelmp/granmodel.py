@@ -70,7 +70,7 @@ class SolidBondLaw:
     model: str | None = None   # MUSEN's name, e.g. "ModelSBKelvin" (None: no SB model chosen)
     # "elastic" (ModelSBElastic) | "kelvin" (ModelSBKelvin) | "plastic"
     # (ModelSBElasticPerfectlyPlastic) | "linear_plastic" (ModelSBLinearPlastic) | "creep"
-    # (ModelSBCreep)
+    # (ModelSBCreep) | "weakening" (ModelSBWeakening) | "aerogel" (ModelSBAerogel)
     form: str = "elastic"
     max_damp_ratio: float = 1.0   # ModelSBKelvin's MAX_DAMP_RATIO (0: no cap)
     breakage: int = 1          # its stress criterion, CONSIDER_BREAKAGE (a later law's; the
@@ -80,14 +80,15 @@ class SolidBondLaw:
     parameters: dict[str, float] = field(default_factory=dict)
 
     @property
-    def breaks_by_strain(self) -> bool:
-        """The plastic and creep laws always test a fracture strain in tension."""
-        return self.form in ("plastic", "creep")
+    def breaks_anyway(self) -> bool:
+        """Whether the law breaks bonds whatever its stress criterion: the plastic and creep
+        laws test a fracture strain in tension, the aerogel law its force."""
+        return self.form in ("plastic", "creep", "aerogel")
 
     @property
     def needs_yield(self) -> bool:
         """Whether the law uses the bond material's yield strength (property 15)."""
-        return self.form in ("plastic", "creep")
+        return self.form in ("plastic", "creep", "weakening")
 
 
 @dataclass
@@ -236,8 +237,8 @@ class GranularPlan:
 
     def bonds_may_break(self) -> bool:
         """Whether any of the solid bonds' laws has a breakage criterion."""
-        return (int(self.bond_breakage) != 0 or self.bond_law.breaks_by_strain
-                or any(law.breakage or law.breaks_by_strain for law in self.then_bond_laws))
+        return (int(self.bond_breakage) != 0 or self.bond_law.breaks_anyway
+                or any(law.breakage or law.breaks_anyway for law in self.then_bond_laws))
 
     def bond_laws_use(self, form: str) -> bool:
         """Whether any of the solid bonds' laws is ``form`` (SolidBondLaw.form)."""

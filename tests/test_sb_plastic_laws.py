@@ -164,3 +164,116 @@ def test_linear_plastic_normal_law(tmp_path, E):
         assert (np.abs(np.diff(f[:, 0])) > 2 * elastic).any()
         # unloading is along KU from the plastic strain: not the loading line KL strain
         assert np.abs(f[:, 0] - A * kl * strain * E).max() > 0.5 * np.abs(f[:, 0]).max()
+
+
+def weakening(strain: np.ndarray, E: float, Y: float) -> np.ndarray:
+    """ModelSBWeakening with WEAKENING_FACTOR 0, normal stress per step: elastic from the
+    plastic strain; beyond Y the plastic strain becomes the whole strain (no stress)."""
+    eps_p, out = 0.0, []
+    for e in strain:
+        s = (e - eps_p) * E
+        if abs(s) > Y:
+            eps_p, s = e, 0.0
+        out.append(s)
+    return np.array(out)
+
+
+def test_weakening_normal_law(tmp_path):
+    u = stretch_path(300, 0.03 * L0, -0.03 * L0)
+    f, breaks = lammps_forces(tmp_path, "breakage 0 weakening 0 0.1 0",
+                              f"{E_B!r} {G_B!r} {NEVER!r} {NEVER!r} 0.0 {D!r} {L0!r} yield {Y_B!r}", u)
+    stress = weakening(strain_of(u[1:]), E_B, Y_B)
+    np.testing.assert_allclose(f[:, 0], stress * A, rtol=1e-12, atol=1e-12 * Y_B * A)
+    assert (stress == 0).sum() > 3 and np.abs(f[:, 0]).max() <= Y_B * A     # it weakened
+    assert not breaks
+    # its strain test (CONSIDER_BREAKAGE 1): tension above BREAKAGE_STRAIN, compression below
+    # twice it with COMPRESSIVE_BREAK 1
+    (tmp_path / "b").mkdir()
+    _, breaks = lammps_forces(tmp_path / "b", "breakage 1 weakening 1 0.012 0",
+                              f"{E_B!r} {G_B!r} {NEVER!r} {NEVER!r} 0.0 {D!r} {L0!r} yield {Y_B!r}", u)
+    assert breaks == [(int(np.flatnonzero(strain_of(u) > 0.012)[0]), 1, 2)]
+
+
+def aerogel(strain: np.ndarray, p: dict) -> tuple[np.ndarray, list[int]]:
+    """ModelSBAerogel's normal force F / (A E) per step (positive: tension) and the steps
+    where it breaks (force above BREAK_STRAIN_TENS A E while not in a broken state)."""
+    eps_p, state, out, breaks = 0.0, 0, [], []
+    for k, e in enumerate(strain):
+        if state == 0:
+            if e < -abs(p["psc"]):
+                d = e + abs(p["psc"])
+                F = -abs(p["psc"]) + d * p["src"]
+                eps_p = d * (1 - p["src"])
+                if F > 0:
+                    state, F = -1, 0.0
+            elif e > abs(p["pst"]):
+                d = e - abs(p["pst"])
+                F = abs(p["pst"]) + d * p["srt"]
+                eps_p = d * (1 - p["srt"])
+                if F < 0:
+                    state, F = 1, 0.0
+            else:
+                F = e - eps_p
+            if F > abs(p["bst"]):
+                breaks.append(k)
+        elif state < 0:
+            eps_p = min(eps_p, e)
+            F = p["hrc"] * (e - eps_p)
+        else:
+            eps_p = max(eps_p, e)
+            F = p["hrt"] * (e - eps_p)
+        out.append(F)
+    return np.array(out), breaks
+
+
+AEROGEL = dict(psc=0.01, pst=0.005, src=-2.0, srt=-0.5, bst=0.5, hrc=0.1, hrt=0.1)
+
+
+@pytest.mark.parametrize("peak,low", [(0.008, -0.03), (0.03, -0.008)],
+                         ids=["broken-in-compression", "broken-in-tension"])
+def test_aerogel_normal_law(tmp_path, peak, low):
+    u = stretch_path(300, peak * L0, low * L0)
+    words = " ".join(repr(v) for v in AEROGEL.values())
+    f, breaks = lammps_forces(tmp_path, f"breakage 0 aerogel {words}",
+                              f"{E_B!r} {G_B!r} {NEVER!r} {NEVER!r} 0.0 {D!r} {L0!r}", u)
+    force, ref_breaks = aerogel(strain_of(u[1:]), AEROGEL)
+    np.testing.assert_allclose(f[:, 0], force * A * E_B, rtol=1e-9, atol=1e-12 * A * E_B)
+    assert not breaks and not ref_breaks
+    # it softened and reached a broken state: the force came back to zero on that side
+    side = force[np.argmin(u[1:]) if low < -peak else np.argmax(u[1:])]
+    assert abs(side) < abs(AEROGEL["psc"])
+
+
+def test_aerogel_breaks_above_its_force(tmp_path):
+    """Without softening (ratio 1 in tension) the force grows past BREAK_STRAIN_TENS A E."""
+    p = dict(AEROGEL, srt=1.0, bst=0.02)
+    u = stretch_path(300, 0.03 * L0, -0.008 * L0)
+    words = " ".join(repr(v) for v in p.values())
+    _, breaks = lammps_forces(tmp_path, f"breakage 0 aerogel {words}",
+                              f"{E_B!r} {G_B!r} {NEVER!r} {NEVER!r} 0.0 {D!r} {L0!r}", u)
+    _, ref = aerogel(strain_of(u[1:]), p)
+    assert ref and breaks == [(ref[0] + 1, 1, 2)]
+
+
+COEFF = f"1 {E_B!r} {G_B!r} {NEVER!r} {NEVER!r} 0.0 {D!r} {L0!r}"
+
+
+@pytest.mark.parametrize("style,coeff,message", [
+    ("breakage 0 plastic 0.1 0 1 1", COEFF, "need each bond type's yield strength"),
+    ("breakage 1 plastic 0.1 0 1 1 ", COEFF + " yield 1e6", "plastic takes breakage 0..0"),
+    ("breakage 0 then creep 2 0.1 0 1 1 0.2 0.5", COEFF + " yield 1e6",
+     "then creep: breakage must be 0..1"),
+    ("breakage 0 linear/plastic 1e6 0", COEFF, "KUnLoad must not be 0"),
+    ("breakage 0 creep 0.1 0 1 1 0.2", COEFF + " yield 1e6", "creep command: missing argument"),
+    ("breakage 0 then viscous 0", COEFF, "unknown law viscous"),
+    ("breakage 0 plastic 0.1 0 1 1", COEFF + " yield -1", "yield strength must be >= 0"),
+])
+def test_bad_law_settings_are_errors(tmp_path, style, coeff, message):
+    x0 = np.array([[0.0, 0.0, 0.0], [L0, 0.0, 0.0]])
+    write_data(tmp_path / "data.bonds", x0, [4e-4, 4e-4], [(0, 1)])
+    with pytest.raises(Exception, match=message):
+        lmp = Lmp(tmp_path, tmp_path / "data.bonds", f"musen/elastic {style}", coeff, DT)
+        try:
+            lmp.run(0)
+        finally:
+            lmp.close()

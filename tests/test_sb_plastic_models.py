@@ -1,6 +1,6 @@
 """MUSEN's plastic solid bonds (translate/granular/models/sb_elastic_perfectly_plastic.py,
-sb_linear_plastic.py, sb_creep.py; ``bond_style musen/elastic ... plastic | linear/plastic |
-creep``) against the real cmusen: three spheres joined by two bonds of a soft binder, pulled
+sb_linear_plastic.py, sb_creep.py, sb_weakening.py, sb_aerogel.py; ``bond_style musen/elastic
+... plastic | linear/plastic | creep | weakening | aerogel``) against the real cmusen: three spheres joined by two bonds of a soft binder, pulled
 apart with spins and sideways velocities, past yield and back
 (tests/data/real-outputs/musen/models/sb_*/README.md).  Compared at every cmusen time point:
 positions (displacements), velocities, angular velocities, which bonds broke and when.  The
@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from fibrelmp import python_api
-from fibrelmp.errors import InputError
+from fibrelmp.errors import InputError, RunError
 from fibrelmp.translate.musen.scene import read, read_time_points
 
 from .conftest import data_path
@@ -37,7 +37,12 @@ CASES = {
                        "breakage 1 linear/plastic 5000000.0 20000000.0 ", [np.inf, np.inf]),
     "creep": ("sb_creep", "creep", "creep", "ModelSBCreep",
               "breakage 1 creep 0.1 0.0 1.0 0.5 0.2 0.5 ", [np.inf, np.inf]),
+    "weakening": ("sb_weakening", "wk", "wk", "ModelSBWeakening",
+                  "breakage 1 weakening 1.0 0.03 0.0 ", [2.75e-5, np.inf]),
+    "aerogel": ("sb_aerogel", "ag", "ag", "ModelSBAerogel",
+                "breakage 0 aerogel 0.01 0.005 -2.0 -0.5 0.5 0.1 0.1 ", [np.inf, np.inf]),
 }
+SINGLE = ["plastic", "linear-plastic", "creep", "weakening", "aerogel"]    # one model each
 
 
 def _case_folder(tmp_path: Path, case: str, job_text: str | None = None) -> Path:
@@ -92,7 +97,7 @@ def test_matches_cmusen_at_every_saved_time(tmp_path, case):
                                   real_end)
 
 
-@pytest.mark.parametrize("case", ["plastic", "linear-plastic", "creep"])
+@pytest.mark.parametrize("case", SINGLE)
 def test_elastic_bond_is_far_from_cmusen(tmp_path, case):
     """The same scene with MUSEN's elastic bond (what fibrelmp ran before) is off by the
     order of the motion: the comparison above can fail."""
@@ -155,6 +160,18 @@ def test_kunload_zero_is_an_input_error(tmp_path):
     assert str(err.value).startswith(f"{job}:12: ")
 
 
+def test_random_weakening_stops_the_run_where_it_draws(tmp_path):
+    """WEAKENING_FACTOR 0.5: MUSEN multiplies by 0.5 rand()/RAND_MAX once a bond exceeds its
+    yield strength; the run stops there with an error naming the bond and the step (up to
+    then the law is exact)."""
+    styles_or_skip()
+    text = (MODELS / "sb_weakening" / "job_wk.txt").read_text().replace("WEAKENING_FACTOR 0",
+                                                                        "WEAKENING_FACTOR 0.5")
+    with pytest.raises(RunError, match=r"bond 1-2 exceeds its yield strength at step 50, where "
+                       r"MUSEN's weakening bond multiplies by WEAKENING_FACTOR rand\(\)"):
+        python_api.run(_case_folder(tmp_path, "weakening", text), work=tmp_path / "work")
+
+
 def test_missing_yield_strength_is_musens_default(tmp_path):
     """A bond material without a yield strength (property 15) has MUSEN's default, 2e10 Pa
     (DefinesMDB.h _YIELD_DEFAULT), as cmusen gives it."""
@@ -167,7 +184,7 @@ def test_missing_yield_strength_is_musens_default(tmp_path):
     assert " yield 20000000000.0  # Binder" in script
 
 
-@pytest.mark.parametrize("case", ["plastic", "linear-plastic", "creep"])
+@pytest.mark.parametrize("case", SINGLE)
 def test_refused_without_fibrelmps_styles(tmp_path, case):
     _, _, _, model, *_ = CASES[case]
     check_refused_without_styles(_case_folder(tmp_path, case), model, 11,

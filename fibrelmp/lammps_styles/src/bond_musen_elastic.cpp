@@ -122,7 +122,61 @@ struct LawOutput {
   double normal_force_length;
   double normal_scalar;    // the normal force along the unit bond vector (-A E strain elastic)
   double tangential_force_length;
+  bool random_branch;      // weakening: MUSEN would draw rand() here (WEAKENING_FACTOR != 0)
+  bool aerogel_unbroken;   // aerogel: the bond was not in a broken state before this step
 };
+
+/* ModelSBAerogel's normal force F (positive: tension; the vector -n F): elastic up to the
+   plastic strains PSC < 0 < PST, softening beyond them with SRC / SRT (eps_p the excess times
+   1 - SR); where the softened force changes sign the bond is "broken" in compression / tension
+   (H_BROKEN -1 / 1, MUSEN's TangentialPlasticStrain.x) and then only resists further
+   compression / tension with HRC / HRT from its furthest strain; a force above BST A E breaks
+   it (unbroken bonds only). */
+void aerogel_normal_force(const LawInput &in, double *h, bool advance, double strain,
+                          const double *currentContact, double A, double *normalForce,
+                          double &force_out)
+{
+  using B = BondMusenElastic;
+  const double *p = in.law->p;
+  double eps_p = h[B::H_PLASTIC];
+  double broken = h[B::H_BROKEN];
+  const double psc = -fabs(p[B::P_PSC]), pst = fabs(p[B::P_PST]);
+  const double KA = A * in.E;
+  double F = 0.;
+  if (fabs(broken) < 0.5) {
+    if ((strain < 0) && (strain < psc)) {
+      const double delta = (strain - psc);
+      F = psc * KA + delta * p[B::P_SRC] * KA;
+      eps_p = delta * (1 - p[B::P_SRC]);
+      if (F > 0) {
+        broken = -1.;
+        F = 0.;
+      }
+    } else if ((strain > 0) && (strain > pst)) {
+      const double delta = (strain - pst);
+      F = pst * KA + delta * p[B::P_SRT] * KA;
+      eps_p = delta * (1 - p[B::P_SRT]);
+      if (F < 0) {
+        broken = 1.;
+        F = 0.;
+      }
+    } else {
+      F = (strain - eps_p) * KA;
+    }
+  } else if (broken < -0.5) {
+    if (strain < eps_p) eps_p = strain;
+    F = KA * p[B::P_HRC] * (strain - eps_p);
+  } else if (broken > 0.5) {
+    if (strain > eps_p) eps_p = strain;
+    F = KA * p[B::P_HRT] * (strain - eps_p);
+  }
+  if (advance) {
+    h[B::H_PLASTIC] = eps_p;
+    h[B::H_BROKEN] = broken;
+  }
+  for (int k = 0; k < 3; k++) normalForce[k] = -1 * currentContact[k] * F;
+  force_out = F;
+}
 
 /* The normal force of the plastic laws, in their operation order, from the plastic strain
    h[H_PLASTIC]; advance: update that strain as the law does (creep: after the force).
@@ -131,11 +185,30 @@ struct LawOutput {
    loading with KL, unloading with KU (the bond's E, <= 2, is a factor; above 2 elastic). */
 void plastic_normal_force(const LawInput &in, double *h, bool advance, double strain,
                           const double *currentContact, double A, double *normalForce,
-                          double &stress_out)
+                          double &stress_out, bool &random_branch)
 {
   using B = BondMusenElastic;
   const B::Law &law = *in.law;
   double &eps_p = h[B::H_PLASTIC];
+  if (law.form == B::AEROGEL) {
+    aerogel_normal_force(in, h, advance, strain, currentContact, A, normalForce, stress_out);
+    return;
+  }
+  if (law.form == B::WEAKENING) {
+    // ModelSBWeakening: beyond the yield strength eps_p = strain - stress WF rand()/RAND_MAX
+    // / E; with WF = 0 that is exactly eps_p = strain (no stress), else MUSEN's random draw
+    double stress = (strain - eps_p) * in.E;
+    if (fabs(stress) > in.Y) {
+      if (law.p[B::P_WF] != 0.0) random_branch = true;    // refused by the caller
+      const double draw = 0.0;    // WF rand()/RAND_MAX with WF = 0
+      const double e = strain - stress * draw / in.E;
+      if (advance) eps_p = e;
+      stress = (strain - e) * in.E;
+    }
+    for (int k = 0; k < 3; k++) normalForce[k] = currentContact[k] * stress * (-1 * A);
+    stress_out = stress;
+    return;
+  }
   if (law.form == B::LINEAR_PLASTIC) {
     const double KL = law.p[B::P_KL], KU = law.p[B::P_KU];
     double s;
@@ -212,7 +285,7 @@ void musen_law(const LawInput &in, double *h, bool advance, bool fresh, LawOutpu
   using B = BondMusenElastic;
   const int form = in.law->form;
   const bool kelvin = form == B::KELVIN;
-  const bool plastic = form == B::PLASTIC || form == B::LINEAR_PLASTIC || form == B::CREEP;
+  const bool plastic = form != B::ELASTIC && form != B::KELVIN;
   const double d = h[B::H_DIAMETER], L0 = h[B::H_LENGTH0];
   const double A = MUSEN_PI * d * d / 4;                // CrossCut (SimplifiedScene)
   const double I = MUSEN_PI * d * d * d * d / 64;       // AxialMoment
@@ -238,11 +311,14 @@ void musen_law(const LawInput &in, double *h, bool advance, bool fresh, LawOutpu
   double normal_scalar = -1 * A * in.E * strain;
   double normalForce[3];
   double plastic_stress = 0.0;    // plastic, creep: the normal stress after the cap
+  out.random_branch = false;
+  out.aerogel_unbroken = fabs(h[B::H_BROKEN]) < 0.5;
   if (!plastic) {
     scale(currentContact, normal_scalar, normalForce);
   } else {
     if (advance || fresh) {
-      plastic_normal_force(in, h, advance, strain, currentContact, A, normalForce, plastic_stress);
+      plastic_normal_force(in, h, advance, strain, currentContact, A, normalForce, plastic_stress,
+                           out.random_branch);
       h[B::H_NFORCE] = plastic_stress;
     } else {
       // the normal force last applied (its plastic strain has moved on since): the same
@@ -250,10 +326,14 @@ void musen_law(const LawInput &in, double *h, bool advance, bool fresh, LawOutpu
       plastic_stress = h[B::H_NFORCE];
       if (form == B::LINEAR_PLASTIC)
         scale(currentContact, plastic_stress, normalForce);
+      else if (form == B::AEROGEL)
+        for (int k = 0; k < 3; k++) normalForce[k] = -1 * currentContact[k] * plastic_stress;
       else
         for (int k = 0; k < 3; k++) normalForce[k] = currentContact[k] * plastic_stress * (-1 * A);
     }
-    normal_scalar = form == B::LINEAR_PLASTIC ? plastic_stress : -plastic_stress * A;
+    normal_scalar = form == B::LINEAR_PLASTIC ? plastic_stress
+        : form == B::AEROGEL                  ? -plastic_stress
+                                              : -plastic_stress * A;
   }
 
   double *overlap = h + B::H_OVERLAP;
@@ -291,6 +371,15 @@ void musen_law(const LawInput &in, double *h, bool advance, bool fresh, LawOutpu
     scale(tangentialVelocity, in.dt, tmp2);
     sub(tmp, tmp2, overlap);
     if (form == B::PLASTIC || form == B::CREEP) plastic_tangential(in, overlap, L0, plastic_stress);
+    if (form == B::WEAKENING) {
+      // ModelSBWeakening: beyond the yield strength the overlap times WF rand()/RAND_MAX
+      double t[3];
+      for (int k = 0; k < 3; k++) t[k] = overlap[k] * in.G / L0;
+      if (length(t) > in.Y) {
+        if (in.law->p[B::P_WF] != 0.0) out.random_branch = true;
+        for (int k = 0; k < 3; k++) overlap[k] *= 0.0;    // WF rand()/RAND_MAX, WF = 0
+      }
+    }
     scale(overlap, kt, tangentialForce);
 
     if (kelvin) {
@@ -361,14 +450,28 @@ bool musen_breaks(int criterion, const double *h, const LawOutput &out, double s
 
 const char *law_name(int form)
 {
-  static const char *const names[] = {"elastic", "kelvin", "plastic", "linear/plastic", "creep"};
+  static const char *const names[] = {"elastic", "kelvin", "plastic", "linear/plastic", "creep",
+                                      "weakening", "aerogel"};
   return names[form];
+}
+
+// ModelSBAerogel: an unbroken bond whose force exceeds BST A E
+bool aerogel_breaks(const BondMusenElastic::Law &law, const LawOutput &out, double d, double E)
+{
+  using B = BondMusenElastic;
+  if (law.form != B::AEROGEL) return false;
+  const double KA = MUSEN_PI * d * d / 4 * E;
+  // out.normal_scalar = -F; a bond in a broken state (H_BROKEN) has no such test
+  return out.aerogel_unbroken && -out.normal_scalar > (fabs(law.p[B::P_BST]) * KA);
 }
 
 // ModelSBElasticPerfectlyPlastic, ModelSBCreep: the fracture strains (FC 0: none)
 bool strain_breaks(const BondMusenElastic::Law &law, double strain)
 {
   using B = BondMusenElastic;
+  if (law.form == B::WEAKENING)    // ModelSBWeakening: with CONSIDER_BREAKAGE on
+    return law.breakage &&
+        (strain > law.p[B::P_BS] || (law.p[B::P_CB] != 0.0 && strain < -2 * law.p[B::P_BS]));
   if (law.form != B::PLASTIC && law.form != B::CREEP) return false;
   return strain > law.p[B::P_FT] || (law.p[B::P_FC] != 0.0 && strain < -law.p[B::P_FC]);
 }
@@ -380,7 +483,7 @@ bool strain_breaks(const BondMusenElastic::Law &law, double strain)
 BondMusenElastic::BondMusenElastic(LAMMPS *lmp) :
     Bond(lmp), youngs(nullptr), shear(nullptr), sigma_n(nullptr), tau_s(nullptr),
     viscosity(nullptr), diam0(nullptr), len0(nullptr), yield(nullptr),
-    first_law{ELASTIC, 1.0, 1, {0.0, 0.0, 0.0, 0.0, 0.0, 0.0}}, breaks_fp(nullptr), per_atom_geometry(0), nslots(0), nvalues_per(0),
+    first_law{ELASTIC, 1.0, 1, {}}, breaks_fp(nullptr), per_atom_geometry(0), nslots(0), nvalues_per(0),
     update_special(0), pairs_waiting(0), warned_build(0), max_length0(0.0), history(nullptr),
     history_id(HISTORY_ID)
 {
@@ -505,8 +608,15 @@ bool BondMusenElastic::apply_laws(int i1, int i2, int type, double *h, bool adva
     }
     musen_law(in, state, advance, fresh, out);
     if (k < nlaws - 1) std::copy(state, state + H_LAWSTATE, own);
+    if (out.random_branch)
+      error->one(FLERR, "Bond style musen/elastic: bond {}-{} exceeds its yield strength at step "
+                 "{}, where MUSEN's weakening bond multiplies by WEAKENING_FACTOR rand()/RAND_MAX: "
+                 "a random draw fibrelmp cannot reproduce (WEAKENING_FACTOR 0 is exact)",
+                 atom->tag[i1], atom->tag[i2], update->ntimestep);
     if (strain_breaks(law, out.strain) ||
-        musen_breaks(law.breakage, state, out, sigma_n[type], tau_s[type]))
+        aerogel_breaks(law, out, h[H_DIAMETER], in.E) ||
+        musen_breaks(law.form == WEAKENING ? 0 : law.breakage, state, out, sigma_n[type],
+                     tau_s[type]))
       return true;
     for (int c = 0; c < 3; c++) {
       f[i1][c] += out.total[c];
@@ -521,18 +631,24 @@ bool BondMusenElastic::apply_laws(int i1, int i2, int type, double *h, bool adva
 
 bool BondMusenElastic::any_breakage() const
 {
-  // the plastic and creep laws always test their fracture strain in tension
-  if (first_law.breakage || first_law.form == PLASTIC || first_law.form == CREEP) return true;
+  // the plastic and creep laws always test their fracture strain in tension, aerogel its force
+  auto breaks = [](const Law &law) {
+    return law.breakage || law.form == PLASTIC || law.form == CREEP || law.form == AEROGEL;
+  };
+  if (breaks(first_law)) return true;
   for (const Law &law : then_laws)
-    if (law.breakage || law.form == PLASTIC || law.form == CREEP) return true;
+    if (breaks(law)) return true;
   return false;
 }
 
 bool BondMusenElastic::uses_yield() const
 {
-  if (first_law.form == PLASTIC || first_law.form == CREEP) return true;
+  auto needs = [](const Law &law) {
+    return law.form == PLASTIC || law.form == CREEP || law.form == WEAKENING;
+  };
+  if (needs(first_law)) return true;
   for (const Law &law : then_laws)
-    if (law.form == PLASTIC || law.form == CREEP) return true;
+    if (needs(law)) return true;
   return false;
 }
 
@@ -718,12 +834,18 @@ int BondMusenElastic::parse_law(const std::string &form, int narg, char **arg, L
   } else if (form == "creep") {
     law.form = CREEP;
     n = 6;
+  } else if (form == "weakening") {
+    law.form = WEAKENING;
+    n = 3;
+  } else if (form == "aerogel") {
+    law.form = AEROGEL;
+    n = 7;
   } else {
     error->all(FLERR, "Bond style musen/elastic: unknown law {} (known: elastic, kelvin, plastic, "
-                      "linear/plastic, creep)", form);
+                      "linear/plastic, creep, weakening, aerogel)", form);
   }
   if (narg < n) utils::missing_cmd_args(FLERR, "bond_style musen/elastic " + form, error);
-  double v[NPARAM] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+  double v[NPARAM] = {};
   for (int k = 0; k < n; k++) {
     v[k] = utils::numeric(FLERR, arg[k], false, lmp);
     if (!std::isfinite(v[k]))
@@ -749,7 +871,7 @@ int BondMusenElastic::parse_law(const std::string &form, int narg, char **arg, L
 void BondMusenElastic::settings(int narg, char **arg)
 {
   then_laws.clear();    // a repeated bond_style command (e.g. after read_restart) restates them
-  first_law = Law{ELASTIC, 1.0, 1, {0.0, 0.0, 0.0, 0.0, 0.0, 0.0}};
+  first_law = Law{ELASTIC, 1.0, 1, {}};
   int iarg = 0;
   while (iarg < narg) {
     const std::string key = arg[iarg];
@@ -760,14 +882,15 @@ void BondMusenElastic::settings(int narg, char **arg)
         error->all(FLERR, "Bond style musen/elastic: breakage must be 0 (none), 1 (MUSEN's two "
                           "stress sums) or 2 (each stress term alone), got {}", arg[iarg + 1]);
       iarg += 2;
-    } else if (key == "kelvin" || key == "plastic" || key == "linear/plastic" || key == "creep") {
+    } else if (key == "kelvin" || key == "plastic" || key == "linear/plastic" || key == "creep" ||
+               key == "weakening" || key == "aerogel") {
       iarg += 1 + parse_law(key, narg - iarg - 1, arg + iarg + 1, first_law);
     } else if (key == "then") {
       // then FORM BREAKAGE [parameters]: one more law
       if (iarg + 3 > narg) utils::missing_cmd_args(FLERR, "bond_style musen/elastic then", error);
       const std::string form = arg[iarg + 1];
       Law law{ELASTIC, 0.0, utils::inumeric(FLERR, arg[iarg + 2], false, lmp),
-              {0.0, 0.0, 0.0, 0.0, 0.0, 0.0}};
+              {}};
       iarg += 3 + parse_law(form, narg - iarg - 3, arg + iarg + 3, law);
       then_laws.push_back(law);
     } else if (key == "geometry") {
@@ -786,17 +909,20 @@ void BondMusenElastic::settings(int narg, char **arg)
       iarg += 2;
     } else {
       error->all(FLERR, "Bond style musen/elastic: unknown keyword {} (known: breakage, kelvin, "
-                        "plastic, linear/plastic, creep, then, geometry, breaks)", key);
+                        "plastic, linear/plastic, creep, weakening, aerogel, then, geometry, "
+                        "breaks)", key);
     }
   }
-  // the stress criteria each law has (MUSEN: Kelvin, linear plastic, creep one; plastic none)
+  // the stress criteria each law has (MUSEN: Kelvin, linear plastic, creep one, weakening its
+  // strain test; plastic, aerogel none)
+  auto most_of = [](int form) { return form == ELASTIC ? 2 : (form == PLASTIC || form == AEROGEL) ? 0 : 1; };
   for (const Law &law : then_laws) {
-    const int most = law.form == ELASTIC ? 2 : law.form == PLASTIC ? 0 : 1;
+    const int most = most_of(law.form);
     if (law.breakage < 0 || law.breakage > most)
       error->all(FLERR, "Bond style musen/elastic: then {}: breakage must be 0..{}, got {}",
                  law_name(law.form), most, law.breakage);
   }
-  const int most = first_law.form == ELASTIC ? 2 : first_law.form == PLASTIC ? 0 : 1;
+  const int most = most_of(first_law.form);
   if (first_law.breakage > most)
     error->all(FLERR, "Bond style musen/elastic: {} takes breakage 0..{}, got {}",
                law_name(first_law.form), most, first_law.breakage);
@@ -901,8 +1027,8 @@ void BondMusenElastic::init_style()
   if (uses_yield())
     for (int i = 1; i <= atom->nbondtypes; i++)
       if (setflag[i] && !std::isfinite(yield[i]))
-        error->all(FLERR, "Bond style musen/elastic: the plastic and creep laws need each bond "
-                          "type's yield strength (bond_coeff ... yield Y); type {} has none", i);
+        error->all(FLERR, "Bond style musen/elastic: the plastic, creep and weakening laws need "
+                          "each bond type's yield strength (bond_coeff ... yield Y); type {} has none", i);
 
   update_special = (force->special_lj[1] != 1.0 || force->special_coul[1] != 1.0) ? 1 : 0;
 

@@ -3,18 +3,21 @@
 
    bond_style musen/elastic: MUSEN's elastic solid bond (and, with the kelvin keyword, its
    Kelvin bond; with plastic, linear/plastic or creep its elastic-perfectly-plastic, linear
-   plastic or creep bond) with MUSEN's breakage criteria.  Re-implemented from MUSEN's
-   Models/SolidBonds/BondModel{Elastic,Kelvin,ElasticPerfectlyPlastic,LinearPlastic,Creep}/
+   plastic, creep, weakening or aerogel bond) with MUSEN's breakage criteria.  Re-implemented from MUSEN's
+   Models/SolidBonds/BondModel{Elastic,Kelvin,ElasticPerfectlyPlastic,LinearPlastic,Creep,
+   Weakening,Aerogel}/
    ModelSB*.cpp (CalculateSB, ConsolidatePart);
    MUSEN is BSD-3-Clause, (c) MUSEN Development Team.
 
-     bond_style musen/elastic [breakage B] [LAW]  [then elastic B | then kelvin B R |
-                              then plastic B FT FC TY RC | then linear/plastic B KL KU |
-                              then creep B FT FC TY RC A m] ...
+     bond_style musen/elastic [breakage B] [LAW]  [then FORM B PARAMETERS] ...
                               [geometry PARTNER VALUES K] [breaks FILE]
-       LAW: kelvin MAX_DAMP_RATIO | plastic FT FC TY RC | linear/plastic KL KU |
-            creep FT FC TY RC A m
-       B: the stress criterion (CONSIDER_BREAKAGE; creep: FRACTURE_BY_STRESS; plastic: 0);
+       LAW = FORM PARAMETERS: kelvin MAX_DAMP_RATIO | plastic FT FC TY RC |
+            linear/plastic KL KU | creep FT FC TY RC A m | weakening CB BS WF |
+            aerogel PSC PST SRC SRT BST HRC HRT (then elastic B: no parameters)
+       B: the stress criterion (CONSIDER_BREAKAGE; creep: FRACTURE_BY_STRESS; weakening: its
+       CONSIDER_BREAKAGE, which turns its strain test on; plastic, aerogel: 0);
+       weakening: CB compressive break 0|1, BS breakage strain, WF weakening factor (random
+       branch refused unless 0); aerogel: MUSEN's seven parameters in its order;
        FT FC: fracture strains in tension / compression (0: none); TY: tangential yield 0|1;
        RC: ratio compressive / tensile yield; KL KU: loading / unloading stiffness;
        A m: creep parameters
@@ -81,23 +84,30 @@ class BondMusenElastic : public Bond {
     H_DAMPN = 12,       // Kelvin normal damping force of the last update, 3
     H_DAMPT = 15,       // Kelvin tangential damping force of the last update, 3
     H_PLASTIC = 18,     // normal plastic strain (MUSEN NormalPlasticStrain)
-    H_NFORCE = 19,      // plastic laws: the normal stress last applied (linear/plastic: force)
-    H_DIAMETER = 20,    // the bond's diameter d
-    H_LENGTH0 = 21,     // its initial length L0
-    H_SIZE = 22,
-    H_LAWSTATE = 20     // the per-law part: offsets 0..19
+    H_NFORCE = 19,      // plastic laws: the normal stress last applied (linear/plastic,
+                        // aerogel: force)
+    H_BROKEN = 20,      // aerogel: -1 / 1 broken in compression / tension (MUSEN keeps it in
+                        // TangentialPlasticStrain.x)
+    H_DIAMETER = 21,    // the bond's diameter d
+    H_LENGTH0 = 22,     // its initial length L0
+    H_SIZE = 23,
+    H_LAWSTATE = 21     // the per-law part: offsets 0..20
   };
 
   // MUSEN's SB models this style runs
-  enum Form { ELASTIC = 0, KELVIN = 1, PLASTIC = 2, LINEAR_PLASTIC = 3, CREEP = 4 };
+  enum Form { ELASTIC = 0, KELVIN, PLASTIC, LINEAR_PLASTIC, CREEP, WEAKENING, AEROGEL };
   // parameters of the plastic laws (Law::p)
-  enum { P_FT = 0, P_FC, P_TY, P_RC, P_A, P_M, P_KL = 0, P_KU = 1, NPARAM = 6 };
+  enum { P_FT = 0, P_FC, P_TY, P_RC, P_A, P_M };                  // plastic, creep
+  enum { P_KL = 0, P_KU };                                        // linear/plastic
+  enum { P_CB = 0, P_BS, P_WF };                                  // weakening
+  enum { P_PSC = 0, P_PST, P_SRC, P_SRT, P_BST, P_HRC, P_HRT };   // aerogel
+  enum { NPARAM = 7 };
 
   struct Law {
     int form;                // Form
     double max_damp_ratio;   // Kelvin: its MAX_DAMP_RATIO (0: no cap)
     int breakage;            // the stress criterion: CONSIDER_BREAKAGE (creep: FRACTURE_BY_STRESS)
-    double p[NPARAM];        // plastic, creep: FT FC TY RC [A m]; linear/plastic: KL KU
+    double p[NPARAM];        // the law's parameters (P_*)
   };
 
  protected:

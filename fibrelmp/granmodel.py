@@ -70,7 +70,8 @@ class SolidBondLaw:
     model: str | None = None   # MUSEN's name, e.g. "ModelSBKelvin" (None: no SB model chosen)
     # "elastic" (ModelSBElastic) | "kelvin" (ModelSBKelvin) | "plastic"
     # (ModelSBElasticPerfectlyPlastic) | "linear_plastic" (ModelSBLinearPlastic) | "creep"
-    # (ModelSBCreep) | "weakening" (ModelSBWeakening) | "aerogel" (ModelSBAerogel)
+    # (ModelSBCreep) | "weakening" (ModelSBWeakening) | "aerogel" (ModelSBAerogel) | "concrete"
+    # (ModelSBPlasticConcrete)
     form: str = "elastic"
     max_damp_ratio: float = 1.0   # ModelSBKelvin's MAX_DAMP_RATIO (0: no cap)
     breakage: int = 1          # its stress criterion, CONSIDER_BREAKAGE (a later law's; the
@@ -88,7 +89,7 @@ class SolidBondLaw:
     @property
     def needs_yield(self) -> bool:
         """Whether the law uses the bond material's yield strength (property 15)."""
-        return self.form in ("plastic", "creep", "weakening")
+        return self.form in ("plastic", "creep", "weakening", "concrete")
 
 
 @dataclass

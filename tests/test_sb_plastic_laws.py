@@ -255,6 +255,48 @@ def test_aerogel_breaks_above_its_force(tmp_path):
     assert ref and breaks == [(ref[0] + 1, 1, 2)]
 
 
+def concrete(strain: np.ndarray, E: float, Y: float) -> tuple[np.ndarray, list[int]]:
+    """ModelSBPlasticConcrete's normal stress per step and its break steps: tension capped at
+    0.7 Y - 0.3 E eps_p (eps_p += excess 1.3 / E; breaks when the stress is then negative),
+    compression at -Y + 0.5 E eps_p (eps_p += excess 0.5 / E)."""
+    eps_p, out, breaks = 0.0, [], []
+    for k, e in enumerate(strain):
+        s = (e - eps_p) * E
+        if e - eps_p >= 0:
+            limit = 0.7 * Y - eps_p * E * 0.3
+            if s > limit:
+                eps_p += (s - limit) * 1.3 / E
+                s = (e - eps_p) * E
+            if s < 0:
+                breaks.append(k)
+        else:
+            limit = -Y + eps_p * E * 0.5
+            if s < limit:
+                eps_p += (s - limit) * 0.5 / E
+                s = (e - eps_p) * E
+        out.append(s)
+    return np.array(out), breaks
+
+
+def test_plastic_concrete_normal_law(tmp_path):
+    """MUSEN's sign: the force on the left sphere is n sigma A, n pointing from the right
+    sphere to it: a stretched bond pushes the left sphere away (-x)."""
+    u = stretch_path(300, 0.03 * L0, -0.03 * L0)
+    coeff = f"{E_B!r} {G_B!r} {NEVER!r} {NEVER!r} 0.0 {D!r} {L0!r} yield {Y_B!r}"
+    f, breaks = lammps_forces(tmp_path, "breakage 0 concrete", coeff, u)
+    stress, ref = concrete(strain_of(u[1:]), E_B, Y_B)
+    np.testing.assert_allclose(f[:, 0], -stress * A, rtol=1e-9, atol=1e-12 * Y_B * A)
+    # it yields in the first stretch (above 0.7 Y) and in compression (below -Y)
+    strain = strain_of(u[1:])
+    stretch = np.arange(len(strain)) < 90
+    assert np.abs(stress - strain * E_B)[stretch].max() > 0.1 * Y_B
+    assert np.abs(stress - strain * E_B)[strain < -Y_B / E_B].max() > 0.1 * Y_B
+    assert not breaks and ref        # the sign test is off with CONSIDER_BREAKAGE 0
+    (tmp_path / "b").mkdir()
+    _, breaks = lammps_forces(tmp_path / "b", "breakage 1 concrete", coeff, u)
+    assert breaks == [(ref[0] + 1, 1, 2)]
+
+
 COEFF = f"1 {E_B!r} {G_B!r} {NEVER!r} {NEVER!r} 0.0 {D!r} {L0!r}"
 
 

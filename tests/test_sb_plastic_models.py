@@ -1,6 +1,6 @@
 """MUSEN's plastic solid bonds (translate/granular/models/sb_elastic_perfectly_plastic.py,
-sb_linear_plastic.py, sb_creep.py, sb_weakening.py, sb_aerogel.py; ``bond_style musen/elastic
-... plastic | linear/plastic | creep | weakening | aerogel``) against the real cmusen: three spheres joined by two bonds of a soft binder, pulled
+sb_linear_plastic.py, sb_creep.py, sb_weakening.py, sb_aerogel.py, sb_plastic_concrete.py; ``bond_style
+musen/elastic ... plastic | linear/plastic | creep | weakening | aerogel | concrete``) against the real cmusen: three spheres joined by two bonds of a soft binder, pulled
 apart with spins and sideways velocities, past yield and back
 (tests/data/real-outputs/musen/models/sb_*/README.md).  Compared at every cmusen time point:
 positions (displacements), velocities, angular velocities, which bonds broke and when.  The
@@ -41,8 +41,10 @@ CASES = {
                   "breakage 1 weakening 1.0 0.03 0.0 ", [2.75e-5, np.inf]),
     "aerogel": ("sb_aerogel", "ag", "ag", "ModelSBAerogel",
                 "breakage 0 aerogel 0.01 0.005 -2.0 -0.5 0.5 0.1 0.1 ", [np.inf, np.inf]),
+    "plastic-concrete": ("sb_plastic_concrete", "pc", "pc", "ModelSBPlasticConcrete",
+                         "breakage 1 concrete ", [1.08e-5, 1.6e-5]),
 }
-SINGLE = ["plastic", "linear-plastic", "creep", "weakening", "aerogel"]    # one model each
+SINGLE = ["plastic", "linear-plastic", "creep", "weakening", "aerogel", "plastic-concrete"]
 
 
 def _case_folder(tmp_path: Path, case: str, job_text: str | None = None) -> Path:

@@ -124,6 +124,7 @@ struct LawOutput {
   double tangential_force_length;
   bool random_branch;      // weakening: MUSEN would draw rand() here (WEAKENING_FACTOR != 0)
   bool aerogel_unbroken;   // aerogel: the bond was not in a broken state before this step
+  bool concrete_break;     // plastic concrete: a tension-side stress below 0 after yielding
 };
 
 /* ModelSBAerogel's normal force F (positive: tension; the vector -n F): elastic up to the
@@ -178,6 +179,44 @@ void aerogel_normal_force(const LawInput &in, double *h, bool advance, double st
   force_out = F;
 }
 
+/* ModelSBPlasticConcrete's normal force n sigma A (MUSEN's sign: a stretched bond pushes its
+   spheres apart, kept), from the elastic strain strain - eps_p: in tension capped at
+   0.7 Y - 0.3 E eps_p (eps_p growing by the excess times 1.3 / E; the bond breaks, with
+   CONSIDER_BREAKAGE, when the stress is then below 0), in compression at -Y + 0.5 E eps_p
+   (eps_p moving by the excess times 0.5 / E). */
+void concrete_normal_force(const LawInput &in, double *h, bool advance, double strain,
+                           const double *currentContact, double A, double *normalForce,
+                           double &stress_out, bool &breaks)
+{
+  using B = BondMusenElastic;
+  const double compr_yield = -in.Y, tens_yield = 0.7 * in.Y;
+  const double beta = 0.5, alpha = 0.3, Kn = in.E;
+  double eps_p = h[B::H_PLASTIC];
+  double elastic = strain - eps_p;
+  double stress;
+  if (elastic >= 0) {    // tension
+    stress = elastic * in.E;
+    const double limit = tens_yield - eps_p * Kn * alpha;
+    if (stress > limit) {
+      eps_p += (stress - limit) * (1 + alpha) / Kn;
+      elastic = strain - eps_p;
+      stress = elastic * in.E;
+    }
+    if (in.law->breakage && stress < 0) breaks = true;
+  } else {
+    stress = elastic * in.E;
+    const double limit = compr_yield + eps_p * Kn * beta;
+    if (stress < limit) {
+      eps_p += (stress - limit) * (1 - beta) / Kn;
+      elastic = strain - eps_p;
+      stress = elastic * in.E;
+    }
+  }
+  if (advance) h[B::H_PLASTIC] = eps_p;
+  for (int k = 0; k < 3; k++) normalForce[k] = currentContact[k] * stress * A;
+  stress_out = stress;
+}
+
 /* The normal force of the plastic laws, in their operation order, from the plastic strain
    h[H_PLASTIC]; advance: update that strain as the law does (creep: after the force).
    ModelSBElasticPerfectlyPlastic / ModelSBCreep: stress (strain - eps_p) E capped at the
@@ -185,13 +224,18 @@ void aerogel_normal_force(const LawInput &in, double *h, bool advance, double st
    loading with KL, unloading with KU (the bond's E, <= 2, is a factor; above 2 elastic). */
 void plastic_normal_force(const LawInput &in, double *h, bool advance, double strain,
                           const double *currentContact, double A, double *normalForce,
-                          double &stress_out, bool &random_branch)
+                          double &stress_out, bool &random_branch, bool &concrete_break)
 {
   using B = BondMusenElastic;
   const B::Law &law = *in.law;
   double &eps_p = h[B::H_PLASTIC];
   if (law.form == B::AEROGEL) {
     aerogel_normal_force(in, h, advance, strain, currentContact, A, normalForce, stress_out);
+    return;
+  }
+  if (law.form == B::CONCRETE) {
+    concrete_normal_force(in, h, advance, strain, currentContact, A, normalForce, stress_out,
+                          concrete_break);
     return;
   }
   if (law.form == B::WEAKENING) {
@@ -274,6 +318,17 @@ void plastic_tangential(const LawInput &in, double *overlap, double L0, double s
   }
 }
 
+// F_t: overlap G A / L0; ModelSBPlasticConcrete: (overlap - its tangential plastic strain,
+// which only M rotates and so stays 0) G A, without the 1 / L0
+void tangential_force(int form, const double *overlap, double kt, double G, double A,
+                      double *force)
+{
+  if (form == BondMusenElastic::CONCRETE)
+    for (int k = 0; k < 3; k++) force[k] = overlap[k] * G * A;
+  else
+    scale(overlap, kt, force);
+}
+
 /* One evaluation of MUSEN's solid bond on the state h (FixMusenHistory values, H_* layout).
    advance: MUSEN's CalculateSB (rotate and increment the state by one step of dt);
    otherwise the forces of the stored state (tangential overlap, moments, damping; the
@@ -312,13 +367,14 @@ void musen_law(const LawInput &in, double *h, bool advance, bool fresh, LawOutpu
   double normalForce[3];
   double plastic_stress = 0.0;    // plastic, creep: the normal stress after the cap
   out.random_branch = false;
+  out.concrete_break = false;
   out.aerogel_unbroken = fabs(h[B::H_BROKEN]) < 0.5;
   if (!plastic) {
     scale(currentContact, normal_scalar, normalForce);
   } else {
     if (advance || fresh) {
       plastic_normal_force(in, h, advance, strain, currentContact, A, normalForce, plastic_stress,
-                           out.random_branch);
+                           out.random_branch, out.concrete_break);
       h[B::H_NFORCE] = plastic_stress;
     } else {
       // the normal force last applied (its plastic strain has moved on since): the same
@@ -328,11 +384,14 @@ void musen_law(const LawInput &in, double *h, bool advance, bool fresh, LawOutpu
         scale(currentContact, plastic_stress, normalForce);
       else if (form == B::AEROGEL)
         for (int k = 0; k < 3; k++) normalForce[k] = -1 * currentContact[k] * plastic_stress;
+      else if (form == B::CONCRETE)
+        for (int k = 0; k < 3; k++) normalForce[k] = currentContact[k] * plastic_stress * A;
       else
         for (int k = 0; k < 3; k++) normalForce[k] = currentContact[k] * plastic_stress * (-1 * A);
     }
     normal_scalar = form == B::LINEAR_PLASTIC ? plastic_stress
         : form == B::AEROGEL                  ? -plastic_stress
+        : form == B::CONCRETE                 ? plastic_stress * A
                                               : -plastic_stress * A;
   }
 
@@ -380,7 +439,7 @@ void musen_law(const LawInput &in, double *h, bool advance, bool fresh, LawOutpu
         for (int k = 0; k < 3; k++) overlap[k] *= 0.0;    // WF rand()/RAND_MAX, WF = 0
       }
     }
-    scale(overlap, kt, tangentialForce);
+    tangential_force(form, overlap, kt, in.G, A, tangentialForce);
 
     if (kelvin) {
       const double ol = length(overlap);
@@ -389,14 +448,20 @@ void musen_law(const LawInput &in, double *h, bool advance, bool fresh, LawOutpu
     }
 
     matvec(M, nmoment, tmp);
-    scale(normalAngleVel, in.dt * 2 * I * in.G / L0, tmp2);
+    if (form == B::CONCRETE)    // ModelSBPlasticConcrete: (w_n (dt 2 I G)) / L0
+      for (int k = 0; k < 3; k++) tmp2[k] = normalAngleVel[k] * (in.dt * 2 * I * in.G) / L0;
+    else
+      scale(normalAngleVel, in.dt * 2 * I * in.G / L0, tmp2);
     sub(tmp, tmp2, nmoment);
     matvec(M, tmoment, tmp);
-    scale(tangAngleVel, in.dt * in.E * I / L0, tmp2);
+    if (form == B::CONCRETE)
+      for (int k = 0; k < 3; k++) tmp2[k] = tangAngleVel[k] * (in.dt * in.E * I) / L0;
+    else
+      scale(tangAngleVel, in.dt * in.E * I / L0, tmp2);
     sub(tmp, tmp2, tmoment);
     for (int k = 0; k < 3; k++) h[B::H_PREVBOND + k] = currentBond[k];
   } else {
-    scale(overlap, kt, tangentialForce);
+    tangential_force(form, overlap, kt, in.G, A, tangentialForce);
     if (kelvin && fresh) {
       for (int k = 0; k < 3; k++) dampn[k] = normalVelocity[k] * -in.mu * A * in.E * fabs(strain);
       cap_damping(dampn, length(normalForce), in.law->max_damp_ratio);
@@ -451,7 +516,7 @@ bool musen_breaks(int criterion, const double *h, const LawOutput &out, double s
 const char *law_name(int form)
 {
   static const char *const names[] = {"elastic", "kelvin", "plastic", "linear/plastic", "creep",
-                                      "weakening", "aerogel"};
+                                      "weakening", "aerogel", "concrete"};
   return names[form];
 }
 
@@ -613,9 +678,10 @@ bool BondMusenElastic::apply_laws(int i1, int i2, int type, double *h, bool adva
                  "{}, where MUSEN's weakening bond multiplies by WEAKENING_FACTOR rand()/RAND_MAX: "
                  "a random draw fibrelmp cannot reproduce (WEAKENING_FACTOR 0 is exact)",
                  atom->tag[i1], atom->tag[i2], update->ntimestep);
-    if (strain_breaks(law, out.strain) ||
+    if (out.concrete_break || strain_breaks(law, out.strain) ||
         aerogel_breaks(law, out, h[H_DIAMETER], in.E) ||
-        musen_breaks(law.form == WEAKENING ? 0 : law.breakage, state, out, sigma_n[type],
+        musen_breaks(law.form == WEAKENING || law.form == CONCRETE ? 0 : law.breakage, state,
+                     out, sigma_n[type],
                      tau_s[type]))
       return true;
     for (int c = 0; c < 3; c++) {
@@ -644,7 +710,8 @@ bool BondMusenElastic::any_breakage() const
 bool BondMusenElastic::uses_yield() const
 {
   auto needs = [](const Law &law) {
-    return law.form == PLASTIC || law.form == CREEP || law.form == WEAKENING;
+    return law.form == PLASTIC || law.form == CREEP || law.form == WEAKENING ||
+        law.form == CONCRETE;
   };
   if (needs(first_law)) return true;
   for (const Law &law : then_laws)
@@ -840,9 +907,11 @@ int BondMusenElastic::parse_law(const std::string &form, int narg, char **arg, L
   } else if (form == "aerogel") {
     law.form = AEROGEL;
     n = 7;
+  } else if (form == "concrete") {
+    law.form = CONCRETE;
   } else {
     error->all(FLERR, "Bond style musen/elastic: unknown law {} (known: elastic, kelvin, plastic, "
-                      "linear/plastic, creep, weakening, aerogel)", form);
+                      "linear/plastic, creep, weakening, aerogel, concrete)", form);
   }
   if (narg < n) utils::missing_cmd_args(FLERR, "bond_style musen/elastic " + form, error);
   double v[NPARAM] = {};
@@ -883,7 +952,7 @@ void BondMusenElastic::settings(int narg, char **arg)
                           "stress sums) or 2 (each stress term alone), got {}", arg[iarg + 1]);
       iarg += 2;
     } else if (key == "kelvin" || key == "plastic" || key == "linear/plastic" || key == "creep" ||
-               key == "weakening" || key == "aerogel") {
+               key == "weakening" || key == "aerogel" || key == "concrete") {
       iarg += 1 + parse_law(key, narg - iarg - 1, arg + iarg + 1, first_law);
     } else if (key == "then") {
       // then FORM BREAKAGE [parameters]: one more law
@@ -909,8 +978,8 @@ void BondMusenElastic::settings(int narg, char **arg)
       iarg += 2;
     } else {
       error->all(FLERR, "Bond style musen/elastic: unknown keyword {} (known: breakage, kelvin, "
-                        "plastic, linear/plastic, creep, weakening, aerogel, then, geometry, "
-                        "breaks)", key);
+                        "plastic, linear/plastic, creep, weakening, aerogel, concrete, then, "
+                        "geometry, breaks)", key);
     }
   }
   // the stress criteria each law has (MUSEN: Kelvin, linear plastic, creep one, weakening its
@@ -1027,8 +1096,8 @@ void BondMusenElastic::init_style()
   if (uses_yield())
     for (int i = 1; i <= atom->nbondtypes; i++)
       if (setflag[i] && !std::isfinite(yield[i]))
-        error->all(FLERR, "Bond style musen/elastic: the plastic, creep and weakening laws need "
-                          "each bond type's yield strength (bond_coeff ... yield Y); type {} has none", i);
+        error->all(FLERR, "Bond style musen/elastic: the plastic, creep, weakening and concrete "
+                          "laws need each bond type's yield strength (bond_coeff ... yield Y); type {} has none", i);
 
   update_special = (force->special_lj[1] != 1.0 || force->special_coul[1] != 1.0) ? 1 : 0;
 

@@ -3,9 +3,9 @@
 
    bond_style musen/elastic: MUSEN's elastic solid bond (and, with the kelvin keyword, its
    Kelvin bond; with plastic, linear/plastic or creep its elastic-perfectly-plastic, linear
-   plastic, creep, weakening or aerogel bond) with MUSEN's breakage criteria.  Re-implemented from MUSEN's
+   plastic, creep, weakening, aerogel or plastic concrete bond) with MUSEN's breakage criteria.  Re-implemented from MUSEN's
    Models/SolidBonds/BondModel{Elastic,Kelvin,ElasticPerfectlyPlastic,LinearPlastic,Creep,
-   Weakening,Aerogel}/
+   Weakening,Aerogel,PlasticConcrete}/
    ModelSB*.cpp (CalculateSB, ConsolidatePart);
    MUSEN is BSD-3-Clause, (c) MUSEN Development Team.
 
@@ -13,9 +13,11 @@
                               [geometry PARTNER VALUES K] [breaks FILE]
        LAW = FORM PARAMETERS: kelvin MAX_DAMP_RATIO | plastic FT FC TY RC |
             linear/plastic KL KU | creep FT FC TY RC A m | weakening CB BS WF |
-            aerogel PSC PST SRC SRT BST HRC HRT (then elastic B: no parameters)
+            aerogel PSC PST SRC SRT BST HRC HRT | concrete (then elastic B, then concrete B:
+            no parameters)
        B: the stress criterion (CONSIDER_BREAKAGE; creep: FRACTURE_BY_STRESS; weakening: its
-       CONSIDER_BREAKAGE, which turns its strain test on; plastic, aerogel: 0);
+       CONSIDER_BREAKAGE, which turns its strain test on; concrete: its CONSIDER_BREAKAGE,
+       the tension-side sign test; plastic, aerogel: 0);
        weakening: CB compressive break 0|1, BS breakage strain, WF weakening factor (random
        branch refused unless 0); aerogel: MUSEN's seven parameters in its order;
        FT FC: fracture strains in tension / compression (0: none); TY: tangential yield 0|1;
@@ -95,7 +97,7 @@ class BondMusenElastic : public Bond {
   };
 
   // MUSEN's SB models this style runs
-  enum Form { ELASTIC = 0, KELVIN, PLASTIC, LINEAR_PLASTIC, CREEP, WEAKENING, AEROGEL };
+  enum Form { ELASTIC = 0, KELVIN, PLASTIC, LINEAR_PLASTIC, CREEP, WEAKENING, AEROGEL, CONCRETE };
   // parameters of the plastic laws (Law::p)
   enum { P_FT = 0, P_FC, P_TY, P_RC, P_A, P_M };                  // plastic, creep
   enum { P_KL = 0, P_KU };                                        // linear/plastic

@@ -21,6 +21,7 @@ from fibrelmp.post.lammps_dump.reader import iter_frames
 from fibrelmp.translate.granular_job import GranularJob
 from fibrelmp.translate.granular.geometry import nearest_triangle
 from fibrelmp.translate.granular.musen_clock import MusenClock
+from fibrelmp.translate.granular.schedule import UNKNOWN_STEP
 
 
 class _BreakLog:
@@ -75,6 +76,7 @@ class FrameBuilder:
         self.prev_v = np.asarray(sp.velocity, float).copy()
         # the time of a step: MUSEN's summed clock (read forwards) or t_start + step dt
         self.frame_clock, self.break_clock = _clock(job), _clock(job)
+        self.variable_clock = None     # variable time step: fix musen/leapfrog's line per frame
         self.inlet_clock = _clock(job)
         self.deletion_time: dict[int, float] = {}
         deletion_clock = _clock(job)
@@ -127,9 +129,16 @@ class FrameBuilder:
         return words[:3] == ["write_dump", "spheres", "custom"]
 
     def read(self, step: int) -> GranularFrame:
+        """The next frame, saved at ``step`` (UNKNOWN_STEP: a variable time step's, whose step
+        and time fix musen/leapfrog wrote to ``job.variable_clock``)."""
         job = self.job
-        t = self.frame_clock(step)
         f = next(self.frames, None)
+        if step == UNKNOWN_STEP:
+            if f is None:
+                raise wrong_frame(job.frames, -1, None)
+            step, t = f.step, self._variable_time(f.step)
+        else:
+            t = self.frame_clock(step)
         if f is None or f.step != step:
             raise wrong_frame(job.frames, step, None if f is None else f.step)
         c = f.columns
@@ -174,6 +183,17 @@ class FrameBuilder:
             self._triangles(frame, t, c)
         self.prev_t, self.prev_x[rows], self.prev_v[rows] = t, pos, vel
         return frame
+
+    def _variable_time(self, step: int) -> float:
+        """MUSEN's summed time of the frame at ``step`` (the clock file's next line)."""
+        path = self.job.variable_clock
+        if self.variable_clock is None:
+            self.variable_clock = open(path, encoding="ascii")
+        line = self.variable_clock.readline().split()
+        if len(line) != 3 or int(line[0]) != step:
+            raise RunError(f"{path}: expected the time of the frame at step {step}, found "
+                           f"{' '.join(line) or 'nothing'}")
+        return float(line[1])
 
     def _generated(self, rows: np.ndarray, c: dict) -> None:
         """Spheres fix musen/inlet made since the last frame fill their reserved rows:
@@ -313,6 +333,8 @@ class FrameBuilder:
 
     def close(self) -> None:
         self.breaks.close()
+        if self.variable_clock is not None:
+            self.variable_clock.close()
         for dump in (self.frames, self.bonds, self.tiles, self.mesh):
             if dump is not None:
                 dump.close()

@@ -154,8 +154,8 @@ def simulate(request: RunRequest, options: RunOptions, rank: int = 0, size: int 
     tally = getattr(source, "tally", None)
     summary = record.summary(rendered, time.monotonic() - started, request.model.warnings,
                              tally() if tally is not None else None)
-    if schedule.stopped:          # the frames written, not the scheduled ones
-        summary["frames"] = schedule.given
+    if schedule.stopped or summary.get("frames") is None:   # the frames written (a stop, a
+        summary["frames"] = schedule.given                   # variable step): not scheduled
     write_summary(rendered.folder, summary)
     if size > 1:
         mpi_barrier()
@@ -227,7 +227,7 @@ def _scheduled(tokens: Iterator[Any], source, schedule: Iterator[int], rendered:
         else:
             yield source.read(step)
     missing = next(schedule, None)
-    if missing is not None:
+    if missing is not None and missing >= 0:     # (a variable step's open schedule: none missing)
         raise RunError(f"{rendered.script}: the run ended without the frame of step {missing} "
                        f"({_count(rendered.schedule)} were scheduled)")
 

@@ -65,6 +65,11 @@ def _musen_run_time(model: GranularModel, dim: int, dt: float, t_start: float) -
     t_end = float(plan.t_end)
     if not t_end > t_start:            # nothing to simulate: the scene as it is
         return RunTime(dim, dt, 0, t_start, t_start)
+    if plan.variable_step is not None:
+        # MUSEN's variable step: the steps, saves and end come from fix musen/leapfrog during
+        # the run; the steps at SIMULATION_STEP (the largest) are the progress bar's estimate
+        total = max(1, math.ceil((t_end - t_start) / dt))
+        return RunTime(dim, dt, total, t_start, t_end, VariableSaves(total))
     total, saves, exact = musen_run(t_start, dt, t_end, every, MAX_IRREGULAR_SAVES)
     if not exact:
         model.warnings.append(("musen-save-drift", "over this long run cmusen's summed clock "
@@ -80,6 +85,63 @@ def _musen_run_time(model: GranularModel, dim: int, dt: float, t_start: float) -
     clock = MusenClock(t_start, dt)
     end = clock.time(total) if exact else t_start + total * dt     # (not summed: too long)
     return RunTime(dim, dt, total, t_start, end, steps, clock)
+
+
+def variable_step_refusals(model: GranularModel, integrator: bool, deletions: bool = False) -> str | None:
+    """Why fibrelmp cannot run ``model`` with MUSEN's variable time step (None: it can).  It
+    needs fibrelmp's integrator (fix musen/leapfrog: ``integrator``), and no event at a step
+    fixed in advance (activity ends, ``deletions``; inlets) or whose time needs the time of
+    every step (breakable bonds and the stop criterion counting them)."""
+    plan = model.plan
+    bonds = model.bonds is not None and model.bonds.count > 0
+    refused = []
+    if not integrator:
+        refused.append("it needs fibrelmp's LAMMPS styles (fix musen/leapfrog)")
+    if deletions:
+        refused.append("spheres whose activity ends during the run are not supported with it")
+    if plan.inlets:
+        refused.append("dynamic generators (inlets) are not supported with it")
+    if plan.stop_broken_bonds is not None and bonds:
+        refused.append("a stop criterion (BROKEN_BONDS) is not supported with it")
+    if bonds and plan.bonds_may_break():
+        refused.append("breakable bonds are not supported with it (a break's time needs the "
+                       "time of its step)")
+    return "MUSEN's variable time step: " + "; ".join(refused) if refused else None
+
+
+UNKNOWN_STEP = -1          # a frame whose step the run decides (variable time step)
+
+
+class VariableSaves:
+    """The frames of a variable time step: their steps are known once the run makes them (fix
+    musen/leapfrog stops the run where MUSEN saves), so the schedule gives UNKNOWN_STEP per frame
+    and has no length."""
+
+    period = None
+    explicit = None
+
+    def __init__(self, estimate: int):
+        self.total = estimate          # steps at the largest step: the progress estimate
+
+    def __iter__(self):
+        while True:
+            yield UNKNOWN_STEP
+
+    def __contains__(self, step: int) -> bool:
+        return False
+
+
+VARIABLE_LOOP, VARIABLE_DONE = "fl_vardt", "fl_vardt_done"
+RUN_CHUNK = 2 ** 31 - 1     # LAMMPS's largest run N: fix musen/leapfrog stops it much earlier
+
+
+def variable_schedule() -> list[tuple]:
+    """Actions of a variable-step script: MUSEN's start (first frame, prediction), then runs
+    that fix musen/leapfrog stops after each step where MUSEN saves, a frame after each, until
+    the step reaching END_TIME, whose frame is the last (a loop of LAMMPS: `lmp -in` replays it)."""
+    return [("run0",), ("frame", 0), ("predict",),
+            ("loop", VARIABLE_LOOP, RUN_CHUNK), ("run", RUN_CHUNK, False), ("vardt_check", VARIABLE_DONE),
+            ("frame", None), ("end", VARIABLE_LOOP), ("label", VARIABLE_DONE), ("frame", None)]
 
 
 def schedule(total: int, saves: SaveSteps, deletions: list[tuple[int, np.ndarray]],

@@ -120,6 +120,9 @@ def test_fibrelmp_saves_cmusens_time_points(tmp_path):
     theirs = read_time_points(DATA / "cmusen_vardt_result_prec17.txt")
     assert len(ours.times) == 31 and np.array_equal(ours.times, theirs.times)
     _same_states(ours, theirs)
+    summary = json.loads((tmp_path / "work" / "job2" / "summary.json").read_text())
+    assert summary["frames"] == 31 and summary["time"]["end"] == theirs.times[-1]
+    assert summary["steps"]["total"] == 997       # the every-step reference's steps
 
 
 def test_fibrelmp_makes_cmusens_steps(tmp_path):
@@ -306,3 +309,55 @@ def test_references_are_cmusens_output(tmp_path: Path, job: str, export: str, st
     if stored.endswith(".gz"):
         reference = gzip.decompress(reference)
     assert (tmp_path / export).read_bytes() == reference
+
+
+def _falling_sphere(tmp_path: Path, move: float, saving: float):
+    """One glass sphere in free space under gravity, integrated by fix musen/leapfrog variable
+    (STEP 1e-6 s, FACTOR 1.05, END 1 s)."""
+    from fibrelmp._lammps import new_lammps
+
+    lmp = new_lammps(["-log", "none", "-screen", "none", "-nocite"])
+    for command in (f"plugin load {lammps_styles.plugin().path}", "units si", "atom_style sphere",
+                    "region box block -1 1 -1 1 -1 1", "create_box 1 box",
+                    "create_atoms 1 single 0 0 0", "set atom 1 diameter 0.002 density 2500",
+                    "pair_style zero 0.01", "pair_coeff * *", "timestep 1e-6",
+                    "fix grav all gravity 9.81 vector 0 0 -1", "thermo_style custom step time",
+                    f"fix fl all musen/leapfrog variable {move!r} 1.05 1e-6 {saving!r} 1.0",
+                    "run 0 post no"):
+        lmp.command(command)
+    return lmp
+
+
+def test_rule_on_a_falling_sphere(tmp_path):
+    """The fix's steps follow MUSEN's rule computed here with numpy (F = m g: dt_max =
+    sqrt(MOVE sqrt(m^2/|F|^2)) = 3.19e-8 s; the step drops to it, then grows by 1.05 above it
+    and drops back), and its time is their running sum; saving at every step, each run stops
+    after one step."""
+    styles_or_skip()
+    move = 1e-14
+    lmp = _falling_sphere(tmp_path, move, 1e-12)
+    mass = float(lmp.extract_atom("rmass")[0])
+    force = mass * -9.81
+    dt_max = np.sqrt(np.sqrt(mass ** 2 / force ** 2) * move)
+    dt, t = 1e-6, 0.0
+    clock = tmp_path / "clock.txt"
+    for step in range(1, 9):
+        dt = dt_max if dt > dt_max else min(dt * 1.05, 1e-6)
+        t += dt
+        lmp.command("run 1000 pre no post no")
+        assert lmp.extract_global("ntimestep") == step          # stopped after one step
+        assert lmp.extract_global("dt") == dt and lmp.extract_fix("fl", 0, 1, 0) == t
+        lmp.command(f"fix_modify fl write {clock} append yes")
+    steps = [float(line.split()[2]) for line in clock.read_text().splitlines()]
+    assert steps[0] == dt_max and steps[1] == dt_max * 1.05 and steps[2] == dt_max
+    lmp.close()
+
+
+def test_a_run_ending_before_a_save_is_an_error(tmp_path):
+    """A run of N steps must end where MUSEN saves or ends (the job's runs are 2^31 - 1
+    steps): one that ran out first would write a frame at a time MUSEN does not save."""
+    styles_or_skip()
+    lmp = _falling_sphere(tmp_path, 1e-10, 0.5)
+    with pytest.raises(Exception, match="ended before MUSEN's next save"):
+        lmp.command("run 5 pre no post no")
+    lmp.close()

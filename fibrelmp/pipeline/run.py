@@ -226,8 +226,9 @@ def _scheduled(tokens: Iterator[Any], source, schedule: Iterator[int], rendered:
             yield frame
         else:
             yield source.read(step)
-    missing = next(schedule, None)
-    if missing is not None and missing >= 0:     # (a variable step's open schedule: none missing)
+    # (a _FrameSteps knows a variable step's open schedule, whose frames are never missing)
+    missing = schedule.missing() if isinstance(schedule, _FrameSteps) else next(schedule, None)
+    if missing is not None:
         raise RunError(f"{rendered.script}: the run ended without the frame of step {missing} "
                        f"({_count(rendered.schedule)} were scheduled)")
 
@@ -250,6 +251,12 @@ class _FrameSteps:
 
     def stop(self) -> None:
         self._steps, self.stopped = iter([self._last + 1]), True
+
+    def missing(self) -> int | None:
+        """The step of a scheduled frame the run did not write, else None (a variable time
+        step's open schedule, whose steps are negative, misses none)."""
+        step = next(self._steps, None)
+        return step if step is not None and step >= 0 else None
 
 
 def _count(schedule) -> str:

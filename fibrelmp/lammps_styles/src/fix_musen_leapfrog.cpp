@@ -249,7 +249,12 @@ void FixMusenLeapfrog::end_of_step()
 
 void FixMusenLeapfrog::post_run()
 {
-  if (variable) timer->reset_timeout();    // later runs go on (fix halt's "continue")
+  if (!variable) return;
+  timer->reset_timeout();    // later runs go on (fix halt's "continue")
+  // a run of steps always ends where MUSEN saves or ends; else its N steps ran out first
+  if (update->nsteps > 0 && stopped_for == 0)
+    error->all(FLERR, "Fix musen/leapfrog: the run's {} steps ended before MUSEN's next save "
+               "(time {:.17g}): its frame would be at a time MUSEN does not save", update->nsteps, t_now);
 }
 
 double FixMusenLeapfrog::compute_vector(int n)

@@ -123,6 +123,15 @@ def test_fibrelmp_saves_cmusens_time_points(tmp_path):
     summary = json.loads((tmp_path / "work" / "job2" / "summary.json").read_text())
     assert summary["frames"] == 31 and summary["time"]["end"] == theirs.times[-1]
     assert summary["steps"]["total"] == 997       # the every-step reference's steps
+    # fibrelmp post of the work folder's dump takes the times from the fix's clock (the dump's
+    # ITEM: TIME has 16 digits)
+    job = tmp_path / "work" / "job2"
+    posted = tmp_path / "posted.txt"
+    done = subprocess.run([sys.executable, "-m", "fibrelmp.cli", "-q", "post", str(job / "frames.dump"),
+                           "--to", "musen", "-o", str(posted), "--data", str(job / "data.lammps"),
+                           "--precision", "17"], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert np.array_equal(read_time_points(posted).times, theirs.times)
 
 
 def test_fibrelmp_makes_cmusens_steps(tmp_path):

@@ -42,7 +42,7 @@ from fibrelmp.translate.granular.walls import (WallPlan, describe_walls, plan_wa
                                                wall_warnings)
 from fibrelmp.translate.lammps_format import float_text
 from fibrelmp.translate.steps import SaveSteps
-from fibrelmp.translate.work_facts import WorkFacts, write_facts
+from fibrelmp.translate.work_facts import VARIABLE_CLOCK, WorkFacts, write_facts
 
 __all__ = ["BONDS_NAME", "BREAKS_NAME", "CONTACTS_NAME", "DATA_NAME", "FRAMES_NAME", "SCRIPT_NAME", "TILES_NAME",
            "GranularJob", "WallPlan", "build_granular_job", "describe_walls", "law_args", "plan_walls",
@@ -55,7 +55,7 @@ BONDS_NAME = "bonds.dump"
 TILES_NAME = "walls.dump"
 BREAKS_NAME = "breaks.dump"
 CONTACTS_NAME = "contacts.dump"
-CLOCK_NAME = "clock.txt"         # variable time step: "step time dt" of every frame (fix musen/leapfrog)
+CLOCK_NAME = VARIABLE_CLOCK      # variable time step: "step time dt" of every frame (fix musen/leapfrog)
 
 
 @dataclass
@@ -129,6 +129,7 @@ def granular_packages(uses_plugin: bool, wall_cmds: list[str]) -> list[str]:
 
 def job_facts(model: GranularModel, spheres, tiles, t_start: float, dt: float,
               musen_clock: bool = False) -> WorkFacts:
+    # (MUSEN's variable time step: the frames' times are fix musen/leapfrog's clock file's)
     """What ``fibrelmp post --data`` needs beyond the data file and dump to write the spheres
     as the run does (translate.work_facts): names, MUSEN keys and ids, initial orientations,
     the DEMDF document."""
@@ -144,7 +145,8 @@ def job_facts(model: GranularModel, spheres, tiles, t_start: float, dt: float,
         object_ids=np.asarray(sp.ids, np.int64) if model.kind == "musen" else None,
         orientation=None if identity else q,
         radius=None if np.array_equal(spheres.crad, sp.radius) else np.asarray(sp.radius, float),
-        demdf=demdf, clock="musen" if musen_clock else "product")
+        demdf=demdf, clock=("variable" if model.plan.variable_step is not None else
+                            "musen" if musen_clock else "product"))
 
 
 def build_granular_job(model: GranularModel, folder: str | Path):

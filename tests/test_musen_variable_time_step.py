@@ -148,6 +148,36 @@ def test_fibrelmp_makes_cmusens_steps(tmp_path):
     _same_states(ours, theirs, slice(1, None))
 
 
+def test_breaking_bonds_as_cmusen(tmp_path):
+    """Five bonded spheres pulled apart (the stop-criterion scene without its criterion): the
+    step shrinks from 5e-8 s to 8.3e-9 s as the bonds stretch, three bonds break.  Times bit for
+    bit, sphere positions and velocities to 1e-12 of their scale, and each break's time (bond
+    style musen/elastic logs MUSEN's time with each break) equal to the activity end cmusen
+    stores in its .mdem, bit for bit."""
+    from fibrelmp.translate.musen.mdem.document import MdemFile
+
+    styles_or_skip()
+    shutil.copy(DATA / "vardt_bonds_scene.txt", tmp_path)
+    shutil.copy(DATA / "job_vardt_bonds.txt", tmp_path)
+    python_api.run(tmp_path / "job_vardt_bonds.txt", work=tmp_path / "work")
+    ours = read_time_points(tmp_path / "vardt_bonds_result_prec17.txt")
+    theirs = read_time_points(DATA / "cmusen_vardt_bonds_result_prec17.txt")
+    assert len(ours.times) == 26 and np.array_equal(ours.times, theirs.times)
+    for tag in (COORD, VEL):
+        scale = np.max(np.abs(theirs.fields[tag][:, :5]))
+        assert np.max(np.abs(ours.fields[tag][:, :5] - theirs.fields[tag][:, :5])) <= 1e-12 * scale
+    steps = [float(ln.split()[2]) for ln in (tmp_path / "work" / "job2" / "clock.txt").read_text().splitlines()]
+    assert min(steps) < 0.2 * max(steps)                       # the step did vary
+    with MdemFile(DATA / "cmusen_vardt_bonds_result.mdem") as mdem:
+        objects = mdem.storage.info.particles
+        ends = {tuple(sorted((int(ln.split()[1]) - 1, int(ln.split()[2]) - 1))): float(ln.split()[3])
+                for ln in (tmp_path / "work" / "job2" / "breaks.dump").read_text().splitlines()}
+        bonds = {(0, 1): 5, (1, 2): 6, (2, 3): 7, (3, 4): 8}       # sphere pair -> MUSEN object id
+        cmusen_ends = {pair: objects[i].activity_end for pair, i in bonds.items()
+                       if objects[i].activity_end < 1e300}
+    assert len(ends) == 3 and ends == cmusen_ends
+
+
 # Runs the CLI once per argument list in one process and prints the exit codes; a run given a
 # K stops (as on SIGTERM) when its K-th run command asks whether to stop (test_checkpoint.py)
 _RUNS = """\
@@ -307,9 +337,10 @@ def test_refused_without_fibrelmps_styles_at_the_line(tmp_path):
 @pytest.mark.parametrize("job, export, stored", [
     ("job_vardt.txt", "vardt_result_prec17.txt", "cmusen_vardt_result_prec17.txt"),
     ("job_vardt_steps.txt", "vardt_steps_result_prec17.txt", "cmusen_vardt_steps_result_prec17.txt.gz"),
+    ("job_vardt_bonds.txt", "vardt_bonds_result_prec17.txt", "cmusen_vardt_bonds_result_prec17.txt"),
 ])
 def test_references_are_cmusens_output(tmp_path: Path, job: str, export: str, stored: str):
-    for name in ("vardt_scene.txt", job):
+    for name in ("vardt_scene.txt", "vardt_bonds_scene.txt", job):
         shutil.copy(DATA / name, tmp_path)
     done = subprocess.run([CMUSEN, "-t=1", f"-s={job}"], cwd=tmp_path, capture_output=True,
                           text=True, timeout=300)

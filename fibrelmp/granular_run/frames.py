@@ -25,13 +25,19 @@ from fibrelmp.translate.granular.schedule import UNKNOWN_STEP
 
 
 class _BreakLog:
-    """Reads the per-step broken-bond dump (``step id1 id2`` lines) as LAMMPS appends it."""
+    """Reads the per-step broken-bond dump (``step id1 id2`` lines, and the time as a 4th
+    column with a variable time step) as LAMMPS appends it."""
 
     def __init__(self, path: Path | None):
         self.path = path
         self.fh = None
         self.pending = b""
         self.rows: list[tuple[float, float, float]] = []
+        self.times: dict[tuple[int, int, int], float] = {}    # a variable step's break times
+
+    def time(self, step: int, id1: int, id2: int) -> float:
+        """The time logged with a break (variable time step)."""
+        return self.times[(step, id1, id2)]
 
     def upto(self, step: int) -> list[tuple[int, int, int]]:
         if self.path is None:
@@ -46,6 +52,8 @@ class _BreakLog:
             w = ln.split()
             if len(w) >= 3:
                 self.rows.append((float(w[0]), float(w[1]), float(w[2])))
+            if len(w) >= 4:
+                self.times[(int(w[0]), int(w[1]), int(w[2]))] = float(w[3])
         out = [(int(s), int(a), int(b)) for s, a, b in self.rows if s <= step]
         self.rows = [r for r in self.rows if r[0] > step]
         return out
@@ -229,14 +237,17 @@ class FrameBuilder:
             broken = broken[np.argsort(broken[:, 0], kind="stable")]
             r = self._bond_lookup(broken[:, 1], broken[:, 2])
             ok = r >= 0
-            r, bsteps = r[ok], broken[ok, 0]
+            r, bsteps, records = r[ok], broken[ok, 0], broken[ok]
             r, first = np.unique(r, return_index=True)     # earliest record per bond (MPI
-            bsteps = bsteps[first]                          # ranks may both report it)
+            bsteps, records = bsteps[first], records[first]     # ranks may both report it)
             live = self.bond_alive[r]
             self.bond_alive[r[live]] = False
             order = np.argsort(bsteps[live], kind="stable")
             ends = np.empty(len(order))
-            ends[order] = [self.break_clock(int(s)) for s in bsteps[live][order]]
+            if self.job.variable_clock is not None:      # the bond style logged MUSEN's time
+                ends[:] = [self.breaks.time(*map(int, rec)) for rec in records[live]]
+            else:
+                ends[order] = [self.break_clock(int(s)) for s in bsteps[live][order]]
             self.bond_end[r[live]] = ends
         pair = self.model.bonds.pair
         end = np.minimum(self.sphere_end[pair[:, 0]], self.sphere_end[pair[:, 1]])

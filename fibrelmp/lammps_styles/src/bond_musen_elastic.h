@@ -10,6 +10,8 @@
      bond_style musen/elastic [breakage 0|1|2] [kelvin MAX_DAMP_RATIO]
                               [then elastic 0|1|2] [then kelvin 0|1 MAX_DAMP_RATIO] ...
                               [geometry PARTNER VALUES K] [breaks FILE]
+   (FILE: "step id1 id2" per broken bond; with fix musen/leapfrog's variable time step a 4th
+   column holds MUSEN's time of that step, %.17g, which a step number no longer gives)
      bond_coeff N E G sigma_n tau_s mu [d L0]
 
    The law is incremental: every bond keeps MUSEN's state (tangential overlap, twisting and
@@ -92,6 +94,7 @@ class BondMusenElastic : public Bond {
   std::vector<Law> then_laws;   // laws acting after the first one, in cmusen's order
   std::string partners_name, values_name;    // per-atom geometry slots (empty: coefficients)
   std::string breaks_file;   // "step id1 id2" per broken bond (rank 0 appends)
+  int timed_breaks = 0;      // fix musen/leapfrog's variable time step: "step id1 id2 time"
   FILE *breaks_fp;
   int per_atom_geometry;
   int nslots, nvalues_per;                     // K slots of nvalues_per values

@@ -250,7 +250,8 @@ class _FrameSteps:
         return self._last
 
     def stop(self) -> None:
-        self._steps, self.stopped = iter([self._last + 1]), True
+        # (a variable step's frames have no step known in advance: the last one's neither)
+        self._steps, self.stopped = iter([self._last + 1 if self._last >= 0 else self._last]), True
 
     def missing(self) -> int | None:
         """The step of a scheduled frame the run did not write, else None (a variable time

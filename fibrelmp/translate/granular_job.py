@@ -272,7 +272,7 @@ def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> 
     plan, run, spheres, tiles, bonds = model.plan, parts.run, parts.spheres, parts.tiles, parts.bonds
     if plan.variable_step is not None:
         _check_variable_step(model, parts)
-        acts = variable_schedule()
+        acts = _stop_criterion(model, parts, variable_schedule(), last_unchecked=True)
     else:
         # MUSEN's integrator (with fibrelmp's styles) starts with its half-step prediction
         acts = _stop_criterion(model, parts, schedule(run.total, saves, spheres.deletions, predict=parts.musen_hm))
@@ -336,7 +336,8 @@ def _check_variable_step(model: GranularModel, parts: _JobParts) -> None:
         raise InputError(model.source, None, why)
 
 
-def _stop_criterion(model: GranularModel, parts: _JobParts, acts: list[tuple]) -> list[tuple]:
+def _stop_criterion(model: GranularModel, parts: _JobParts, acts: list[tuple],
+                    last_unchecked: bool = False) -> list[tuple]:
     """The actions with MUSEN's stop criterion BROKEN_BONDS checked at every save (none
     without bonds: none can break)."""
     limit, bonds = model.plan.stop_broken_bonds, parts.bonds
@@ -349,7 +350,7 @@ def _stop_criterion(model: GranularModel, parts: _JobParts, acts: list[tuple]) -
     if any(np.isin(bonded, rows).any() for _, rows in parts.spheres.deletions):
         raise InputError(model.source, None, "a stop criterion on broken bonds with bonded spheres "
                          "whose activity ends is not supported (their bonds would count as broken)")
-    return with_stop_criterion(acts, limit, len(bonds.rows))
+    return with_stop_criterion(acts, limit, len(bonds.rows), last_unchecked)
 
 
 def _moving_periodic_box(model: GranularModel, axes: BoxAxes, styles) -> np.ndarray | None:

@@ -252,7 +252,8 @@ void FixMusenLeapfrog::post_run()
   if (!variable) return;
   timer->reset_timeout();    // later runs go on (fix halt's "continue")
   // a run of steps always ends where MUSEN saves or ends; else its N steps ran out first
-  if (update->nsteps > 0 && stopped_for == 0)
+  // (a run of one step is the stop criterion's last step: MUSEN saves after it regardless)
+  if (update->nsteps > 1 && stopped_for == 0)
     error->all(FLERR, "Fix musen/leapfrog: the run's {} steps ended before MUSEN's next save "
                "(time {:.17g}): its frame would be at a time MUSEN does not save", update->nsteps, t_now);
 }

@@ -90,11 +90,9 @@ def _musen_run_time(model: GranularModel, dim: int, dt: float, t_start: float) -
 def variable_step_refusals(model: GranularModel, integrator: bool, deletions: bool = False) -> str | None:
     """Why fibrelmp cannot run ``model`` with MUSEN's variable time step (None: it can).  It
     needs fibrelmp's integrator (fix musen/leapfrog: ``integrator``), and no event at a step
-    fixed in advance (activity ends, ``deletions``; inlets) nor the stop criterion (its extra
-    step after the save that finds it, not done by the fix's runs).  Breaks are timed by the
-    bond style (bond_style musen/elastic logs MUSEN's time with each)."""
+    fixed in advance (activity ends, ``deletions``; inlets).  Breaks are timed by the bond
+    style (bond_style musen/elastic logs MUSEN's time with each)."""
     plan = model.plan
-    bonds = model.bonds is not None and model.bonds.count > 0
     refused = []
     if not integrator:
         refused.append("it needs fibrelmp's LAMMPS styles (fix musen/leapfrog)")
@@ -102,8 +100,6 @@ def variable_step_refusals(model: GranularModel, integrator: bool, deletions: bo
         refused.append("spheres whose activity ends during the run are not supported with it")
     if plan.inlets:
         refused.append("dynamic generators (inlets) are not supported with it")
-    if plan.stop_broken_bonds is not None and bonds:
-        refused.append("a stop criterion (BROKEN_BONDS) is not supported with it")
     return "MUSEN's variable time step: " + "; ".join(refused) if refused else None
 
 
@@ -245,15 +241,18 @@ def compress_ids(ids: np.ndarray) -> str:
 STOP_LABEL, END_LABEL = "fl_stopped", "fl_finish"
 
 
-def with_stop_criterion(acts: list[tuple], max_broken: int, bonds0: int) -> list[tuple]:
+def with_stop_criterion(acts: list[tuple], max_broken: int, bonds0: int,
+                        last_unchecked: bool = False) -> list[tuple]:
     """MUSEN's stop criterion BROKEN_BONDS (BaseSimulator::PreCalculationStep): at every save
     after the first, more than ``max_broken`` bonds broken since the start (``bonds0`` at the
     start) stop the run; cmusen then still makes that step and saves once more
-    (FinalizeSimulation), so the stop block is one step and its frame."""
+    (FinalizeSimulation), so the stop block is one step and its frame.  ``last_unchecked``: the
+    last frame is FinalizeSimulation's save, which checks nothing (a variable step's script)."""
     out: list[tuple] = [("stopvar", bonds0)]
-    for act in acts:
+    last = max((k for k, act in enumerate(acts) if act[0] == "frame"), default=-1)
+    for k, act in enumerate(acts):
         out.append(act)
-        if act[0] == "frame" and act[1] != 0:
+        if act[0] == "frame" and act[1] != 0 and not (last_unchecked and k == last):
             out.append(("stopcheck", max_broken))
     said = (f"{STOP_PRINT}: more than {max_broken} bonds broken (MUSEN BROKEN_BONDS): one more "
             "step, its frame, the end")

@@ -95,11 +95,13 @@ def test_saves_follow_the_summed_time(every_step):
         assert np.array_equal(every_step.fields[tag][picks], saved.fields[tag][1:], equal_nan=True)
 
 
-def _run(tmp_path: Path, job: str = "job_vardt.txt") -> TimePoints:
+def _run(tmp_path: Path, job: str = "job_vardt.txt", warned: list | None = None) -> TimePoints:
     """fibrelmp runs one of the reference's job scripts in ``tmp_path``; its 17-digit export."""
     shutil.copy(DATA / "vardt_scene.txt", tmp_path)
     shutil.copy(DATA / job, tmp_path)
-    python_api.run(tmp_path / job, work=tmp_path / "work")
+    result = python_api.run(tmp_path / job, work=tmp_path / "work")
+    if warned is not None:
+        warned += [kind for kind, _ in result.warnings]
     return read_time_points(tmp_path / job.replace("job_", "").replace(".txt", "_result_prec17.txt"))
 
 
@@ -116,7 +118,9 @@ def test_fibrelmp_saves_cmusens_time_points(tmp_path):
     """Every saved time as cmusen's, bit for bit (the irregular ones after the step first
     shrank included, and the last: the first step reaching END_TIME), every state with it."""
     styles_or_skip()
-    ours = _run(tmp_path)
+    warned: list[str] = []
+    ours = _run(tmp_path, warned=warned)
+    assert "musen-first-time-point" not in warned
     theirs = read_time_points(DATA / "cmusen_vardt_result_prec17.txt")
     assert len(ours.times) == 31 and np.array_equal(ours.times, theirs.times)
     _same_states(ours, theirs)
@@ -140,7 +144,9 @@ def test_fibrelmp_makes_cmusens_steps(tmp_path):
     step is below 0.1 dt: it saves at t = 0 again, over the first); fibrelmp's is the initial
     state, so that point is left out."""
     styles_or_skip()
-    ours = _run(tmp_path, "job_vardt_steps.txt")
+    warned: list[str] = []
+    ours = _run(tmp_path, "job_vardt_steps.txt", warned)
+    assert "musen-first-time-point" in warned          # that t = 0 point differs, said so
     text = tmp_path / "steps_prec17.txt"
     text.write_bytes(gzip.decompress((DATA / "cmusen_vardt_steps_result_prec17.txt.gz").read_bytes()))
     theirs = read_time_points(text)

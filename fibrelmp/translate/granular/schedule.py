@@ -65,6 +65,14 @@ def _musen_run_time(model: GranularModel, dim: int, dt: float, t_start: float) -
     t_end = float(plan.t_end)
     if not t_end > t_start:            # nothing to simulate: the scene as it is
         return RunTime(dim, dt, 0, t_start, t_start)
+    if every is not None and every < 0.1 * dt:
+        # PreCalculationStep at t = 0 after the prediction step: |0 - 0| + 0.1 dt > saving step
+        model.warnings.append(("musen-first-time-point", "the saving step is below 0.1 x the "
+                               "simulation step: cmusen then saves t = 0 a second time after its "
+                               "prediction step (with the half-step velocities), over the first"
+                               + (" (when its step is still above 10 x the saving step)"
+                                  if plan.variable_step is not None else "")
+                               + "; fibrelmp's first time point is the initial state"))
     if plan.variable_step is not None:
         # MUSEN's variable step: the steps, saves and end come from fix musen/leapfrog during
         # the run; the steps at SIMULATION_STEP (the largest) are the progress bar's estimate

@@ -220,6 +220,8 @@ class GranularPlan:
     then_bond_laws: list[SolidBondLaw] = field(default_factory=list)
     contacts_between_bonded: bool = True    # MUSEN default
     velocity_limit: float | None = None     # MUSEN's particle velocity limit (m/s; None: none)
+    # MUSEN's variable time step (MAX_PART_MOVE m, STEP_INC_FACTOR); None: the fixed step
+    variable_step: tuple[float, float] | None = None
     # MUSEN's stop criterion BROKEN_BONDS N: at a save with more than N bonds broken since the
     # start, one more step, its frame, the end (None: no criterion)
     stop_broken_bonds: int | None = None

@@ -11,6 +11,7 @@
 #include "fix_musen_wall_mesh.h"
 #include "style_registry.h"
 #include "fix_musen_history.h"
+#include "fix_musen_leapfrog.h"
 #include "musen_startup.h"
 
 #include "atom.h"
@@ -543,6 +544,11 @@ void FixMusenWallMesh::init()
   if (!atom->radius_flag || !atom->rmass_flag || !atom->omega_flag || !atom->torque_flag)
     error->all(FLERR, "Fix musen/wall/mesh needs per-atom radius, rmass, omega and torque (atom_style sphere or bpm/sphere)");
   if (!history) error->all(FLERR, "Fix musen/wall/mesh: its history fix is missing");
+  clock = nullptr;
+  for (const auto &fix : modify->get_fix_list()) {
+    auto *leapfrog = dynamic_cast<FixMusenLeapfrog *>(fix);
+    if (leapfrog && leapfrog->variable_step()) clock = leapfrog;
+  }
   // every sphere type in the group needs a law with every wall material in use
   std::vector<char> used(nmat, 0);
   for (int t = 0; t < ntri; t++) used[tmat[t]] = 1;
@@ -574,7 +580,7 @@ void FixMusenWallMesh::setup(int vflag)
     // MoveWalls from those wall forces (CBaseSimulator::StartSimulation)
     start_vert = vert;    // a frame before the first step shows them here (MUSEN saves first)
     post_force(vflag);
-    step_walls(current_time());
+    step_walls(current_time(), update->dt);
     started = true;
     pending = false;
     at_start = true;
@@ -820,7 +826,10 @@ void FixMusenWallMesh::post_force(int /*vflag*/)
 {
   // a time step first moves the stepped geometries by the previous step's wall forces
   if (any_stepped && pending && !update->setupflag) {
-    step_walls(current_time() - update->dt);
+    if (clock)    // MoveWalls(dt before MoveParticles changed it), at the time before the step
+      step_walls(clock->step_start_time(), clock->previous_dt());
+    else
+      step_walls(current_time() - update->dt, update->dt);
     pending = false;
   }
   at_start = false;

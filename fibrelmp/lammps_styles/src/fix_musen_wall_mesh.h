@@ -78,6 +78,8 @@
    the sum of its triangles' forces switches force-dependent intervals, the whole force plus
    gravity x MASS accelerates free axes), plus MUSEN's extra update of its half-step
    prediction before the first step, so at time t its triangles are where MUSEN's are.
+   With fix musen/leapfrog's variable time step, a step moves them by the dt from before that
+   step's change, at the time before the step (MoveWalls gets m_currSimulationStep's old value).
    compute_array's vertices then come from this stepping, and "fix_modify write" adds each
    triangle's velocity and vertices (vx vy vz x1 .. z3) to its frame.
 
@@ -222,7 +224,8 @@ class FixMusenWallMesh : public Fix {
   void find_adjacent();
   void place(double t);
   void motion_state(double t);
-  void step_walls(double t);
+  void step_walls(double t, double dt);
+  class FixMusenLeapfrog *clock = nullptr;    // a variable time step's clock (else none)
   static void update_motion(Geometry &G, double value);
   static void rotation_matrix(const double *w, double dt, double R[3][3]);
   void centroid(const Geometry &G, double *centre) const;

@@ -83,8 +83,9 @@ def plan_walls(model: GranularModel, dt: float, t_end: float, mesh: bool | None 
             desc = (f"{len(rows)} exact triangles -> fix musen/wall/mesh (MUSEN's particle-wall "
                     "contact, face/edge/vertex)")
             if stepped:
-                desc += (", moving step by step as MUSEN moves it ("
-                         + ("force-dependent" if geom.motion_type in (2, 3) else "free") + " motion)")
+                kind = ("force-dependent" if geom.motion_type in (2, 3) else
+                        "free" if is_stepped(geom) else "time-dependent")
+                desc += f", moving step by step as MUSEN moves it ({kind} motion)"
             elif kin.moving:
                 desc += ", moving (time-dependent motion)"
             plans.append(WallPlan(name, "mesh", desc, rows, kin, material,

@@ -221,6 +221,15 @@ def apply_simulator_settings(model: GranularModel, job: MusenJob) -> None:
             raise InputError(job.path, job.where("LIMIT_PARTICLE_VELOCITY"), "LIMIT_PARTICLE_VELOCITY "
                              "needs fibrelmp's LAMMPS styles (fix musen/leapfrog vlimit)")
     _apply_times(model, job)
+    if plan.variable_step is not None:
+        from fibrelmp.translate.granular.schedule import variable_step_refusals
+
+        why = variable_step_refusals(model, lammps_styles.plugin().available)
+        if why is not None:
+            if "VARIABLE_TIME_STEP" in job.lines:
+                raise InputError(job.path, job.where("VARIABLE_TIME_STEP"), why)
+            raise InputError(scene_record(model).mdem_source or model.source, None,
+                             f"flexible_time_step: {why}")
 
 
 def _apply_materials(model: GranularModel, job: MusenJob) -> None:
@@ -308,12 +317,21 @@ def _apply_motion(model: GranularModel, job: MusenJob) -> None:
         g.force_motion.append(interval)
 
 
+# MUSEN's defaults (CBaseSimulator: m_partMoveLimit, m_timeStepFactor)
+MUSEN_VARIABLE_STEP = (1e-8, 1.01)
+
+
 def _refuse_file_settings(model: GranularModel, job: MusenJob) -> None:
     """A .mdem's settings fibrelmp cannot simulate (``MusenSceneRecord.refused``), unless the
     job switches them off as cmusen's ConsoleSimulator would (VARIABLE_TIME_STEP 0,
     STOP_CRITERION NONE)."""
     record = scene_record(model)
-    if job.variable_time_step is False:
+    if job.variable_time_step is not None:       # cmusen: the script's flag replaces the file's
+        model.plan.variable_step = (MUSEN_VARIABLE_STEP if job.variable_time_step else None)
+    if model.plan.variable_step is not None:
+        move, factor = model.plan.variable_step
+        model.plan.variable_step = (job.max_part_move or move, job.step_inc_factor or factor)
+    if model.plan.variable_step is None:         # switched off: the file's values do not matter
         record.refused.pop("flexible_time_step", None)
     if job.stop_criteria:       # cmusen: the script's criteria replace the file's
         record.refused.pop("stop_criteria", None)

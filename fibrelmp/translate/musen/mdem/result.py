@@ -240,6 +240,9 @@ class MdemResultWriter(MusenResultWriter):
             (float(g) for g in plan.gravity)
         sim.simulator_type = sim.simulator_type or 1           # CPU
         sim.part_velocity_limit = plan.velocity_limit or 0.0   # as MUSEN saves it (0: none)
+        if plan.variable_step is not None:
+            sim.flexible_time_step = True
+            sim.part_move_limit, sim.time_step_factor = plan.variable_step
         if plan.stop_broken_bonds is not None:                 # MUSEN's SaveConfiguration
             storage.info.stop_criteria.types[:] = [1]
             storage.info.stop_criteria.max_broken_bonds = plan.stop_broken_bonds

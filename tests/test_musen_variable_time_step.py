@@ -182,6 +182,11 @@ def test_breaking_bonds_as_cmusen(tmp_path):
         cmusen_ends = {pair: objects[i].activity_end for pair, i in bonds.items()
                        if objects[i].activity_end < 1e300}
     assert len(ends) == 3 and ends == cmusen_ends
+    with MdemFile(tmp_path / "vardt_bonds_result.mdem") as mdem:    # fibrelmp's result .mdem
+        objects = mdem.storage.info.particles
+        written = {pair: objects[i].activity_end for pair, i in bonds.items()
+                   if objects[i].activity_end < 1e300}
+    assert written == cmusen_ends                            # exact, not the text's %g
 
 
 def test_stop_criterion_as_cmusen(tmp_path):

@@ -142,11 +142,17 @@ class MdemResultWriter(MusenResultWriter):
                     out.write("".join(h + "\n" for h in self._headers(t, ids[sel], rows[sel])))
             out.write(self._scene_text())
         storage, _ = import_text(text)
+        # the text headers hold activity times as MUSEN's text export writes them (%g); the
+        # .mdem keeps them exact, as cmusen's does
+        self._set_ends(storage.info.particles)
         return storage
 
     def _set_activity(self, storage: Any) -> None:
-        particles = storage.info.particles
-        self._add_generated(particles)
+        self._add_generated(storage.info.particles)
+        self._set_ends(storage.info.particles)
+
+    def _set_ends(self, particles: Any) -> None:
+        """Every removed sphere's and broken bond's activity end, exactly."""
         for ids, end in ((self.sphere_ids, self.sphere_end), (self.bond_ids, self.bond_end)):
             if ids is None or end is None:
                 continue

@@ -198,3 +198,25 @@ def test_refused_where_breaks_cannot_be_counted(tmp_path):
     with lammps_styles.stock(True), pytest.raises(InputError, match="a stop criterion on broken bonds needs fibrelmp's LAMMPS styles"):
         python_api.run(job, work=tmp_path / "work")
     assert not (tmp_path / "case" / "stop_result_prec17.txt").exists()
+
+
+@pytest.mark.parametrize("job, ref", [("job_stop_end.txt", "cmusen_stop_end_result_prec17.txt"),
+                                      ("job_stop_loop.txt", "cmusen_stop_loop_result_prec17.txt")])
+def test_last_save_checks_nothing(tmp_path, job, ref):
+    """Two bonds broken before the save of the step that reaches END_TIME: that save is cmusen's
+    FinalizeSimulation, which checks no criterion, so the run ends there with no extra step
+    (2.31e-6 s; fibrelmp made one more step and frame before).  The second job's saving interval
+    divides the last step, which would otherwise be the last pass of a LAMMPS loop."""
+    styles_or_skip()
+    for name in ("stop_scene.txt", job):
+        shutil.copy(DATA / name, tmp_path)
+    python_api.run(tmp_path / job, work=tmp_path / "work")
+    result = (DATA / job).read_text().split("RESULT_FILE")[-1].split()[0]
+    ours, theirs = read_time_points(tmp_path / result), read_time_points(DATA / ref)
+    assert theirs.times[-1] == pytest.approx(2.31e-6, rel=1e-12) and len(theirs.times) == 4
+    assert np.array_equal(ours.times, theirs.times)
+    assert _bond_ends(tmp_path / result) == _bond_ends(DATA / ref) == {"5": 2.22e-6, "6": 1e300,
+                                                                       "7": 1e300, "8": 1.77e-6}
+    for tag in (COORD, VEL):
+        scale = np.max(np.abs(theirs.fields[tag][:, SPHERES]))
+        assert np.max(np.abs(ours.fields[tag][:, SPHERES] - theirs.fields[tag][:, SPHERES])) <= 1e-12 * scale

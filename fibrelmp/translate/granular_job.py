@@ -272,7 +272,9 @@ def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> 
         acts = _stop_criterion(model, parts, variable_schedule(), last_unchecked=True)
     else:
         # MUSEN's integrator (with fibrelmp's styles) starts with its half-step prediction
-        acts = _stop_criterion(model, parts, schedule(run.total, saves, spheres.deletions, predict=parts.musen_hm))
+        acts = schedule(run.total, saves, spheres.deletions, predict=parts.musen_hm)
+        # cmusen's save of the step reaching END_TIME (FinalizeSimulation) checks no criterion
+        acts = _stop_criterion(model, parts, acts, last_unchecked=acts[-1] == ("frame", run.total))
     skin = 0.5 * tiles.largest_radius(spheres.r_max)
     pair_cut = 2.0 * tiles.largest_radius(spheres.r_max)
     comm_cut = max(pair_cut, 1.5 * bonds.max_length) + skin

@@ -177,7 +177,9 @@ def schedule(total: int, saves: SaveSteps, deletions: list[tuple[int, np.ndarray
     k = saves.period
     last_regular = (total // k) * k
     for stop in sorted(d for d in dels if d > 0) + [None]:
-        limit = min(stop - 1 if stop is not None else total, last_regular)
+        # the last step is never inside a loop: its frame is MUSEN's FinalizeSimulation save,
+        # which a stop criterion does not check (with_stop_criterion)
+        limit = min(stop - 1 if stop is not None else total - 1, last_regular)
         first = (step // k + 1) * k
         if first <= limit:
             event(first)                  # its gap (or pre) may differ from the regular ones
@@ -255,7 +257,7 @@ def with_stop_criterion(acts: list[tuple], max_broken: int, bonds0: int,
     after the first, more than ``max_broken`` bonds broken since the start (``bonds0`` at the
     start) stop the run; cmusen then still makes that step and saves once more
     (FinalizeSimulation), so the stop block is one step and its frame.  ``last_unchecked``: the
-    last frame is FinalizeSimulation's save, which checks nothing (a variable step's script)."""
+    last frame is FinalizeSimulation's save (the step reaching END_TIME), which checks nothing."""
     out: list[tuple] = [("stopvar", bonds0)]
     last = max((k for k, act in enumerate(acts) if act[0] == "frame"), default=-1)
     for k, act in enumerate(acts):

@@ -184,6 +184,15 @@ class Plane:
 
 
 @dataclass
+class ExternalField:
+    """One MUSEN external-force (EF) model acting on every sphere (fibrelmp's ``fix
+    musen/field``, translate/granular/models/ef_*.py)."""
+    model: str                      # MUSEN's name, e.g. "ModelEFViscousField"
+    parameters: dict[str, float]    # its parameters (MUSEN's names)
+    fix_args: str                   # what follows ``musen/field``: the law and its numbers
+
+
+@dataclass
 class GranularPlan:
     dt: float
     t_start: float
@@ -201,6 +210,8 @@ class GranularPlan:
     # every active model of a kind; each continues the bond's state and may break it)
     then_bond_laws: list[SolidBondLaw] = field(default_factory=list)
     contacts_between_bonded: bool = True    # MUSEN default
+    # MUSEN's active EF models, in cmusen's order (each adds its force in turn, before all others)
+    external_fields: list[ExternalField] = field(default_factory=list)
     velocity_limit: float | None = None     # MUSEN's particle velocity limit (m/s; None: none)
     # MUSEN's stop criterion BROKEN_BONDS N: at a save with more than N bonds broken since the
     # start, one more step, its frame, the end (None: no criterion)

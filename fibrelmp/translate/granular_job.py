@@ -283,8 +283,12 @@ def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> 
         raise InputError(model.source, None, "a particle velocity limit needs fibrelmp's LAMMPS "
                          "styles (fix musen/leapfrog)")
     pbc_velocity = _moving_periodic_box(model, parts.axes, styles)
+    if plan.external_fields and not parts.musen_hm:
+        raise InputError(model.source, None, f"{plan.external_fields[0].model} needs fibrelmp's "
+                         f"LAMMPS styles (fix musen/field): {styles.how}")
     uses_plugin = bool(styles.path) and (parts.musen_hm or geometry is not None or len(parts.mesh) > 0
-                                         or plan.velocity_limit is not None or pbc_velocity is not None)
+                                         or plan.velocity_limit is not None or pbc_velocity is not None
+                                         or bool(plan.external_fields))
     return template_environment().get_template("granular.lammps.j2").render(
         model=model, plugin=lammps_path(styles.path, "plugin") if uses_plugin else None,
         packages=granular_packages(uses_plugin, parts.wall_cmds),
@@ -311,7 +315,7 @@ def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> 
         walls=[(wp.name, wp.description) for wp in parts.wall_plans],
         mesh_fix=MESH_FIX if len(parts.mesh) else None, mesh_forces_name=MESH_FORCES_NAME,
         contacts_name=CONTACTS_NAME, velocity_limit=plan.velocity_limit, pbc_velocity=pbc_velocity,
-        musen_integrator=parts.musen_hm,
+        musen_integrator=parts.musen_hm, fields=plan.external_fields,
         thermo_every=min(saves.period or 0, 2 ** 31 - 1),      # thermo N is a C int
         stop_label=STOP_LABEL,
     )

@@ -30,7 +30,7 @@ def _resolve_models(model: GranularModel, job: MusenJob) -> tuple[dict[str, Mode
     file's models as loaded, then ``AddActiveModel`` for each of the job's: a model already
     active keeps its place and takes the job's parameters on top of the file's).  Every
     active model acts (CPUSimulator runs all models of a kind, in turn): the first of each
-    kind, and the later SB models (in order), which act after it (``_one_per_kind``)."""
+    kind, and the later SB and EF models (in order), which act after it (``_one_per_kind``)."""
     chosen: dict[str, ModelChoice] = dict(model.models)
     active: list[ModelChoice] = []
     by_name: dict[str, int] = {}
@@ -50,7 +50,7 @@ def _resolve_models(model: GranularModel, job: MusenJob) -> tuple[dict[str, Mode
         active.append(_model_choice(model, spec, job.path, spec.line))
     for choice in _one_per_kind(active, model.source):
         chosen[choice.kind] = choice
-    return chosen, [c for c in active if c.kind == "SB" and c is not chosen.get("SB")]
+    return chosen, [c for c in active if c.kind in ("SB", "EF") and c is not chosen.get(c.kind)]
 
 
 _ACTS_ON = {"PP": "particle-particle contact", "PW": "particle-wall contact", "SB": "solid bond",
@@ -63,12 +63,13 @@ def _chosen_at(choice: ModelChoice, source) -> str:
 
 def _one_per_kind(active: list[ModelChoice], source) -> list[ModelChoice]:
     """The first active model of each kind.  Several SB models act together (the later ones
-    become the plan's ``then_bond_laws``); two of another kind are refused, named where the
+    become the plan's ``then_bond_laws``) and so do several EF models (the plan's
+    ``external_fields``, each adding its force in turn); two of another kind are refused, named where the
     second was selected: cmusen adds their forces, which fibrelmp does not simulate."""
     seen: dict[str, ModelChoice] = {}
     for choice in active:
         first = seen.setdefault(choice.kind, choice)
-        if first is choice or choice.kind == "SB":
+        if first is choice or choice.kind in ("SB", "EF"):
             continue
         hint = ("remove one of the two MODEL_ lines" if first.line is not None else
                 "a script cannot drop a file's model: remove it in MUSEN (models tab) and save "
@@ -115,7 +116,9 @@ def _model_choice(model: GranularModel, spec, path, line: int | None) -> ModelCh
         what = physics.KIND_WORDS[kind]
         ok = [f"{m.name} (with fibrelmp's LAMMPS styles)" if m.needs_styles else m.name
               for m in physics.of_kind(kind)]
+        why = physics.UNTRANSLATED_WHY.get(spec.name)
         raise InputError(path, line, f"{where}{spec.name}: this {what} model is not supported"
+                         + (f" ({why})" if why else "")
                          + (f"; fibrelmp translates {' and '.join(ok)}" if ok
                             else f"; fibrelmp translates no {what} model")
                          + ("; name another in the job script (MODEL_" + kind + ")" if line is None else ""))
@@ -158,20 +161,24 @@ def apply_simulator_settings(model: GranularModel, job: MusenJob) -> None:
     if job.reset_bonds:
         reset_bond_lengths(model)
     _apply_motion(model, job)
-    models, later_bond_models = _resolve_models(model, job)
+    models, later_models = _resolve_models(model, job)
     model.models = models
     _check_models(model, job, models)
     if "PP" in models:                            # the laws stand for the PP model chosen
         for law in model.contacts.values():
             law.model = models["PP"].name
+    plan.external_fields = []         # the EF models' apply() add theirs, in cmusen's order
     for kind, choice in models.items():
         # a kind's parameter errors point at its PARAMS line (cmusen reads them there)
         physics.find(choice.name).apply(plan, choice.parameters, job.path,
                                         job.where(f"MODEL_{kind}_PARAMS"))
     plan.then_bond_laws = []
-    for choice in later_bond_models:    # in cmusen's order, after the first SB model
-        physics.add_later_bond_law(plan, choice.name, choice.parameters, choice.source,
-                                   choice.line)
+    for choice in later_models:    # in cmusen's order, after the first model of their kind
+        if choice.kind == "SB":
+            physics.add_later_bond_law(plan, choice.name, choice.parameters, choice.source,
+                                       choice.line)
+        else:
+            physics.find(choice.name).apply(plan, choice.parameters, choice.source, choice.line)
     if job.connected_pp_contact is not None:
         plan.contacts_between_bonded = job.connected_pp_contact
     _refuse_file_settings(model, job)

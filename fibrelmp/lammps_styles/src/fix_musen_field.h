@@ -1,0 +1,53 @@
+/* -*- c++ -*- ----------------------------------------------------------
+   fibrelmp's LAMMPS styles; GPL-2.0-or-later like LAMMPS (see ../LICENSE).
+
+   FixMusenField (fix style musen/field): MUSEN's external-force (EF) models on every sphere of
+   the group, operation by operation as MUSEN 1.74.2 (e0ff360) computes them:
+
+     fix ID group musen/field viscous NU RHO
+         ModelEFViscousField: drag on the sphere's velocity v (the medium at rest):
+         Re = 2 r |v| / NU (NU: kinematic viscosity, m2/s); Cd = 24/Re (Re < 0.5),
+         27/Re^0.8 (Re < 10.1), else 17/Re^0.6; F -= v/|v| Cd pi r^2 RHO/2 |v|^2; none at Re = 0
+     fix ID group musen/field centrifugal OMEGA RHO MU
+         ModelEFCentrifugalCasting: a sphere in a liquid (density RHO, dynamic viscosity MU)
+         turning at OMEGA rad/s about y: buoyant centrifugal force (m - 4/3 pi r^3 RHO)
+         OMEGA^2 (x, 0, z) plus Stokes drag 6 pi MU r (u - v) towards the liquid's velocity
+         u = OMEGA (z, 0, -x)
+
+   Where MUSEN adds it: CCPUSimulator::CalculateForcesStep runs the EF models first, on the
+   cleared forces, before the particle-particle, particle-wall and bond forces, and
+   MoveParticles adds gravity after all of them; every evaluation (its prediction iteration at
+   t = 0 too) uses the positions and velocities the forces are computed at.  This fix adds its
+   force in pre_force (and setup_pre_force), which LAMMPS calls right after clearing the
+   forces and before the pair, bond and fix post_force (gravity, walls) forces, with x and v
+   of that evaluation.  Several such fixes act in the order they are defined (MUSEN: its EF
+   models in the model manager's order).  The field adds no torque and keeps no state.
+------------------------------------------------------------------------- */
+
+#ifndef FIBRELMP_FIX_MUSEN_FIELD_H
+#define FIBRELMP_FIX_MUSEN_FIELD_H
+
+#include "fix.h"
+
+namespace LAMMPS_NS {
+
+class FixMusenField : public Fix {
+ public:
+  FixMusenField(class LAMMPS *, int, char **);
+  int setmask() override;
+  void init() override;
+  void setup_pre_force(int) override;
+  void pre_force(int) override;
+
+ private:
+  enum Law { VISCOUS, CENTRIFUGAL };
+  Law law;
+  double nu, medium_density;                            // viscous
+  double omega, liquid_density, liquid_viscosity;       // centrifugal
+  void viscous();
+  void centrifugal();
+};
+
+}    // namespace LAMMPS_NS
+
+#endif

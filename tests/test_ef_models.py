@@ -1,0 +1,243 @@
+"""MUSEN's external-force models ModelEFViscousField and ModelEFCentrifugalCasting
+(translate/granular/models/ef_*.py, fibrelmp's ``fix musen/field``) against the real cmusen:
+free spheres in each field and in both together, from a job script's MODEL_EF lines and from
+a .mdem's stored models (tests/data/real-outputs/musen/models/ef_*/README.md); and the force
+laws against an independent numpy version of MUSEN's formulas.  The opt-in tests
+(FIBRELMP_CMUSEN) rerun cmusen and check the stored references are still its output."""
+
+from __future__ import annotations
+
+import math
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fibrelmp import python_api
+from fibrelmp.errors import InputError
+from fibrelmp.translate.musen.text import read_time_points
+
+from .conftest import data_path
+from .musen_model_checks import (ANGVEL, COORD, VEL, check_reference_is_cmusens_output,
+                                 check_refused_without_styles, model_job, needs_cmusen,
+                                 styles_or_skip)
+
+FORCE = 20                                      # MUSEN text tag: the saved total force
+MODELS = data_path("real-outputs/musen/models")
+VF_PARAMS = "MEDIUM_VISCOSITY 1e-6 MEDIUM_DENSITY 1000"
+CC_PARAMS = "ROTATION_VELOCITY 10 LIQUID_DENSITY 1000 LIQUID_VISCOSITY 0.01"
+# folder, prefix, its PARAMS text, the fix lines fibrelmp renders, gravity
+CASES = {
+    "viscous": ("ef_viscous_field", "vf", VF_PARAMS,
+                ["musen/field viscous 1e-06 1000.0"], (0.0, 0.0, -9.81)),
+    "centrifugal": ("ef_centrifugal_casting", "cc", CC_PARAMS,
+                    ["musen/field centrifugal 10.0 1000.0 0.01"], (0.0, -9.81, 0.0)),
+    "both": ("ef_centrifugal_and_viscous", "vc", CC_PARAMS,
+             ["musen/field centrifugal 10.0 1000.0 0.01", "musen/field viscous 1e-06 1000.0"],
+             (0.0, -9.81, 0.0)),
+}
+DENSITY = {"MGLASS": 2500.0, "MLIGHT": {"vf": 1200.0, "cc": 800.0, "vc": 800.0}}
+
+
+# ---- MUSEN's laws, written again from Models/ExternalForce/*/ModelEF*.cpp -------------------
+
+def viscous_force(r: np.ndarray, v: np.ndarray, nu: float, rho: float) -> np.ndarray:
+    """ModelEFViscousField: drag of a medium at rest, three regimes of the drag coefficient."""
+    speed = np.linalg.norm(v, axis=1)
+    re = 2 * r * speed / nu
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cd = np.where(re < 0.5, 24.0 / re, np.where(re < 10.1, 27.0 / re ** 0.8, 17.0 / re ** 0.6))
+        unit = v / speed[:, None]
+        f = -unit * (cd * math.pi * r ** 2 * rho / 2 * speed ** 2)[:, None]
+    return np.where((re > 0)[:, None], f, 0.0)
+
+
+def centrifugal_force(r: np.ndarray, m: np.ndarray, x: np.ndarray, v: np.ndarray, omega: float,
+                      rho: float, mu: float) -> np.ndarray:
+    """ModelEFCentrifugalCasting: buoyant centrifugal force about y plus Stokes drag towards the
+    turning liquid's velocity omega (z, 0, -x)."""
+    buoyant = (m - 4.0 / 3.0 * math.pi * r ** 3 * rho) * omega ** 2
+    radial = np.stack([x[:, 0], np.zeros(len(x)), x[:, 2]], axis=1) * buoyant[:, None]
+    liquid = np.stack([x[:, 2], np.zeros(len(x)), -x[:, 0]], axis=1) * omega
+    return radial + (liquid - v) * (6 * math.pi * mu * r)[:, None]
+
+
+def field_force(case: str, r, m, x, v) -> np.ndarray:
+    f = np.zeros_like(x)
+    if case in ("centrifugal", "both"):
+        f += centrifugal_force(r, m, x, v, 10.0, 1000.0, 0.01)
+    if case in ("viscous", "both"):
+        f += viscous_force(r, v, 1e-6, 1000.0)
+    return f
+
+
+def test_viscous_law_regimes_and_signs():
+    """Stokes's law 3 pi mu d v below Re 0.5, the other regimes' coefficients, opposite to v,
+    nothing at rest; Re of each row: 0.2, 5, 200, 0."""
+    nu, rho = 1e-6, 1000.0
+    r = np.array([1e-4, 5e-4, 1e-3, 1e-3])
+    v = np.array([[1e-3, 0, 0], [0, -5e-3, 0], [0, 0.06, 0.08], [0, 0, 0]])
+    f = viscous_force(r, v, nu, rho)
+    np.testing.assert_allclose(f[0], -3 * math.pi * (nu * rho) * 2e-4 * v[0], rtol=1e-14)
+    assert f[1][1] > 0 and f[2][1] < 0 and f[2][2] < 0 and not f[3].any()
+    np.testing.assert_allclose(np.linalg.norm(f[1]), 27 / 5 ** 0.8 * math.pi * 25e-8 * 500 * 25e-6,
+                               rtol=1e-14)
+    np.testing.assert_allclose(np.linalg.norm(f[2]), 17 / 200 ** 0.6 * math.pi * 1e-6 * 500 * 0.01,
+                               rtol=1e-14)
+
+
+def test_centrifugal_law_signs():
+    """Heavier than the liquid: pushed out; lighter: pulled in; at rest on the axis only the
+    drag of a sphere moving through the liquid."""
+    r = np.full(3, 1e-3)
+    vol = 4 / 3 * math.pi * 1e-9
+    m = np.array([2500.0, 800.0, 1000.0]) * vol
+    x = np.array([[0.05, 0, 0], [0.05, 0, 0], [0, 0, 0]])
+    v = np.array([[0, 0, -0.5], [0, 0, -0.5], [0.1, 0, 0]])       # row 0/1 co-rotating
+    f = centrifugal_force(r, m, x, v, 10.0, 1000.0, 0.01)
+    assert f[0][0] > 0 and f[1][0] < 0
+    np.testing.assert_allclose(f[0], [1500 * vol * 100 * 0.05, 0, 0], rtol=1e-14)
+    np.testing.assert_allclose(f[2], [-6 * math.pi * 0.01 * 1e-3 * 0.1, 0, 0], rtol=1e-14)
+
+
+# ---- runs --------------------------------------------------------------------------------
+
+def _job(tmp_path: Path, case: str, params: str | None = None) -> Path:
+    folder, prefix, old, _, _ = CASES[case]
+    return model_job(tmp_path, MODELS / folder, prefix, old, params)
+
+
+def _assert_matches(ours_file: Path, theirs_file: Path, rel: float = 1e-10) -> None:
+    ours, theirs = read_time_points(ours_file), read_time_points(theirs_file)
+    np.testing.assert_allclose(ours.times, theirs.times, rtol=1e-12, atol=0)
+    assert np.array_equal(ours.ids, theirs.ids) and len(theirs.times) == 21
+    for tag in (COORD, VEL, ANGVEL):
+        scale = np.abs(theirs.fields[tag]).max()
+        np.testing.assert_allclose(ours.fields[tag], theirs.fields[tag], rtol=0, atol=rel * scale)
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_free_spheres_in_the_field_are_cmusens(tmp_path, case):
+    styles_or_skip()
+    folder, prefix, _, fixes, g = CASES[case]
+    python_api.run(_job(tmp_path, case), work=tmp_path / "work")
+    script = (tmp_path / "work" / "job2" / "in.lammps").read_text()
+    assert [ln.split(None, 3)[3] for ln in script.splitlines() if "musen/field" in ln
+            and ln.startswith("fix")] == fixes
+    reference = MODELS / folder / f"cmusen_{prefix}_result_prec17.txt"
+    _assert_matches(tmp_path / f"{prefix}_result_prec17.txt", reference)
+    # the field acts clearly: cmusen's velocities are far from free flight v0 + g t
+    theirs = read_time_points(reference)
+    free = theirs.fields[VEL][0] + theirs.times[:, None, None] * np.array(g)
+    assert np.abs(theirs.fields[VEL] - free).max() > 0.05 * np.abs(theirs.fields[VEL]).max()
+
+
+def test_stored_models_of_a_mdem_act(tmp_path):
+    """cmusen's own .mdem result of the two-field run stores both models: run as a scene it
+    runs them (its settings, first time point) as cmusen did."""
+    styles_or_skip()
+    folder = MODELS / "ef_centrifugal_and_viscous"
+    shutil.copy(folder / "cmusen_vc_result.mdem", tmp_path)
+    python_api.run(tmp_path / "cmusen_vc_result.mdem", out=tmp_path / "out.txt", precision=17,
+                   work=tmp_path / "work")
+    script = (tmp_path / "work" / "in.lammps").read_text()
+    assert script.index("musen/field centrifugal") < script.index("musen/field viscous")
+    _assert_matches(tmp_path / "out.txt", folder / "cmusen_vc_result_prec17.txt")
+
+
+def _scene_spheres(scene: Path, prefix: str) -> tuple[np.ndarray, np.ndarray]:
+    radius, mass = [], []
+    for line in scene.read_text().splitlines():
+        tok = line.split()
+        if tok[0] == "0" and tok[3] == "1":
+            r, mat = float(tok[5]), tok[8]
+            rho = DENSITY[mat] if mat == "MGLASS" else DENSITY[mat][prefix]
+            radius.append(r)
+            mass.append(rho * 4.0 / 3.0 * math.pi * r ** 3)
+    return np.array(radius), np.array(mass)
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_force_is_the_numpy_law(tmp_path, case):
+    """Saving every step: the force fibrelmp saves at step k (MUSEN's: the evaluation before
+    it, at the state saved at step k - 1) is the numpy law at that state plus m g."""
+    styles_or_skip()
+    folder, prefix, params, _, g = CASES[case]
+    job = _job(tmp_path, case)
+    text = job.read_text()
+    dt = 1e-4 if prefix == "vf" else 5e-5
+    text = text.replace("SAVING_STEP          " + ("2e-3" if prefix == "vf" else "1e-3"),
+                        f"SAVING_STEP          {dt}")
+    text = text.replace("END_TIME             " + ("4e-2" if prefix == "vf" else "2e-2"),
+                        f"END_TIME             {60 * dt}")
+    job.write_text(text)
+    python_api.run(job, work=tmp_path / "work")
+    ours = read_time_points(tmp_path / f"{prefix}_result_prec17.txt")
+    assert len(ours.times) == 61
+    r, m = _scene_spheres(tmp_path / f"{prefix}_scene.txt", prefix)
+    x, v, f = ours.fields[COORD], ours.fields[VEL], ours.fields[FORCE]
+    for k in range(2, len(ours.times)):
+        expected = field_force(case, r, m, x[k - 1], v[k - 1]) + m[:, None] * np.array(g)
+        scale = np.abs(expected).max()
+        np.testing.assert_allclose(f[k], expected, rtol=0, atol=1e-12 * scale, err_msg=f"step {k}")
+
+
+def test_later_ef_models_are_written_to_the_mdem_result(tmp_path):
+    """fibrelmp's .mdem result stores both EF models, in cmusen's order, with their parameters."""
+    styles_or_skip()
+    from fibrelmp.translate.musen.mdem.document import MdemFile
+
+    job = _job(tmp_path, "both")
+    python_api.run(job, work=tmp_path / "work")
+    with MdemFile(tmp_path / "vc_result.mdem") as mdem:
+        models = [(m.path, m.params.split()) for m in mdem.storage.modules_data.model_manager.models]
+    assert [name for name, _ in models] == ["ModelPPHertzMindlin", "ModelEFCentrifugalCasting",
+                                            "ModelEFViscousField"]
+    assert models[2][1] == ["MEDIUM_VISCOSITY", "1e-06", "MEDIUM_DENSITY", "1000"]
+
+
+@pytest.mark.parametrize("params,word", [
+    ("MEDIUM_VISCOSITY 0 MEDIUM_DENSITY 1000", "MEDIUM_VISCOSITY"),
+    ("MEDIUM_VISCOSITY 1e-6 MEDIUM_DENSITY -1", "MEDIUM_DENSITY")])
+def test_bad_viscous_parameter_is_an_input_error(tmp_path, params, word):
+    styles_or_skip()
+    job = _job(tmp_path, "viscous", params)
+    with pytest.raises(InputError, match=rf"ModelEFViscousField parameter {word}") as err:
+        python_api.run(job)
+    assert str(err.value).startswith(f"{job}:12: ")
+    assert not (tmp_path / "vf_init.mdem").exists()
+
+
+def test_bad_centrifugal_parameter_is_an_input_error(tmp_path):
+    styles_or_skip()
+    job = _job(tmp_path, "centrifugal", CC_PARAMS.replace("0.01", "-0.01"))
+    with pytest.raises(InputError, match=r"ModelEFCentrifugalCasting parameter LIQUID_VISCOSITY"):
+        python_api.run(job)
+
+
+@pytest.mark.parametrize("name,words", [
+    ("ModelEFHeatTransfer", "simulates no particle temperature"),
+    ("ModelEFLiquidDiffusion", "does not reproduce")])
+def test_thermal_and_random_models_are_refused_with_the_reason(tmp_path, name, words):
+    job = _job(tmp_path, "viscous")
+    job.write_text(job.read_text().replace("ModelEFViscousField", name).replace(VF_PARAMS, ""))
+    with pytest.raises(InputError, match=words) as err:
+        python_api.run(job)
+    assert str(err.value).startswith(f"{job}:11: {name}: this external-force model is not supported")
+    assert "fibrelmp translates ModelEFCentrifugalCasting (with fibrelmp's LAMMPS styles) and " \
+           "ModelEFViscousField (with fibrelmp's LAMMPS styles)" in str(err.value)
+
+
+@needs_cmusen
+@pytest.mark.parametrize("case", list(CASES))
+def test_reference_is_cmusens_output(tmp_path, case):
+    folder, prefix, _, _, _ = CASES[case]
+    check_reference_is_cmusens_output(tmp_path, MODELS / folder, prefix)
+
+
+@pytest.mark.parametrize("case,line", [("viscous", 11), ("centrifugal", 11)])
+def test_refused_without_fibrelmps_styles(tmp_path, case, line):
+    folder, prefix, _, _, _ = CASES[case]
+    name = "ModelEFViscousField" if case == "viscous" else "ModelEFCentrifugalCasting"
+    check_refused_without_styles(_job(tmp_path, case), name, line, tmp_path / f"{prefix}_init.mdem")

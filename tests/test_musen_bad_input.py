@@ -250,10 +250,11 @@ APPLY_ERRORS = [  # script, line, words: parsed fine, refused when the job is ap
      "ModelSBElastic and ModelSBKelvin (with fibrelmp's LAMMPS styles)"),
     (GOOD.replace("ModelSBElastic", "ModelSBPlasticConcrete"), 3, "ModelSBPlasticConcrete: this "
      "solid-bond model is not supported; fibrelmp translates ModelSBElastic and ModelSBKelvin"),
-    (GOOD + "MODEL_EF ModelEFHeatTransfer\nMODEL_EF_PARAMS HEATING_TIME 2\n", 7,
-     "external-force model is not supported (it heats or cools each particle by convection and "
-     "radiation from the surrounding air, and fibrelmp simulates no particle temperature); "
-     "fibrelmp translates ModelEFCentrifugalCasting (with fibrelmp's LAMMPS styles) and "
+    (GOOD + "MODEL_EF ModelEFLiquidDiffusion\nMODEL_EF_PARAMS TEMPERATURE 350\n", 7,
+     "external-force model is not supported (its Brownian force draws from a std::mt19937_64 per "
+     "particle (seeded from the clock unless FIXED_SEED 1) and follows an annealing temperature "
+     "schedule, which fibrelmp does not reproduce); fibrelmp translates ModelEFCentrifugalCasting "
+     "(with fibrelmp's LAMMPS styles) and ModelEFHeatTransfer (with fibrelmp's LAMMPS styles) and "
      "ModelEFViscousField (with fibrelmp's LAMMPS styles)"),
     (GOOD.replace("ModelPPHertzMindlin", "ModelPPHertzMindlln"), 1, "did you mean ModelPPHertzMindlin?"),
     (GOOD.replace("MODEL_PW ModelPWHertzMindlin", "MODEL_PW ModelPPHertz"), 2,
@@ -378,9 +379,9 @@ def test_check_reads_model_params_after_a_refused_model(tmp_path):
     (tmp_path / "scene.txt").write_bytes((corpus / "scene.txt").read_bytes())
     good = (corpus / "good.txt").read_text()
     assert "MODEL_SB" in good and "MODEL_EF" not in good
-    extra = ("MODEL_EF ModelEFHeatTransfer\nMODEL_EF_PARAMS HEATING_TIME 2\n"
+    extra = ("MODEL_EF ModelEFLiquidDiffusion\nMODEL_EF_PARAMS TEMPERATURE 350\n"
              "MODEL_LB ModelLBCapilarViscous\nMODEL_LB_PARAMS MIN_THICKNESS 1e-5\n"
-             "MODEL_EXT_FORCE_PARAMS SCALING_FACTOR 1\nMODEL_SB_PARAMS CONSIDER_BREAKAGE 7\n")
+             "MODEL_EXT_FORCE_PARAMS STOKES_FACTOR 1\nMODEL_SB_PARAMS CONSIDER_BREAKAGE 7\n")
     (tmp_path / "job.txt").write_text(good + extra)
     n = good.count("\n")
     result = CliRunner().invoke(app, ["check", str(tmp_path / "job.txt")])
@@ -388,10 +389,12 @@ def test_check_reads_model_params_after_a_refused_model(tmp_path):
     errors = [line.split("job.txt", 1)[1] for line in result.stderr.splitlines()
               if line.startswith("error:")]
     assert errors == [
-        f":{n + 1}: ModelEFHeatTransfer: this external-force model is not supported (it heats or "
-        "cools each particle by convection and radiation from the surrounding air, and fibrelmp "
-        "simulates no particle temperature); fibrelmp translates ModelEFCentrifugalCasting "
-        "(with fibrelmp's LAMMPS styles) and ModelEFViscousField (with fibrelmp's LAMMPS styles)",
+        f":{n + 1}: ModelEFLiquidDiffusion: this external-force model is not supported (its "
+        "Brownian force draws from a std::mt19937_64 per particle (seeded from the clock unless "
+        "FIXED_SEED 1) and follows an annealing temperature schedule, which fibrelmp does not "
+        "reproduce); fibrelmp translates ModelEFCentrifugalCasting (with fibrelmp's LAMMPS "
+        "styles) and ModelEFHeatTransfer (with fibrelmp's LAMMPS styles) and ModelEFViscousField "
+        "(with fibrelmp's LAMMPS styles)",
         f":{n + 3}: ModelLBCapilarViscous: this liquid-bond model is not supported; fibrelmp "
         "translates no liquid-bond model",
         f":{n + 6}: CONSIDER_BREAKAGE must be 0, 1 or 2 (got 7)"], result.stderr

@@ -31,6 +31,7 @@ from fibrelmp.translate.granular.reach import Travel, speed_bound
 from fibrelmp.translate.granular.musen_clock import MusenClock
 from fibrelmp.translate.granular.schedule import (STOP_LABEL, RunTime, compress_ids, run_time, save_steps,
                                                   schedule, with_stop_criterion)
+from fibrelmp.translate.granular.fields import TEMPERATURE, field_commands, uses_temperature
 from fibrelmp.translate.granular.inlets import LOG_NAME as INLET_LOG
 from fibrelmp.translate.granular.inlets import inlet_commands
 from fibrelmp.translate.granular.spheres import SimulatedSpheres, select_spheres
@@ -248,6 +249,8 @@ def _plan_parts(model: GranularModel) -> _JobParts:
     pp_model, pp_params = physics.chosen(model, "PP")
     sb_model = physics.solid_bond_model(plan)
     wall_cmds, var_cmds, frame_columns = wall_commands(model, wall_plans, spheres, dt)
+    if uses_temperature(model):
+        frame_columns.append(TEMPERATURE)
     if model.plan.inlets and not musen_hm:
         raise InputError(model.source, None, "MUSEN's dynamic generators need fibrelmp's LAMMPS "
                          f"styles (fix musen/inlet): {styles.how}")
@@ -315,7 +318,8 @@ def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> 
         walls=[(wp.name, wp.description) for wp in parts.wall_plans],
         mesh_fix=MESH_FIX if len(parts.mesh) else None, mesh_forces_name=MESH_FORCES_NAME,
         contacts_name=CONTACTS_NAME, velocity_limit=plan.velocity_limit, pbc_velocity=pbc_velocity,
-        musen_integrator=parts.musen_hm, fields=plan.external_fields,
+        musen_integrator=parts.musen_hm,
+        fields=field_commands(model, spheres.rows, spheres.type_of_mat, parts.ntypes),
         thermo_every=min(saves.period or 0, 2 ** 31 - 1),      # thermo N is a C int
         stop_label=STOP_LABEL,
     )

@@ -24,8 +24,6 @@ KIND_NOUNS = {"PP": "particle-particle law", "PW": "particle-wall law", "SB": "s
 
 # why fibrelmp refuses a MUSEN model it does not translate, where more can be said than that
 UNTRANSLATED_WHY = {
-    "ModelEFHeatTransfer": "it heats or cools each particle by convection and radiation from "
-                           "the surrounding air, and fibrelmp simulates no particle temperature",
     "ModelEFLiquidDiffusion": "its Brownian force draws from a std::mt19937_64 per particle "
                               "(seeded from the clock unless FIXED_SEED 1) and follows an "
                               "annealing temperature schedule, which fibrelmp does not reproduce",

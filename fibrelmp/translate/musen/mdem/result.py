@@ -32,6 +32,7 @@ SPHERE_FIELDS = tp.bit("coord", "vel", "angle_vel", "force", "quaternion")
 BOND_FIELDS = tp.bit("force", "angle_vel", "total_torque")
 WALL_FIELDS = tp.bit("coord", "vel", "angle_vel", "force", "quaternion")
 _Q = tp.FIELDS["quaternion"][1]
+_T = tp.FIELDS["temperature"][1]
 _TORQUE = tp.FIELDS["total_torque"][1]
 
 
@@ -84,6 +85,9 @@ class MdemResultWriter(MusenResultWriter):
         values[ids, 18:21] = np.asarray(saved, np.float64).reshape(-1, 3)
         values[ids, _Q:_Q + 4] = frame.quaternion
         masks[ids] = SPHERE_FIELDS
+        if frame.temperature is not None:      # a heat model ran (MUSEN saves it then)
+            values[ids, _T] = frame.temperature
+            masks[ids] |= tp.bit("temperature")
         if self.bond_ids is not None:
             alive = (np.ones(len(self.bond_ids), bool) if frame.bond_alive is None
                      else np.asarray(frame.bond_alive, bool))

@@ -194,6 +194,7 @@ class ExternalField:
     # the law changes the spheres' temperature (then the job adds `cp` and each type's heat
     # capacity to fix_args and keeps the temperature in d_musen_temperature)
     heat: bool = False
+    style: str = "musen/field"      # its LAMMPS fix style
 
 
 @dataclass

@@ -1,5 +1,6 @@
-"""MUSEN's external-force models ModelEFViscousField, ModelEFCentrifugalCasting and
-ModelEFHeatTransfer (translate/granular/models/ef_*.py, fibrelmp's ``fix musen/field``) against
+"""MUSEN's external-force models ModelEFViscousField, ModelEFCentrifugalCasting,
+ModelEFHeatTransfer (translate/granular/models/ef_*.py, fibrelmp's ``fix musen/field``) and
+ModelEFLiquidDiffusion (``fix musen/diffusion``, MUSEN's random numbers) against
 the real cmusen: free spheres in each field and in two together, from a job script's MODEL_EF
 lines and from a .mdem's stored models (tests/data/real-outputs/musen/models/ef_*/README.md);
 and the laws against an independent numpy version of MUSEN's formulas.  The opt-in tests
@@ -39,9 +40,13 @@ CASES = {
              ["musen/field centrifugal 10.0 1000.0 0.01", "musen/field viscous 1e-06 1000.0"],
              (0.0, -9.81, 0.0)),
 }
+LD_PARAMS = ("TEMPERATURE 310 DYN_VISCOSITY_OF_LIQUID 0.001 STOKES_FACTOR 1.2 HYDR_SHELL 1e-7 "
+             "FIXED_SEED 12345 ORIENT_SWITCH 1")
+DIFFUSION = ("ef_liquid_diffusion", "ld", LD_PARAMS, ["musen/diffusion 310.0 0.001 1.2 1e-07 12345 1"],
+             (0.0, 0.0, 0.0))
 HEAT = ("ef_heat_transfer", "ht", HT_PARAMS,
         ["musen/field heat 400.0 1000.0 0.01 30000.0 5e-06 1.5 cp 840.0 1500.0"], (0.0, 0.0, -9.81))
-DENSITY = {"MGLASS": 2500.0, "MLIGHT": {"vf": 1200.0, "cc": 800.0, "vc": 800.0, "ht": 800.0}}
+DENSITY = {"MGLASS": 2500.0, "MLIGHT": {"vf": 1200.0, "cc": 800.0, "vc": 800.0, "ht": 800.0, "ld": 1000.0}}
 HEAT_CAPACITY = {"MGLASS": 840.0, "MLIGHT": 1500.0}          # the heat case's materials
 
 
@@ -117,7 +122,7 @@ def test_centrifugal_law_signs():
 # ---- runs --------------------------------------------------------------------------------
 
 def _job(tmp_path: Path, case: str, params: str | None = None) -> Path:
-    folder, prefix, old, _, _ = HEAT if case == "heat" else CASES[case]
+    folder, prefix, old, _, _ = {"heat": HEAT, "diffusion": DIFFUSION}.get(case) or CASES[case]
     return model_job(tmp_path, MODELS / folder, prefix, old, params)
 
 
@@ -265,30 +270,39 @@ def test_bad_centrifugal_parameter_is_an_input_error(tmp_path):
         python_api.run(job)
 
 
-def test_random_model_is_refused_with_the_reason(tmp_path):
-    job = _job(tmp_path, "viscous")
-    name = "ModelEFLiquidDiffusion"
-    job.write_text(job.read_text().replace("ModelEFViscousField", name).replace(VF_PARAMS, ""))
-    with pytest.raises(InputError, match="does not reproduce") as err:
+@pytest.mark.parametrize("change,words", [
+    ("FIXED_SEED 12345", "without FIXED_SEED MUSEN seeds its generators from std::random_device"),
+    ("FIXED_SEED 12345 ANNEALING_TYPE 1", "annealing"),
+    ("FIXED_SEED 12345 SHEAR_RATE 10", "shear flow"),
+    ("FIXED_SEED 12345 SAVE_FLAG 1", "SAVE_FLAG 1"),
+    ("FIXED_SEED 12345", None)])
+def test_diffusion_settings_it_cannot_reproduce_are_refused(tmp_path, change, words):
+    job = _job(tmp_path, "diffusion")
+    if words is None:      # spheres that are not MUSEN's objects 0 .. n-1
+        scene = tmp_path / "ld_scene.txt"
+        scene.write_text(scene.read_text().replace("0 0 1 1 5 1e-06", "0 7 1 1 5 1e-06"))
+        words = "objects 0 .. n-1"
+    else:
+        job.write_text(job.read_text().replace("FIXED_SEED 12345", change.replace("FIXED_SEED 12345", "")
+                                               if words.startswith("without") else change))
+    with pytest.raises(InputError, match=words) as err:
         python_api.run(job)
-    assert str(err.value).startswith(f"{job}:11: {name}: this external-force model is not supported")
-    assert "fibrelmp translates ModelEFCentrifugalCasting (with fibrelmp's LAMMPS styles) and " \
-           "ModelEFHeatTransfer (with fibrelmp's LAMMPS styles) and ModelEFViscousField (with " \
-           "fibrelmp's LAMMPS styles)" in str(err.value)
+    assert "ModelEFLiquidDiffusion" in str(err.value)
 
 
 @needs_cmusen
-@pytest.mark.parametrize("case", [*CASES, "heat"])
+@pytest.mark.parametrize("case", [*CASES, "heat", "diffusion"])
 def test_reference_is_cmusens_output(tmp_path, case):
-    folder, prefix, _, _, _ = HEAT if case == "heat" else CASES[case]
+    folder, prefix, _, _, _ = {"heat": HEAT, "diffusion": DIFFUSION}.get(case) or CASES[case]
     check_reference_is_cmusens_output(tmp_path, MODELS / folder, prefix)
 
 
-@pytest.mark.parametrize("case,line", [("viscous", 11), ("centrifugal", 11), ("heat", 11)])
+@pytest.mark.parametrize("case,line", [("viscous", 11), ("centrifugal", 11), ("heat", 11),
+                                       ("diffusion", 11)])
 def test_refused_without_fibrelmps_styles(tmp_path, case, line):
-    folder, prefix, _, _, _ = HEAT if case == "heat" else CASES[case]
+    folder, prefix, _, _, _ = {"heat": HEAT, "diffusion": DIFFUSION}.get(case) or CASES[case]
     name = {"viscous": "ModelEFViscousField", "centrifugal": "ModelEFCentrifugalCasting",
-            "heat": "ModelEFHeatTransfer"}[case]
+            "heat": "ModelEFHeatTransfer", "diffusion": "ModelEFLiquidDiffusion"}[case]
     check_refused_without_styles(_job(tmp_path, case), name, line, tmp_path / f"{prefix}_init.mdem")
 
 
@@ -366,3 +380,67 @@ def test_heat_needs_the_materials_heat_capacity(tmp_path):
     with pytest.raises(InputError, match=r"material MLIGHT \(Light\): the heat model needs its "
                                          r"heat capacity \(property 1\) > 0"):
         python_api.run(job)
+
+
+# ---- ModelEFLiquidDiffusion: MUSEN's random numbers ------------------------------------------
+
+def _displacements(path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    tp = read_time_points(path)
+    return tp.fields[COORD] - tp.fields[COORD][0], tp.fields[VEL], tp.fields[ANGVEL]
+
+
+def test_brownian_spheres_are_cmusens(tmp_path):
+    """With FIXED_SEED fibrelmp draws MUSEN's numbers: displacements (5 nm), velocities and
+    spins (all from the random forces and torques) at every saved time; another seed gives
+    other motion."""
+    styles_or_skip()
+    folder, prefix, _, fixes, _ = DIFFUSION
+    python_api.run(_job(tmp_path, "diffusion"), work=tmp_path / "work")
+    script = (tmp_path / "work" / "job2" / "in.lammps").read_text()
+    assert [ln.split(None, 3)[3] for ln in script.splitlines() if ln.startswith("fix")
+            and "musen/diffusion" in ln] == fixes
+    reference = MODELS / folder / f"cmusen_{prefix}_result_prec17.txt"
+    _assert_matches(tmp_path / f"{prefix}_result_prec17.txt", reference)
+    theirs = _displacements(reference)
+    for ours_q, theirs_q in zip(_displacements(tmp_path / f"{prefix}_result_prec17.txt"), theirs):
+        np.testing.assert_allclose(ours_q, theirs_q, rtol=0, atol=1e-10 * np.abs(theirs_q).max())
+    other = tmp_path / "other"
+    other.mkdir()
+    python_api.run(_job(other, "diffusion", LD_PARAMS.replace("12345", "54321")), work=other / "work")
+    ours = _displacements(other / f"{prefix}_result_prec17.txt")
+    for k in (0, 2):     # displacements and spins are the random numbers'
+        assert np.abs(ours[k] - theirs[k]).max() > 0.3 * np.abs(theirs[k]).max()
+
+
+def test_diffusion_drag_is_the_numpy_law(tmp_path):
+    """Without the random part (T = 1e-60 K), MUSEN's drag coefficients m/dt (1 - e^-a),
+    a = 6 pi mu r_s dt / m (8 pi mu r_s^3 dt / I for the spin), in MUSEN's scheme (a half step
+    at t = 0, then one per step): v_k = v0 (1 - c/2)(1 - c)^k with c = 1 - e^-a."""
+    styles_or_skip()
+    folder, prefix = DIFFUSION[:2]
+    python_api.run(_job(tmp_path, "diffusion", LD_PARAMS.replace("TEMPERATURE 310", "TEMPERATURE 1e-60")),
+                   work=tmp_path / "work")
+    tp = read_time_points(tmp_path / f"{prefix}_result_prec17.txt")
+    scene = read_time_points(MODELS / folder / f"{prefix}_scene.txt")
+    r, m = _scene_spheres(MODELS / folder / f"{prefix}_scene.txt", prefix)
+    dt, rs = 1e-7, 1.2 * r + 1e-7
+    lin = 1 - np.exp(-6 * math.pi * 1e-3 * rs * dt / m)
+    rot = 1 - np.exp(-8 * math.pi * 1e-3 * rs ** 3 * dt / (0.4 * m * r ** 2))
+    steps = np.rint(tp.times / dt)
+    for tag, c in ((VEL, lin), (ANGVEL, rot)):
+        v0 = scene.fields[tag][0]
+        expected = v0[None] * ((1 - c / 2)[None] * (1 - c)[None] ** steps[:, None])[:, :, None]
+        expected[0] = v0
+        np.testing.assert_allclose(tp.fields[tag], expected, rtol=1e-12, atol=1e-12 * np.abs(v0).max())
+
+
+def test_diffusion_checkpoint_and_resume_give_the_uninterrupted_run(tmp_path, monkeypatch):
+    """Each sphere's generator is re-seeded and advanced from the restart file."""
+    styles_or_skip()
+    whole, cut = tmp_path / "whole", tmp_path / "cut"
+    whole.mkdir()
+    cut.mkdir()
+    python_api.run(_job(whole, "diffusion"), work=whole / "work")
+    run_cut_and_resumed(monkeypatch, _job(cut, "diffusion"), cut / "work", 130)
+    name = "ld_result_prec17.txt"
+    assert (cut / name).read_bytes() == (whole / name).read_bytes()

@@ -26,7 +26,7 @@ def uses_temperature(model: GranularModel) -> bool:
 class FieldCommands:
     temperature: bool                  # a heat model: fix property/atom d_musen_temperature
     set_lines: list[str]               # the scene's temperatures
-    fixes: list[tuple[str, str]]       # each EF model's (name, fix musen/field arguments)
+    fixes: list[tuple[str, str, str]]  # each EF model's (name, fix style, its arguments)
 
 
 def field_commands(model: GranularModel, rows: np.ndarray, type_of_mat: dict[int, int],
@@ -40,8 +40,22 @@ def field_commands(model: GranularModel, rows: np.ndarray, type_of_mat: dict[int
         args = fld.fix_args
         if fld.heat:
             args += " cp " + " ".join(float_text(c) for c in _heat_capacities(model, type_of_mat, ntypes))
-        fixes.append((fld.model, args))
+        if fld.style == "musen/diffusion":
+            _check_diffusion(model, rows)
+        fixes.append((fld.model, fld.style, args))
     return FieldCommands(heat, lines, fixes)
+
+
+def _check_diffusion(model: GranularModel, rows: np.ndarray) -> None:
+    """ModelEFLiquidDiffusion seeds particle i's generator with MUSEN's i-th seed and reads
+    its coefficients at the particle's object id: the same sphere only when the spheres are
+    objects 0 .. n-1, all simulated, in id order (fix musen/diffusion takes atom ID - 1)."""
+    sp = model.spheres
+    if not np.array_equal(sp.ids, np.arange(sp.count)) or len(rows) != sp.count or model.plan.inlets:
+        raise InputError(model.source, None, "ModelEFLiquidDiffusion needs the spheres to be "
+                         "objects 0 .. n-1, in that order, all simulated from the start and no "
+                         "dynamic generators (MUSEN indexes its generators and coefficients by "
+                         "these numbers)")
 
 
 def _heat_capacities(model: GranularModel, type_of_mat: dict[int, int], ntypes: int) -> list[float]:

@@ -23,11 +23,7 @@ KIND_NOUNS = {"PP": "particle-particle law", "PW": "particle-wall law", "SB": "s
               "LB": "liquid bond", "EF": "external force"}
 
 # why fibrelmp refuses a MUSEN model it does not translate, where more can be said than that
-UNTRANSLATED_WHY = {
-    "ModelEFLiquidDiffusion": "its Brownian force draws from a std::mt19937_64 per particle "
-                              "(seeded from the clock unless FIXED_SEED 1) and follows an "
-                              "annealing temperature schedule, which fibrelmp does not reproduce",
-}
+UNTRANSLATED_WHY: dict[str, str] = {}
 
 _REGISTRY: dict[str, type[PhysicsModel]] = {}
 _loaded = False

@@ -152,6 +152,19 @@ def test_free_spheres_in_the_field_are_cmusens(tmp_path, case):
     assert np.abs(theirs.fields[VEL] - free).max() > 0.05 * np.abs(theirs.fields[VEL]).max()
 
 
+def test_collision_in_the_field_is_cmusens(tmp_path):
+    """Two spheres colliding in the viscous field: MUSEN adds the field's force first, then
+    the contact's, then gravity; positions, velocities and spins agree at every saved time,
+    through the contact (measured: bit for bit)."""
+    styles_or_skip()
+    folder = MODELS / "ef_viscous_field"
+    python_api.run(model_job(tmp_path, folder, "vfc", VF_PARAMS), work=tmp_path / "work")
+    theirs = read_time_points(folder / "cmusen_vfc_result_prec17.txt")
+    assert theirs.fields[VEL][0, 0, 0] == 0.3 and theirs.fields[VEL][-1, 0, 0] < -0.15    # bounced
+    _assert_matches(tmp_path / "vfc_result_prec17.txt", folder / "cmusen_vfc_result_prec17.txt",
+                    rel=1e-13)
+
+
 def test_stored_models_of_a_mdem_act(tmp_path):
     """cmusen's own .mdem result of the two-field run stores both models: run as a scene it
     runs them (its settings, first time point) as cmusen did."""
@@ -444,3 +457,8 @@ def test_diffusion_checkpoint_and_resume_give_the_uninterrupted_run(tmp_path, mo
     run_cut_and_resumed(monkeypatch, _job(cut, "diffusion"), cut / "work", 130)
     name = "ld_result_prec17.txt"
     assert (cut / name).read_bytes() == (whole / name).read_bytes()
+
+
+@needs_cmusen
+def test_collision_reference_is_cmusens_output(tmp_path):
+    check_reference_is_cmusens_output(tmp_path, MODELS / "ef_viscous_field", "vfc")

@@ -462,3 +462,10 @@ def test_diffusion_checkpoint_and_resume_give_the_uninterrupted_run(tmp_path, mo
 @needs_cmusen
 def test_collision_reference_is_cmusens_output(tmp_path):
     check_reference_is_cmusens_output(tmp_path, MODELS / "ef_viscous_field", "vfc")
+
+
+def test_check_lists_the_fields_in_order(tmp_path):
+    lines = python_api.check(_job(tmp_path, "both")).lines
+    assert [ln for ln in lines if ln.startswith("field")] == [
+        "field        ModelEFCentrifugalCasting: musen/field centrifugal 10.0 1000.0 0.01",
+        "field        ModelEFViscousField: musen/field viscous 1e-06 1000.0"]

@@ -419,10 +419,17 @@ def test_brownian_spheres_are_cmusens(tmp_path):
         np.testing.assert_allclose(ours_q, theirs_q, rtol=0, atol=1e-10 * np.abs(theirs_q).max())
     other = tmp_path / "other"
     other.mkdir()
-    python_api.run(_job(other, "diffusion", LD_PARAMS.replace("12345", "54321")), work=other / "work")
+    python_api.run(_job(other, "diffusion", LD_PARAMS.replace("12345", "1234567891")),
+                   work=other / "work")
     ours = _displacements(other / f"{prefix}_result_prec17.txt")
     for k in (0, 2):     # displacements and spins are the random numbers'
         assert np.abs(ours[k] - theirs[k]).max() > 0.3 * np.abs(theirs[k]).max()
+    # the .mdem result keeps the seed's every digit (%g would store 1.23457e+09)
+    from fibrelmp.translate.musen.mdem.document import MdemFile
+
+    with MdemFile(other / "ld_result.mdem") as mdem:
+        stored = {m.path: m.params for m in mdem.storage.modules_data.model_manager.models}
+    assert " FIXED_SEED 1234567891.0 " in " " + stored["ModelEFLiquidDiffusion"]
 
 
 def test_diffusion_drag_is_the_numpy_law(tmp_path):

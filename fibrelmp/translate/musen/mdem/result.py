@@ -259,7 +259,7 @@ class MdemResultWriter(MusenResultWriter):
                 entry = manager.models.add()
                 entry.key = mdem_key(choice.name)
                 entry.path = choice.name
-                entry.params = "".join(f"{k} {v:g} " for k, v in choice.parameters.items())
+                entry.params = _params_text(choice.parameters)
                 if kind == "SB":    # the later SB models, which act after it (cmusen's order)
                     for law in plan.then_bond_laws:
                         entry = manager.models.add()
@@ -270,10 +270,16 @@ class MdemResultWriter(MusenResultWriter):
                     for fld in plan.external_fields[1:]:
                         entry = manager.models.add()
                         entry.key, entry.path = mdem_key(fld.model), fld.model
-                        entry.params = "".join(f"{k} {v:g} " for k, v in fld.parameters.items())
+                        entry.params = _params_text(fld.parameters)
             manager.connected_pp_contact = bool(plan.contacts_between_bonded)
 
 
+
+
+def _params_text(params: dict[str, float]) -> str:
+    """A model's parameters as MUSEN stores them ("NAME value " each): %g, or every digit
+    where %g would change the value (a seed, a fine viscosity)."""
+    return "".join(f"{k} {v:g} " if float(f"{v:g}") == v else f"{k} {v!r} " for k, v in params.items())
 
 
 def _replace_property(props: Any, pid: int, value: float, set_constant) -> None:

@@ -476,3 +476,23 @@ def test_check_lists_the_fields_in_order(tmp_path):
     assert [ln for ln in lines if ln.startswith("field")] == [
         "field        ModelEFCentrifugalCasting: musen/field centrifugal 10.0 1000.0 0.01",
         "field        ModelEFViscousField: musen/field viscous 1e-06 1000.0"]
+
+
+@needs_cmusen
+def test_cmusen_runs_both_fields_of_fibrelmps_mdem(tmp_path):
+    """The real cmusen reads fibrelmp's .mdem result: both EF models, their parameters, in order."""
+    import subprocess
+
+    from .musen_model_checks import CMUSEN
+
+    styles_or_skip()
+    python_api.run(_job(tmp_path, "both"), work=tmp_path / "work")
+    (tmp_path / "again.txt").write_text("JOB\nSOURCE_FILE ./vc_result.mdem\nRESULT_FILE ./again.mdem\n"
+                                        "COMPONENT SIMULATOR\nSIMULATOR_TYPE CPU\nSIMULATION_STEP 5e-5\n"
+                                        "SAVING_STEP 1e-3\nEND_TIME 1e-3\n")
+    done = subprocess.run([CMUSEN, "-t=1", "-s=again.txt"], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=300)
+    assert done.returncode == 0 and "Error:" not in done.stdout, done.stdout + done.stderr
+    assert ("External force:                        Centrifugal Casting\n\tROTATION_VELOCITY 10 "
+            "LIQUID_DENSITY 1000 LIQUID_VISCOSITY 0.01 \nExternal force:                        "
+            "Viscous Field\n\tMEDIUM_VISCOSITY 1e-06 MEDIUM_DENSITY 1000 \n") in done.stdout

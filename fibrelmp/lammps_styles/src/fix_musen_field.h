@@ -34,7 +34,8 @@
    force in pre_force (and setup_pre_force), which LAMMPS calls right after clearing the
    forces and before the pair, bond and fix post_force (gravity, walls) forces, with x and v
    of that evaluation.  Several such fixes act in the order they are defined (MUSEN: its EF
-   models in the model manager's order).  The field adds no torque and keeps no state.
+   models in the model manager's order).  No law adds torque; only heat keeps a per-atom
+   value between evaluations (the last flux), which any set-up recomputes.
 ------------------------------------------------------------------------- */
 
 #ifndef FIBRELMP_FIX_MUSEN_FIELD_H

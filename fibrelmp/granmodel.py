@@ -68,10 +68,28 @@ class SolidBondLaw:
     module in translate/granular/models that set it) and the form ``granular.bonds`` renders."""
 
     model: str | None = None   # MUSEN's name, e.g. "ModelSBKelvin" (None: no SB model chosen)
-    form: str = "elastic"      # "elastic" (ModelSBElastic) | "kelvin" (ModelSBKelvin)
+    # "elastic" (ModelSBElastic) | "kelvin" (ModelSBKelvin) | "plastic"
+    # (ModelSBElasticPerfectlyPlastic) | "linear_plastic" (ModelSBLinearPlastic) | "creep"
+    # (ModelSBCreep) | "weakening" (ModelSBWeakening) | "aerogel" (ModelSBAerogel) | "concrete"
+    # (ModelSBPlasticConcrete)
+    form: str = "elastic"
     max_damp_ratio: float = 1.0   # ModelSBKelvin's MAX_DAMP_RATIO (0: no cap)
-    breakage: int = 1          # its CONSIDER_BREAKAGE (a later law's; the first law's is the
-                               # plan's bond_breakage)
+    breakage: int = 1          # its stress criterion, CONSIDER_BREAKAGE (a later law's; the
+                               # first law's is the plan's bond_breakage)
+    # the model's parameters as MUSEN names them (the .mdem model manager; the plastic laws'
+    # bond_style words)
+    parameters: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def breaks_anyway(self) -> bool:
+        """Whether the law breaks bonds whatever its stress criterion: the plastic and creep
+        laws test a fracture strain in tension, the aerogel law its force."""
+        return self.form in ("plastic", "creep", "aerogel")
+
+    @property
+    def needs_yield(self) -> bool:
+        """Whether the law uses the bond material's yield strength (property 15)."""
+        return self.form in ("plastic", "creep", "weakening", "concrete")
 
 
 @dataclass
@@ -236,11 +254,16 @@ class GranularPlan:
 
     def bonds_may_break(self) -> bool:
         """Whether any of the solid bonds' laws has a breakage criterion."""
-        return int(self.bond_breakage) != 0 or any(law.breakage for law in self.then_bond_laws)
+        return (int(self.bond_breakage) != 0 or self.bond_law.breaks_anyway
+                or any(law.breakage or law.breaks_anyway for law in self.then_bond_laws))
 
     def bond_laws_use(self, form: str) -> bool:
-        """Whether any of the solid bonds' laws is ``form`` ("elastic" | "kelvin")."""
+        """Whether any of the solid bonds' laws is ``form`` (SolidBondLaw.form)."""
         return any(law.form == form for law in (self.bond_law, *self.then_bond_laws))
+
+    def bond_laws_need_yield(self) -> bool:
+        """Whether any of the solid bonds' laws uses the yield strength."""
+        return any(law.needs_yield for law in (self.bond_law, *self.then_bond_laws))
 
 
 class SourceRecord:

@@ -5,7 +5,7 @@ Where stock LAMMPS cannot express a source code's law, fibrelmp writes it as a L
 
 ==========================  =============================================================
 ``pair musen/hm``           MUSEN Hertz-Mindlin particle-particle contact
-``bond musen/elastic``      MUSEN elastic (and Kelvin) solid bond, MUSEN's breakage criteria
+``bond musen/elastic``      MUSEN elastic, Kelvin and plastic solid bonds, MUSEN's breakage criteria
 ``fix musen/wall/mesh``     MUSEN particle-wall contact against moving triangle walls
 ``angle fibrenet``          FibreNet's bending law
 ``fix fibrenet/output``     FibreNet's xyz/restart files written by LAMMPS (with the

@@ -109,9 +109,8 @@ inline void cap_damping(double *damp, double elastic_length, double ratio)
 struct LawInput {
   const double *xl, *xr;    // left sphere, right sphere (the image closest to the left one)
   const double *vl, *vr, *wl, *wr;
-  double dt, E, G, mu;
-  int kelvin;
-  double max_damp_ratio;
+  double dt, E, G, mu, Y;   // Y: the bond type's yield strength (plastic, creep)
+  const BondMusenElastic::Law *law;
 };
 
 struct LawOutput {
@@ -121,18 +120,227 @@ struct LawOutput {
   double bond[3];       // left - right
   double strain;
   double normal_force_length;
-  double normal_scalar;    // -A E strain: the normal force along the unit bond vector
+  double normal_scalar;    // the normal force along the unit bond vector (-A E strain elastic)
   double tangential_force_length;
+  bool random_branch;      // weakening: MUSEN would draw rand() here (WEAKENING_FACTOR != 0)
+  bool aerogel_unbroken;   // aerogel: the bond was not in a broken state before this step
+  bool concrete_break;     // plastic concrete: a tension-side stress below 0 after yielding
 };
+
+/* ModelSBAerogel's normal force F (positive: tension; the vector -n F): elastic up to the
+   plastic strains PSC < 0 < PST, softening beyond them with SRC / SRT (eps_p the excess times
+   1 - SR); where the softened force changes sign the bond is "broken" in compression / tension
+   (H_BROKEN -1 / 1, MUSEN's TangentialPlasticStrain.x) and then only resists further
+   compression / tension with HRC / HRT from its furthest strain; a force above BST A E breaks
+   it (unbroken bonds only). */
+void aerogel_normal_force(const LawInput &in, double *h, bool advance, double strain,
+                          const double *currentContact, double A, double *normalForce,
+                          double &force_out)
+{
+  using B = BondMusenElastic;
+  const double *p = in.law->p;
+  double eps_p = h[B::H_PLASTIC];
+  double broken = h[B::H_BROKEN];
+  const double psc = -fabs(p[B::P_PSC]), pst = fabs(p[B::P_PST]);
+  const double KA = A * in.E;
+  double F = 0.;
+  if (fabs(broken) < 0.5) {
+    if ((strain < 0) && (strain < psc)) {
+      const double delta = (strain - psc);
+      F = psc * KA + delta * p[B::P_SRC] * KA;
+      eps_p = delta * (1 - p[B::P_SRC]);
+      if (F > 0) {
+        broken = -1.;
+        F = 0.;
+      }
+    } else if ((strain > 0) && (strain > pst)) {
+      const double delta = (strain - pst);
+      F = pst * KA + delta * p[B::P_SRT] * KA;
+      eps_p = delta * (1 - p[B::P_SRT]);
+      if (F < 0) {
+        broken = 1.;
+        F = 0.;
+      }
+    } else {
+      F = (strain - eps_p) * KA;
+    }
+  } else if (broken < -0.5) {
+    if (strain < eps_p) eps_p = strain;
+    F = KA * p[B::P_HRC] * (strain - eps_p);
+  } else if (broken > 0.5) {
+    if (strain > eps_p) eps_p = strain;
+    F = KA * p[B::P_HRT] * (strain - eps_p);
+  }
+  if (advance) {
+    h[B::H_PLASTIC] = eps_p;
+    h[B::H_BROKEN] = broken;
+  }
+  for (int k = 0; k < 3; k++) normalForce[k] = -1 * currentContact[k] * F;
+  force_out = F;
+}
+
+/* ModelSBPlasticConcrete's normal force n sigma A (MUSEN's sign: a stretched bond pushes its
+   spheres apart, kept), from the elastic strain strain - eps_p: in tension capped at
+   0.7 Y - 0.3 E eps_p (eps_p growing by the excess times 1.3 / E; the bond breaks, with
+   CONSIDER_BREAKAGE, when the stress is then below 0), in compression at -Y + 0.5 E eps_p
+   (eps_p moving by the excess times 0.5 / E). */
+void concrete_normal_force(const LawInput &in, double *h, bool advance, double strain,
+                           const double *currentContact, double A, double *normalForce,
+                           double &stress_out, bool &breaks)
+{
+  using B = BondMusenElastic;
+  const double compr_yield = -in.Y, tens_yield = 0.7 * in.Y;
+  const double beta = 0.5, alpha = 0.3, Kn = in.E;
+  double eps_p = h[B::H_PLASTIC];
+  double elastic = strain - eps_p;
+  double stress;
+  if (elastic >= 0) {    // tension
+    stress = elastic * in.E;
+    const double limit = tens_yield - eps_p * Kn * alpha;
+    if (stress > limit) {
+      eps_p += (stress - limit) * (1 + alpha) / Kn;
+      elastic = strain - eps_p;
+      stress = elastic * in.E;
+    }
+    if (in.law->breakage && stress < 0) breaks = true;
+  } else {
+    stress = elastic * in.E;
+    const double limit = compr_yield + eps_p * Kn * beta;
+    if (stress < limit) {
+      eps_p += (stress - limit) * (1 - beta) / Kn;
+      elastic = strain - eps_p;
+      stress = elastic * in.E;
+    }
+  }
+  if (advance) h[B::H_PLASTIC] = eps_p;
+  for (int k = 0; k < 3; k++) normalForce[k] = currentContact[k] * stress * A;
+  stress_out = stress;
+}
+
+/* The normal force of the plastic laws, in their operation order, from the plastic strain
+   h[H_PLASTIC]; advance: update that strain as the law does (creep: after the force).
+   ModelSBElasticPerfectlyPlastic / ModelSBCreep: stress (strain - eps_p) E capped at the
+   yield strength Y (times RC in compression), eps_p following the cap; ModelSBLinearPlastic:
+   loading with KL, unloading with KU (the bond's E, <= 2, is a factor; above 2 elastic). */
+void plastic_normal_force(const LawInput &in, double *h, bool advance, double strain,
+                          const double *currentContact, double A, double *normalForce,
+                          double &stress_out, bool &random_branch, bool &concrete_break)
+{
+  using B = BondMusenElastic;
+  const B::Law &law = *in.law;
+  double &eps_p = h[B::H_PLASTIC];
+  if (law.form == B::AEROGEL) {
+    aerogel_normal_force(in, h, advance, strain, currentContact, A, normalForce, stress_out);
+    return;
+  }
+  if (law.form == B::CONCRETE) {
+    concrete_normal_force(in, h, advance, strain, currentContact, A, normalForce, stress_out,
+                          concrete_break);
+    return;
+  }
+  if (law.form == B::WEAKENING) {
+    // ModelSBWeakening: beyond the yield strength eps_p = strain - stress WF rand()/RAND_MAX
+    // / E; with WF = 0 that is exactly eps_p = strain (no stress), else MUSEN's random draw
+    double stress = (strain - eps_p) * in.E;
+    if (fabs(stress) > in.Y) {
+      if (law.p[B::P_WF] != 0.0) random_branch = true;    // refused by the caller
+      const double draw = 0.0;    // WF rand()/RAND_MAX with WF = 0
+      const double e = strain - stress * draw / in.E;
+      if (advance) eps_p = e;
+      stress = (strain - e) * in.E;
+    }
+    for (int k = 0; k < 3; k++) normalForce[k] = currentContact[k] * stress * (-1 * A);
+    stress_out = stress;
+    return;
+  }
+  if (law.form == B::LINEAR_PLASTIC) {
+    const double KL = law.p[B::P_KL], KU = law.p[B::P_KU];
+    double s;
+    if (in.E <= 2.0) {
+      if (fabs(KU * (strain - eps_p)) > fabs(KL * strain)) {    // loading: eps_p grows
+        s = -1 * A * KL * strain * in.E;
+        if (advance) eps_p = strain * (1 - KL / KU);
+      } else {
+        s = -1 * A * KU * (strain - eps_p) * in.E;
+      }
+    } else {
+      s = -1 * A * in.E * strain;
+    }
+    scale(currentContact, s, normalForce);
+    stress_out = s;
+    return;
+  }
+  double stress = (strain - eps_p) * in.E;
+  double Y = in.Y;
+  if (stress < 0) Y *= law.p[B::P_RC];    // compression
+  if (stress > Y) {
+    if (advance) eps_p = strain - Y / in.E;
+    stress = Y;
+  } else if (stress < -Y) {
+    if (advance) eps_p = strain + Y / in.E;
+    stress = -Y;
+  }
+  // currentContact * stress * (-1 * CrossCut): the vector times each scalar in turn
+  for (int k = 0; k < 3; k++) normalForce[k] = currentContact[k] * stress * (-1 * A);
+  stress_out = stress;
+  if (advance && law.form == B::CREEP) {    // creep in the normal direction
+    const double rate = in.dt * law.p[B::P_A] * pow(fabs(stress), law.p[B::P_M]);
+    if (stress > 0)
+      eps_p += rate;
+    else
+      eps_p -= rate;
+  }
+}
+
+/* The tangential yield (and creep) of the plastic and creep laws on the just advanced
+   overlap, in ModelSBElasticPerfectlyPlastic / ModelSBCreep's order.  MUSEN's CPU code
+   compares the tangential stress with the unscaled yield strength but scales the overlap to
+   the one of the normal stress's sign (times RC in compression): kept. */
+void plastic_tangential(const LawInput &in, double *overlap, double L0, double stress)
+{
+  using B = BondMusenElastic;
+  const B::Law &law = *in.law;
+  double tau = length(overlap) * in.G / L0;
+  double Y = in.Y;
+  if (stress < 0) Y *= law.p[B::P_RC];
+  if (law.p[B::P_TY] != 0.0 && tau > in.Y) {
+    const double s = Y * L0 / (in.G * length(overlap));
+    for (int k = 0; k < 3; k++) overlap[k] *= s;
+    tau = Y;
+  }
+  if (law.form == B::CREEP) {
+    const double sq = overlap[0] * overlap[0] + overlap[1] * overlap[1] + overlap[2] * overlap[2];
+    if (sq > 0) {
+      const double s = 1 - in.dt * law.p[B::P_A] * pow(fabs(tau), law.p[B::P_M]) * L0 /
+          length(overlap);
+      for (int k = 0; k < 3; k++) overlap[k] *= s;
+    }
+  }
+}
+
+// F_t: overlap G A / L0; ModelSBPlasticConcrete: (overlap - its tangential plastic strain,
+// which only M rotates and so stays 0) G A, without the 1 / L0
+void tangential_force(int form, const double *overlap, double kt, double G, double A,
+                      double *force)
+{
+  if (form == BondMusenElastic::CONCRETE)
+    for (int k = 0; k < 3; k++) force[k] = overlap[k] * G * A;
+  else
+    scale(overlap, kt, force);
+}
 
 /* One evaluation of MUSEN's solid bond on the state h (FixMusenHistory values, H_* layout).
    advance: MUSEN's CalculateSB (rotate and increment the state by one step of dt);
-   otherwise the forces of the stored state (tangential overlap, moments, damping) at the
-   current positions.  damp_now (not advancing): compute the Kelvin damping from the current
-   velocities and store it (a bond's first evaluation has no stored damping). */
-void musen_law(const LawInput &in, double *h, bool advance, bool damp_now, LawOutput &out)
+   otherwise the forces of the stored state (tangential overlap, moments, damping; the
+   plastic laws' normal force) at the current positions.  fresh (not advancing): a bond's
+   first evaluation, which has no stored damping or plastic normal force: compute and store
+   them from the current positions and velocities. */
+void musen_law(const LawInput &in, double *h, bool advance, bool fresh, LawOutput &out)
 {
   using B = BondMusenElastic;
+  const int form = in.law->form;
+  const bool kelvin = form == B::KELVIN;
+  const bool plastic = form != B::ELASTIC && form != B::KELVIN;
   const double d = h[B::H_DIAMETER], L0 = h[B::H_LENGTH0];
   const double A = MUSEN_PI * d * d / 4;                // CrossCut (SimplifiedScene)
   const double I = MUSEN_PI * d * d * d * d / 64;       // AxialMoment
@@ -155,9 +363,37 @@ void musen_law(const LawInput &in, double *h, bool advance, bool damp_now, LawOu
   sub(relativeVelocity, normalVelocity, tangentialVelocity);
 
   const double strain = (dist - L0) / L0;
-  const double normal_scalar = -1 * A * in.E * strain;
+  double normal_scalar = -1 * A * in.E * strain;
   double normalForce[3];
-  scale(currentContact, normal_scalar, normalForce);
+  double plastic_stress = 0.0;    // plastic, creep: the normal stress after the cap
+  out.random_branch = false;
+  out.concrete_break = false;
+  out.aerogel_unbroken = fabs(h[B::H_BROKEN]) < 0.5;
+  if (!plastic) {
+    scale(currentContact, normal_scalar, normalForce);
+  } else {
+    if (advance || fresh) {
+      plastic_normal_force(in, h, advance, strain, currentContact, A, normalForce, plastic_stress,
+                           out.random_branch, out.concrete_break);
+      h[B::H_NFORCE] = plastic_stress;
+    } else {
+      // the normal force last applied (its plastic strain has moved on since): the same
+      // operations on the stored stress (linear/plastic: force)
+      plastic_stress = h[B::H_NFORCE];
+      if (form == B::LINEAR_PLASTIC)
+        scale(currentContact, plastic_stress, normalForce);
+      else if (form == B::AEROGEL)
+        for (int k = 0; k < 3; k++) normalForce[k] = -1 * currentContact[k] * plastic_stress;
+      else if (form == B::CONCRETE)
+        for (int k = 0; k < 3; k++) normalForce[k] = currentContact[k] * plastic_stress * A;
+      else
+        for (int k = 0; k < 3; k++) normalForce[k] = currentContact[k] * plastic_stress * (-1 * A);
+    }
+    normal_scalar = form == B::LINEAR_PLASTIC ? plastic_stress
+        : form == B::AEROGEL                  ? -plastic_stress
+        : form == B::CONCRETE                 ? plastic_stress * A
+                                              : -plastic_stress * A;
+  }
 
   double *overlap = h + B::H_OVERLAP;
   double *nmoment = h + B::H_NMOMENT;
@@ -184,43 +420,59 @@ void musen_law(const LawInput &in, double *h, bool advance, bool damp_now, LawOu
     scale(currentContact, dot(currentContact, relAngleVel), normalAngleVel);
     sub(relAngleVel, normalAngleVel, tangAngleVel);
 
-    if (in.kelvin) {
+    if (kelvin) {
       // -mu * v_n * A * E * |strain|, left to right
       for (int k = 0; k < 3; k++) dampn[k] = normalVelocity[k] * -in.mu * A * in.E * fabs(strain);
-      cap_damping(dampn, length(normalForce), in.max_damp_ratio);
+      cap_damping(dampn, length(normalForce), in.law->max_damp_ratio);
     }
 
     matvec(M, overlap, tmp);
     scale(tangentialVelocity, in.dt, tmp2);
     sub(tmp, tmp2, overlap);
-    scale(overlap, kt, tangentialForce);
+    if (form == B::PLASTIC || form == B::CREEP) plastic_tangential(in, overlap, L0, plastic_stress);
+    if (form == B::WEAKENING) {
+      // ModelSBWeakening: beyond the yield strength the overlap times WF rand()/RAND_MAX
+      double t[3];
+      for (int k = 0; k < 3; k++) t[k] = overlap[k] * in.G / L0;
+      if (length(t) > in.Y) {
+        if (in.law->p[B::P_WF] != 0.0) out.random_branch = true;
+        for (int k = 0; k < 3; k++) overlap[k] *= 0.0;    // WF rand()/RAND_MAX, WF = 0
+      }
+    }
+    tangential_force(form, overlap, kt, in.G, A, tangentialForce);
 
-    if (in.kelvin) {
+    if (kelvin) {
       const double ol = length(overlap);
       for (int k = 0; k < 3; k++) dampt[k] = tangentialVelocity[k] * -in.mu * ol * kt;
-      cap_damping(dampt, length(tangentialForce), in.max_damp_ratio);
+      cap_damping(dampt, length(tangentialForce), in.law->max_damp_ratio);
     }
 
     matvec(M, nmoment, tmp);
-    scale(normalAngleVel, in.dt * 2 * I * in.G / L0, tmp2);
+    if (form == B::CONCRETE)    // ModelSBPlasticConcrete: (w_n (dt 2 I G)) / L0
+      for (int k = 0; k < 3; k++) tmp2[k] = normalAngleVel[k] * (in.dt * 2 * I * in.G) / L0;
+    else
+      scale(normalAngleVel, in.dt * 2 * I * in.G / L0, tmp2);
     sub(tmp, tmp2, nmoment);
     matvec(M, tmoment, tmp);
-    scale(tangAngleVel, in.dt * in.E * I / L0, tmp2);
+    if (form == B::CONCRETE)
+      for (int k = 0; k < 3; k++) tmp2[k] = tangAngleVel[k] * (in.dt * in.E * I) / L0;
+    else
+      scale(tangAngleVel, in.dt * in.E * I / L0, tmp2);
     sub(tmp, tmp2, tmoment);
     for (int k = 0; k < 3; k++) h[B::H_PREVBOND + k] = currentBond[k];
   } else {
-    scale(overlap, kt, tangentialForce);
-    if (in.kelvin && damp_now) {
+    tangential_force(form, overlap, kt, in.G, A, tangentialForce);
+    if (kelvin && fresh) {
       for (int k = 0; k < 3; k++) dampn[k] = normalVelocity[k] * -in.mu * A * in.E * fabs(strain);
-      cap_damping(dampn, length(normalForce), in.max_damp_ratio);
+      cap_damping(dampn, length(normalForce), in.law->max_damp_ratio);
       const double ol = length(overlap);
       for (int k = 0; k < 3; k++) dampt[k] = tangentialVelocity[k] * -in.mu * ol * kt;
-      cap_damping(dampt, length(tangentialForce), in.max_damp_ratio);
+      cap_damping(dampt, length(tangentialForce), in.law->max_damp_ratio);
     }
   }
 
   add(normalForce, tangentialForce, out.total);
-  if (in.kelvin) {
+  if (kelvin) {
     add(out.total, dampn, out.total);
     add(out.total, dampt, out.total);
   }
@@ -239,7 +491,8 @@ void musen_law(const LawInput &in, double *h, bool advance, bool damp_now, LawOu
   out.tangential_force_length = length(tangentialForce);
 }
 
-// MUSEN's breakage test (ModelSBElastic: CONSIDER_BREAKAGE 1 and 2; ModelSBKelvin: 1)
+// MUSEN's stress breakage test (ModelSBElastic: CONSIDER_BREAKAGE 1 and 2; ModelSBKelvin,
+// ModelSBLinearPlastic: 1; ModelSBCreep: FRACTURE_BY_STRESS 1)
 bool musen_breaks(int criterion, const double *h, const LawOutput &out, double sigma_n,
                   double tau_s)
 {
@@ -260,14 +513,42 @@ bool musen_breaks(int criterion, const double *h, const LawOutput &out, double s
       maxTorque1 >= tau_s || maxTorque2 >= tau_s;
 }
 
+const char *law_name(int form)
+{
+  static const char *const names[] = {"elastic", "kelvin", "plastic", "linear/plastic", "creep",
+                                      "weakening", "aerogel", "concrete"};
+  return names[form];
+}
+
+// ModelSBAerogel: an unbroken bond whose force exceeds BST A E
+bool aerogel_breaks(const BondMusenElastic::Law &law, const LawOutput &out, double d, double E)
+{
+  using B = BondMusenElastic;
+  if (law.form != B::AEROGEL) return false;
+  const double KA = MUSEN_PI * d * d / 4 * E;
+  // out.normal_scalar = -F; a bond in a broken state (H_BROKEN) has no such test
+  return out.aerogel_unbroken && -out.normal_scalar > (fabs(law.p[B::P_BST]) * KA);
+}
+
+// ModelSBElasticPerfectlyPlastic, ModelSBCreep: the fracture strains (FC 0: none)
+bool strain_breaks(const BondMusenElastic::Law &law, double strain)
+{
+  using B = BondMusenElastic;
+  if (law.form == B::WEAKENING)    // ModelSBWeakening: with CONSIDER_BREAKAGE on
+    return law.breakage &&
+        (strain > law.p[B::P_BS] || (law.p[B::P_CB] != 0.0 && strain < -2 * law.p[B::P_BS]));
+  if (law.form != B::PLASTIC && law.form != B::CREEP) return false;
+  return strain > law.p[B::P_FT] || (law.p[B::P_FC] != 0.0 && strain < -law.p[B::P_FC]);
+}
+
 }    // namespace
 
 /* ---------------------------------------------------------------------- */
 
 BondMusenElastic::BondMusenElastic(LAMMPS *lmp) :
     Bond(lmp), youngs(nullptr), shear(nullptr), sigma_n(nullptr), tau_s(nullptr),
-    viscosity(nullptr), diam0(nullptr), len0(nullptr), breakage(1), kelvin(0),
-    max_damp_ratio(1.0), breaks_fp(nullptr), per_atom_geometry(0), nslots(0), nvalues_per(0),
+    viscosity(nullptr), diam0(nullptr), len0(nullptr), yield(nullptr),
+    first_law{ELASTIC, 1.0, 1, {}}, breaks_fp(nullptr), per_atom_geometry(0), nslots(0), nvalues_per(0),
     update_special(0), pairs_waiting(0), warned_build(0), max_length0(0.0), history(nullptr),
     history_id(HISTORY_ID)
 {
@@ -294,6 +575,7 @@ BondMusenElastic::~BondMusenElastic()
     memory->destroy(viscosity);
     memory->destroy(diam0);
     memory->destroy(len0);
+    memory->destroy(yield);
   }
 }
 
@@ -375,13 +657,13 @@ bool BondMusenElastic::apply_laws(int i1, int i2, int type, double *h, bool adva
   in.E = youngs[type];
   in.G = shear[type];
   in.mu = viscosity[type];
+  in.Y = yield[type];
   LawOutput out;
   const int nlaws = 1 + (int) then_laws.size();
   double scratch[H_SIZE];
   for (int k = 0; k < nlaws; k++) {
-    const Law law = k == 0 ? Law{kelvin, max_damp_ratio, breakage} : then_laws[k - 1];
-    in.kelvin = law.kelvin;
-    in.max_damp_ratio = law.max_damp_ratio;
+    const Law &law = k == 0 ? first_law : then_laws[k - 1];
+    in.law = &law;
     double *own = h + H_SIZE + H_LAWSTATE * k;    // law k's copy (k < nlaws - 1)
     double *state = h;
     if (!advance && k < nlaws - 1) {    // a set-up evaluation of law k's own state
@@ -391,7 +673,17 @@ bool BondMusenElastic::apply_laws(int i1, int i2, int type, double *h, bool adva
     }
     musen_law(in, state, advance, fresh, out);
     if (k < nlaws - 1) std::copy(state, state + H_LAWSTATE, own);
-    if (musen_breaks(law.breakage, state, out, sigma_n[type], tau_s[type])) return true;
+    if (out.random_branch)
+      error->one(FLERR, "Bond style musen/elastic: bond {}-{} exceeds its yield strength at step "
+                 "{}, where MUSEN's weakening bond multiplies by WEAKENING_FACTOR rand()/RAND_MAX: "
+                 "a random draw fibrelmp cannot reproduce (WEAKENING_FACTOR 0 is exact)",
+                 atom->tag[i1], atom->tag[i2], update->ntimestep);
+    if (out.concrete_break || strain_breaks(law, out.strain) ||
+        aerogel_breaks(law, out, h[H_DIAMETER], in.E) ||
+        musen_breaks(law.form == WEAKENING || law.form == CONCRETE ? 0 : law.breakage, state,
+                     out, sigma_n[type],
+                     tau_s[type]))
+      return true;
     for (int c = 0; c < 3; c++) {
       f[i1][c] += out.total[c];
       torque[i1][c] += out.mleft[c];
@@ -405,9 +697,25 @@ bool BondMusenElastic::apply_laws(int i1, int i2, int type, double *h, bool adva
 
 bool BondMusenElastic::any_breakage() const
 {
-  if (breakage) return true;
+  // the plastic and creep laws always test their fracture strain in tension, aerogel its force
+  auto breaks = [](const Law &law) {
+    return law.breakage || law.form == PLASTIC || law.form == CREEP || law.form == AEROGEL;
+  };
+  if (breaks(first_law)) return true;
   for (const Law &law : then_laws)
-    if (law.breakage) return true;
+    if (breaks(law)) return true;
+  return false;
+}
+
+bool BondMusenElastic::uses_yield() const
+{
+  auto needs = [](const Law &law) {
+    return law.form == PLASTIC || law.form == CREEP || law.form == WEAKENING ||
+        law.form == CONCRETE;
+  };
+  if (needs(first_law)) return true;
+  for (const Law &law : then_laws)
+    if (needs(law)) return true;
   return false;
 }
 
@@ -564,56 +872,96 @@ void BondMusenElastic::allocate()
   memory->create(viscosity, np1, "bond:viscosity");
   memory->create(diam0, np1, "bond:diam0");
   memory->create(len0, np1, "bond:len0");
+  memory->create(yield, np1, "bond:yield");
   memory->create(setflag, np1, "bond:setflag");
   for (int i = 1; i < np1; i++) {
     setflag[i] = 0;
     diam0[i] = len0[i] = 0.0;
+    yield[i] = std::nan("");    // bond_coeff ... yield Y (the plastic laws need it)
   }
 }
 
-/* bond_style musen/elastic [breakage 0|1|2] [kelvin ratio] [geometry PARTNERS VALUES]
-   [breaks FILE] */
+/* the parameters of a law after its form's word: kelvin R | plastic FT FC TY RC |
+   linear/plastic KL KU | creep FT FC TY RC A m (elastic: none); returns how many it read */
+
+int BondMusenElastic::parse_law(const std::string &form, int narg, char **arg, Law &law)
+{
+  int n = 0;
+  if (form == "elastic") {
+    law.form = ELASTIC;
+  } else if (form == "kelvin") {
+    law.form = KELVIN;
+    n = 1;
+  } else if (form == "plastic") {
+    law.form = PLASTIC;
+    n = 4;
+  } else if (form == "linear/plastic") {
+    law.form = LINEAR_PLASTIC;
+    n = 2;
+  } else if (form == "creep") {
+    law.form = CREEP;
+    n = 6;
+  } else if (form == "weakening") {
+    law.form = WEAKENING;
+    n = 3;
+  } else if (form == "aerogel") {
+    law.form = AEROGEL;
+    n = 7;
+  } else if (form == "concrete") {
+    law.form = CONCRETE;
+  } else {
+    error->all(FLERR, "Bond style musen/elastic: unknown law {} (known: elastic, kelvin, plastic, "
+                      "linear/plastic, creep, weakening, aerogel, concrete)", form);
+  }
+  if (narg < n) utils::missing_cmd_args(FLERR, "bond_style musen/elastic " + form, error);
+  double v[NPARAM] = {};
+  for (int k = 0; k < n; k++) {
+    v[k] = utils::numeric(FLERR, arg[k], false, lmp);
+    if (!std::isfinite(v[k]))
+      error->all(FLERR, "Bond style musen/elastic: {} parameters must be finite, got {}", form,
+                 arg[k]);
+  }
+  if (law.form == KELVIN) {
+    law.max_damp_ratio = v[0];
+    if (law.max_damp_ratio < 0.0)
+      error->all(FLERR, "Bond style musen/elastic: kelvin MAX_DAMP_RATIO must be >= 0 (0: no "
+                        "cap), got {}", arg[0]);
+  } else {
+    std::copy(v, v + NPARAM, law.p);
+  }
+  if (law.form == LINEAR_PLASTIC && !(law.p[P_KU] != 0.0))
+    error->all(FLERR, "Bond style musen/elastic: linear/plastic KUnLoad must not be 0");
+  return n;
+}
+
+/* bond_style musen/elastic [breakage 0|1|2] [LAW ...] [then FORM B ...] [geometry PARTNERS
+   VALUES K] [breaks FILE] (bond_musen_elastic.h) */
 
 void BondMusenElastic::settings(int narg, char **arg)
 {
   then_laws.clear();    // a repeated bond_style command (e.g. after read_restart) restates them
+  first_law = Law{ELASTIC, 1.0, 1, {}};
   int iarg = 0;
   while (iarg < narg) {
     const std::string key = arg[iarg];
     if (key == "breakage") {
       if (iarg + 2 > narg) utils::missing_cmd_args(FLERR, "bond_style musen/elastic breakage", error);
-      breakage = utils::inumeric(FLERR, arg[iarg + 1], false, lmp);
-      if (breakage < 0 || breakage > 2)
+      first_law.breakage = utils::inumeric(FLERR, arg[iarg + 1], false, lmp);
+      if (first_law.breakage < 0 || first_law.breakage > 2)
         error->all(FLERR, "Bond style musen/elastic: breakage must be 0 (none), 1 (MUSEN's two "
                           "stress sums) or 2 (each stress term alone), got {}", arg[iarg + 1]);
       iarg += 2;
-    } else if (key == "kelvin") {
-      if (iarg + 2 > narg) utils::missing_cmd_args(FLERR, "bond_style musen/elastic kelvin", error);
-      kelvin = 1;
-      max_damp_ratio = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
-      if (max_damp_ratio < 0.0 || !std::isfinite(max_damp_ratio))
-        error->all(FLERR, "Bond style musen/elastic: kelvin MAX_DAMP_RATIO must be >= 0 "
-                          "(0: no cap), got {}", arg[iarg + 1]);
-      iarg += 2;
+    } else if (key == "kelvin" || key == "plastic" || key == "linear/plastic" || key == "creep" ||
+               key == "weakening" || key == "aerogel" || key == "concrete") {
+      iarg += 1 + parse_law(key, narg - iarg - 1, arg + iarg + 1, first_law);
     } else if (key == "then") {
-      // then elastic BREAKAGE | then kelvin BREAKAGE MAX_DAMP_RATIO: one more law
+      // then FORM BREAKAGE [parameters]: one more law
       if (iarg + 3 > narg) utils::missing_cmd_args(FLERR, "bond_style musen/elastic then", error);
       const std::string form = arg[iarg + 1];
-      Law law{form == "kelvin" ? 1 : 0, 0.0, utils::inumeric(FLERR, arg[iarg + 2], false, lmp)};
-      if (form != "kelvin" && form != "elastic")
-        error->all(FLERR, "Bond style musen/elastic: then takes elastic or kelvin, got {}", form);
-      if (law.breakage < 0 || law.breakage > (law.kelvin ? 1 : 2))
-        error->all(FLERR, "Bond style musen/elastic: then {}: breakage must be 0..{}, got {}",
-                   form, law.kelvin ? 1 : 2, arg[iarg + 2]);
-      if (law.kelvin) {
-        if (iarg + 4 > narg) utils::missing_cmd_args(FLERR, "bond_style musen/elastic then kelvin", error);
-        law.max_damp_ratio = utils::numeric(FLERR, arg[iarg + 3], false, lmp);
-        if (law.max_damp_ratio < 0.0 || !std::isfinite(law.max_damp_ratio))
-          error->all(FLERR, "Bond style musen/elastic: then kelvin MAX_DAMP_RATIO must be >= 0 "
-                            "(0: no cap), got {}", arg[iarg + 3]);
-      }
+      Law law{ELASTIC, 0.0, utils::inumeric(FLERR, arg[iarg + 2], false, lmp),
+              {}};
+      iarg += 3 + parse_law(form, narg - iarg - 3, arg + iarg + 3, law);
       then_laws.push_back(law);
-      iarg += law.kelvin ? 4 : 3;
     } else if (key == "geometry") {
       if (iarg + 4 > narg) utils::missing_cmd_args(FLERR, "bond_style musen/elastic geometry", error);
       partners_name = arg[iarg + 1];
@@ -630,15 +978,37 @@ void BondMusenElastic::settings(int narg, char **arg)
       iarg += 2;
     } else {
       error->all(FLERR, "Bond style musen/elastic: unknown keyword {} (known: breakage, kelvin, "
-                        "then, geometry, breaks)", key);
+                        "plastic, linear/plastic, creep, weakening, aerogel, concrete, then, "
+                        "geometry, breaks)", key);
     }
   }
+  // the stress criteria each law has (MUSEN: Kelvin, linear plastic, creep one, weakening its
+  // strain test; plastic, aerogel none)
+  auto most_of = [](int form) { return form == ELASTIC ? 2 : (form == PLASTIC || form == AEROGEL) ? 0 : 1; };
+  for (const Law &law : then_laws) {
+    const int most = most_of(law.form);
+    if (law.breakage < 0 || law.breakage > most)
+      error->all(FLERR, "Bond style musen/elastic: then {}: breakage must be 0..{}, got {}",
+                 law_name(law.form), most, law.breakage);
+  }
+  const int most = most_of(first_law.form);
+  if (first_law.breakage > most)
+    error->all(FLERR, "Bond style musen/elastic: {} takes breakage 0..{}, got {}",
+               law_name(first_law.form), most, first_law.breakage);
 }
 
-/* bond_coeff N E G sigma_n tau_s mu [d L0] */
+/* bond_coeff N E G sigma_n tau_s mu [d L0] [yield Y] */
 
 void BondMusenElastic::coeff(int narg, char **arg)
 {
+  double Y = std::nan("");
+  if (narg >= 2 && strcmp(arg[narg - 2], "yield") == 0) {
+    Y = utils::numeric(FLERR, arg[narg - 1], false, lmp);
+    if (!(Y >= 0.0) || !std::isfinite(Y))
+      error->all(FLERR, "Bond style musen/elastic: yield strength must be >= 0, got {}",
+                 arg[narg - 1]);
+    narg -= 2;
+  }
   const int want = per_atom_geometry ? 6 : 8;
   if (narg != want)
     error->all(FLERR, "Bond style musen/elastic: bond_coeff needs {}: type E G sigma_n tau_s mu{}",
@@ -677,6 +1047,7 @@ void BondMusenElastic::coeff(int narg, char **arg)
     viscosity[i] = mu;
     diam0[i] = d;
     len0[i] = L0;
+    yield[i] = Y;
     setflag[i] = 1;
     count++;
   }
@@ -722,6 +1093,12 @@ void BondMusenElastic::init_style()
     }
   }
 
+  if (uses_yield())
+    for (int i = 1; i <= atom->nbondtypes; i++)
+      if (setflag[i] && !std::isfinite(yield[i]))
+        error->all(FLERR, "Bond style musen/elastic: the plastic, creep, weakening and concrete "
+                          "laws need each bond type's yield strength (bond_coeff ... yield Y); type {} has none", i);
+
   update_special = (force->special_lj[1] != 1.0 || force->special_coul[1] != 1.0) ? 1 : 0;
 
   if (!history) {
@@ -755,7 +1132,7 @@ double BondMusenElastic::equilibrium_distance(int i)
 void BondMusenElastic::write_restart(FILE *fp)
 {
   const int n = atom->nbondtypes;
-  for (double *a : {youngs, shear, sigma_n, tau_s, viscosity, diam0, len0})
+  for (double *a : {youngs, shear, sigma_n, tau_s, viscosity, diam0, len0, yield})
     fwrite(&a[1], sizeof(double), n, fp);
 }
 
@@ -763,7 +1140,7 @@ void BondMusenElastic::read_restart(FILE *fp)
 {
   allocate();
   const int n = atom->nbondtypes;
-  for (double *a : {youngs, shear, sigma_n, tau_s, viscosity, diam0, len0}) {
+  for (double *a : {youngs, shear, sigma_n, tau_s, viscosity, diam0, len0, yield}) {
     if (comm->me == 0) utils::sfread(FLERR, &a[1], sizeof(double), n, fp, nullptr, error);
     MPI_Bcast(&a[1], n, MPI_DOUBLE, 0, world);
   }
@@ -772,41 +1149,26 @@ void BondMusenElastic::read_restart(FILE *fp)
 
 void BondMusenElastic::write_restart_settings(FILE *fp)
 {
-  fwrite(&breakage, sizeof(int), 1, fp);
-  fwrite(&kelvin, sizeof(int), 1, fp);
-  fwrite(&max_damp_ratio, sizeof(double), 1, fp);
   const int nthen = (int) then_laws.size();
   fwrite(&nthen, sizeof(int), 1, fp);
-  for (const Law &law : then_laws) {
-    fwrite(&law.kelvin, sizeof(int), 1, fp);
-    fwrite(&law.max_damp_ratio, sizeof(double), 1, fp);
-    fwrite(&law.breakage, sizeof(int), 1, fp);
-  }
+  fwrite(&first_law, sizeof(Law), 1, fp);
+  if (nthen) fwrite(then_laws.data(), sizeof(Law), nthen, fp);
 }
 
 void BondMusenElastic::read_restart_settings(FILE *fp)
 {
-  if (comm->me == 0) {
-    utils::sfread(FLERR, &breakage, sizeof(int), 1, fp, nullptr, error);
-    utils::sfread(FLERR, &kelvin, sizeof(int), 1, fp, nullptr, error);
-    utils::sfread(FLERR, &max_damp_ratio, sizeof(double), 1, fp, nullptr, error);
-  }
-  MPI_Bcast(&breakage, 1, MPI_INT, 0, world);
-  MPI_Bcast(&kelvin, 1, MPI_INT, 0, world);
-  MPI_Bcast(&max_damp_ratio, 1, MPI_DOUBLE, 0, world);
   int nthen = 0;
-  if (comm->me == 0) utils::sfread(FLERR, &nthen, sizeof(int), 1, fp, nullptr, error);
+  if (comm->me == 0) {
+    utils::sfread(FLERR, &nthen, sizeof(int), 1, fp, nullptr, error);
+    utils::sfread(FLERR, &first_law, sizeof(Law), 1, fp, nullptr, error);
+  }
   MPI_Bcast(&nthen, 1, MPI_INT, 0, world);
-  then_laws.assign(nthen, Law{0, 0.0, 0});
-  for (Law &law : then_laws) {
-    if (comm->me == 0) {
-      utils::sfread(FLERR, &law.kelvin, sizeof(int), 1, fp, nullptr, error);
-      utils::sfread(FLERR, &law.max_damp_ratio, sizeof(double), 1, fp, nullptr, error);
-      utils::sfread(FLERR, &law.breakage, sizeof(int), 1, fp, nullptr, error);
-    }
-    MPI_Bcast(&law.kelvin, 1, MPI_INT, 0, world);
-    MPI_Bcast(&law.max_damp_ratio, 1, MPI_DOUBLE, 0, world);
-    MPI_Bcast(&law.breakage, 1, MPI_INT, 0, world);
+  MPI_Bcast(&first_law, sizeof(Law), MPI_CHAR, 0, world);
+  then_laws.resize(nthen);
+  if (nthen) {
+    if (comm->me == 0)
+      utils::sfread(FLERR, then_laws.data(), sizeof(Law), nthen, fp, nullptr, error);
+    MPI_Bcast(then_laws.data(), (int) (sizeof(Law) * nthen), MPI_CHAR, 0, world);
   }
 }
 
@@ -852,10 +1214,9 @@ double BondMusenElastic::single(int type, double /*rsq*/, int i, int j, double &
   in.E = youngs[type];
   in.G = shear[type];
   in.mu = viscosity[type];
+  in.Y = yield[type];
   // several laws: the last one's force, which is what MUSEN keeps as the bond's TotalForce
-  const Law last = then_laws.empty() ? Law{kelvin, max_damp_ratio, breakage} : then_laws.back();
-  in.kelvin = last.kelvin;
-  in.max_damp_ratio = last.max_damp_ratio;
+  in.law = then_laws.empty() ? &first_law : &then_laws.back();
   double copy[H_SIZE];    // evaluating must not touch the state
   std::copy(h, h + H_SIZE, copy);
   LawOutput out;
@@ -876,7 +1237,7 @@ double BondMusenElastic::single(int type, double /*rsq*/, int i, int j, double &
 double BondMusenElastic::memory_usage()
 {
   double bytes = Bond::memory_usage();
-  bytes += 8.0 * (atom->nbondtypes + 1) * sizeof(double);
+  bytes += 9.0 * (atom->nbondtypes + 1) * sizeof(double);
   return bytes;
 }
 

@@ -2,15 +2,29 @@
    fibrelmp's LAMMPS styles; GPL-2.0-or-later like LAMMPS (see ../LICENSE).
 
    bond_style musen/elastic: MUSEN's elastic solid bond (and, with the kelvin keyword, its
-   Kelvin bond) with MUSEN's breakage criteria.  Re-implemented from MUSEN's
-   Models/SolidBonds/BondModelElastic/ModelSBElastic.cpp and
-   Models/SolidBonds/BondModelKelvin/ModelSBKelvin.cpp (CalculateSB, ConsolidatePart);
+   Kelvin bond; with plastic, linear/plastic or creep its elastic-perfectly-plastic, linear
+   plastic, creep, weakening, aerogel or plastic concrete bond) with MUSEN's breakage criteria.  Re-implemented from MUSEN's
+   Models/SolidBonds/BondModel{Elastic,Kelvin,ElasticPerfectlyPlastic,LinearPlastic,Creep,
+   Weakening,Aerogel,PlasticConcrete}/
+   ModelSB*.cpp (CalculateSB, ConsolidatePart);
    MUSEN is BSD-3-Clause, (c) MUSEN Development Team.
 
-     bond_style musen/elastic [breakage 0|1|2] [kelvin MAX_DAMP_RATIO]
-                              [then elastic 0|1|2] [then kelvin 0|1 MAX_DAMP_RATIO] ...
+     bond_style musen/elastic [breakage B] [LAW]  [then FORM B PARAMETERS] ...
                               [geometry PARTNER VALUES K] [breaks FILE]
-     bond_coeff N E G sigma_n tau_s mu [d L0]
+       LAW = FORM PARAMETERS: kelvin MAX_DAMP_RATIO | plastic FT FC TY RC |
+            linear/plastic KL KU | creep FT FC TY RC A m | weakening CB BS WF |
+            aerogel PSC PST SRC SRT BST HRC HRT | concrete (then elastic B, then concrete B:
+            no parameters)
+       B: the stress criterion (CONSIDER_BREAKAGE; creep: FRACTURE_BY_STRESS; weakening: its
+       CONSIDER_BREAKAGE, which turns its strain test on; concrete: its CONSIDER_BREAKAGE,
+       the tension-side sign test; plastic, aerogel: 0);
+       weakening: CB compressive break 0|1, BS breakage strain, WF weakening factor (random
+       branch refused unless 0); aerogel: MUSEN's seven parameters in its order;
+       FT FC: fracture strains in tension / compression (0: none); TY: tangential yield 0|1;
+       RC: ratio compressive / tensile yield; KL KU: loading / unloading stiffness;
+       A m: creep parameters
+     bond_coeff N E G sigma_n tau_s mu [d L0] [yield Y]
+       Y: the yield strength (MUSEN's material property 15) the plastic and creep laws need
 
    The law is incremental: every bond keeps MUSEN's state (tangential overlap, twisting and
    bending moments, the previous bond vector; see the H_* offsets) in a FixMusenHistory
@@ -71,24 +85,37 @@ class BondMusenElastic : public Bond {
     H_PREVBOND = 9,     // bond vector left - right of the last update (MUSEN PrevBond), 3
     H_DAMPN = 12,       // Kelvin normal damping force of the last update, 3
     H_DAMPT = 15,       // Kelvin tangential damping force of the last update, 3
-    H_DIAMETER = 18,    // the bond's diameter d
-    H_LENGTH0 = 19,     // its initial length L0
-    H_SIZE = 20,
-    H_LAWSTATE = 18     // the per-law part: overlap, moments, prev. bond, damping (offsets 0..17)
+    H_PLASTIC = 18,     // normal plastic strain (MUSEN NormalPlasticStrain)
+    H_NFORCE = 19,      // plastic laws: the normal stress last applied (linear/plastic,
+                        // aerogel: force)
+    H_BROKEN = 20,      // aerogel: -1 / 1 broken in compression / tension (MUSEN keeps it in
+                        // TangentialPlasticStrain.x)
+    H_DIAMETER = 21,    // the bond's diameter d
+    H_LENGTH0 = 22,     // its initial length L0
+    H_SIZE = 23,
+    H_LAWSTATE = 21     // the per-law part: offsets 0..20
   };
 
+  // MUSEN's SB models this style runs
+  enum Form { ELASTIC = 0, KELVIN, PLASTIC, LINEAR_PLASTIC, CREEP, WEAKENING, AEROGEL, CONCRETE };
+  // parameters of the plastic laws (Law::p)
+  enum { P_FT = 0, P_FC, P_TY, P_RC, P_A, P_M };                  // plastic, creep
+  enum { P_KL = 0, P_KU };                                        // linear/plastic
+  enum { P_CB = 0, P_BS, P_WF };                                  // weakening
+  enum { P_PSC = 0, P_PST, P_SRC, P_SRT, P_BST, P_HRC, P_HRT };   // aerogel
+  enum { NPARAM = 7 };
+
   struct Law {
-    int kelvin;              // 1: ModelSBKelvin's damping
-    double max_damp_ratio;   // its MAX_DAMP_RATIO (0: no cap)
-    int breakage;            // the law's CONSIDER_BREAKAGE
+    int form;                // Form
+    double max_damp_ratio;   // Kelvin: its MAX_DAMP_RATIO (0: no cap)
+    int breakage;            // the stress criterion: CONSIDER_BREAKAGE (creep: FRACTURE_BY_STRESS)
+    double p[NPARAM];        // the law's parameters (P_*)
   };
 
  protected:
   // per bond type: material constants
-  double *youngs, *shear, *sigma_n, *tau_s, *viscosity, *diam0, *len0;
-  int breakage;              // MUSEN CONSIDER_BREAKAGE: 0 none, 1 sums, 2 each term
-  int kelvin;                // 1: ModelSBKelvin's damping
-  double max_damp_ratio;     // its MAX_DAMP_RATIO (0: no cap)
+  double *youngs, *shear, *sigma_n, *tau_s, *viscosity, *diam0, *len0, *yield;
+  Law first_law;             // the first law (breakage: 0 none, 1 sums, 2 each term)
   std::vector<Law> then_laws;   // laws acting after the first one, in cmusen's order
   std::string partners_name, values_name;    // per-atom geometry slots (empty: coefficients)
   std::string breaks_file;   // "step id1 id2" per broken bond (rank 0 appends)
@@ -108,6 +135,8 @@ class BondMusenElastic : public Bond {
   int entry_size() const { return H_SIZE + H_LAWSTATE * (int) then_laws.size(); }
   bool apply_laws(int i1, int i2, int type, double *h, bool advance, bool fresh, double *total);
   bool any_breakage() const;
+  bool uses_yield() const;
+  int parse_law(const std::string &form, int narg, char **arg, Law &law);
   void allocate();
   double *init_entry(int i1, int i2, int type);
   void process_breaks();

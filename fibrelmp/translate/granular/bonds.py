@@ -171,8 +171,9 @@ def bond_geometry(model: GranularModel, bonds: SimulatedBonds, atom_rows: np.nda
 
 def _musen_coeffs(model: GranularModel, mat: int, count: int) -> dict:
     """bond_coeff of musen/elastic for the bonds of material ``mat``: E G sigma_n tau_s mu
-    (SimplifiedScene::AddSolidBond: NormalStiffness = E, TangentialStiffness = G =
-    E/(2(1+nu)), strengths and the compound's dynamic viscosity)."""
+    [yield Y] (SimplifiedScene::AddSolidBond: NormalStiffness = E, TangentialStiffness = G =
+    E/(2(1+nu)), strengths, the compound's dynamic viscosity and, for the plastic and creep
+    laws, its yield strength)."""
     m = model.materials[mat]
     E, G = m.youngs, m.shear_modulus
     if not (E > 0 and math.isfinite(E) and G > 0 and math.isfinite(G)):
@@ -185,10 +186,18 @@ def _musen_coeffs(model: GranularModel, mat: int, count: int) -> dict:
             raise InputError(model.source, None, f"material '{m.name}' of solid bonds needs a "
                              "dynamic viscosity >= 0 (property 2), which MUSEN's Kelvin bond uses")
 
+    ys = None
+    if model.plan.bond_laws_need_yield():
+        ys = m.props.get(15, float("nan"))
+        if not (math.isfinite(ys) and ys >= 0):
+            raise InputError(model.source, None, f"material '{m.name}' of solid bonds needs a "
+                             "yield strength >= 0 (property 15), which MUSEN's plastic and creep "
+                             "bonds use")
+
     def strength(value: float) -> float:
         return value if math.isfinite(value) else BIG
     return dict(E=E, G=G, sn=strength(m.normal_strength), ts=strength(m.shear_strength), mu=mu,
-                comment=f"{comment_text(m.name)} ({count} bonds)")
+                ys=ys, comment=f"{comment_text(m.name)} ({count} bonds)")
 
 
 def _tol_bins(values: np.ndarray, rtol: float) -> np.ndarray:

@@ -84,6 +84,11 @@ def _one_per_kind(active: list[ModelChoice], source) -> list[ModelChoice]:
     return list(seen.values())
 
 
+def _names(names: list[str]) -> str:
+    """"A", "A and B", "A, B and C"."""
+    return " and ".join(filter(None, [", ".join(names[:-1]), *names[-1:]]))
+
+
 def accepted_models(kind: str) -> list[str]:
     """The MUSEN models of ``kind`` fibrelmp translates (with its LAMMPS styles, if any)."""
     return [m.name for m in physics.of_kind(kind)]
@@ -114,12 +119,12 @@ def _model_choice(model: GranularModel, spec, path, line: int | None) -> ModelCh
                                 if stock is not None else ""))
     elif found is None:
         what = physics.KIND_WORDS[kind]
-        ok = [f"{m.name} (with fibrelmp's LAMMPS styles)" if m.needs_styles else m.name
-              for m in physics.of_kind(kind)]
-        why = physics.UNTRANSLATED_WHY.get(spec.name)
+        plain = [m.name for m in physics.of_kind(kind) if not m.needs_styles]
+        styled = [m.name for m in physics.of_kind(kind) if m.needs_styles]
+        ok = _names(plain) + (", and with fibrelmp's LAMMPS styles " if plain and styled else
+                              "with fibrelmp's LAMMPS styles " if styled else "") + _names(styled)
         raise InputError(path, line, f"{where}{spec.name}: this {what} model is not supported"
-                         + (f" ({why})" if why else "")
-                         + (f"; fibrelmp translates {' and '.join(ok)}" if ok
+                         + (f"; fibrelmp translates {ok}" if ok
                             else f"; fibrelmp translates no {what} model")
                          + ("; name another in the job script (MODEL_" + kind + ")" if line is None else ""))
     params = found.read_parameters(spec.params, path, line, model)

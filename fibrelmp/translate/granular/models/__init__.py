@@ -22,9 +22,6 @@ KIND_WORDS = {"PP": "particle-particle", "PW": "particle-wall", "SB": "solid-bon
 KIND_NOUNS = {"PP": "particle-particle law", "PW": "particle-wall law", "SB": "solid bond",
               "LB": "liquid bond", "EF": "external force"}
 
-# why fibrelmp refuses a MUSEN model it does not translate, where more can be said than that
-UNTRANSLATED_WHY: dict[str, str] = {}
-
 _REGISTRY: dict[str, type[PhysicsModel]] = {}
 _loaded = False
 
@@ -43,6 +40,8 @@ class PhysicsModel:
     default: ClassVar[bool] = False
     # SB models: their SolidBondLaw.form (what granular.bonds renders)
     plan_bond_model: ClassVar[str | None] = None
+    # SB models: the law's name in the script's comment (None: bond_law's)
+    law_title: ClassVar[str | None] = None
 
     @classmethod
     def read_parameters(cls, text: str, path: Path | str | None, line: int | None,
@@ -162,7 +161,8 @@ def bond_style_law(plan: GranularPlan) -> tuple[str, str]:
     name, words = solid_bond_model(plan).bond_law(plan)
     for law in plan.then_bond_laws:
         model = next(m for m in of_kind("SB") if m.plan_bond_model == law.form)
-        name += f" then {model.bond_law(plan)[0].lower()}"
+        title = model.law_title if model.law_title else model.bond_law(plan)[0]
+        name += f" then {title.lower()}"
         words += f" {model.then_words(law)}"
     return name, words
 

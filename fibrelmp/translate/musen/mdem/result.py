@@ -264,8 +264,11 @@ class MdemResultWriter(MusenResultWriter):
                     for law in plan.then_bond_laws:
                         entry = manager.models.add()
                         entry.key, entry.path = mdem_key(law.model), law.model
-                        entry.params = f"CONSIDER_BREAKAGE {law.breakage:g} " + (
-                            f"MAX_DAMP_RATIO {law.max_damp_ratio:g} " if law.form == "kelvin" else "")
+                        entry.params = ("".join(f"{k} {v:g} " for k, v in law.parameters.items())
+                                        if law.parameters else
+                                        f"CONSIDER_BREAKAGE {law.breakage:g} " + (
+                                            f"MAX_DAMP_RATIO {law.max_damp_ratio:g} "
+                                            if law.form == "kelvin" else ""))
                 if kind == "EF":    # the later EF models, which act after it (cmusen's order)
                     for fld in plan.external_fields[1:]:
                         entry = manager.models.add()

@@ -236,6 +236,8 @@ class GranularPlan:
     # MUSEN's active EF models, in cmusen's order (each adds its force in turn, before all others)
     external_fields: list[ExternalField] = field(default_factory=list)
     velocity_limit: float | None = None     # MUSEN's particle velocity limit (m/s; None: none)
+    # MUSEN's variable time step (MAX_PART_MOVE m, STEP_INC_FACTOR); None: the fixed step
+    variable_step: tuple[float, float] | None = None
     # MUSEN's stop criterion BROKEN_BONDS N: at a save with more than N bonds broken since the
     # start, one more step, its frame, the end (None: no criterion)
     stop_broken_bonds: int | None = None
@@ -320,6 +322,9 @@ class GranularModel(ParticleModel):
     origin: SourceRecord | None = None
     liquid_bonds: list[LiquidBond] = field(default_factory=list)
     models: dict[str, ModelChoice] = field(default_factory=dict)   # kind -> chosen model
+    # further PP, PW and EF models acting after models[kind], in cmusen's order
+    # (cmusen runs every selected model of a kind in turn; forces add)
+    later_models: list[ModelChoice] = field(default_factory=list)
     # post: the dump's atom ids of the spheres and their sort order (post.to_granular)
     atom_ids: np.ndarray | None = None
     atom_order: np.ndarray | None = None

@@ -161,6 +161,12 @@ class Recorder:
             # MUSEN's summed time, as its results write it (LAMMPS's Time is step * dt)
             out["time"] = {"start": clock.time(thermo_int(start, "Step")),
                            "end": clock.time(thermo_int(self.last, "Step"))}
+        variable = getattr(job, "variable_clock", None)
+        if variable is not None and variable.exists():
+            # a variable time step: MUSEN's time of the last frame, as fix musen/leapfrog wrote
+            # it (a run the fix stopped printed no thermo line at its last step)
+            last = variable.read_text(encoding="ascii").split("\n")[-2].split()
+            out["time"]["end"] = float(last[1])
         out["final_step"] = self.final["step"]
         scale = time_step_scale(model)
         if scale is not None:

@@ -136,8 +136,8 @@ def test_docs_table_has_every_row():
         assert f"| `{key}` | {cls} |" in section, key
 
 
-def test_two_stored_models_of_one_kind_are_refused(tmp_path):
-    """A version-1 model list with two particle-particle models: MUSEN runs both."""
+def test_two_stored_models_of_one_kind_both_act(tmp_path):
+    """A version-1 model list with two particle-particle models: MUSEN runs both, in order."""
     from fibrelmp.registry import INPUT, detect
 
     def edit(s):
@@ -146,8 +146,7 @@ def test_two_stored_models_of_one_kind_are_refused(tmp_path):
         manager.models.add(key="B18A46C2786D4D44B925A8A04D0D1008", path="ModelPPHertzMindlin")
         manager.models.add(key="K2", path="ModelPPLinearElastic", params="Kn 1e5 Kt 1e5")
     path = _edited(tmp_path, edit)
-    with pytest.raises(InputError) as err:
-        detect(path).load(INPUT)().model(path)
-    assert err.value.path == str(path) and err.value.line is None
-    assert err.value.message.startswith("ModelPPLinearElastic (stored in edited.mdem) and "
-                                        "ModelPPHertzMindlin (stored in edited.mdem) are both PP")
+    model = detect(path).load(INPUT)().model(path)
+    assert model.models["PP"].name == "ModelPPHertzMindlin"
+    assert [(c.name, c.parameters, c.line) for c in model.later_models] == [
+        ("ModelPPLinearElastic", {"Kn": 1e5, "Kt": 1e5}, None)]

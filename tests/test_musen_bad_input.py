@@ -226,6 +226,8 @@ SCRIPT_ERRORS = [
     ("STOP_CRITERION SOMETIMES\n", 1, "NONE or BROKEN_BONDS"),
     ("STOP_CRITERION BROKEN_BONDS five\n", 1, "BROKEN_BONDS needs the number of broken bonds"),
     ("CONNECTED_PP_CONTACT maybe\n", 1, "expected 1/0"),
+    ("MAX_PART_MOVE -1e-9\n", 1, "expected a value >= 0 (0 keeps the simulator's)"),
+    ("STEP_INC_FACTOR -1\n", 1, "expected a value >= 0 (0 keeps the simulator's)"),
     ("GEOMETRY_MOTION_TIME Plate 0 1 0 0\n", 1, "needs 11 number"),
     ("\n\n", None, "empty cmusen job script"),
 ]
@@ -260,7 +262,6 @@ APPLY_ERRORS = [  # script, line, words: parsed fine, refused when the job is ap
     (GOOD.replace("MODEL_PW ModelPWHertzMindlin\n", "\n"), 1, "has walls but no MODEL_PW"),
     (GOOD.replace("MODEL_SB ModelSBElastic\n", "\n"), 1, "solid bonds but no MODEL_SB"),
     (GOOD + "MODEL_LB ModelLBCapilarViscous\n", 7, "liquid-bond model is not supported"),
-    (GOOD + "VARIABLE_TIME_STEP 1\n", 7, "variable time step"),
     (GOOD + "MATERIAL_PROPERTY DENSITY Glass 3000\n", 7, "material 'Glass' has key GLASS"),
     (GOOD + "MATERIAL_PROPERTY POISSON_RATIO GLASS 0.6\n", 7, "Poisson ratio"),
     (GOOD + "INTERACTION_PROPERTY SLIDING_FRICTION GLASS WOOD 0.1\n", 7, "no material with key 'WOOD'"),

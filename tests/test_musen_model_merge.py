@@ -2,18 +2,18 @@
 models, then the job's added; a model already active takes the job's parameters on top of
 the file's).  Every active model acts: several solid-bond models -- MUSEN's Example 3: the
 file's Kelvin bond and the script's Elastic bond, both listed in cmusen's log -- act on each
-bond in turn (tests/test_musen_several_bond_models.py compares that with cmusen); two models
-of another kind are refused, never silently reduced to one."""
+bond in turn (tests/test_musen_several_bond_models.py compares that with cmusen); and so do
+several particle-particle and particle-wall models (tests/test_musen_several_models.py); two
+models of another kind are refused, never silently reduced to one."""
 
 from __future__ import annotations
 
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
+from fibrelmp import lammps_styles
 from fibrelmp.errors import InputError
 from fibrelmp.registry import INPUT, detect
 
@@ -67,20 +67,22 @@ def test_example_3_job_applies_both_laws_in_cmusens_order(tmp_path):
     assert "MUSEN's Kelvin then elastic solid bond" in script
 
 
-def test_two_particle_particle_models_are_still_refused_through_the_cli(tmp_path):
+def test_two_particle_particle_models_both_act_in_the_scripts_order(tmp_path):
+    """cmusen runs both (tests/test_musen_several_models.py compares that with cmusen)."""
+    from fibrelmp.translate.granular_job import write_granular_job
+
     shutil.copy(TEXT_SCENE, tmp_path)
     script = tmp_path / "job.txt"
     script.write_text(f"SOURCE_FILE {TEXT_SCENE.name}\nRESULT_FILE ./r.txt\n"
-                      "MODEL_PP ModelPPHertzMindlin\nMODEL_PP ModelPPLinearElastic\n"
-                      "END_TIME 1e-7\n")
-    before = sorted(p.name for p in tmp_path.iterdir())
-    proc = subprocess.run([sys.executable, "-m", "fibrelmp.cli", "run", script.name],
-                          cwd=tmp_path, capture_output=True, text=True, timeout=120)
-    assert proc.returncode == 2, proc.stderr
-    assert (f"{script.name}:4: ModelPPLinearElastic (line 4) and ModelPPHertzMindlin (line 3) "
-            "are both PP models") in proc.stderr
-    assert "Traceback" not in proc.stderr
-    assert sorted(p.name for p in tmp_path.iterdir()) == before
+                      "MODEL_PP ModelPPHertzMindlin\nMODEL_PP ModelPPLinearElastic\nMODEL_SB ModelSBElastic\n"
+                      "MODEL_PARAMS ModelPPLinearElastic Kn 3e5 Kt 2e5\nSIMULATION_STEP 1e-8\nEND_TIME 1e-7\n")
+    model = _model(script)
+    assert model.models["PP"].name == "ModelPPHertzMindlin"
+    assert [(c.name, c.parameters, c.line) for c in model.later_models] == [
+        ("ModelPPLinearElastic", {"Kn": 3e5, "Kt": 2e5}, 4)]
+    if lammps_styles.plugin().available:
+        lines = write_granular_job(model, tmp_path / "job").script.read_text().splitlines()
+        assert "pair_style      musen/hm then linear/elastic 300000.0 200000.0" in lines
 
 
 def test_the_files_model_named_again_takes_the_scripts_parameters_on_top(tmp_path):

@@ -517,7 +517,7 @@ CASE_SCRIPT = r"""
 import sys, json
 sys.path.insert(0, {root!r})
 from tests.test_style_musen_pair import persistent_lammps, gathered
-lmp = persistent_lammps({plugin!r}, procs={procs!r})
+lmp = persistent_lammps({plugin!r}, procs={procs!r}, style={style!r})
 lmp.command("run {steps} post no")
 state = gathered(lmp)
 lmp.close()
@@ -526,9 +526,9 @@ if state is not None:
 """
 
 
-def persistent_lammps(plugin, procs=None, record=False, log=None):
+def persistent_lammps(plugin, procs=None, record=False, log=None, style="pair_style musen/hm"):
     """The two contacts above; ``record``: a fix external (for a Recorder) placed before the
-    spring, so that it sees the pair forces alone."""
+    spring, so that it sees the pair forces alone; ``style``: the pair_style line."""
     laws = default_laws()
     lmp = new_lammps(["-log", "none", "-screen", str(log) if log else "none", "-nocite"])
     (xl, xh), (yl, yh), (zl, zh) = BOX
@@ -538,7 +538,7 @@ def persistent_lammps(plugin, procs=None, record=False, log=None):
         cmds.append(f"processors {procs}")
     cmds += [f"region box block {xl} {xh} {yl} {yh} {zl} {zh}", "create_box 2 box"]
     cmds += body_commands(PERSISTENT)
-    cmds += ["pair_style musen/hm"] + [coeff_line(i, j, p) for (i, j), p in laws.items()]
+    cmds += [style] + [coeff_line(i, j, p) for (i, j), p in laws.items()]
     cmds += ["neighbor 0.0005 bin", "neigh_modify every 1 delay 0 check yes",
              f"timestep {PERSISTENT_DT!r}", "fix integrate all nve/sphere"]
     if record:
@@ -586,9 +586,13 @@ def test_history_migrates_with_atoms_serial():
     assert rec.slip_steps >= 5 and rec.stick_steps > 1000, (rec.slip_steps, rec.stick_steps)
 
 
-def _run_case(plugin, ranks, steps, tmp_path):
+# several MUSEN laws on each contact (cmusen's several PP models; tests/test_musen_several_models.py)
+SEVERAL_LAWS = "pair_style musen/hm then linear/elastic 30000.0 20000.0 then hertz/mindlin"
+
+
+def _run_case(plugin, ranks, steps, tmp_path, style="pair_style musen/hm"):
     code = CASE_SCRIPT.format(root=str(ROOT), plugin=str(plugin), procs="1 2 1" if ranks else None,
-                              steps=steps)
+                              steps=steps, style=style)
     cmd = ([MPIEXEC, "-n", str(ranks)] if ranks else []) + [sys.executable, "-c", code]
     env = dict(os.environ, OMP_NUM_THREADS="1")
     proc = subprocess.run(cmd, capture_output=True, text=True, timeout=120, cwd=tmp_path, env=env)
@@ -600,22 +604,25 @@ def _run_case(plugin, ranks, steps, tmp_path):
 
 
 @pytest.mark.skipif(not MPIEXEC, reason="mpiexec not found (pip install mpich)")
-def test_serial_and_two_ranks_bitwise(tmp_path):
+@pytest.mark.parametrize("style", ["pair_style musen/hm", SEVERAL_LAWS])
+def test_serial_and_two_ranks_bitwise(tmp_path, style):
     """The contacts above under mpiexec -n 2 (each contact crosses the processor boundary;
     pairs with a ghost are computed on both ranks from each side): bit-identical to serial."""
     plugin = plugin_or_skip()
-    serial = _run_case(plugin, None, STEPS, tmp_path)
-    two = _run_case(plugin, 2, STEPS, tmp_path)
+    serial = _run_case(plugin, None, STEPS, tmp_path, style)
+    two = _run_case(plugin, 2, STEPS, tmp_path, style)
     for name in ("x", "v", "omega"):
         assert serial[name] == two[name], name
 
 
-def test_restart_round_trip(tmp_path):
+@pytest.mark.parametrize("style", ["pair_style musen/hm", SEVERAL_LAWS])
+def test_restart_round_trip(tmp_path, style):
     """write_restart in the middle of the pressed contact; a new LAMMPS reading it (and
-    re-defining the fixes) continues bit for bit as the original."""
+    re-defining the fixes, not the pair style: the restart file keeps the laws) continues bit
+    for bit as the original."""
     plugin = plugin_or_skip()
     restart = tmp_path / "mid.restart"
-    lmp = persistent_lammps(plugin)
+    lmp = persistent_lammps(plugin, style=style)
     try:
         lmp.command(f"run {STEPS // 2} post no")
         lmp.command(f"write_restart {restart}")
@@ -648,7 +655,10 @@ def test_restart_round_trip(tmp_path):
     (("pair_coeff 1 1", "pair_coeff 1 1 5e10 2e10 0.9 0.3 -1e-3"), "mu_r must be >= 0"),
     (("pair_coeff 1 1", "pair_coeff 1 1 5e10 2e10 0.9 0.3"), "pair_coeff I J Estar Gstar e mu mu_r"),
     (("comm_modify", "comm_modify vel no"), "comm_modify vel yes"),
-    (("pair_style", "pair_style musen/hm 1.0"), "it takes no arguments"),
+    (("pair_style", "pair_style musen/hm 1.0"), "law hertz/mindlin takes no parameters"),
+    (("pair_style", "pair_style musen/hm then"), "'then' needs a law name"),
+    (("pair_style", "pair_style musen/hm then linear/elastic 1e3"), "linear/elastic needs Kn > 0 and Kt > 0"),
+    (("pair_style", "pair_style musen/hm then nosuch"), "unknown particle-particle law nosuch"),
 ])
 def test_bad_input_is_a_clear_error(change, message):
     plugin = plugin_or_skip()

@@ -103,24 +103,28 @@ END_TIME 2e-5
 """
 
 
-def test_mdem_variable_step_is_refused_by_name(tmp_path):
-    """cmusen's .mdem stores VARIABLE_TIME_STEP 1 and STOP_CRITERION BROKEN_BONDS 5: the
-    variable step is refused with the file and the field's name, nothing written; a job that
-    switches it off runs (the stop criterion is honoured: tests/test_stop_criterion.py)."""
+def test_mdem_variable_step_and_criterion_are_read(tmp_path):
+    """cmusen's .mdem stores VARIABLE_TIME_STEP 1 (with MUSEN's default MAX_PART_MOVE 1e-8 m
+    and STEP_INC_FACTOR 1.01, which job_flex.txt left alone) and STOP_CRITERION BROKEN_BONDS 5:
+    both are read and the job runs (no bonds: the criterion cannot act; the variable step
+    itself is compared with cmusen in tests/test_musen_variable_time_step.py); a job script's
+    VARIABLE_TIME_STEP 0 switches the step off."""
+    from fibrelmp.translate.musen import script as ms
+
     styles_or_skip()
     shutil.copy(DATA / "cmusen_flex_result.mdem", tmp_path)
+    mdem = tmp_path / "cmusen_flex_result.mdem"
+    plan = read_scene(mdem).plan
+    assert plan.variable_step == (1e-8, 1.01) and plan.stop_broken_bonds == 5
     job = tmp_path / "job.txt"
     job.write_text(FLEX_JOB)
-    mdem = tmp_path / "cmusen_flex_result.mdem"
-    with pytest.raises(InputError) as err:
-        python_api.run(job, work=tmp_path / "work")
-    assert str(err.value) == (f"{mdem}: flexible_time_step: MUSEN's variable time step is not "
-                              "supported: its step changes every step with the forces; a job "
-                              "script's VARIABLE_TIME_STEP 0 runs it with its fixed step")
-    assert not (tmp_path / "again.mdem").exists()
-    job.write_text(FLEX_JOB + "VARIABLE_TIME_STEP 0\n")
     python_api.run(job, work=tmp_path / "work")
-    assert (tmp_path / "again.mdem").exists()
+    assert read_scene(tmp_path / "again.mdem").plan.variable_step == (1e-8, 1.01)
+    job.write_text(FLEX_JOB + "VARIABLE_TIME_STEP 0\n")
+    (simulator,) = ms.read_script(job)
+    model = read_scene(mdem)
+    ms.apply_simulator_settings(model, simulator)
+    assert model.plan.variable_step is None
 
 
 def test_mdem_moving_periodic_box_is_read():

@@ -21,16 +21,23 @@ from fibrelmp.post.lammps_dump.reader import iter_frames
 from fibrelmp.translate.granular_job import GranularJob
 from fibrelmp.translate.granular.geometry import nearest_triangle
 from fibrelmp.translate.granular.musen_clock import MusenClock
+from fibrelmp.translate.granular.schedule import UNKNOWN_STEP
 
 
 class _BreakLog:
-    """Reads the per-step broken-bond dump (``step id1 id2`` lines) as LAMMPS appends it."""
+    """Reads the per-step broken-bond dump (``step id1 id2`` lines, and the time as a 4th
+    column with a variable time step) as LAMMPS appends it."""
 
     def __init__(self, path: Path | None):
         self.path = path
         self.fh = None
         self.pending = b""
         self.rows: list[tuple[float, float, float]] = []
+        self.times: dict[tuple[int, int, int], float] = {}    # a variable step's break times
+
+    def time(self, step: int, id1: int, id2: int) -> float:
+        """The time logged with a break (variable time step)."""
+        return self.times[(step, id1, id2)]
 
     def upto(self, step: int) -> list[tuple[int, int, int]]:
         if self.path is None:
@@ -45,6 +52,8 @@ class _BreakLog:
             w = ln.split()
             if len(w) >= 3:
                 self.rows.append((float(w[0]), float(w[1]), float(w[2])))
+            if len(w) >= 4:
+                self.times[(int(w[0]), int(w[1]), int(w[2]))] = float(w[3])
         out = [(int(s), int(a), int(b)) for s, a, b in self.rows if s <= step]
         self.rows = [r for r in self.rows if r[0] > step]
         return out
@@ -75,6 +84,7 @@ class FrameBuilder:
         self.prev_v = np.asarray(sp.velocity, float).copy()
         # the time of a step: MUSEN's summed clock (read forwards) or t_start + step dt
         self.frame_clock, self.break_clock = _clock(job), _clock(job)
+        self.variable_clock = None     # variable time step: fix musen/leapfrog's line per frame
         self.inlet_clock = _clock(job)
         self.deletion_time: dict[int, float] = {}
         deletion_clock = _clock(job)
@@ -127,9 +137,16 @@ class FrameBuilder:
         return words[:3] == ["write_dump", "spheres", "custom"]
 
     def read(self, step: int) -> GranularFrame:
+        """The next frame, saved at ``step`` (UNKNOWN_STEP: a variable time step's, whose step
+        and time fix musen/leapfrog wrote to ``job.variable_clock``)."""
         job = self.job
-        t = self.frame_clock(step)
         f = next(self.frames, None)
+        if step == UNKNOWN_STEP:
+            if f is None:
+                raise wrong_frame(job.frames, -1, None)
+            step, t = f.step, self._variable_time(f.step)
+        else:
+            t = self.frame_clock(step)
         if f is None or f.step != step:
             raise wrong_frame(job.frames, step, None if f is None else f.step)
         c = f.columns
@@ -177,6 +194,17 @@ class FrameBuilder:
         self.prev_t, self.prev_x[rows], self.prev_v[rows] = t, pos, vel
         return frame
 
+    def _variable_time(self, step: int) -> float:
+        """MUSEN's summed time of the frame at ``step`` (the clock file's next line)."""
+        path = self.job.variable_clock
+        if self.variable_clock is None:
+            self.variable_clock = open(path, encoding="ascii")
+        line = self.variable_clock.readline().split()
+        if len(line) != 3 or int(line[0]) != step:
+            raise RunError(f"{path}: expected the time of the frame at step {step}, found "
+                           f"{' '.join(line) or 'nothing'}")
+        return float(line[1])
+
     def _generated(self, rows: np.ndarray, c: dict) -> None:
         """Spheres fix musen/inlet made since the last frame fill their reserved rows:
         activity start (cmusen's clock at the step of the inlet log), radius, mass and
@@ -211,14 +239,17 @@ class FrameBuilder:
             broken = broken[np.argsort(broken[:, 0], kind="stable")]
             r = self._bond_lookup(broken[:, 1], broken[:, 2])
             ok = r >= 0
-            r, bsteps = r[ok], broken[ok, 0]
+            r, bsteps, records = r[ok], broken[ok, 0], broken[ok]
             r, first = np.unique(r, return_index=True)     # earliest record per bond (MPI
-            bsteps = bsteps[first]                          # ranks may both report it)
+            bsteps, records = bsteps[first], records[first]     # ranks may both report it)
             live = self.bond_alive[r]
             self.bond_alive[r[live]] = False
             order = np.argsort(bsteps[live], kind="stable")
             ends = np.empty(len(order))
-            ends[order] = [self.break_clock(int(s)) for s in bsteps[live][order]]
+            if self.job.variable_clock is not None:      # the bond style logged MUSEN's time
+                ends[:] = [self.breaks.time(*map(int, rec)) for rec in records[live]]
+            else:
+                ends[order] = [self.break_clock(int(s)) for s in bsteps[live][order]]
             self.bond_end[r[live]] = ends
         pair = self.model.bonds.pair
         end = np.minimum(self.sphere_end[pair[:, 0]], self.sphere_end[pair[:, 1]])
@@ -315,6 +346,8 @@ class FrameBuilder:
 
     def close(self) -> None:
         self.breaks.close()
+        if self.variable_clock is not None:
+            self.variable_clock.close()
         for dump in (self.frames, self.bonds, self.tiles, self.mesh):
             if dump is not None:
                 dump.close()

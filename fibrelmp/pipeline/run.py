@@ -154,8 +154,8 @@ def simulate(request: RunRequest, options: RunOptions, rank: int = 0, size: int 
     tally = getattr(source, "tally", None)
     summary = record.summary(rendered, time.monotonic() - started, request.model.warnings,
                              tally() if tally is not None else None)
-    if schedule.stopped:          # the frames written, not the scheduled ones
-        summary["frames"] = schedule.given
+    if schedule.stopped or summary.get("frames") is None:   # the frames written (a stop, a
+        summary["frames"] = schedule.given                   # variable step): not scheduled
     write_summary(rendered.folder, summary)
     if size > 1:
         mpi_barrier()
@@ -226,7 +226,8 @@ def _scheduled(tokens: Iterator[Any], source, schedule: Iterator[int], rendered:
             yield frame
         else:
             yield source.read(step)
-    missing = next(schedule, None)
+    # (a _FrameSteps knows a variable step's open schedule, whose frames are never missing)
+    missing = schedule.missing() if isinstance(schedule, _FrameSteps) else next(schedule, None)
     if missing is not None:
         raise RunError(f"{rendered.script}: the run ended without the frame of step {missing} "
                        f"({_count(rendered.schedule)} were scheduled)")
@@ -249,7 +250,14 @@ class _FrameSteps:
         return self._last
 
     def stop(self) -> None:
-        self._steps, self.stopped = iter([self._last + 1]), True
+        # (a variable step's frames have no step known in advance: the last one's neither)
+        self._steps, self.stopped = iter([self._last + 1 if self._last >= 0 else self._last]), True
+
+    def missing(self) -> int | None:
+        """The step of a scheduled frame the run did not write, else None (a variable time
+        step's open schedule, whose steps are negative, misses none)."""
+        step = next(self._steps, None)
+        return step if step is not None and step >= 0 else None
 
 
 def _count(schedule) -> str:

@@ -30,7 +30,8 @@ from fibrelmp.translate.granular.data import write_data
 from fibrelmp.translate.granular.reach import Travel, speed_bound
 from fibrelmp.translate.granular.musen_clock import MusenClock
 from fibrelmp.translate.granular.schedule import (STOP_LABEL, RunTime, compress_ids, run_time, save_steps,
-                                                  schedule, with_stop_criterion)
+                                                  schedule, variable_schedule, variable_step_refusals,
+                                                  with_stop_criterion)
 from fibrelmp.translate.granular.fields import TEMPERATURE, field_commands, uses_temperature
 from fibrelmp.translate.granular.inlets import LOG_NAME as INLET_LOG
 from fibrelmp.translate.granular.inlets import inlet_commands
@@ -42,7 +43,7 @@ from fibrelmp.translate.granular.walls import (WallPlan, describe_walls, plan_wa
                                                wall_warnings)
 from fibrelmp.translate.lammps_format import float_text
 from fibrelmp.translate.steps import SaveSteps
-from fibrelmp.translate.work_facts import WorkFacts, write_facts
+from fibrelmp.translate.work_facts import VARIABLE_CLOCK, WorkFacts, write_facts
 
 __all__ = ["BONDS_NAME", "BREAKS_NAME", "CONTACTS_NAME", "DATA_NAME", "FRAMES_NAME", "SCRIPT_NAME", "TILES_NAME",
            "GranularJob", "WallPlan", "build_granular_job", "describe_walls", "law_args", "plan_walls",
@@ -55,6 +56,7 @@ BONDS_NAME = "bonds.dump"
 TILES_NAME = "walls.dump"
 BREAKS_NAME = "breaks.dump"
 CONTACTS_NAME = "contacts.dump"
+CLOCK_NAME = VARIABLE_CLOCK      # variable time step: "step time dt" of every frame (fix musen/leapfrog)
 
 
 @dataclass
@@ -89,6 +91,7 @@ class GranularJob:
     contacts: Path | None = None     # sphere-sphere contacts per frame (compute pair/local)
     inlet_log: Path | None = None    # fix musen/inlet: "STEP ID" per inserted sphere
     type_materials: dict[int, int] | None = None   # LAMMPS sphere type -> material
+    variable_clock: Path | None = None   # variable time step: each frame's step, time and dt
 
     @property
     def inputs(self) -> list[Path]:
@@ -127,6 +130,7 @@ def granular_packages(uses_plugin: bool, wall_cmds: list[str]) -> list[str]:
 
 def job_facts(model: GranularModel, spheres, tiles, t_start: float, dt: float,
               musen_clock: bool = False) -> WorkFacts:
+    # (MUSEN's variable time step: the frames' times are fix musen/leapfrog's clock file's)
     """What ``fibrelmp post --data`` needs beyond the data file and dump to write the spheres
     as the run does (translate.work_facts): names, MUSEN keys and ids, initial orientations,
     the DEMDF document."""
@@ -142,7 +146,8 @@ def job_facts(model: GranularModel, spheres, tiles, t_start: float, dt: float,
         object_ids=np.asarray(sp.ids, np.int64) if model.kind == "musen" else None,
         orientation=None if identity else q,
         radius=None if np.array_equal(spheres.crad, sp.radius) else np.asarray(sp.radius, float),
-        demdf=demdf, clock="musen" if musen_clock else "product")
+        demdf=demdf, clock=("variable" if model.plan.variable_step is not None else
+                            "musen" if musen_clock else "product"))
 
 
 def build_granular_job(model: GranularModel, folder: str | Path):
@@ -183,7 +188,8 @@ def build_granular_job(model: GranularModel, folder: str | Path):
         geometry=folder / GEOMETRY_NAME if parts.geometry is not None else None,
         contacts=folder / CONTACTS_NAME,
         inlet_log=folder / INLET_LOG if model.plan.inlets else None,
-        type_materials={t: m for m, t in spheres.type_of_mat.items()})
+        type_materials={t: m for m, t in spheres.type_of_mat.items()},
+        variable_clock=folder / CLOCK_NAME if model.plan.variable_step is not None else None)
     return job, script, write_data_file
 
 
@@ -206,8 +212,6 @@ class _JobParts:
     bonds: SimulatedBonds
     musen_hm: bool
     pair_lines: list[str]
-    pp_model: type[physics.PhysicsModel]
-    pp_params: dict[str, float]
     sb_model: type[physics.PhysicsModel]
     wall_cmds: list[str]
     var_cmds: list[str]
@@ -246,7 +250,6 @@ def _plan_parts(model: GranularModel) -> _JobParts:
     # style, which is exact for it
     musen_hm = styles.available and model.kind == "musen"
     pair_lines = pair_coeff_lines(model, spheres, tiles.materials, tiles.radius, dt, musen_hm)
-    pp_model, pp_params = physics.chosen(model, "PP")
     sb_model = physics.solid_bond_model(plan)
     wall_cmds, var_cmds, frame_columns = wall_commands(model, wall_plans, spheres, dt)
     if uses_temperature(model):
@@ -260,15 +263,19 @@ def _plan_parts(model: GranularModel) -> _JobParts:
     geometry = (bond_geometry(model, bonds, spheres.rows, len(spheres.rows) + len(tiles.x))
                 if bonds.exact and len(bonds.rows) else None)
     return _JobParts(run, warnings, dom_lo, dom_hi, spheres, wall_plans, mesh, tiles, ntypes, axes,
-                     styles, bonds, musen_hm, pair_lines, pp_model, pp_params, sb_model, box_cmds + wall_cmds, var_cmds,
+                     styles, bonds, musen_hm, pair_lines, sb_model, box_cmds + wall_cmds, var_cmds,
                      frame_columns, geometry)
 
 
 def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> str:
     """in.lammps of the planned job (templates/granular.lammps.j2)."""
     plan, run, spheres, tiles, bonds = model.plan, parts.run, parts.spheres, parts.tiles, parts.bonds
-    # MUSEN's integrator (with fibrelmp's styles) starts with its half-step prediction
-    acts = _stop_criterion(model, parts, schedule(run.total, saves, spheres.deletions, predict=parts.musen_hm))
+    if plan.variable_step is not None:
+        _check_variable_step(model, parts)
+        acts = _stop_criterion(model, parts, variable_schedule(), last_unchecked=True)
+    else:
+        # MUSEN's integrator (with fibrelmp's styles) starts with its half-step prediction
+        acts = _stop_criterion(model, parts, schedule(run.total, saves, spheres.deletions, predict=parts.musen_hm))
     skin = 0.5 * tiles.largest_radius(spheres.r_max)
     pair_cut = 2.0 * tiles.largest_radius(spheres.r_max)
     comm_cut = max(pair_cut, 1.5 * bonds.max_length) + skin
@@ -305,7 +312,7 @@ def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> 
         bond_values=VALUES, geometry_fix=GEOMETRY_FIX, geometry_name=GEOMETRY_NAME,
         bond_criterion=int(plan.bond_breakage),
         bond_law=physics.bond_style_law(plan) if geometry is not None else None,
-        pair_style_lines=parts.pp_model.pair_style_lines(parts.pp_params, parts.musen_hm),
+        pair_style_lines=physics.pair_style_lines(model, parts.musen_hm),
         sphere_types=[spheres.type_of_mat[m] for m in mats],
         sphere_type_names=[model.materials[m].name for m in mats],
         tile_types=[tiles.type_of_mat[m] for m in tile_mats],
@@ -320,12 +327,22 @@ def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> 
         contacts_name=CONTACTS_NAME, velocity_limit=plan.velocity_limit, pbc_velocity=pbc_velocity,
         musen_integrator=parts.musen_hm,
         fields=field_commands(model, spheres.rows, spheres.type_of_mat, parts.ntypes),
+        variable_step=None if plan.variable_step is None else " ".join(float_text(v) for v in (
+            *plan.variable_step, run.dt, plan.save_every_time or 1e300, run.t_end)),
+        clock_name=CLOCK_NAME,
         thermo_every=min(saves.period or 0, 2 ** 31 - 1),      # thermo N is a C int
         stop_label=STOP_LABEL,
     )
 
 
-def _stop_criterion(model: GranularModel, parts: _JobParts, acts: list[tuple]) -> list[tuple]:
+def _check_variable_step(model: GranularModel, parts: _JobParts) -> None:
+    why = variable_step_refusals(model, parts.musen_hm, bool(parts.spheres.deletions))
+    if why is not None:
+        raise InputError(model.source, None, why)
+
+
+def _stop_criterion(model: GranularModel, parts: _JobParts, acts: list[tuple],
+                    last_unchecked: bool = False) -> list[tuple]:
     """The actions with MUSEN's stop criterion BROKEN_BONDS checked at every save (none
     without bonds: none can break)."""
     limit, bonds = model.plan.stop_broken_bonds, parts.bonds
@@ -338,7 +355,7 @@ def _stop_criterion(model: GranularModel, parts: _JobParts, acts: list[tuple]) -
     if any(np.isin(bonded, rows).any() for _, rows in parts.spheres.deletions):
         raise InputError(model.source, None, "a stop criterion on broken bonds with bonded spheres "
                          "whose activity ends is not supported (their bonds would count as broken)")
-    return with_stop_criterion(acts, limit, len(bonds.rows))
+    return with_stop_criterion(acts, limit, len(bonds.rows), last_unchecked)
 
 
 def _moving_periodic_box(model: GranularModel, axes: BoxAxes, styles) -> np.ndarray | None:

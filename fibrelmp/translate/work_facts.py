@@ -25,6 +25,9 @@ from fibrelmp.textio import atomic_write, read_text
 
 SUFFIX = ".fibrelmp.json"
 VERSION = 1
+# MUSEN's variable time step: fix musen/leapfrog writes "step time dt" per frame (17 digits)
+# to this file beside the data file; those frames' times come from it
+VARIABLE_CLOCK = "clock.txt"
 
 
 def facts_path(data: str | Path) -> Path:
@@ -51,11 +54,14 @@ class WorkFacts:
     output_fields: list[str] | None = None       # FibreNet output_data (position velocity force)
     demdf: dict[str, Any] | None = None          # what DEMDF snapshots repeat (the document, ...)
     path: Path | None = None
-    clock: str = "product"                       # "musen": cmusen's summed time (t += dt)
-    _musen: Any = field(default=None, repr=False, compare=False)
+    clock: str = "product"                       # "musen": cmusen's summed time (t += dt);
+                                                 # "variable": VARIABLE_CLOCK's times
+    _musen: Any = field(default=None, repr=False, compare=False)   # the clock, once read
 
     def time(self, step: int) -> float:
         """The simulated time of ``step``, computed as the run computes it."""
+        if self.clock == "variable":
+            return self._variable_time(step)
         if self.clock == "musen":
             if self._musen is None:
                 from fibrelmp.translate.granular.musen_clock import MusenClock
@@ -63,6 +69,22 @@ class WorkFacts:
                 self._musen = MusenClock(self.time_start, self.time_step)
             return self._musen.time(step)
         return self.time_start + step * self.time_step
+
+
+    def _variable_time(self, step: int) -> float:
+        if self._musen is None:
+            clock = (self.path.parent if self.path is not None else Path(".")) / VARIABLE_CLOCK
+            times: dict[int, float] = {}
+            for line in read_text(clock, "the variable time step's clock").splitlines():
+                words = line.split()
+                if len(words) == 3:
+                    times[int(words[0])] = float(words[1])
+            self._musen = (clock, times)
+        clock, times = self._musen
+        if step not in times:
+            raise InputError(clock, None, f"no time for step {step}: MUSEN's variable time step "
+                             "gives times only to the steps of the run's frames")
+        return times[step]
 
 
 def write_facts(data: str | Path, facts: WorkFacts) -> Path:
@@ -120,7 +142,7 @@ def read_facts(data: str | Path) -> WorkFacts | None:
             output_types=[str(t) for t in doc["output_types"]] if "output_types" in doc else None,
             output_fields=[str(t) for t in doc["output_fields"]] if "output_fields" in doc else None,
             demdf=doc.get("demdf"), path=path, clock=str(time.get("clock", "product")))
-        if facts.clock not in ("product", "musen"):
+        if facts.clock not in ("product", "musen", "variable"):
             raise ValueError(f"unknown clock {facts.clock!r}")
         if not (math.isfinite(facts.time_start) and math.isfinite(facts.time_step)):
             raise ValueError("non-finite time")

@@ -24,6 +24,7 @@
 #include "musen_startup.h"
 
 #include "fix_musen_history.h"
+#include "fix_musen_leapfrog.h"
 
 #include "atom.h"
 #include "comm.h"
@@ -805,7 +806,12 @@ void BondMusenElastic::process_breaks()
   std::sort(rec.begin(), rec.end());
 
   atom->nbonds -= nbroken;
-  if (comm->me == 0 && breaks_fp) {
+  if (comm->me == 0 && breaks_fp && timed_breaks) {
+    // MUSEN's time of this evaluation (the fix keeps atime at it: atimestep is this step)
+    const double t = update->atime + (update->ntimestep - update->atimestep) * update->dt;
+    for (const auto &r : rec) utils::print(breaks_fp, "{} {} {} {:.17g}\n", r[0], r[1], r[2], t);
+    fflush(breaks_fp);
+  } else if (comm->me == 0 && breaks_fp) {
     for (const auto &r : rec) utils::print(breaks_fp, "{} {} {}\n", r[0], r[1], r[2]);
     fflush(breaks_fp);
   }
@@ -1058,6 +1064,11 @@ void BondMusenElastic::coeff(int narg, char **arg)
 
 void BondMusenElastic::init_style()
 {
+  timed_breaks = 0;
+  for (const auto &fix : modify->get_fix_list()) {
+    auto *leapfrog = dynamic_cast<FixMusenLeapfrog *>(fix);
+    if (leapfrog && leapfrog->variable_step()) timed_breaks = 1;
+  }
   if (!atom->omega_flag || !atom->torque_flag)
     error->all(FLERR, "Bond style musen/elastic needs an atom style with omega and torque "
                       "(e.g. bpm/sphere)");

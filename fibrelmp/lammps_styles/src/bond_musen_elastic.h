@@ -11,6 +11,8 @@
 
      bond_style musen/elastic [breakage B] [LAW]  [then FORM B PARAMETERS] ...
                               [geometry PARTNER VALUES K] [breaks FILE]
+       (FILE: "step id1 id2" per broken bond; with fix musen/leapfrog's variable time step a 4th
+       column holds MUSEN's time of that step, %.17g, which a step number no longer gives)
        LAW = FORM PARAMETERS: kelvin MAX_DAMP_RATIO | plastic FT FC TY RC |
             linear/plastic KL KU | creep FT FC TY RC A m | weakening CB BS WF |
             aerogel PSC PST SRC SRT BST HRC HRT | concrete (then elastic B, then concrete B:
@@ -119,6 +121,7 @@ class BondMusenElastic : public Bond {
   std::vector<Law> then_laws;   // laws acting after the first one, in cmusen's order
   std::string partners_name, values_name;    // per-atom geometry slots (empty: coefficients)
   std::string breaks_file;   // "step id1 id2" per broken bond (rank 0 appends)
+  int timed_breaks = 0;      // fix musen/leapfrog's variable time step: "step id1 id2 time"
   FILE *breaks_fp;
   int per_atom_geometry;
   int nslots, nvalues_per;                     // K slots of nvalues_per values

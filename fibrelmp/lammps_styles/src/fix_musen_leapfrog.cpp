@@ -8,6 +8,9 @@
 #include "musen_startup.h"
 
 #include "atom.h"
+#include "comm.h"
+#include "pair.h"
+#include "timer.h"
 #include "domain.h"
 #include "error.h"
 #include "force.h"
@@ -16,21 +19,51 @@
 #include "update.h"
 #include "utils.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <cstring>
 
 using namespace LAMMPS_NS;
 using namespace FixConst;
 
 FixMusenLeapfrog::FixMusenLeapfrog(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), vmax(0.0)
+    Fix(lmp, narg, arg), vmax(0.0), variable(false), move_limit(0.0), step_factor(0.0),
+    step_max(0.0), saving_step(0.0), end_time(0.0), t_now(0.0), t_last(0.0), t_before(0.0),
+    dt_before(0.0), stopped_for(0)
 {
-  if (narg != 3 && !(narg == 5 && strcmp(arg[3], "vlimit") == 0))
-    error->all(FLERR, "Illegal fix musen/leapfrog command: fix ID group musen/leapfrog [vlimit VMAX]");
-  if (narg == 5) {
-    vmax = utils::numeric(FLERR, arg[4], false, lmp);
-    if (!(vmax > 0) || !std::isfinite(vmax))
-      error->all(FLERR, "Fix musen/leapfrog: vlimit must be a positive finite speed");
+  const char *usage = "Illegal fix musen/leapfrog command: fix ID group musen/leapfrog "
+                      "[vlimit VMAX] [variable MOVE FACTOR STEP SAVING END]";
+  int iarg = 3;
+  while (iarg < narg) {
+    if (strcmp(arg[iarg], "vlimit") == 0 && iarg + 2 <= narg) {
+      vmax = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
+      if (!(vmax > 0) || !std::isfinite(vmax))
+        error->all(FLERR, "Fix musen/leapfrog: vlimit must be a positive finite speed");
+      iarg += 2;
+    } else if (strcmp(arg[iarg], "variable") == 0 && iarg + 6 <= narg) {
+      variable = true;
+      move_limit = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
+      step_factor = utils::numeric(FLERR, arg[iarg + 2], false, lmp);
+      step_max = utils::numeric(FLERR, arg[iarg + 3], false, lmp);
+      saving_step = utils::numeric(FLERR, arg[iarg + 4], false, lmp);
+      end_time = utils::numeric(FLERR, arg[iarg + 5], false, lmp);
+      if (!(move_limit > 0) || !(step_factor > 0) || !(step_max > 0) || !(saving_step > 0))
+        error->all(FLERR, "Fix musen/leapfrog: variable MOVE FACTOR STEP SAVING must be > 0");
+      iarg += 6;
+    } else {
+      error->all(FLERR, usage);
+    }
+  }
+  if (variable) {
+    // MUSEN's clock starts at the time of this step; the restart file may replace it
+    t_now = t_last = t_before = update->atime + (update->ntimestep - update->atimestep) * update->dt;
+    dt_before = update->dt;
+    vector_flag = 1;
+    size_vector = 4;
+    global_freq = 1;
+    extvector = 0;
+    restart_global = 1;
   }
   time_integrate = 1;
   peratom_flag = 1;
@@ -114,7 +147,7 @@ double FixMusenLeapfrog::memory_usage()
 
 int FixMusenLeapfrog::setmask()
 {
-  return INITIAL_INTEGRATE;
+  return variable ? INITIAL_INTEGRATE | END_OF_STEP : INITIAL_INTEGRATE;
 }
 
 void FixMusenLeapfrog::init()
@@ -155,6 +188,14 @@ void FixMusenLeapfrog::initial_integrate(int /*vflag*/)
   for (int i = 0; i < atom->nlocal; i++)
     if (atom->mask[i] & groupbit)
       for (int k = 0; k < 3; k++) saved_force[i][k] = f[i][k];
+  if (variable) {
+    t_before = t_now;
+    dt_before = update->dt;
+    vary_step();
+    t_now = t_before + update->dt;    // CBaseSimulator::StartSimulation: m_currentTime += dt
+    update->atime = t_now;
+    update->atimestep = update->ntimestep;
+  }
   kick(1.0);
   double **x = atom->x, **v = atom->v;
   const int *mask = atom->mask;
@@ -162,6 +203,113 @@ void FixMusenLeapfrog::initial_integrate(int /*vflag*/)
   for (int i = 0; i < atom->nlocal; i++)
     if (mask[i] & groupbit)
       for (int k = 0; k < 3; k++) x[i][k] += v[i][k] * dt;    // Coord += Vel * dt
+}
+
+void FixMusenLeapfrog::vary_step()
+{
+  // CCPUSimulator::MoveParticles: maxStep over the particles whose force is not zero
+  const double *const *f = atom->f;
+  const double *rmass = atom->rmass;
+  const int *mask = atom->mask;
+  double ratio = std::numeric_limits<double>::max();
+  for (int i = 0; i < atom->nlocal; i++) {
+    if (!(mask[i] & groupbit)) continue;
+    if (f[i][0] == 0.0 && f[i][1] == 0.0 && f[i][2] == 0.0) continue;
+    const double squared = f[i][0] * f[i][0] + f[i][1] * f[i][1] + f[i][2] * f[i][2];
+    ratio = std::min(ratio, std::pow(rmass[i], 2.) / squared);
+  }
+  double ratio_all;
+  MPI_Allreduce(&ratio, &ratio_all, 1, MPI_DOUBLE, MPI_MIN, world);
+  const double max_step = std::sqrt(std::sqrt(ratio_all) * move_limit);
+  double dt = update->dt;
+  if (dt > max_step)
+    dt = max_step;
+  else if (dt < step_max)
+    dt = std::min(dt * step_factor, step_max);
+  if (dt == update->dt) return;
+  // as fix dt/reset: the styles that keep dt-dependent values recompute them
+  update->dt = dt;
+  update->dt_default = 0;
+  if (force->pair) force->pair->reset_dt();
+  for (auto &ifix : modify->get_fix_list()) ifix->reset_dt();
+}
+
+void FixMusenLeapfrog::end_of_step()
+{
+  // CBaseSimulator::StartSimulation ends at t >= END; PreCalculationStep saves when
+  // |t - t_last| + 0.1 dt > SAVING (dt: the step that reached t): stop the run for the frame
+  if (t_now >= end_time)
+    stopped_for = 2;
+  else if (std::fabs(t_now - t_last) + 0.1 * update->dt > saving_step)
+    stopped_for = 1;
+  else
+    return;
+  timer->force_timeout();
+}
+
+void FixMusenLeapfrog::post_run()
+{
+  if (!variable) return;
+  timer->reset_timeout();    // later runs go on (fix halt's "continue")
+  // a run of steps always ends where MUSEN saves or ends; else its N steps ran out first
+  // (a run of one step is the stop criterion's last step: MUSEN saves after it regardless)
+  if (update->nsteps > 1 && stopped_for == 0)
+    error->all(FLERR, "Fix musen/leapfrog: the run's {} steps ended before MUSEN's next save "
+               "(time {:.17g}): its frame would be at a time MUSEN does not save", update->nsteps, t_now);
+}
+
+double FixMusenLeapfrog::compute_vector(int n)
+{
+  switch (n) {
+    case 0: return t_now;
+    case 1: return t_now >= end_time ? 1.0 : 0.0;
+    case 2: return update->dt;
+    default: return dt_before;
+  }
+}
+
+int FixMusenLeapfrog::modify_param(int narg, char **arg)
+{
+  if (strcmp(arg[0], "write") != 0) return 0;
+  if (!variable) error->all(FLERR, "fix_modify {} write: only with a variable time step", id);
+  if (narg != 2 && !(narg == 4 && strcmp(arg[2], "append") == 0))
+    error->all(FLERR, "Illegal fix_modify {} write FILE [append yes|no]", id);
+  const bool append = narg == 4 && utils::logical(FLERR, arg[3], false, lmp);
+  if (comm->me == 0) {
+    FILE *fp = fopen(arg[1], append ? "a" : "w");
+    if (!fp) error->one(FLERR, "fix_modify {} write: cannot open {}", id, arg[1]);
+    fmt::print(fp, "{} {:.17g} {:.17g}\n", update->ntimestep, t_now, update->dt);
+    fclose(fp);
+  }
+  t_last = t_now;    // SaveData: m_lastSavingTime = m_currentTime
+  stopped_for = 0;
+  return narg;
+}
+
+void FixMusenLeapfrog::write_restart(FILE *fp)
+{
+  if (!variable) return;
+  double list[6] = {t_now, t_last, t_before, dt_before, update->dt, (double) stopped_for};
+  if (comm->me == 0) {
+    int size = sizeof(list);
+    fwrite(&size, sizeof(int), 1, fp);
+    fwrite(list, sizeof(double), 6, fp);
+  }
+}
+
+void FixMusenLeapfrog::restart(char *buf)
+{
+  if (!variable) return;
+  const auto *list = reinterpret_cast<const double *>(buf);
+  t_now = list[0];
+  t_last = list[1];
+  t_before = list[2];
+  dt_before = list[3];
+  update->dt = list[4];    // the script's timestep command set the initial one
+  update->dt_default = 0;
+  stopped_for = static_cast<int>(list[5]);
+  update->atime = t_now;
+  update->atimestep = update->ntimestep;
 }
 
 void MusenPredict::command(int narg, char **arg)
@@ -174,7 +322,10 @@ void MusenPredict::command(int narg, char **arg)
   // start: the next set-up (run 0) is the evaluation of MUSEN's prediction iteration;
   // else f and torque hold its forces: the half kick, and the next set-up is MUSEN's
   // evaluation of its first step, at x(0) with the predicted velocities
-  if (!start) fix->kick(0.5);
+  if (!start) {
+    if (fix->variable_step()) fix->vary_step();    // MoveParticles applies the rule here too
+    fix->kick(0.5);
+  }
   musen_startup::advancing_setups() = 1;
 }
 

@@ -11,6 +11,7 @@
 #include "fix_musen_wall_mesh.h"
 #include "style_registry.h"
 #include "fix_musen_history.h"
+#include "fix_musen_leapfrog.h"
 #include "musen_startup.h"
 
 #include "atom.h"
@@ -242,17 +243,28 @@ FixMusenWallMesh::FixMusenWallMesh(LAMMPS *lmp, int narg, char **arg) :
     placed(false), reduced_step(-1), reduced_valid(false), history(nullptr), grid_valid(false),
     grid_cell(0.0), grid_rmax(0.0), grid_margin(0.0)
 {
-  const char *usage = "fix ID group musen/wall/mesh FILE [law NAME [parameters]]";
-  if (narg < 4 || narg == 5 || (narg > 5 && strcmp(arg[4], "law") != 0))
+  const char *usage = "fix ID group musen/wall/mesh FILE [law NAME [parameters]] ...";
+  if (narg < 4 || narg == 5 || (narg > 4 && strcmp(arg[4], "law") != 0))
     error->all(FLERR, "Illegal fix musen/wall/mesh command: {}", usage);
   file = arg[3];
-  // the particle-wall law (MUSEN's ModelPWHertzMindlin unless named)
-  const std::string law_name = narg > 5 ? arg[5] : "hertz/mindlin";
-  std::vector<double> law_params;
-  for (int a = 6; a < narg; a++) law_params.push_back(utils::numeric(FLERR, arg[a], false, lmp));
-  std::string why;
-  pw_law = musen_pw::create(law_name, law_params, why);
-  if (!pw_law) error->all(FLERR, "Fix musen/wall/mesh: {}", why);
+  // the particle-wall laws in the order they act (MUSEN's ModelPWHertzMindlin unless named):
+  // cmusen runs every selected PW model on each contact in turn (CPUSimulator.cpp
+  // CalculateForcesPW), forces add and a law continues the history the previous one left
+  int a = 4;
+  while (a < narg || pw_laws.empty()) {
+    std::string law_name = "hertz/mindlin";
+    std::vector<double> law_params;
+    if (a < narg) {
+      if (++a == narg) error->all(FLERR, "Illegal fix musen/wall/mesh command: {}", usage);
+      law_name = arg[a++];
+      for (; a < narg && strcmp(arg[a], "law") != 0; a++)
+        law_params.push_back(utils::numeric(FLERR, arg[a], false, lmp));
+    }
+    std::string why;
+    auto law = musen_pw::create(law_name, law_params, why);
+    if (!law) error->all(FLERR, "Fix musen/wall/mesh: {}", why);
+    pw_laws.push_back(std::move(law));
+  }
   if (domain->dimension != 3) error->all(FLERR, "Fix musen/wall/mesh needs a 3d simulation");
   if (domain->triclinic) error->all(FLERR, "Fix musen/wall/mesh needs an orthogonal box");
   read_file();
@@ -532,6 +544,11 @@ void FixMusenWallMesh::init()
   if (!atom->radius_flag || !atom->rmass_flag || !atom->omega_flag || !atom->torque_flag)
     error->all(FLERR, "Fix musen/wall/mesh needs per-atom radius, rmass, omega and torque (atom_style sphere or bpm/sphere)");
   if (!history) error->all(FLERR, "Fix musen/wall/mesh: its history fix is missing");
+  clock = nullptr;
+  for (const auto &fix : modify->get_fix_list()) {
+    auto *leapfrog = dynamic_cast<FixMusenLeapfrog *>(fix);
+    if (leapfrog && leapfrog->variable_step()) clock = leapfrog;
+  }
   // every sphere type in the group needs a law with every wall material in use
   std::vector<char> used(nmat, 0);
   for (int t = 0; t < ntri; t++) used[tmat[t]] = 1;
@@ -563,7 +580,7 @@ void FixMusenWallMesh::setup(int vflag)
     // MoveWalls from those wall forces (CBaseSimulator::StartSimulation)
     start_vert = vert;    // a frame before the first step shows them here (MUSEN saves first)
     post_force(vflag);
-    step_walls(current_time());
+    step_walls(current_time(), update->dt);
     started = true;
     pending = false;
     at_start = true;
@@ -809,7 +826,10 @@ void FixMusenWallMesh::post_force(int /*vflag*/)
 {
   // a time step first moves the stepped geometries by the previous step's wall forces
   if (any_stepped && pending && !update->setupflag) {
-    step_walls(current_time() - update->dt);
+    if (clock)    // MoveWalls(dt before MoveParticles changed it), at the time before the step
+      step_walls(clock->step_start_time(), clock->previous_dt());
+    else
+      step_walls(current_time() - update->dt, update->dt);
     pending = false;
   }
   at_start = false;
@@ -990,8 +1010,8 @@ void FixMusenWallMesh::post_force(int /*vflag*/)
 }
 
 /* MUSEN's CalculatePW for sphere i and one contact, up to the law (musen_pw_law.h): the
-   contact's geometry and relative velocity; the chosen law gives force fo and torque to on
-   the sphere and updates hist, the contact's history (tangential overlap). */
+   contact's geometry and relative velocity; the laws, in turn, give force fo and torque to on
+   the sphere (summed) and update hist, the contact's history (tangential overlap). */
 void FixMusenWallMesh::wall_force(int i, const Candidate &cd, double *hist, double dt, double *fo,
                                   double *to)
 {
@@ -1049,7 +1069,15 @@ void FixMusenWallMesh::wall_force(int i, const Candidate &cd, double *hist, doub
   for (int k = 0; k < 3; k++) c.vel[k] = atom->v[i][k] - G.vel[k] + rot_vel[k];
   c.dt = dt;
   const musen_pw::Materials mats{L.estar, L.gstar, L.alpha, L.mu, L.mur};
-  pw_law->force(c, mats, hist, fo, to);
+  pw_laws[0]->force(c, mats, hist, fo, to);
+  for (std::size_t l = 1; l < pw_laws.size(); l++) {
+    double fo_more[3], to_more[3];
+    pw_laws[l]->force(c, mats, hist, fo_more, to_more);
+    for (int k = 0; k < 3; k++) {
+      fo[k] += fo_more[k];
+      to[k] += to_more[k];
+    }
+  }
 }
 
 /* ---------------------------------------------------------------------- */

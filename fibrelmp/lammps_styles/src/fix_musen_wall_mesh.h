@@ -4,7 +4,9 @@
    FixMusenWallMesh (fix style musen/wall/mesh): MUSEN's particle-wall contact against walls
    made of triangles, moving rigidly by time-dependent motion intervals.
 
-     fix ID group musen/wall/mesh FILE [law NAME [parameters]]   (default law hertz/mindlin)
+     fix ID group musen/wall/mesh FILE [law NAME [parameters]] ...   (default law hertz/mindlin)
+   (several laws act on each contact in the order given, as cmusen runs several PW models:
+   their forces and torques add, each continues the contact's history the previous left)
 
    What it reproduces (MUSEN 1.74.2, github.com/msolids/musen e0ff360; file/function named
    where each part is implemented below):
@@ -76,6 +78,8 @@
    the sum of its triangles' forces switches force-dependent intervals, the whole force plus
    gravity x MASS accelerates free axes), plus MUSEN's extra update of its half-step
    prediction before the first step, so at time t its triangles are where MUSEN's are.
+   With fix musen/leapfrog's variable time step, a step moves them by the dt from before that
+   step's change, at the time before the step (MoveWalls gets m_currSimulationStep's old value).
    compute_array's vertices then come from this stepping, and "fix_modify write" adds each
    triangle's velocity and vertices (vx vy vz x1 .. z3) to its frame.
 
@@ -156,7 +160,8 @@ class FixMusenWallMesh : public Fix {
     // the wall motion MUSEN's contact law sees now
     double vel[3], rotvel[3], rotcentre[3];
   };
-  std::unique_ptr<musen_pw::Law> pw_law;    // the particle-wall law (musen_pw_law.h)
+  // the particle-wall laws, in the order they act (musen_pw_law.h)
+  std::vector<std::unique_ptr<musen_pw::Law>> pw_laws;
   struct Law {
     bool set;
     double estar, gstar, alpha, mu, mur;
@@ -219,7 +224,8 @@ class FixMusenWallMesh : public Fix {
   void find_adjacent();
   void place(double t);
   void motion_state(double t);
-  void step_walls(double t);
+  void step_walls(double t, double dt);
+  class FixMusenLeapfrog *clock = nullptr;    // a variable time step's clock (else none)
   static void update_motion(Geometry &G, double value);
   static void rotation_matrix(const double *w, double dt, double R[3][3]);
   void centroid(const Geometry &G, double *centre) const;

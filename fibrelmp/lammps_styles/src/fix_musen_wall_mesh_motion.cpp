@@ -140,12 +140,11 @@ void FixMusenWallMesh::centroid(const Geometry &G, double *centre) const
 }
 
 /* CCPUSimulator::MoveWalls for the stepped geometries, from the triangle forces in ftri
-   (the last force evaluation's) at MUSEN's time t of that evaluation. */
-void FixMusenWallMesh::step_walls(double t)
+   (the last force evaluation's) at MUSEN's time t of that evaluation, by the step dt. */
+void FixMusenWallMesh::step_walls(double t, double dt)
 {
   MPI_Allreduce(ftri.data(), ftri_all.data(), 3 * ntri, MPI_DOUBLE, MPI_SUM, world);
   reduced_valid = false;
-  const double dt = update->dt;
   for (auto &G : geoms) {
     if (!G.stepped || G.tris.empty()) continue;
     if (G.motion_kind == 2 || G.motion_kind == 3) {

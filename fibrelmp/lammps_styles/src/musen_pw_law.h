@@ -4,7 +4,8 @@
    MUSEN particle-wall laws for fix musen/wall/mesh.  The fix finds each contact (closest
    point, wall normal, overlap, relative velocity, history entry); a law, chosen by name
    (fix ... musen/wall/mesh FILE law NAME [params]), turns it into the force and torque on
-   the sphere.  A law is one .cpp file that registers itself with one line:
+   the sphere; several laws (... law A ... law B ...) act in turn, their forces adding.
+   A law is one .cpp file that registers itself with one line:
      const bool registered = musen_pw::add("NAME", &create_function);
 ------------------------------------------------------------------------- */
 
@@ -40,7 +41,8 @@ class Law {
  public:
   virtual ~Law() = default;
   // force fo and torque to on the sphere; hist: the contact's 3 history values (created at
-  // zero, carried across adjacent triangles by the fix), updated by the law
+  // zero, carried across adjacent triangles by the fix), updated by the law; with several
+  // laws each reads what the previous one left this step (MUSEN's one vTangOverlap)
   virtual void force(const Contact &c, const Materials &m, double *hist, double *fo,
                      double *to) const = 0;
 };

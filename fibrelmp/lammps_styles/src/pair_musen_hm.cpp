@@ -1,10 +1,12 @@
 /* ----------------------------------------------------------------------
    fibrelmp's LAMMPS styles; GPL-2.0-or-later like LAMMPS (see ../LICENSE).
 
-   pair_style musen/hm: MUSEN's Hertz-Mindlin particle-particle contact.  The formulas follow
-   MUSEN (BSD-3, commit e0ff360) operation by operation, so that the forces equal a
-   reference written from MUSEN's code to the last bit where the arithmetic allows:
-     - CModelPPHertzMindlin::CalculatePP            (the force and moment law)
+   pair_style musen/hm: MUSEN's particle-particle contact laws (musen_pp_law.h; Hertz-Mindlin
+   first).  The formulas follow MUSEN (BSD-3, commit e0ff360) operation by operation, so that
+   the forces equal a reference written from MUSEN's code to the last bit where the
+   arithmetic allows:
+     - CModelPPHertzMindlin::CalculatePP            (the force and moment law, in the laws)
+     - CCPUSimulator::CalculateForcesPP             (several laws: each in turn, forces add)
      - CSimplifiedScene::CalculateInteractionProperty (dAlpha from the restitution)
      - CCollisionsCalculator::CheckPPCollision       (when a contact exists; overlap, R*, m*)
    MUSEN's vector algebra (Vector3.h) is written out component-wise in the same order:
@@ -29,6 +31,7 @@
 #include "pair_musen_hm.h"
 #include "style_registry.h"
 #include "musen_startup.h"
+#include "musen_pp_hertz_mindlin.h"
 
 #include "atom.h"
 #include "comm.h"
@@ -52,18 +55,22 @@ using namespace LAMMPS_NS;
 namespace {
 // MUSENDefinitions.h
 constexpr double MUSEN_PI = 3.14159265358979323846;
-constexpr double MUSEN_2_SQRT_5_6 = 1.825741858350553711523232609336;
-// Vector3.h: MinValueHelper<double>::min_value()
-constexpr double MIN_SIGNIFICANT = 1e-100;
 
-inline bool significant(const double *v)
-{
-  return std::fabs(v[0]) > MIN_SIGNIFICANT || std::fabs(v[1]) > MIN_SIGNIFICANT ||
-      std::fabs(v[2]) > MIN_SIGNIFICANT;
-}
+// Vector3.h: Length()
 inline double length(const double *v)
 {
   return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+}
+// a later law's force and moments added to the earlier ones
+inline void add_result(musen_pp::Result &sum, const musen_pp::Result &more)
+{
+  sum.fn_len += more.fn_len;
+  for (int k = 0; k < 3; k++) {
+    sum.fn[k] += more.fn[k];
+    sum.ft[k] += more.ft[k];
+    sum.m1[k] += more.m1[k];
+    sum.m2[k] += more.m2[k];
+  }
 }
 inline void cross(const double *a, const double *b, double *c)
 {
@@ -75,19 +82,9 @@ inline void cross(const double *a, const double *b, double *c)
 
 /* ---------------------------------------------------------------------- */
 
-void PairMusenHM::stiffness(int itype, int jtype, double overlap, double equiv_radius,
-                            double &kn, double &kt, double &fn_el) const
-{
-  // Hertz: both stiffnesses grow with the contact area radius
-  const double contact_area_radius = std::sqrt(equiv_radius * overlap);
-  kn = 2 * estar[itype][jtype] * contact_area_radius;
-  fn_el = -overlap * kn * 2. / 3.;
-  kt = 8 * gstar[itype][jtype] * contact_area_radius;
-}
-
 PairMusenHM::PairMusenHM(LAMMPS *lmp) :
     Pair(lmp), estar(nullptr), gstar(nullptr), restitution(nullptr), alpha(nullptr),
-    mu(nullptr), mu_roll(nullptr), maxrad(nullptr), history(nullptr)
+    mu(nullptr), mu_roll(nullptr), maxrad(nullptr), history(nullptr), only_hertz(nullptr)
 {
   // single(): the contact force at the current state, for compute pair/local
   single_enable = 1;
@@ -123,7 +120,31 @@ PairMusenHM::~PairMusenHM()
 void PairMusenHM::compute(int eflag, int vflag)
 {
   ev_init(eflag, vflag);
+  if (only_hertz) {
+    // MUSEN's default, alone: its law called directly (inlined), not through the list
+    const musen_pp::HertzMindlin &law = *only_hertz;
+    contacts([&law](const musen_pp::Contact &c, const musen_pp::Materials &m, double *xi,
+                    musen_pp::Result &r) { law.calculate_pp(c, m, xi, r); });
+  } else {
+    contacts([this](const musen_pp::Contact &c, const musen_pp::Materials &m, double *xi,
+                    musen_pp::Result &r) { apply_laws(c, m, xi, r); });
+  }
+}
 
+void PairMusenHM::apply_laws(const musen_pp::Contact &c, const musen_pp::Materials &m,
+                             double *xi, musen_pp::Result &r) const
+{
+  laws[0]->force(c, m, xi, r);
+  // later laws (MUSEN's later PP models): their forces and moments add
+  for (std::size_t l = 1; l < laws.size(); l++) {
+    musen_pp::Result more;
+    laws[l]->force(c, m, xi, more);
+    add_result(r, more);
+  }
+}
+
+template <class Laws> void PairMusenHM::contacts(Laws apply)
+{
   // LAMMPS recomputes forces at the start of every run (setup) and for `run 0`: those
   // evaluations must not advance the tangential overlap (MUSEN advances it once per step)
   const bool advance = musen_startup::advances(update);    // musen_startup.h
@@ -169,63 +190,40 @@ void PairMusenHM::compute(int eflag, int vflag)
 
       // stored tangential overlap (zero for a new contact)
       double *xi_i = nullptr;
-      double xi_old[3] = {0.0, 0.0, 0.0};
+      double xi[3] = {0.0, 0.0, 0.0};
       if (advance) {
         xi_i = history->get(i, tag[j]);
-        xi_old[0] = xi_i[0];
-        xi_old[1] = xi_i[1];
-        xi_old[2] = xi_i[2];
+        xi[0] = xi_i[0];
+        xi[1] = xi_i[1];
+        xi[2] = xi_i[2];
       } else if (const double *found = history->find(i, tag[j])) {
-        xi_old[0] = found[0];
-        xi_old[1] = found[1];
-        xi_old[2] = found[2];
+        xi[0] = found[0];
+        xi[1] = found[1];
+        xi[2] = found[2];
       }
 
-      // ---- CalculatePP
-      const double *w1 = omega[i], *w2 = omega[j];
+      // ---- CalculatePP of each law in turn (MUSEN's order), each continuing xi
       double n[3], cvlen, vn, vt[3];
       kinematics(i, j, cv, n, cvlen, vn, vt);
-
-      // rotate the old tangential overlap into the tangent plane, keeping its length
-      const double xi_n = n[0] * xi_old[0] + n[1] * xi_old[1] + n[2] * xi_old[2];
-      double xi_rot[3];
-      for (int k = 0; k < 3; k++) xi_rot[k] = xi_old[k] - n[k] * xi_n;
-      if (significant(xi_rot)) {
-        const double scale = length(xi_old) / length(xi_rot);
-        for (int k = 0; k < 3; k++) xi_rot[k] *= scale;
-      }
-      double xi[3];
-      for (int k = 0; k < 3; k++) xi[k] = xi_rot[k] + vt[k] * dt;
-
-      double fn_el, fn_damp, ft[3];
-      contact_force(itype, jtype, overlap, equiv_radius, equiv_mass, vn, vt, xi, fn_el, fn_damp, ft);
-
-      // rolling torque on each sphere's own angular velocity, with the elastic normal force
-      double roll1[3] = {0.0, 0.0, 0.0}, roll2[3] = {0.0, 0.0, 0.0};
-      if (significant(w1)) {
-        const double c = -mu_roll[itype][jtype] * std::fabs(fn_el) * r1 / length(w1);
-        for (int k = 0; k < 3; k++) roll1[k] = w1[k] * c;
-      }
-      if (significant(w2)) {
-        const double c = -mu_roll[itype][jtype] * std::fabs(fn_el) * r2 / length(w2);
-        for (int k = 0; k < 3; k++) roll2[k] = w2[k] * c;
-      }
-
-      // total force on src; moments with the full radii
-      const double fn = fn_el + fn_damp;
-      double ftot[3], nxft[3];
-      for (int k = 0; k < 3; k++) ftot[k] = n[k] * fn + ft[k];
-      cross(n, ft, nxft);
+      const musen_pp::Contact c{overlap, equiv_radius, equiv_mass, r1, r2, n, vn, vt,
+                                omega[i], omega[j], dt};
+      const musen_pp::Materials mats{estar[itype][jtype], gstar[itype][jtype],
+                                     alpha[itype][jtype], mu[itype][jtype],
+                                     mu_roll[itype][jtype]};
+      musen_pp::Result r;
+      apply(c, mats, xi, r);
 
       // ---- ConsolidateSrc / ConsolidateDst
+      double ftot[3];
       for (int k = 0; k < 3; k++) {
+        ftot[k] = r.fn[k] + r.ft[k];
         f[i][k] += ftot[k];
-        torque[i][k] += nxft[k] * r1 + roll1[k];
+        torque[i][k] += r.m1[k];
       }
       if (j < nlocal) {
         for (int k = 0; k < 3; k++) {
           f[j][k] -= ftot[k];
-          torque[j][k] += nxft[k] * r2 + roll2[k];
+          torque[j][k] += r.m2[k];
         }
       }
 
@@ -233,15 +231,15 @@ void PairMusenHM::compute(int eflag, int vflag)
       if (advance) {
         for (int k = 0; k < 3; k++) {
           xi_i[k] = xi[k];
-          xi_i[3 + k] = n[k] * fn;
-          xi_i[6 + k] = ft[k];
+          xi_i[3 + k] = r.fn[k];
+          xi_i[6 + k] = r.ft[k];
         }
         if (j < nlocal) {
           double *xi_j = history->get(j, tag[i]);
           for (int k = 0; k < 3; k++) {
             xi_j[k] = -xi[k];
-            xi_j[3 + k] = -(n[k] * fn);
-            xi_j[6 + k] = -ft[k];
+            xi_j[3 + k] = -r.fn[k];
+            xi_j[6 + k] = -r.ft[k];
           }
         }
       }
@@ -274,9 +272,63 @@ void PairMusenHM::allocate()
   maxrad = new double[np1];
 }
 
-void PairMusenHM::settings(int narg, char ** /*arg*/)
+void PairMusenHM::settings(int narg, char **arg)
 {
-  if (narg != 0) error->all(FLERR, "Illegal pair_style musen/hm command: it takes no arguments");
+  set_laws("hertz/mindlin", narg, arg);
+}
+
+void PairMusenHM::set_laws(const std::string &first, int narg, char **arg)
+{
+  // FIRST [params] then NAME [params] then ...: the words, kept for restart files
+  law_words.assign(1, first);
+  for (int a = 0; a < narg; a++) law_words.emplace_back(arg[a]);
+  laws.clear();
+  std::size_t w = 0;
+  while (w < law_words.size()) {
+    const std::string name = law_words[w++];
+    std::vector<double> params;
+    for (; w < law_words.size() && law_words[w] != "then"; w++)
+      params.push_back(utils::numeric(FLERR, law_words[w], false, lmp));
+    if (w < law_words.size() && ++w == law_words.size())
+      error->all(FLERR, "pair {}: 'then' needs a law name (known: {})", force->pair_style,
+                 musen_pp::names());
+    std::string why;
+    auto law = musen_pp::create(name, params, why);
+    if (!law) error->all(FLERR, "pair {}: {}", force->pair_style, why);
+    laws.push_back(std::move(law));
+  }
+  only_hertz = laws.size() == 1 ? dynamic_cast<const musen_pp::HertzMindlin *>(laws[0].get())
+                                : nullptr;
+}
+
+void PairMusenHM::write_restart_settings(FILE *fp)
+{
+  const int count = static_cast<int>(law_words.size()) - 1;    // the first is the style's
+  fwrite(&count, sizeof(int), 1, fp);
+  for (int w = 1; w <= count; w++) {
+    const int len = static_cast<int>(law_words[w].size());
+    fwrite(&len, sizeof(int), 1, fp);
+    fwrite(law_words[w].data(), sizeof(char), len, fp);
+  }
+}
+
+void PairMusenHM::read_restart_settings(FILE *fp)
+{
+  int count = 0;
+  if (comm->me == 0) utils::sfread(FLERR, &count, sizeof(int), 1, fp, nullptr, error);
+  MPI_Bcast(&count, 1, MPI_INT, 0, world);
+  std::vector<std::string> words(count);
+  for (auto &word : words) {
+    int len = 0;
+    if (comm->me == 0) utils::sfread(FLERR, &len, sizeof(int), 1, fp, nullptr, error);
+    MPI_Bcast(&len, 1, MPI_INT, 0, world);
+    word.resize(len);
+    if (comm->me == 0 && len) utils::sfread(FLERR, &word[0], sizeof(char), len, fp, nullptr, error);
+    if (len) MPI_Bcast(&word[0], len, MPI_CHAR, 0, world);
+  }
+  std::vector<char *> args;
+  for (auto &word : words) args.push_back(&word[0]);
+  settings(count, args.data());
 }
 
 void PairMusenHM::coeff(int narg, char **arg)
@@ -416,34 +468,6 @@ void PairMusenHM::kinematics(int i, int j, const double cv[3], double n[3], doub
   for (int k = 0; k < 3; k++) vt[k] = rel[k] - vn * n[k];
 }
 
-void PairMusenHM::contact_force(int itype, int jtype, double overlap, double equiv_radius,
-                                double equiv_mass, double vn, const double vt[3], double xi[3],
-                                double &fn_el, double &fn_damp, double ft[3]) const
-{
-  // normal force with damping (negative: pushes src away from dst)
-  double kn, kt;
-  stiffness(itype, jtype, overlap, equiv_radius, kn, kt, fn_el);
-  fn_damp = -MUSEN_2_SQRT_5_6 * alpha[itype][jtype] * vn * std::sqrt(kn * equiv_mass);
-
-  // tangential force with damping
-  double ft_spring[3];
-  for (int k = 0; k < 3; k++) ft_spring[k] = xi[k] * kt;
-  const double damp_t = -MUSEN_2_SQRT_5_6 * alpha[itype][jtype] * std::sqrt(kt * equiv_mass);
-
-  // MUSEN tests the spring force alone against mu |Fn_el + Fn_damp|; when it slips the
-  // force is the capped spring force (no damping) and xi shrinks to match it
-  const double ft_spring_len = length(ft_spring);
-  const double friction_len = mu[itype][jtype] * std::fabs(fn_el + fn_damp);
-  if (ft_spring_len > friction_len) {
-    for (int k = 0; k < 3; k++) {
-      ft[k] = ft_spring[k] * friction_len / ft_spring_len;
-      xi[k] = ft[k] / kt;
-    }
-  } else {
-    for (int k = 0; k < 3; k++) ft[k] = ft_spring[k] + vt[k] * damp_t;
-  }
-}
-
 /* ----------------------------------------------------------------------
    The contact force on i (compute pair/local, between runs): the force compute() applied
    in the last step, as its history entry keeps it (a contact is swept the step it ends, so
@@ -482,14 +506,18 @@ double PairMusenHM::single(int i, int j, int itype, int jtype, double rsq, doubl
 
   double n[3], cvlen, vn, vt[3];
   kinematics(i, j, cv, n, cvlen, vn, vt);
-  double xi[3];
-  for (int k = 0; k < 3; k++) xi[k] = 0.0 + vt[k] * update->dt;    // a new contact's first xi
-  double fn_el, fn_damp, ft[3];
-  contact_force(itype, jtype, overlap, equiv_radius, equiv_mass, vn, vt, xi, fn_el, fn_damp, ft);
+  const musen_pp::Contact c{overlap, equiv_radius, equiv_mass, r1, r2, n, vn, vt,
+                            atom->omega[i], atom->omega[j], update->dt};
+  const musen_pp::Materials mats{estar[itype][jtype], gstar[itype][jtype], alpha[itype][jtype],
+                                 mu[itype][jtype], mu_roll[itype][jtype]};
+  double xi[3] = {0.0, 0.0, 0.0};    // a new contact's
+  musen_pp::Result r;
+  apply_laws(c, mats, xi, r);
+  const double fn_len = r.fn_len;
+  for (int k = 0; k < 3; k++) svector[k] = r.ft[k];
 
-  // normal force on i: n (fn_el + fn_damp) = (x_i - x_j) fforce
-  if (cvlen != 0) fforce = -(fn_el + fn_damp) / cvlen;
-  for (int k = 0; k < 3; k++) svector[k] = ft[k];
+  // normal force on i: n fn_len = (x_i - x_j) fforce
+  if (cvlen != 0) fforce = -fn_len / cvlen;
   return 0.0;
 }
 
@@ -497,6 +525,7 @@ double PairMusenHM::single(int i, int j, int itype, int jtype, double rsq, doubl
 
 void PairMusenHM::write_restart(FILE *fp)
 {
+  write_restart_settings(fp);    // LAMMPS calls only write_restart / read_restart
   for (int i = 1; i <= atom->ntypes; i++)
     for (int j = i; j <= atom->ntypes; j++) {
       fwrite(&setflag[i][j], sizeof(int), 1, fp);
@@ -513,6 +542,7 @@ void PairMusenHM::write_restart(FILE *fp)
 
 void PairMusenHM::read_restart(FILE *fp)
 {
+  read_restart_settings(fp);
   allocate();
   const int me = comm->me;
   for (int i = 1; i <= atom->ntypes; i++)

@@ -5,8 +5,13 @@
    (MUSEN commit e0ff360, Models/ParticleParticle/HertzMindlin/ModelPPHertzMindlin.cpp,
    CModelPPHertzMindlin::CalculatePP), re-implemented operation by operation.
 
-     pair_style musen/hm
+     pair_style musen/hm [then LAW [params]] ...
      pair_coeff I J Estar Gstar e mu mu_r
+
+   LAW: a MUSEN particle-particle law (musen_pp_law.h: hertz/mindlin, linear/elastic Kn Kt);
+   musen/hm's first law is hertz/mindlin, and every law named after `then` acts on each
+   contact after it, as cmusen runs several selected PP models (forces add, each law
+   continues the tangential overlap the previous one left).
 
    Estar, Gstar: the effective (already mixed) Young's and shear moduli of the material pair,
    as MUSEN's CSimplifiedScene::CalculateInteractionProperty computes them; e: restitution
@@ -28,10 +33,18 @@ PairStyle(musen/hm,PairMusenHM);
 #define FIBRELMP_PAIR_MUSEN_HM_H
 
 #include "pair.h"
+#include "musen_pp_law.h"
+
+#include <memory>
+#include <string>
+#include <vector>
 
 namespace LAMMPS_NS {
 
 class FixMusenHistory;
+namespace musen_pp {
+class HertzMindlin;
+}
 
 class PairMusenHM : public Pair {
  public:
@@ -45,6 +58,8 @@ class PairMusenHM : public Pair {
   double init_one(int, int) override;
   double single(int, int, int, int, double, double, double, double &) override;
   void write_restart(FILE *) override;
+  void write_restart_settings(FILE *) override;
+  void read_restart_settings(FILE *) override;
   void read_restart(FILE *) override;
   void *extract(const char *, int &) override;
   double memory_usage() override;
@@ -62,22 +77,22 @@ class PairMusenHM : public Pair {
   double *maxrad;             // largest radius per type (neighbor cutoff)
   FixMusenHistory *history;
 
-  // the law's normal and tangential stiffness and elastic normal force (<= 0) of a contact
-  // of types itype, jtype at this overlap: MUSEN's Hertz-Mindlin here; a style whose law
-  // differs from it only there (musen/linear) overrides this alone
-  virtual void stiffness(int itype, int jtype, double overlap, double equiv_radius,
-                         double &kn, double &kt, double &fn_el) const;
+  // the laws in the order they act, and the words that named them (the first: the style's)
+  std::vector<std::unique_ptr<musen_pp::Law>> laws;
+  std::vector<std::string> law_words;
+  // FIRST [its params] [then NAME [params]] ... from the style's arguments
+  void set_laws(const std::string &first, int narg, char **arg);
+  // the single law when it is hertz/mindlin (called without the list: musen/hm's speed)
+  const musen_pp::HertzMindlin *only_hertz;
+  // every law in turn on one contact; the loop over the contacts with one of those
+  void apply_laws(const musen_pp::Contact &c, const musen_pp::Materials &m, double *xi,
+                  musen_pp::Result &r) const;
+  template <class Laws> void contacts(Laws apply);
 
-  // MUSEN's CalculatePP for spheres i (src) and j (dst), cv = x_j - x_i: the unit normal n
-  // (zero with cv), |cv|, and the normal and tangential relative velocity at the contact point
+  // the contact's geometry for the laws, spheres i (src) and j (dst), cv = x_j - x_i: the unit
+  // normal n (zero with cv), |cv|, and the normal and tangential relative velocity there
   void kinematics(int i, int j, const double cv[3], double n[3], double &cvlen, double &vn,
                   double vt[3]) const;
-  // the normal force (elastic fn_el <= 0, damping fn_damp) and tangential force ft from the
-  // tangential overlap xi (this step's, shrunk to match ft when the contact slips)
-  void contact_force(int itype, int jtype, double overlap, double equiv_radius,
-                     double equiv_mass, double vn, const double vt[3], double xi[3],
-                     double &fn_el, double &fn_damp, double ft[3]) const;
-
   void allocate();
 };
 

@@ -3,11 +3,10 @@
 
    pair_style musen/linear: MUSEN's linear elastic particle-particle contact (MUSEN commit
    e0ff360, Models/ParticleParticle/LinearElastic/ModelPPLinearElastic.cpp, CalculatePP).
-     pair_style musen/linear Kn Kt
+     pair_style musen/linear Kn Kt [then LAW [params]] ...
      pair_coeff I J Estar Gstar e mu mu_r        (as musen/hm; Estar, Gstar unused)
-   MUSEN's law is musen/hm's with constant stiffnesses Kn, Kt [N/m] and the elastic normal
-   force -Kn * overlap: damping (from e and m*), tangential overlap, Coulomb test and rolling
-   torque are the same operations, so the style overrides PairMusenHM::stiffness only.
+   musen/hm whose first law is linear/elastic Kn Kt (musen_pp_linear_elastic.cpp: constant
+   stiffnesses Kn, Kt [N/m], elastic normal force -Kn * overlap); later laws as musen/hm's.
 ------------------------------------------------------------------------- */
 
 #ifdef PAIR_CLASS
@@ -27,13 +26,6 @@ class PairMusenLinear : public PairMusenHM {
  public:
   PairMusenLinear(class LAMMPS *);
   void settings(int, char **) override;
-  void write_restart_settings(FILE *) override;
-  void read_restart_settings(FILE *) override;
-
- protected:
-  double normal_stiffness = 0.0, tangential_stiffness = 0.0;    // MUSEN's Kn, Kt
-  void stiffness(int itype, int jtype, double overlap, double equiv_radius, double &kn,
-                 double &kt, double &fn_el) const override;
 };
 
 }    // namespace LAMMPS_NS

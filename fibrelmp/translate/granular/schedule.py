@@ -65,6 +65,19 @@ def _musen_run_time(model: GranularModel, dim: int, dt: float, t_start: float) -
     t_end = float(plan.t_end)
     if not t_end > t_start:            # nothing to simulate: the scene as it is
         return RunTime(dim, dt, 0, t_start, t_start)
+    if every is not None and every < 0.1 * dt:
+        # PreCalculationStep at t = 0 after the prediction step: |0 - 0| + 0.1 dt > saving step
+        model.warnings.append(("musen-first-time-point", "the saving step is below 0.1 x the "
+                               "simulation step: cmusen then saves t = 0 a second time after its "
+                               "prediction step (with the half-step velocities), over the first"
+                               + (" (when its step is still above 10 x the saving step)"
+                                  if plan.variable_step is not None else "")
+                               + "; fibrelmp's first time point is the initial state"))
+    if plan.variable_step is not None:
+        # MUSEN's variable step: the steps, saves and end come from fix musen/leapfrog during
+        # the run; the steps at SIMULATION_STEP (the largest) are the progress bar's estimate
+        total = max(1, math.ceil((t_end - t_start) / dt))
+        return RunTime(dim, dt, total, t_start, t_end, VariableSaves(total))
     total, saves, exact = musen_run(t_start, dt, t_end, every, MAX_IRREGULAR_SAVES)
     if not exact:
         model.warnings.append(("musen-save-drift", "over this long run cmusen's summed clock "
@@ -80,6 +93,57 @@ def _musen_run_time(model: GranularModel, dim: int, dt: float, t_start: float) -
     clock = MusenClock(t_start, dt)
     end = clock.time(total) if exact else t_start + total * dt     # (not summed: too long)
     return RunTime(dim, dt, total, t_start, end, steps, clock)
+
+
+def variable_step_refusals(model: GranularModel, integrator: bool, deletions: bool = False) -> str | None:
+    """Why fibrelmp cannot run ``model`` with MUSEN's variable time step (None: it can).  It
+    needs fibrelmp's integrator (fix musen/leapfrog: ``integrator``), and no event at a step
+    fixed in advance (activity ends, ``deletions``; inlets).  Breaks are timed by the bond
+    style (bond_style musen/elastic logs MUSEN's time with each)."""
+    plan = model.plan
+    refused = []
+    if not integrator:
+        refused.append("it needs fibrelmp's LAMMPS styles (fix musen/leapfrog)")
+    if deletions:
+        refused.append("spheres whose activity ends during the run are not supported with it")
+    if plan.inlets:
+        refused.append("dynamic generators (inlets) are not supported with it")
+    return "MUSEN's variable time step: " + "; ".join(refused) if refused else None
+
+
+UNKNOWN_STEP = -1          # a frame whose step the run decides (variable time step)
+
+
+class VariableSaves:
+    """The frames of a variable time step: their steps are known once the run makes them (fix
+    musen/leapfrog stops the run where MUSEN saves), so the schedule gives UNKNOWN_STEP per frame
+    and has no length."""
+
+    period = None
+    explicit = None
+
+    def __init__(self, estimate: int):
+        self.total = estimate          # steps at the largest step: the progress estimate
+
+    def __iter__(self):
+        while True:
+            yield UNKNOWN_STEP
+
+    def __contains__(self, step: int) -> bool:
+        return False
+
+
+VARIABLE_LOOP, VARIABLE_DONE = "fl_vardt", "fl_vardt_done"
+RUN_CHUNK = 2 ** 31 - 1     # LAMMPS's largest run N: fix musen/leapfrog stops it much earlier
+
+
+def variable_schedule() -> list[tuple]:
+    """Actions of a variable-step script: MUSEN's start (first frame, prediction), then runs
+    that fix musen/leapfrog stops after each step where MUSEN saves, a frame after each, until
+    the step reaching END_TIME, whose frame is the last (a loop of LAMMPS: `lmp -in` replays it)."""
+    return [("run0",), ("frame", 0), ("predict",),
+            ("loop", VARIABLE_LOOP, RUN_CHUNK), ("run", RUN_CHUNK, False), ("vardt_check", VARIABLE_DONE),
+            ("frame", None), ("end", VARIABLE_LOOP), ("label", VARIABLE_DONE), ("frame", None)]
 
 
 def schedule(total: int, saves: SaveSteps, deletions: list[tuple[int, np.ndarray]],
@@ -185,15 +249,18 @@ def compress_ids(ids: np.ndarray) -> str:
 STOP_LABEL, END_LABEL = "fl_stopped", "fl_finish"
 
 
-def with_stop_criterion(acts: list[tuple], max_broken: int, bonds0: int) -> list[tuple]:
+def with_stop_criterion(acts: list[tuple], max_broken: int, bonds0: int,
+                        last_unchecked: bool = False) -> list[tuple]:
     """MUSEN's stop criterion BROKEN_BONDS (BaseSimulator::PreCalculationStep): at every save
     after the first, more than ``max_broken`` bonds broken since the start (``bonds0`` at the
     start) stop the run; cmusen then still makes that step and saves once more
-    (FinalizeSimulation), so the stop block is one step and its frame."""
+    (FinalizeSimulation), so the stop block is one step and its frame.  ``last_unchecked``: the
+    last frame is FinalizeSimulation's save, which checks nothing (a variable step's script)."""
     out: list[tuple] = [("stopvar", bonds0)]
-    for act in acts:
+    last = max((k for k, act in enumerate(acts) if act[0] == "frame"), default=-1)
+    for k, act in enumerate(acts):
         out.append(act)
-        if act[0] == "frame" and act[1] != 0:
+        if act[0] == "frame" and act[1] != 0 and not (last_unchecked and k == last):
             out.append(("stopcheck", max_broken))
     said = (f"{STOP_PRINT}: more than {max_broken} bonds broken (MUSEN BROKEN_BONDS): one more "
             "step, its frame, the end")

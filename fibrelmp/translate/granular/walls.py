@@ -83,8 +83,9 @@ def plan_walls(model: GranularModel, dt: float, t_end: float, mesh: bool | None 
             desc = (f"{len(rows)} exact triangles -> fix musen/wall/mesh (MUSEN's particle-wall "
                     "contact, face/edge/vertex)")
             if stepped:
-                desc += (", moving step by step as MUSEN moves it ("
-                         + ("force-dependent" if geom.motion_type in (2, 3) else "free") + " motion)")
+                kind = ("force-dependent" if geom.motion_type in (2, 3) else
+                        "free" if is_stepped(geom) else "time-dependent")
+                desc += f", moving step by step as MUSEN moves it ({kind} motion)"
             elif kin.moving:
                 desc += ", moving (time-dependent motion)"
             plans.append(WallPlan(name, "mesh", desc, rows, kin, material,
@@ -302,9 +303,8 @@ def wall_commands(model: GranularModel, wall_plans: list[WallPlan], spheres, dt:
     if any(wp.kind == "mesh" for wp in wall_plans):
         wall_cmds.append(LammpsText("# " + comment_text(f"the exact triangles of every wall geometry "
                                                          f"({MESH_NAME}), MUSEN's particle-wall contact")))
-        pw_model, pw_params = physics.chosen(model, "PW")
         wall_cmds.append(f"fix             {MESH_FIX} spheres musen/wall/mesh {MESH_NAME}"
-                         f"{pw_model.mesh_law_args(pw_params)}")
+                         f"{physics.mesh_law_args(model)}")
     for gi, wp in enumerate(wall_plans):
         tag = f"w{gi + 1}"
         if wp.kind == "mesh":

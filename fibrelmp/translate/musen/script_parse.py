@@ -69,7 +69,6 @@ _IGNORED = {
     "POSTPROCESS": "post-processing commands are not supported",
     "SELECTIVE_SAVING_P": "every field is saved", "SELECTIVE_SAVING_SB": "every field is saved",
     "SELECTIVE_SAVING_LB": "every field is saved", "SELECTIVE_SAVING_TW": "every field is saved",
-    "MAX_PART_MOVE": "only for a variable time step", "STEP_INC_FACTOR": "only for a variable time step",
 }
 # keywords only the generator / analyser / snapshot components read: accepted, no effect
 _OTHER_COMPONENT_KEYS = ("AGGLOMERATES_DB",)
@@ -111,6 +110,8 @@ class MusenJob:
     contact_radius: bool | None = None
     reset_bonds: bool | None = None
     variable_time_step: bool | None = None
+    max_part_move: float = 0.0               # MAX_PART_MOVE (0: keep the simulator's)
+    step_inc_factor: float = 0.0             # STEP_INC_FACTOR (0: keep the simulator's)
     velocity_limit: float | None = None      # LIMIT_PARTICLE_VELOCITY (<= 0: no limit)
     # STOP_CRITERION lines in order (NONE / BROKEN_BONDS; any replaces a .mdem's criteria) and
     # the last BROKEN_BONDS number (cmusen keeps one value)
@@ -325,11 +326,17 @@ def _refuse(why: str):
 
 def _variable_step(job: MusenJob, line: _Line) -> None:
     job.variable_time_step = line.flag()
-    if job.variable_time_step:
-        job.refused.append((line.key, line.ln, "MUSEN's variable time step is not supported: "
-                            "its step changes every step with the forces and its saves fall "
-                            "between steps; give VARIABLE_TIME_STEP 0 to run with the fixed "
-                            "SIMULATION_STEP"))
+
+
+def _variable_step_setting(attr: str):
+    # cmusen: a value other than 0 replaces the simulator's (ConsoleSimulator); a negative one
+    # would make MUSEN's step nan
+    def handler(job: MusenJob, line: _Line) -> None:
+        value = line.floats(1)[0]
+        if value < 0:
+            raise line.error(f"expected a value >= 0 (0 keeps the simulator's), got {value:g}")
+        setattr(job, attr, value)
+    return handler
 
 
 def _velocity_limit(job: MusenJob, line: _Line) -> None:
@@ -485,7 +492,8 @@ _HANDLERS = {
     "RESET_INITIAL_BOND_LENGTH": _flag("reset_bonds"),
     "EXT_ACCEL": _tuple("ext_accel", 3), "SIMULATION_DOMAIN": _tuple("simulation_domain", 6),
     "PBC_FLAGS": _pbc_flags, "PBC_DOMAIN": _tuple("pbc_domain", 6),
-    "VARIABLE_TIME_STEP": _variable_step, "STOP_CRITERION": _stop,
+    "VARIABLE_TIME_STEP": _variable_step, "MAX_PART_MOVE": _variable_step_setting("max_part_move"),
+    "STEP_INC_FACTOR": _variable_step_setting("step_inc_factor"), "STOP_CRITERION": _stop,
     "LIMIT_PARTICLE_VELOCITY": _velocity_limit,
     "MATERIAL_PROPERTY": _material_property, "INTERACTION_PROPERTY": _interaction_property,
     "TEXT_EXPORT_PRECISION": _precision, "TIME_INTERVAL": _time_interval,

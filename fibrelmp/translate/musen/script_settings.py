@@ -14,7 +14,7 @@ import numpy as np
 
 from fibrelmp import lammps_styles
 from fibrelmp.errors import InputError
-from fibrelmp.granmodel import GranularModel, ModelChoice
+from fibrelmp.granmodel import GranularModel, GranularPlan, ModelChoice
 from fibrelmp.translate.musen.scene import (INTERACTION_DEFAULTS, _check_material, check_simulable, contact_law,
                     domain_warning)
 from fibrelmp.translate.granular import models as physics
@@ -30,12 +30,14 @@ def _resolve_models(model: GranularModel, job: MusenJob) -> tuple[dict[str, Mode
     file's models as loaded, then ``AddActiveModel`` for each of the job's: a model already
     active keeps its place and takes the job's parameters on top of the file's).  Every
     active model acts (CPUSimulator runs all models of a kind, in turn): the first of each
-    kind, and the later SB and EF models (in order), which act after it (``_one_per_kind``)."""
+    kind, and the later ones (in order), which act after it (``_first_and_later``)."""
     chosen: dict[str, ModelChoice] = dict(model.models)
     active: list[ModelChoice] = []
     by_name: dict[str, int] = {}
     for spec in scene_record(model).file_models:
-        by_name[spec.name] = len(active)
+        # a file may list a model twice (MUSEN loads both); a job's parameters go to the
+        # first (CModelManager::SetModelParameters)
+        by_name.setdefault(spec.name, len(active))
         active.append(_model_choice(model, spec, model.source, None))
     for spec in job.models:
         if spec.name.startswith(REFUSED_MODEL):    # check's stand-in for a model refused above
@@ -48,28 +50,35 @@ def _resolve_models(model: GranularModel, job: MusenJob) -> tuple[dict[str, Mode
             continue
         by_name[spec.name] = len(active)
         active.append(_model_choice(model, spec, job.path, spec.line))
-    for choice in _one_per_kind(active, model.source):
-        chosen[choice.kind] = choice
-    return chosen, [c for c in active if c.kind in ("SB", "EF") and c is not chosen.get(c.kind)]
+    first, later = _first_and_later(active, model.source)
+    chosen.update(first)
+    return chosen, later
 
 
 _ACTS_ON = {"PP": "particle-particle contact", "PW": "particle-wall contact", "SB": "solid bond",
             "LB": "liquid bond", "EF": "particle"}
+# kinds of which fibrelmp runs several models together, as cmusen does (each in turn on every
+# contact, bond or particle: PP, PW and EF forces add, SB laws continue the bond's state)
+SEVERAL_OF_A_KIND = ("PP", "PW", "SB", "EF")
 
 
 def _chosen_at(choice: ModelChoice, source) -> str:
     return f"line {choice.line}" if choice.line is not None else f"stored in {Path(source).name}"
 
 
-def _one_per_kind(active: list[ModelChoice], source) -> list[ModelChoice]:
-    """The first active model of each kind.  Several SB models act together (the later ones
-    become the plan's ``then_bond_laws``) and so do several EF models (the plan's
-    ``external_fields``, each adding its force in turn); two of another kind are refused, named where the
-    second was selected: cmusen adds their forces, which fibrelmp does not simulate."""
+def _first_and_later(active: list[ModelChoice], source) -> tuple[dict[str, ModelChoice],
+                                                                    list[ModelChoice]]:
+    """The first active model of each kind, and the later ones of the kinds that act together
+    (``SEVERAL_OF_A_KIND``), in cmusen's order.  Two of another kind (LB) are refused,
+    named where the second was selected."""
     seen: dict[str, ModelChoice] = {}
+    later: list[ModelChoice] = []
     for choice in active:
         first = seen.setdefault(choice.kind, choice)
-        if first is choice or choice.kind in ("SB", "EF"):
+        if first is choice:
+            continue
+        if choice.kind in SEVERAL_OF_A_KIND:
+            later.append(choice)
             continue
         hint = ("remove one of the two MODEL_ lines" if first.line is not None else
                 "a script cannot drop a file's model: remove it in MUSEN (models tab) and save "
@@ -78,10 +87,30 @@ def _one_per_kind(active: list[ModelChoice], source) -> list[ModelChoice]:
                          f"{choice.name} ({_chosen_at(choice, source)}) and {first.name} "
                          f"({_chosen_at(first, source)}) are both {choice.kind} models: cmusen "
                          f"runs every selected model, both acting on each "
-                         f"{_ACTS_ON.get(choice.kind, 'object')} in turn (forces add); fibrelmp "
-                         f"applies one model of a kind (several only for solid bonds) and does "
-                         f"not simulate that: {hint}")
-    return list(seen.values())
+                         f"{_ACTS_ON.get(choice.kind, 'object')} in turn; fibrelmp runs several "
+                         f"models of a kind only for {', '.join(SEVERAL_OF_A_KIND)} and not two "
+                         f"{physics.KIND_WORDS[choice.kind]} models together: {hint}")
+    return seen, later
+
+
+def _apply_later_contact_models(model: GranularModel, plan) -> None:
+    """The later PP / PW models: checked as each model checks its parameters (at its MODEL_
+    line), only with fibrelmp's LAMMPS styles (pair musen/hm's and fix musen/wall/mesh's law
+    lists), and their contact durations joined to the first's for ``fibrelmp check``."""
+    for kind in ("PP", "PW"):
+        own_plans = []
+        for choice in (c for c in model.later_models if c.kind == kind):
+            styles = lammps_styles.plugin()
+            if not styles.available:
+                raise InputError(choice.source, choice.line, f"{choice.name} after "
+                                 f"{model.models[kind].name}: several {kind} models acting "
+                                 "together need fibrelmp's LAMMPS styles, which are not "
+                                 f"available here ({styles.how})")
+            own = GranularPlan(dt=plan.dt, t_start=plan.t_start, t_end=plan.t_end)
+            physics.find(choice.name).apply(own, choice.parameters, choice.source, choice.line)
+            own_plans.append(own)
+        if own_plans:
+            physics.combine_contact_times(plan, kind, own_plans)
 
 
 def _names(names: list[str]) -> str:
@@ -166,7 +195,7 @@ def apply_simulator_settings(model: GranularModel, job: MusenJob) -> None:
     if job.reset_bonds:
         reset_bond_lengths(model)
     _apply_motion(model, job)
-    models, later_models = _resolve_models(model, job)
+    models, later = _resolve_models(model, job)
     model.models = models
     _check_models(model, job, models)
     if "PP" in models:                            # the laws stand for the PP model chosen
@@ -178,12 +207,14 @@ def apply_simulator_settings(model: GranularModel, job: MusenJob) -> None:
         physics.find(choice.name).apply(plan, choice.parameters, job.path,
                                         job.where(f"MODEL_{kind}_PARAMS"))
     plan.then_bond_laws = []
-    for choice in later_models:    # in cmusen's order, after the first model of their kind
+    for choice in later:                # in cmusen's order, after the first of their kind
         if choice.kind == "SB":
             physics.add_later_bond_law(plan, choice.name, choice.parameters, choice.source,
                                        choice.line)
-        else:
+        elif choice.kind == "EF":      # its fix after the first's (plan.external_fields)
             physics.find(choice.name).apply(plan, choice.parameters, choice.source, choice.line)
+    model.later_models = [c for c in later if c.kind != "SB"]
+    _apply_later_contact_models(model, plan)
     if job.connected_pp_contact is not None:
         plan.contacts_between_bonded = job.connected_pp_contact
     _refuse_file_settings(model, job)
@@ -193,6 +224,15 @@ def apply_simulator_settings(model: GranularModel, job: MusenJob) -> None:
             raise InputError(job.path, job.where("LIMIT_PARTICLE_VELOCITY"), "LIMIT_PARTICLE_VELOCITY "
                              "needs fibrelmp's LAMMPS styles (fix musen/leapfrog vlimit)")
     _apply_times(model, job)
+    if plan.variable_step is not None:
+        from fibrelmp.translate.granular.schedule import variable_step_refusals
+
+        why = variable_step_refusals(model, lammps_styles.plugin().available)
+        if why is not None:
+            if "VARIABLE_TIME_STEP" in job.lines:
+                raise InputError(job.path, job.where("VARIABLE_TIME_STEP"), why)
+            raise InputError(scene_record(model).mdem_source or model.source, None,
+                             f"flexible_time_step: {why}")
 
 
 def _apply_materials(model: GranularModel, job: MusenJob) -> None:
@@ -280,12 +320,21 @@ def _apply_motion(model: GranularModel, job: MusenJob) -> None:
         g.force_motion.append(interval)
 
 
+# MUSEN's defaults (CBaseSimulator: m_partMoveLimit, m_timeStepFactor)
+MUSEN_VARIABLE_STEP = (1e-8, 1.01)
+
+
 def _refuse_file_settings(model: GranularModel, job: MusenJob) -> None:
     """A .mdem's settings fibrelmp cannot simulate (``MusenSceneRecord.refused``), unless the
     job switches them off as cmusen's ConsoleSimulator would (VARIABLE_TIME_STEP 0,
     STOP_CRITERION NONE)."""
     record = scene_record(model)
-    if job.variable_time_step is False:
+    if job.variable_time_step is not None:       # cmusen: the script's flag replaces the file's
+        model.plan.variable_step = (MUSEN_VARIABLE_STEP if job.variable_time_step else None)
+    if model.plan.variable_step is not None:
+        move, factor = model.plan.variable_step
+        model.plan.variable_step = (job.max_part_move or move, job.step_inc_factor or factor)
+    if model.plan.variable_step is None:         # switched off: the file's values do not matter
         record.refused.pop("flexible_time_step", None)
     if job.stop_criteria:       # cmusen: the script's criteria replace the file's
         record.refused.pop("stop_criteria", None)

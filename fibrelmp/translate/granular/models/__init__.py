@@ -9,12 +9,15 @@ from __future__ import annotations
 
 import dataclasses
 import importlib
+import math
 import pkgutil
 from pathlib import Path
 from typing import ClassVar
 
 from fibrelmp.errors import InputError
 from fibrelmp.granmodel import GranularModel, GranularPlan, SolidBondLaw
+from fibrelmp.lammps_text import LammpsText
+from fibrelmp.sanity import hertz_contact_time
 
 KIND_WORDS = {"PP": "particle-particle", "PW": "particle-wall", "SB": "solid-bond",
               "LB": "liquid-bond", "EF": "external-force"}
@@ -73,10 +76,23 @@ class PhysicsModel:
         raise NotImplementedError(f"{cls.name} is not a particle-particle model")
 
     @classmethod
+    def pp_law_words(cls, params: dict[str, float]) -> str:
+        """PP models: the law's words after ``then`` in ``pair_style musen/hm`` (NAME
+        parameters, musen_pp_law.h), when it acts after another PP model."""
+        raise NotImplementedError(f"{cls.name} is not a particle-particle model")
+
+    @classmethod
+    def mesh_law_words(cls, params: dict[str, float]) -> str:
+        """PW models: the law's words after ``law`` in ``fix musen/wall/mesh FILE``
+        (NAME parameters, musen_pw_law.h)."""
+        raise NotImplementedError(f"{cls.name} is not a particle-wall model")
+
+    @classmethod
     def mesh_law_args(cls, params: dict[str, float]) -> str:
         """PW models: what follows the file name of ``fix musen/wall/mesh`` ("" for its
         default law, hertz/mindlin; else " law NAME parameters", musen_pw_law.h)."""
-        raise NotImplementedError(f"{cls.name} is not a particle-wall model")
+        words = cls.mesh_law_words(params)
+        return "" if words == "hertz/mindlin" else f" law {words}"
 
     @classmethod
     def bond_law(cls, plan: GranularPlan) -> tuple[str, str]:
@@ -139,6 +155,56 @@ def chosen(model: GranularModel, kind: str) -> tuple[type[PhysicsModel], dict[st
         return find(picked.name), picked.parameters
     stock = default_model(kind)
     return stock, dict(stock.parameters)
+
+
+def chosen_all(model: GranularModel, kind: str) -> list[tuple[type[PhysicsModel], dict[str, float]]]:
+    """Every model of ``kind`` a scene runs, in the order they act on each contact: the
+    chosen one (``chosen``), then the later ones of that kind (``model.later_models``; cmusen
+    runs every selected PP / PW model on each contact in turn, forces adding)."""
+    return [chosen(model, kind)] + [(find(c.name), c.parameters) for c in model.later_models
+                                    if c.kind == kind]
+
+
+def pair_style_lines(model: GranularModel, own_styles: bool) -> list[str]:
+    """The ``pair_style`` line (and its comment) of the PP models a scene runs: the first
+    one's, each later model's law after ``then``."""
+    (first, params), *later = chosen_all(model, "PP")
+    lines = first.pair_style_lines(params, own_styles)
+    if later:
+        if not own_styles:
+            raise RuntimeError("several PP models need fibrelmp's LAMMPS styles (checked earlier)")
+        lines[-1] += "".join(f" then {m.pp_law_words(p)}" for m, p in later)
+        lines.insert(-1, LammpsText("# and after it, on each contact (cmusen's order, forces add): "
+                                    + ", ".join(m.name for m, _ in later)))
+    return lines
+
+
+def mesh_law_args(model: GranularModel) -> str:
+    """What follows the file name of ``fix musen/wall/mesh``: the PW models' laws in order
+    ("" for MUSEN's Hertz-Mindlin alone, the fix's default)."""
+    laws = chosen_all(model, "PW")
+    if len(laws) == 1:
+        return laws[0][0].mesh_law_args(laws[0][1])
+    return "".join(f" law {m.mesh_law_words(p)}" for m, p in laws)
+
+
+def combine_contact_times(plan: GranularPlan, kind: str, later: list[GranularPlan]) -> None:
+    """Several PP (or PW) laws act together: their stiffnesses add, so the contact is shorter
+    than each law's own; n springs in parallel are at most n times the stiffest, hence
+    (shortest duration) / sqrt(n) bounds it from below (``fibrelmp check``'s figure)."""
+    attr = "pp" if kind == "PP" else "pw"
+    plans = [plan, *later]
+    times = [getattr(p, f"{attr}_contact_time") or hertz_contact_time for p in plans]
+    names = [getattr(p, f"{attr}_contact_law") if getattr(p, f"{attr}_contact_time") else "Hertz"
+             for p in plans]
+    root = math.sqrt(len(times))
+
+    def contact_time(m_eff: float, r_eff: float, e_star: float, speed: float) -> float:
+        return min(t(m_eff, r_eff, e_star, speed) for t in times) / root
+
+    setattr(plan, f"{attr}_contact_time", contact_time)
+    setattr(plan, f"{attr}_contact_law", f"{' + '.join(names)}: shortest / sqrt({len(times)}), "
+                                         "a lower bound")
 
 
 def solid_bond_model(plan: GranularPlan) -> type[PhysicsModel]:

@@ -20,3 +20,7 @@ class PPHertzMindlin(PhysicsModel):
             return [LammpsText("# MUSEN's Hertz-Mindlin particle-particle contact; pair_coeff: "
                                "E* G* e mu mu_r"), "pair_style      musen/hm"]
         return ["pair_style      granular"]
+
+    @classmethod
+    def pp_law_words(cls, params: dict[str, float]) -> str:
+        return "hertz/mindlin"

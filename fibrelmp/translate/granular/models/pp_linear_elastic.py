@@ -47,3 +47,7 @@ class PPLinearElastic(PhysicsModel):
         return [LammpsText("# MUSEN's linear elastic particle-particle contact; pair_style: Kn Kt; "
                            "pair_coeff: E* G* e mu mu_r (E*, G* unused)"),
                 f"pair_style      musen/linear {float_text(params['Kn'])} {float_text(params['Kt'])}"]
+
+    @classmethod
+    def pp_law_words(cls, params: dict[str, float]) -> str:
+        return f"linear/elastic {float_text(params['Kn'])} {float_text(params['Kt'])}"

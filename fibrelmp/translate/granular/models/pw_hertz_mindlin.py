@@ -13,5 +13,5 @@ class PWHertzMindlin(PhysicsModel):
     default = True
 
     @classmethod
-    def mesh_law_args(cls, params: dict[str, float]) -> str:
-        return ""                   # the fix's default law
+    def mesh_law_words(cls, params: dict[str, float]) -> str:
+        return "hertz/mindlin"      # the fix's default law

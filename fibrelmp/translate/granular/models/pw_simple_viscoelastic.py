@@ -43,6 +43,5 @@ class PWSimpleViscoElastic(PhysicsModel):
         plan.pw_contact_law = "simple viscoelastic"
 
     @classmethod
-    def mesh_law_args(cls, params: dict[str, float]) -> str:
-        return (f" law simple/viscoelastic {float_text(params[STIFFNESS])} "
-                f"{float_text(params[DAMPING])}")
+    def mesh_law_words(cls, params: dict[str, float]) -> str:
+        return f"simple/viscoelastic {float_text(params[STIFFNESS])} {float_text(params[DAMPING])}"

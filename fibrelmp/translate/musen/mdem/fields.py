@@ -31,9 +31,9 @@ _DB = "materials database, read through the text form (`32`/`33`)"
 _STOP = ("BROKEN_BONDS (type 1, max_broken_bonds) stops the run as cmusen does, checked at every "
          "save (model.py `_refused_settings`, lammps_flow.py); an unknown type is refused by name; "
          "a job script's STOP_CRITERION replaces it")
-_VARIABLE_STEP = ("MUSEN's variable time step is not simulated (its rule and a cmusen reference are "
-                  "in tests/data/real-outputs/musen/variable_time_step/); refused unless the job "
-                  "script switches it off (VARIABLE_TIME_STEP 0)")
+_VARIABLE_STEP = ("MUSEN's variable time step: fix musen/leapfrog variable (its rule, saves and "
+                  "end; compared with cmusen in tests/test_musen_variable_time_step.py); a job "
+                  "script's VARIABLE_TIME_STEP replaces it")
 _INLETS = ("an active dynamic generator (inlet) of spheres into a box volume inserts "
            "them during the run (mdem/generators.py `read_inlets`, fix musen/inlet); "
            "agglomerates, other volume shapes and inside_geometries off are refused by name "
@@ -172,11 +172,11 @@ FIELDS: dict[str, tuple[str, str]] = {
     "ProtoModuleSimulator.max_cells_number": (NOT_SIMULATION, "neighbour search: LAMMPS's own"),
     "ProtoModuleSimulator.verlet_dist_coeff": (NOT_SIMULATION, "neighbour search: LAMMPS's own"),
     "ProtoModuleSimulator.verlet_auto_adjust": (NOT_SIMULATION, "neighbour search: LAMMPS's own"),
-    "ProtoModuleSimulator.flexible_time_step": (REFUSED, _VARIABLE_STEP),
-    "ProtoModuleSimulator.part_move_limit": (HONOURED, "read by MUSEN only with a variable time "
-                                             "step, which is refused"),
-    "ProtoModuleSimulator.time_step_factor": (HONOURED, "read by MUSEN only with a variable "
-                                              "time step, which is refused"),
+    "ProtoModuleSimulator.flexible_time_step": (HONOURED, _VARIABLE_STEP),
+    "ProtoModuleSimulator.part_move_limit": (HONOURED, "MOVE of fix musen/leapfrog variable "
+                                             "(read only with a variable time step)"),
+    "ProtoModuleSimulator.time_step_factor": (HONOURED, "FACTOR of fix musen/leapfrog variable "
+                                              "(read only with a variable time step)"),
     "ProtoModuleSimulator.part_velocity_limit": (HONOURED, "fix musen/leapfrog vlimit (> 0; "
                                                  "MUSEN: <= 0 is no limit; item 4)"),
     "ProtoModuleObjectsGenerator.*": (HONOURED, _INLETS),

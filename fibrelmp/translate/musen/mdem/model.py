@@ -93,10 +93,15 @@ def _refused_settings(model: GranularModel, storage) -> None:
     ``CBaseSimulator::LoadConfiguration``): kept by name, refused when simulated; and the
     moving periodic box (``SPBC::vVel``), which it does."""
     refused = scene_record(model, keep=True).refused
-    if storage.modules_data.simulator.flexible_time_step:
-        refused["flexible_time_step"] = ("MUSEN's variable time step is not supported: its step "
-                                         "changes every step with the forces; a job script's "
-                                         "VARIABLE_TIME_STEP 0 runs it with its fixed step")
+    sim = storage.modules_data.simulator
+    if sim.flexible_time_step:
+        if sim.part_move_limit > 0 and sim.time_step_factor > 0:
+            model.plan.variable_step = (sim.part_move_limit, sim.time_step_factor)
+        else:
+            refused["flexible_time_step"] = (
+                f"MUSEN's variable time step with part_move_limit {sim.part_move_limit:g} and "
+                f"time_step_factor {sim.time_step_factor:g}: both must be > 0 (MUSEN's step "
+                "would become 0 or nan)")
     criteria = storage.info.stop_criteria
     if any(t not in (0, 1) for t in criteria.types):                # 0 NONE, 1 BROKEN_BONDS
         refused["stop_criteria"] = (f"stop criterion types {sorted(set(criteria.types))}: MUSEN "

@@ -244,6 +244,9 @@ class MdemResultWriter(MusenResultWriter):
             (float(g) for g in plan.gravity)
         sim.simulator_type = sim.simulator_type or 1           # CPU
         sim.part_velocity_limit = plan.velocity_limit or 0.0   # as MUSEN saves it (0: none)
+        if plan.variable_step is not None:
+            sim.flexible_time_step = True
+            sim.part_move_limit, sim.time_step_factor = plan.variable_step
         if plan.stop_broken_bonds is not None:                 # MUSEN's SaveConfiguration
             storage.info.stop_criteria.types[:] = [1]
             storage.info.stop_criteria.max_broken_bonds = plan.stop_broken_bonds
@@ -260,6 +263,10 @@ class MdemResultWriter(MusenResultWriter):
                 entry.key = mdem_key(choice.name)
                 entry.path = choice.name
                 entry.params = _params_text(choice.parameters)
+                for later in (c for c in m.later_models if c.kind == kind):   # act after it
+                    entry = manager.models.add()
+                    entry.key, entry.path = mdem_key(later.name), later.name
+                    entry.params = _params_text(later.parameters)
                 if kind == "SB":    # the later SB models, which act after it (cmusen's order)
                     for law in plan.then_bond_laws:
                         entry = manager.models.add()
@@ -269,11 +276,6 @@ class MdemResultWriter(MusenResultWriter):
                                         f"CONSIDER_BREAKAGE {law.breakage:g} " + (
                                             f"MAX_DAMP_RATIO {law.max_damp_ratio:g} "
                                             if law.form == "kelvin" else ""))
-                if kind == "EF":    # the later EF models, which act after it (cmusen's order)
-                    for fld in plan.external_fields[1:]:
-                        entry = manager.models.add()
-                        entry.key, entry.path = mdem_key(fld.model), fld.model
-                        entry.params = _params_text(fld.parameters)
             manager.connected_pp_contact = bool(plan.contacts_between_bonded)
 
 

@@ -496,3 +496,15 @@ def test_cmusen_runs_both_fields_of_fibrelmps_mdem(tmp_path):
     assert ("External force:                        Centrifugal Casting\n\tROTATION_VELOCITY 10 "
             "LIQUID_DENSITY 1000 LIQUID_VISCOSITY 0.01 \nExternal force:                        "
             "Viscous Field\n\tMEDIUM_VISCOSITY 1e-06 MEDIUM_DENSITY 1000 \n") in done.stdout
+
+
+@pytest.mark.parametrize("case", ["heat", "diffusion"])
+def test_variable_time_step_is_refused_for_step_dependent_models(tmp_path, case):
+    """MUSEN's temperature update takes the current step and its diffusion coefficients the
+    first: with a variable step fibrelmp refuses these two models (the force fields run)."""
+    styles_or_skip()
+    job = _job(tmp_path, case)
+    job.write_text(job.read_text().replace("SIMULATOR_TYPE       CPU",
+                                           "SIMULATOR_TYPE       CPU\nVARIABLE_TIME_STEP   1"))
+    with pytest.raises(InputError, match="with a variable time step is not supported"):
+        python_api.run(job)

@@ -34,6 +34,14 @@ def field_commands(model: GranularModel, rows: np.ndarray, type_of_mat: dict[int
     """What the job needs for the plan's EF models, for the simulated sphere ``rows`` (LAMMPS
     id = row + 1; sphere material m has type ``type_of_mat[m]``), in MUSEN's order."""
     heat = uses_temperature(model)
+    if model.plan.variable_step is not None:
+        for fld in model.plan.external_fields:
+            if fld.heat or fld.style != "musen/field":
+                # MUSEN: the temperature update takes the current step, the diffusion
+                # coefficients the first one; these fixes take LAMMPS's fixed dt
+                raise InputError(model.source, None, f"{fld.model} with a variable time step is "
+                                 "not supported (its temperature or random-force coefficients "
+                                 "depend on the step)")
     lines = _set_temperatures(model, rows) if heat else []
     fixes = []
     for fld in model.plan.external_fields:

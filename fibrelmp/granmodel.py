@@ -106,6 +106,7 @@ class Spheres:
     active_start: np.ndarray   # (n,)
     active_end: np.ndarray     # (n,) inf = active for ever
     compound_key: list[str] | None = None   # per-sphere key as written (MUSEN 23)
+    temperature: np.ndarray | None = None   # (n,) K, MUSEN 37 (simulated by ModelEFHeatTransfer)
 
     @property
     def count(self) -> int:
@@ -202,6 +203,19 @@ class Plane:
 
 
 @dataclass
+class ExternalField:
+    """One MUSEN external-force (EF) model acting on every sphere (fibrelmp's ``fix
+    musen/field``, translate/granular/models/ef_*.py)."""
+    model: str                      # MUSEN's name, e.g. "ModelEFViscousField"
+    parameters: dict[str, float]    # its parameters (MUSEN's names)
+    fix_args: str                   # what follows ``musen/field``: the law and its numbers
+    # the law changes the spheres' temperature (then the job adds `cp` and each type's heat
+    # capacity to fix_args and keeps the temperature in d_musen_temperature)
+    heat: bool = False
+    style: str = "musen/field"      # its LAMMPS fix style
+
+
+@dataclass
 class GranularPlan:
     dt: float
     t_start: float
@@ -219,6 +233,8 @@ class GranularPlan:
     # every active model of a kind; each continues the bond's state and may break it)
     then_bond_laws: list[SolidBondLaw] = field(default_factory=list)
     contacts_between_bonded: bool = True    # MUSEN default
+    # MUSEN's active EF models, in cmusen's order (each adds its force in turn, before all others)
+    external_fields: list[ExternalField] = field(default_factory=list)
     velocity_limit: float | None = None     # MUSEN's particle velocity limit (m/s; None: none)
     # MUSEN's variable time step (MAX_PART_MOVE m, STEP_INC_FACTOR); None: the fixed step
     variable_step: tuple[float, float] | None = None
@@ -306,7 +322,7 @@ class GranularModel(ParticleModel):
     origin: SourceRecord | None = None
     liquid_bonds: list[LiquidBond] = field(default_factory=list)
     models: dict[str, ModelChoice] = field(default_factory=dict)   # kind -> chosen model
-    # further PP and PW models acting on each contact after models[kind], in cmusen's order
+    # further PP, PW and EF models acting after models[kind], in cmusen's order
     # (cmusen runs every selected model of a kind in turn; forces add)
     later_models: list[ModelChoice] = field(default_factory=list)
     # post: the dump's atom ids of the spheres and their sort order (post.to_granular)
@@ -498,5 +514,6 @@ class GranularFrame:
     triangle_vertices: np.ndarray | None = None # (k,3,3)
     triangle_velocity: np.ndarray | None = None # (k,3)
     triangle_force: np.ndarray | None = None    # (k,3) force the particles exert on each triangle
+    temperature: np.ndarray | None = None      # (n',) K, when a heat model changes it
     saved_force: np.ndarray | None = None      # (n',3) the force cmusen saves now (MUSEN's
                                                # integrator: the previous evaluation's)

@@ -34,6 +34,8 @@ def summary(model: GranularModel) -> list[str]:
         lo, hi = plan.domain
         lines.append(f"domain       {' '.join(f'{v:g}' for v in lo)} .. {' '.join(f'{v:g}' for v in hi)}")
     lines.append(f"gravity      {' '.join(f'{v:g}' for v in plan.gravity)}")
+    for fld in plan.external_fields:      # MUSEN's EF models, in the order they act
+        lines.append(f"field        {fld.model}: {fld.style} {fld.fix_args}")
     lines.append(f"time         {plan.t_start:g} .. {plan.t_end:g}  step {plan.dt:g}")
     if plan.save_every_time is not None:
         lines.append(f"saves        every {plan.save_every_time:g} time units")

@@ -252,8 +252,9 @@ APPLY_ERRORS = [  # script, line, words: parsed fine, refused when the job is ap
      "model is not supported; fibrelmp translates ModelSBElastic, and with fibrelmp's LAMMPS "
      "styles ModelSBAerogel, ModelSBCreep, ModelSBElasticPerfectlyPlastic, ModelSBKelvin, "
      "ModelSBLinearPlastic, ModelSBPlasticConcrete and ModelSBWeakening"),
-    (GOOD + "MODEL_EF ModelEFViscousField\nMODEL_EF_PARAMS MEDIUM_VISCOSITY 1e-5\n", 7,
-     "external-force model is not supported; fibrelmp translates no external-force model"),
+    (GOOD + "MODEL_EF ModelEFLiquidDiffusion\nMODEL_EF_PARAMS TEMPERATURE 350\n", 8,
+     "ModelEFLiquidDiffusion: without FIXED_SEED MUSEN seeds its generators from "
+     "std::random_device"),
     (GOOD.replace("ModelPPHertzMindlin", "ModelPPHertzMindlln"), 1, "did you mean ModelPPHertzMindlin?"),
     (GOOD.replace("MODEL_PW ModelPWHertzMindlin", "MODEL_PW ModelPPHertz"), 2,
      "is a PP model, given as MODEL_PW"),
@@ -365,7 +366,8 @@ def test_script_mutations_only_input_errors(tmp_path):
 def test_check_reads_model_params_after_a_refused_model(tmp_path):
     """Issue 24: ``check`` said 'no MODEL_EF line before it' of a MODEL_EF_PARAMS line right
     after a (refused) MODEL_EF line: cmusen gives those parameters to that model, so the one
-    error is the model's; a PARAMS line with no model line before it is still an error."""
+    error is the model's (now shown with a refused MODEL_LB: every EF model is translated); a
+    PARAMS line with no model line before it is still an error."""
     from pathlib import Path
 
     from typer.testing import CliRunner
@@ -375,10 +377,10 @@ def test_check_reads_model_params_after_a_refused_model(tmp_path):
     corpus = Path(__file__).resolve().parent / "bad_inputs" / "musen_script"
     (tmp_path / "scene.txt").write_bytes((corpus / "scene.txt").read_bytes())
     good = (corpus / "good.txt").read_text()
-    assert "MODEL_SB" in good and "MODEL_EF" not in good
-    extra = ("MODEL_EF ModelEFViscousField\nMODEL_EF_PARAMS MEDIUM_VISCOSITY 1e-5\n"
-             "MODEL_LB ModelLBCapilarViscous\nMODEL_LB_PARAMS MIN_THICKNESS 1e-5\n"
-             "MODEL_EXT_FORCE_PARAMS MEDIUM_DENSITY 1\nMODEL_SB_PARAMS CONSIDER_BREAKAGE 7\n")
+    assert "MODEL_SB" in good and "MODEL_LB" not in good
+    # (every MUSEN EF model is translated: only liquid-bond models are refused by kind)
+    extra = ("MODEL_LB ModelLBCapilarViscous\nMODEL_LB_PARAMS MIN_THICKNESS 1e-5\n"
+             "MODEL_SB_PARAMS CONSIDER_BREAKAGE 7\n")
     (tmp_path / "job.txt").write_text(good + extra)
     n = good.count("\n")
     result = CliRunner().invoke(app, ["check", str(tmp_path / "job.txt")])
@@ -386,11 +388,9 @@ def test_check_reads_model_params_after_a_refused_model(tmp_path):
     errors = [line.split("job.txt", 1)[1] for line in result.stderr.splitlines()
               if line.startswith("error:")]
     assert errors == [
-        f":{n + 1}: ModelEFViscousField: this external-force model is not supported; fibrelmp "
-        "translates no external-force model",
-        f":{n + 3}: ModelLBCapilarViscous: this liquid-bond model is not supported; fibrelmp "
+        f":{n + 1}: ModelLBCapilarViscous: this liquid-bond model is not supported; fibrelmp "
         "translates no liquid-bond model",
-        f":{n + 6}: CONSIDER_BREAKAGE must be 0, 1 or 2 (got 7)"], result.stderr
+        f":{n + 3}: CONSIDER_BREAKAGE must be 0, 1 or 2 (got 7)"], result.stderr
     (tmp_path / "orphan.txt").write_text(good + "MODEL_EF_PARAMS MEDIUM_VISCOSITY 1e-5\n")
     with pytest.raises(InputError, match=f":{n + 1}: MODEL_EF_PARAMS: no MODEL_EF line before it"):
         ms.read_script(tmp_path / "orphan.txt")

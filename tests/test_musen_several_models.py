@@ -180,16 +180,16 @@ def test_a_files_model_twice_is_refused_without_fibrelmps_styles(tmp_path):
 def test_two_models_of_a_kind_fibrelmp_does_not_combine_are_refused_at_the_second():
     from fibrelmp.translate.musen.script_settings import _first_and_later
     script = Path("job.txt")
-    first = ModelChoice("ModelEFOne", "EF", {}, script, 3)
-    second = ModelChoice("ModelEFTwo", "EF", {}, script, 4)
+    first = ModelChoice("ModelLBOne", "LB", {}, script, 3)
+    second = ModelChoice("ModelLBTwo", "LB", {}, script, 4)
     with pytest.raises(InputError) as err:
         _first_and_later([first, second], script)
     assert err.value.line == 4
     assert err.value.message == (
-        "ModelEFTwo (line 4) and ModelEFOne (line 3) are both EF models: cmusen runs every "
-        "selected model, both acting on each particle in turn; fibrelmp runs several models of "
-        "a kind only for PP, PW, SB and not two external-force models together: remove one of "
-        "the two MODEL_ lines")
+        "ModelLBTwo (line 4) and ModelLBOne (line 3) are both LB models: cmusen runs every "
+        "selected model, both acting on each liquid bond in turn; fibrelmp runs several models "
+        "of a kind only for PP, PW, SB, EF and not two liquid-bond models together: remove one "
+        "of the two MODEL_ lines")
 
 
 @needs_cmusen

@@ -183,6 +183,8 @@ class FrameBuilder:
 
         frame = GranularFrame(time=t, step=step, sphere_rows=rows, position=pos, velocity=vel,
                               omega=omega, force=force, quaternion=quat)
+        if "d_musen_temperature" in c:    # fix musen/field heat: MUSEN's particle temperature
+            frame.temperature = np.asarray(c["d_musen_temperature"], np.float64)
         if "sfx" in c:      # fix musen/leapfrog: the force cmusen saves (the previous evaluation's)
             frame.saved_force = np.column_stack([c["sfx"], c["sfy"], c["sfz"]])
         if self.nb:

@@ -132,6 +132,8 @@ def granular_frame(frame: Frame, time: float, model: GranularModel,
                         quaternion=_orientation(frame, facts))
     if "sfx" in frame.columns:       # fix musen/leapfrog: the force cmusen saves, as the run writes
         out.saved_force = _vector(frame, ("sfx", "sfy", "sfz"), n)
+    if "d_musen_temperature" in frame.columns:    # fix musen/field heat: MUSEN's temperature
+        out.temperature = np.asarray(frame.column("d_musen_temperature"), np.float64)
     return out
 
 
@@ -157,7 +159,8 @@ class GranularTarget(DumpTarget):
     lookahead = 2                 # the save interval comes from the first two frames
     # what model_from_frame and granular_frame take from a dump
     finite_columns = frozenset({"vx", "vy", "vz", "omegax", "omegay", "omegaz", "fx", "fy", "fz",
-                                "sfx", "sfy", "sfz", "quatw", "quati", "quatj", "quatk", "radius", "diameter", "mass"})
+                                "sfx", "sfy", "sfz", "quatw", "quati", "quatj", "quatk", "radius", "diameter", "mass",
+                                "d_musen_temperature"})
     kind: ClassVar[str]
     keeps_ids: ClassVar[bool]
 

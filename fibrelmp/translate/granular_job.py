@@ -32,6 +32,7 @@ from fibrelmp.translate.granular.musen_clock import MusenClock
 from fibrelmp.translate.granular.schedule import (STOP_LABEL, RunTime, compress_ids, run_time, save_steps,
                                                   schedule, variable_schedule, variable_step_refusals,
                                                   with_stop_criterion)
+from fibrelmp.translate.granular.fields import TEMPERATURE, field_commands, uses_temperature
 from fibrelmp.translate.granular.inlets import LOG_NAME as INLET_LOG
 from fibrelmp.translate.granular.inlets import inlet_commands
 from fibrelmp.translate.granular.spheres import SimulatedSpheres, select_spheres
@@ -251,6 +252,8 @@ def _plan_parts(model: GranularModel) -> _JobParts:
     pair_lines = pair_coeff_lines(model, spheres, tiles.materials, tiles.radius, dt, musen_hm)
     sb_model = physics.solid_bond_model(plan)
     wall_cmds, var_cmds, frame_columns = wall_commands(model, wall_plans, spheres, dt)
+    if uses_temperature(model):
+        frame_columns.append(TEMPERATURE)
     if model.plan.inlets and not musen_hm:
         raise InputError(model.source, None, "MUSEN's dynamic generators need fibrelmp's LAMMPS "
                          f"styles (fix musen/inlet): {styles.how}")
@@ -292,8 +295,12 @@ def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> 
         raise InputError(model.source, None, "a particle velocity limit needs fibrelmp's LAMMPS "
                          "styles (fix musen/leapfrog)")
     pbc_velocity = _moving_periodic_box(model, parts.axes, styles)
+    if plan.external_fields and not parts.musen_hm:
+        raise InputError(model.source, None, f"{plan.external_fields[0].model} needs fibrelmp's "
+                         f"LAMMPS styles (fix musen/field): {styles.how}")
     uses_plugin = bool(styles.path) and (parts.musen_hm or geometry is not None or len(parts.mesh) > 0
-                                         or plan.velocity_limit is not None or pbc_velocity is not None)
+                                         or plan.velocity_limit is not None or pbc_velocity is not None
+                                         or bool(plan.external_fields))
     return template_environment().get_template("granular.lammps.j2").render(
         model=model, plugin=lammps_path(styles.path, "plugin") if uses_plugin else None,
         packages=granular_packages(uses_plugin, parts.wall_cmds),
@@ -321,6 +328,7 @@ def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> 
         mesh_fix=MESH_FIX if len(parts.mesh) else None, mesh_forces_name=MESH_FORCES_NAME,
         contacts_name=CONTACTS_NAME, velocity_limit=plan.velocity_limit, pbc_velocity=pbc_velocity,
         musen_integrator=parts.musen_hm,
+        fields=field_commands(model, spheres.rows, spheres.type_of_mat, parts.ntypes),
         variable_step=None if plan.variable_step is None else " ".join(float_text(v) for v in (
             *plan.variable_step, run.dt, plan.save_every_time or 1e300, run.t_end)),
         clock_name=CLOCK_NAME,

@@ -43,6 +43,8 @@ def reserve_rows(model: GranularModel, requested: int) -> int:
     sp.active_end = np.r_[sp.active_end, np.full(n, np.inf)]
     if sp.compound_key is not None:
         sp.compound_key = list(sp.compound_key) + [""] * n
+    if sp.temperature is not None:
+        sp.temperature = np.r_[sp.temperature, np.zeros(n)]
     model.plan.inlet_rows = first
     return first
 

@@ -169,7 +169,7 @@ def _spheres(scan, rows, key_index, materials, t, late, path, warn) -> Spheres:
         raise InputError(path, scan.lines[r], f"sphere {scan.ids[r]}: radius must be positive")
     contact[contact == 0] = radius[contact == 0]     # Sphere.cpp: contact radius 0 -> radius
     density = np.array([m.density for m in materials])[mat] if len(mat) else np.zeros(0)
-    st = _state(scan, rows, (12, 15, 16, 31), t, late)
+    st = _state(scan, rows, (12, 15, 16, 31, 37), t, late)
     no_xyz = np.isnan(st[12]).any(axis=1)
     if no_xyz.any():
         r = rows[int(np.flatnonzero(no_xyz)[0])]
@@ -183,7 +183,8 @@ def _spheres(scan, rows, key_index, materials, t, late, path, warn) -> Spheres:
                    position=_fill(st[12], 0.0), velocity=_fill(st[15], 0.0),
                    omega=_fill(st[16], 0.0), quaternion=_fill(st[31], (0.0, 1.0, 0.0, 0.0)),
                    active_start=start, active_end=end,
-                   compound_key=[scan.keys[r] for r in rows])
+                   compound_key=[scan.keys[r] for r in rows],
+                   temperature=_fill(st[37], 0.0)[:, 0])
 
 
 def _bond_ends(scan, rows, ids, types, sphere_rows, path, what):

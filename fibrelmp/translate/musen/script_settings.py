@@ -58,8 +58,8 @@ def _resolve_models(model: GranularModel, job: MusenJob) -> tuple[dict[str, Mode
 _ACTS_ON = {"PP": "particle-particle contact", "PW": "particle-wall contact", "SB": "solid bond",
             "LB": "liquid bond", "EF": "particle"}
 # kinds of which fibrelmp runs several models together, as cmusen does (each in turn on every
-# contact or bond: PP and PW forces add, SB laws continue the bond's state)
-SEVERAL_OF_A_KIND = ("PP", "PW", "SB")
+# contact, bond or particle: PP, PW and EF forces add, SB laws continue the bond's state)
+SEVERAL_OF_A_KIND = ("PP", "PW", "SB", "EF")
 
 
 def _chosen_at(choice: ModelChoice, source) -> str:
@@ -69,7 +69,7 @@ def _chosen_at(choice: ModelChoice, source) -> str:
 def _first_and_later(active: list[ModelChoice], source) -> tuple[dict[str, ModelChoice],
                                                                     list[ModelChoice]]:
     """The first active model of each kind, and the later ones of the kinds that act together
-    (``SEVERAL_OF_A_KIND``), in cmusen's order.  Two of another kind (LB, EF) are refused,
+    (``SEVERAL_OF_A_KIND``), in cmusen's order.  Two of another kind (LB) are refused,
     named where the second was selected."""
     seen: dict[str, ModelChoice] = {}
     later: list[ModelChoice] = []
@@ -201,6 +201,7 @@ def apply_simulator_settings(model: GranularModel, job: MusenJob) -> None:
     if "PP" in models:                            # the laws stand for the PP model chosen
         for law in model.contacts.values():
             law.model = models["PP"].name
+    plan.external_fields = []         # the EF models' apply() add theirs, in cmusen's order
     for kind, choice in models.items():
         # a kind's parameter errors point at its PARAMS line (cmusen reads them there)
         physics.find(choice.name).apply(plan, choice.parameters, job.path,
@@ -210,6 +211,8 @@ def apply_simulator_settings(model: GranularModel, job: MusenJob) -> None:
         if choice.kind == "SB":
             physics.add_later_bond_law(plan, choice.name, choice.parameters, choice.source,
                                        choice.line)
+        elif choice.kind == "EF":      # its fix after the first's (plan.external_fields)
+            physics.find(choice.name).apply(plan, choice.parameters, choice.source, choice.line)
     model.later_models = [c for c in later if c.kind != "SB"]
     _apply_later_contact_models(model, plan)
     if job.connected_pp_contact is not None:

@@ -34,7 +34,8 @@ from fibrelmp.translate.musen.text_writer import (export_selectors, gather_spool
 
 # per type: (flag, tag, width) in the exporter's order, and the spooled column block.
 # Spheres: principal stresses (42) and the stress tensor (36) are never written (fibrelmp
-# does not compute them); temperature (37) is 0, as MUSEN writes without a thermal model.
+# does not compute them); temperature (37) is 0, as MUSEN writes without a thermal model
+# (the frame's, when ModelEFHeatTransfer runs).
 _SPHERE = (("angVel", 16, 3), ("coord", 12, 3), ("force", 20, 3), ("forceAmpl", 18, 1),
            ("orient", 31, 4), ("temperature", 37, 1), ("velocity", 15, 3))
 _BOND = (("coord", 12, 3), ("force", 20, 3), ("forceAmpl", 18, 1), ("tangOverlap", 45, 3),
@@ -135,7 +136,9 @@ class MusenResultWriter(Writer):
         b[rows, 6:9] = force
         b[rows, 9] = np.linalg.norm(force, axis=1)
         b[rows, 10:14] = f.quaternion
-        b[rows, 15:18] = f.velocity          # column 14: temperature 0
+        b[rows, 15:18] = f.velocity
+        if f.temperature is not None:        # column 14: temperature (0 without a heat model)
+            b[rows, 14] = f.temperature
         return b
 
     def _bond_block(self, f: GranularFrame, s: np.ndarray) -> np.ndarray:

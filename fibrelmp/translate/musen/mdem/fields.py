@@ -217,8 +217,8 @@ FIELDS: dict[str, tuple[str, str]] = {
                                             "keep vertex 2 in the quaternion"),
     "ProtoTimeDependentProperties.angle_accl": (NOT_SIMULATION, "old layout only (refused)"),
     "ProtoTimeDependentProperties.total_torque": (HONOURED, "bond torque (a bond's state)"),
-    "ProtoTimeDependentProperties.temperature": (NOT_SIMULATION, "heat transfer is not "
-                                                 "simulated (no heat model can be selected)"),
+    "ProtoTimeDependentProperties.temperature": (HONOURED, "spheres' temperature: the start "
+                                                 "state of ModelEFHeatTransfer, saved when it runs"),
     "ProtoTimeDependentProperties.liquid_film_mass": (NOT_SIMULATION, "liquid bonds are refused"),
     "ProtoTimeDependentProperties.stress_tensor": (NOT_SIMULATION, "a result (written, not read)"),
 }

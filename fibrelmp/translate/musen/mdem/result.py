@@ -32,6 +32,7 @@ SPHERE_FIELDS = tp.bit("coord", "vel", "angle_vel", "force", "quaternion")
 BOND_FIELDS = tp.bit("force", "angle_vel", "total_torque")
 WALL_FIELDS = tp.bit("coord", "vel", "angle_vel", "force", "quaternion")
 _Q = tp.FIELDS["quaternion"][1]
+_T = tp.FIELDS["temperature"][1]
 _TORQUE = tp.FIELDS["total_torque"][1]
 
 
@@ -84,6 +85,9 @@ class MdemResultWriter(MusenResultWriter):
         values[ids, 18:21] = np.asarray(saved, np.float64).reshape(-1, 3)
         values[ids, _Q:_Q + 4] = frame.quaternion
         masks[ids] = SPHERE_FIELDS
+        if frame.temperature is not None:      # a heat model ran (MUSEN saves it then)
+            values[ids, _T] = frame.temperature
+            masks[ids] |= tp.bit("temperature")
         if self.bond_ids is not None:
             alive = (np.ones(len(self.bond_ids), bool) if frame.bond_alive is None
                      else np.asarray(frame.bond_alive, bool))
@@ -264,11 +268,11 @@ class MdemResultWriter(MusenResultWriter):
                 entry = manager.models.add()
                 entry.key = mdem_key(choice.name)
                 entry.path = choice.name
-                entry.params = "".join(f"{k} {v:g} " for k, v in choice.parameters.items())
+                entry.params = _params_text(choice.parameters)
                 for later in (c for c in m.later_models if c.kind == kind):   # act after it
                     entry = manager.models.add()
                     entry.key, entry.path = mdem_key(later.name), later.name
-                    entry.params = "".join(f"{k} {v:g} " for k, v in later.parameters.items())
+                    entry.params = _params_text(later.parameters)
                 if kind == "SB":    # the later SB models, which act after it (cmusen's order)
                     for law in plan.then_bond_laws:
                         entry = manager.models.add()
@@ -281,6 +285,12 @@ class MdemResultWriter(MusenResultWriter):
             manager.connected_pp_contact = bool(plan.contacts_between_bonded)
 
 
+
+
+def _params_text(params: dict[str, float]) -> str:
+    """A model's parameters as MUSEN stores them ("NAME value " each): %g, or every digit
+    where %g would change the value (a seed, a fine viscosity)."""
+    return "".join(f"{k} {v:g} " if float(f"{v:g}") == v else f"{k} {v!r} " for k, v in params.items())
 
 
 def _replace_property(props: Any, pid: int, value: float, set_constant) -> None:

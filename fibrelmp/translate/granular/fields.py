@@ -1,0 +1,100 @@
+"""MUSEN's external-force (EF) models as LAMMPS commands: one ``fix musen/field`` per active
+model (``plan.external_fields``, in MUSEN's order), and for a heat model the spheres'
+temperature as the per-atom property ``d_musen_temperature`` set from the scene (docs/granular.md,
+"External-force models")."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from fibrelmp.errors import InputError
+from fibrelmp.granmodel import GranularModel
+from fibrelmp.translate.lammps_format import float_text
+
+TEMPERATURE = "d_musen_temperature"      # the frames' column of MUSEN's particle temperature
+HEAT_CAPACITY = 1                        # MUSEN's material property id
+
+
+def uses_temperature(model: GranularModel) -> bool:
+    return any(f.heat for f in model.plan.external_fields)
+
+
+@dataclass
+class FieldCommands:
+    temperature: bool                  # a heat model: fix property/atom d_musen_temperature
+    set_lines: list[str]               # the scene's temperatures
+    fixes: list[tuple[str, str, str]]  # each EF model's (name, fix style, its arguments)
+
+
+def field_commands(model: GranularModel, rows: np.ndarray, type_of_mat: dict[int, int],
+                   ntypes: int) -> FieldCommands:
+    """What the job needs for the plan's EF models, for the simulated sphere ``rows`` (LAMMPS
+    id = row + 1; sphere material m has type ``type_of_mat[m]``), in MUSEN's order."""
+    heat = uses_temperature(model)
+    if model.plan.variable_step is not None:
+        for fld in model.plan.external_fields:
+            if fld.heat or fld.style != "musen/field":
+                # MUSEN: the temperature update takes the current step, the diffusion
+                # coefficients the first one; these fixes take LAMMPS's fixed dt
+                raise InputError(model.source, None, f"{fld.model} with a variable time step is "
+                                 "not supported (its temperature or random-force coefficients "
+                                 "depend on the step)")
+    lines = _set_temperatures(model, rows) if heat else []
+    fixes = []
+    for fld in model.plan.external_fields:
+        args = fld.fix_args
+        if fld.heat:
+            args += " cp " + " ".join(float_text(c) for c in _heat_capacities(model, type_of_mat, ntypes))
+        if fld.style == "musen/diffusion":
+            _check_diffusion(model, rows)
+        fixes.append((fld.model, fld.style, args))
+    return FieldCommands(heat, lines, fixes)
+
+
+def _check_diffusion(model: GranularModel, rows: np.ndarray) -> None:
+    """ModelEFLiquidDiffusion seeds particle i's generator with MUSEN's i-th seed and reads
+    its coefficients at the particle's object id: the same sphere only when the spheres are
+    objects 0 .. n-1, all simulated, in id order (fix musen/diffusion takes atom ID - 1)."""
+    sp = model.spheres
+    if not np.array_equal(sp.ids, np.arange(sp.count)) or len(rows) != sp.count or model.plan.inlets:
+        raise InputError(model.source, None, "ModelEFLiquidDiffusion needs the spheres to be "
+                         "objects 0 .. n-1, in that order, all simulated from the start and no "
+                         "dynamic generators (MUSEN indexes its generators and coefficients by "
+                         "these numbers)")
+
+
+def _heat_capacities(model: GranularModel, type_of_mat: dict[int, int], ntypes: int) -> list[float]:
+    """Each LAMMPS type's heat capacity (its sphere material's; 0 for wall types)."""
+    cp = [0.0] * ntypes
+    for m, t in type_of_mat.items():
+        mat = model.materials[m]
+        c = mat.props.get(HEAT_CAPACITY, math.nan)
+        if not (c > 0 and math.isfinite(c)):
+            # MUSEN divides the heat flux by heat capacity x mass
+            raise InputError(model.source, None, f"material {mat.key} ({mat.name}): the heat "
+                             f"model needs its heat capacity (property 1) > 0 in J/(kg K), got {c:g}")
+        cp[t - 1] = c
+    return cp
+
+
+def _set_temperatures(model: GranularModel, rows: np.ndarray) -> list[str]:
+    """A `set` per run of ids of equal non-zero temperature (the scene's 37; resuming from a
+    checkpoint skips `set`, the restart file holds them)."""
+    if model.plan.inlets:
+        raise InputError(model.source, None, "ModelEFHeatTransfer with MUSEN's dynamic generators "
+                         "is not supported (the generated spheres' temperature is not set)")
+    sp = model.spheres
+    temp = (np.zeros(sp.count) if sp.temperature is None else np.asarray(sp.temperature, float))[rows]
+    lines = []
+    ids = np.asarray(rows, np.int64) + 1
+    start = 0
+    for j in range(1, len(ids) + 1):
+        if j == len(ids) or ids[j] != ids[j - 1] + 1 or temp[j] != temp[start]:
+            span = str(ids[start]) if j - 1 == start else f"{ids[start]}*{ids[j - 1]}"
+            if temp[start] != 0.0:
+                lines.append(f"set             atom {span} {TEMPERATURE} {float_text(temp[start])}")
+            start = j
+    return lines

@@ -201,6 +201,10 @@ class GranularPlan:
     # every active model of a kind; each continues the bond's state and may break it)
     then_bond_laws: list[SolidBondLaw] = field(default_factory=list)
     contacts_between_bonded: bool = True    # MUSEN default
+    # MUSEN's contact-list update (fix musen/verlet): Verlet distance = coeff x the smallest
+    # contact radius, auto-adjusted or not (its defaults; a .mdem or VERLET_COEF/AUTO set them)
+    verlet_coeff: float = 2.0
+    verlet_auto: bool = True
     velocity_limit: float | None = None     # MUSEN's particle velocity limit (m/s; None: none)
     # MUSEN's stop criterion BROKEN_BONDS N: at a save with more than N bonds broken since the
     # start, one more step, its frame, the end (None: no criterion)

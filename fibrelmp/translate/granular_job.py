@@ -35,6 +35,7 @@ from fibrelmp.translate.granular.inlets import LOG_NAME as INLET_LOG
 from fibrelmp.translate.granular.inlets import inlet_commands
 from fibrelmp.translate.granular.spheres import SimulatedSpheres, select_spheres
 from fibrelmp.translate.granular.tiles import TILE_MASS_FACTOR, WallTiles, place_tiles, tile_estimate, tile_types
+from fibrelmp.translate.granular.verlet import VerletSchedule, musen_verlet
 from fibrelmp.translate.granular import models as physics
 from fibrelmp.translate.granular.mesh import MESH_FIX, MESH_FORCES_NAME, MESH_NAME, mesh_rows, write_mesh
 from fibrelmp.translate.granular.walls import (WallPlan, describe_walls, plan_walls, wall_commands,
@@ -212,6 +213,7 @@ class _JobParts:
     var_cmds: list[str]
     frame_columns: list[str]
     geometry: BondGeometry | None
+    verlet: VerletSchedule | None    # fix musen/verlet's settings (None: not needed)
 
 
 def _plan_parts(model: GranularModel) -> _JobParts:
@@ -256,9 +258,19 @@ def _plan_parts(model: GranularModel) -> _JobParts:
     # musen/elastic: each bond's d, L0 (and initial tangential overlap) on its first sphere
     geometry = (bond_geometry(model, bonds, spheres.rows, len(spheres.rows) + len(tiles.x))
                 if bonds.exact and len(bonds.rows) else None)
+    # broken bonds' spheres touch from MUSEN's next contact-list update (fix musen/verlet):
+    # only where contacts between bonded spheres are off (else they touch all along)
+    verlet = None
+    if (geometry is not None and musen_hm and plan.bonds_may_break()
+            and not plan.contacts_between_bonded):
+        verlet = musen_verlet(model)
+        if verlet.approximate:
+            warnings.append(("musen-verlet-schedule", f"MUSEN's contact-list updates, which let "
+                             f"broken bonds' spheres touch, may come at other steps: "
+                             f"{verlet.approximate}"))
     return _JobParts(run, warnings, dom_lo, dom_hi, spheres, wall_plans, mesh, tiles, ntypes, axes,
                      styles, bonds, musen_hm, pair_lines, pp_model, pp_params, sb_model, box_cmds + wall_cmds, var_cmds,
-                     frame_columns, geometry)
+                     frame_columns, geometry, verlet)
 
 
 def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> str:
@@ -311,7 +323,7 @@ def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> 
         walls=[(wp.name, wp.description) for wp in parts.wall_plans],
         mesh_fix=MESH_FIX if len(parts.mesh) else None, mesh_forces_name=MESH_FORCES_NAME,
         contacts_name=CONTACTS_NAME, velocity_limit=plan.velocity_limit, pbc_velocity=pbc_velocity,
-        musen_integrator=parts.musen_hm,
+        musen_integrator=parts.musen_hm, verlet=parts.verlet,
         thermo_every=min(saves.period or 0, 2 ** 31 - 1),      # thermo N is a C int
         stop_label=STOP_LABEL,
     )

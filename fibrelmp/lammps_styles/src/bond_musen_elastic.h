@@ -102,6 +102,7 @@ class BondMusenElastic : public Bond {
   double max_length0;        // longest L0 seen (equilibrium_distance)
   class FixMusenHistory *history;
   std::string history_id;
+  class FixMusenVerlet *verlet;    // MUSEN's contact-list schedule for broken pairs (or none)
 
   std::vector<bigint> broken;    // (step, tag left, tag right) found on this rank this call
 

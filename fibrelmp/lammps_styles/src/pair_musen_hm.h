@@ -61,6 +61,11 @@ class PairMusenHM : public Pair {
   double **mu, **mu_roll;     // sliding and rolling friction
   double *maxrad;             // largest radius per type (neighbor cutoff)
   FixMusenHistory *history;
+  class FixMusenVerlet *verlet;    // MUSEN's contact-list schedule (broken bonds' pairs), or none
+
+  // a broken bond's pair the current neighbour list still marks special, already let into
+  // the contacts by MUSEN's contact-list update (fix musen/verlet)
+  bool released(tagint a, tagint b) const;
 
   // the law's normal and tangential stiffness and elastic normal force (<= 0) of a contact
   // of types itype, jtype at this overlap: MUSEN's Hertz-Mindlin here; a style whose law

@@ -1,0 +1,144 @@
+"""MUSEN's contact-list updates decide when a broken bond's spheres may touch (fix
+musen/verlet; docs/musen.md, *Broken bonds and MUSEN's contact list*), against the real cmusen
+(tests/data/real-outputs/musen/verlet_schedule/README.md): two overlapping bonded pairs with
+contacts between bonded spheres off, one bond breaking at t = 0, one at step 120, and a far
+sphere at 9.7 m/s whose displacement makes cmusen update its list; VERLET_COEF 0.01, with
+and without auto-adjustment.  The expected update steps are computed here from MUSEN's rule
+and the reference's own positions."""
+
+from __future__ import annotations
+
+import gzip
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fibrelmp import python_api
+from fibrelmp.translate.musen.text import read_time_points
+
+from .conftest import data_path
+from .musen_model_checks import CMUSEN, needs_cmusen, run_cut_and_resumed, styles_or_skip
+
+DATA = data_path("real-outputs/musen/verlet_schedule")
+COORD, VEL = 12, 15
+PAIR_A, PAIR_B, MOVER = (0, 1), (2, 3), 4      # sphere ids (rows: ids are 0..4)
+RADIUS, COEF, DT = 1e-3, 0.01, 1e-8
+
+
+def _reference(auto: int, folder: Path) -> Path:
+    out = folder / f"cmusen_auto{auto}_prec17.txt"
+    with gzip.open(DATA / f"cmusen_auto{auto}_prec17.txt.gz", "rb") as src:
+        out.write_bytes(src.read())
+    return out
+
+
+def _case(folder: Path, auto: int) -> Path:
+    folder.mkdir(parents=True, exist_ok=True)
+    for name in ("verlet_scene.txt", f"job_auto{auto}.txt"):
+        shutil.copy(DATA / name, folder)
+    return folder / f"job_auto{auto}.txt"
+
+
+def musen_updates(z: np.ndarray, auto: bool) -> list[int]:
+    """The steps at which MUSEN updates its contact list (CVerletList::IsNeedToBeUpdated with
+    no walls: 2 x the largest displacement since the last update >= the Verlet distance;
+    AutoAdjustVerletDistance: x 1.1 at the 2nd and 3rd update), from the mover's positions
+    at every step (z[k]: at step k); the prediction at step 0 always updates."""
+    distance, updates, last = COEF * RADIUS, [0], z[0]
+    for k in range(1, len(z)):
+        moved = abs(z[k] - last)
+        if moved + moved >= distance:
+            updates.append(k)
+            if auto and len(updates) in (2, 3):
+                distance *= 1.1
+            last = z[k]
+    return updates
+
+
+def contact_starts(tp, sphere: int, after: int) -> int:
+    """The first step >= ``after`` whose force evaluation changed the sphere's velocity (the
+    velocity saved at step k + 1 is the one that evaluation gave)."""
+    v = tp.fields[VEL][:, list(tp.ids).index(sphere), 0]
+    changed = np.nonzero(np.diff(v[after:]))[0]
+    return after + int(changed[0])
+
+
+@pytest.mark.parametrize("auto", [0, 1])
+def test_broken_pairs_touch_at_cmusens_list_update(tmp_path, auto):
+    """The contact of each broken pair starts at the step of MUSEN's next list update after
+    its break (pair A: update 2 at step 52; pair B, broken at step 120: step 156 every 52
+    steps, or 172 with the distance grown 10 % at updates 2 and 3), in cmusen and in
+    fibrelmp; every position and velocity equals cmusen's (measured: bit for bit)."""
+    styles_or_skip()
+    ref = read_time_points(_reference(auto, tmp_path), tags=(COORD, VEL))
+    mover = list(ref.ids).index(MOVER)
+    updates = musen_updates(ref.fields[COORD][:-1, mover, 2], bool(auto))
+    broken_b = 120                              # the reference's bond 6 end: 1.2e-6 s
+    expect_a = next(k for k in updates if k > 0)
+    expect_b = next(k for k in updates if k > broken_b)
+    assert (expect_a, expect_b) == ((52, 156) if auto == 0 else (52, 172))
+    assert contact_starts(ref, PAIR_A[1], 0) == expect_a
+    assert contact_starts(ref, PAIR_B[0], broken_b + 1) == expect_b
+
+    job = _case(tmp_path / "case", auto)
+    python_api.run(job, work=tmp_path / "work")
+    ours = read_time_points(job.parent / f"cmusen_auto{auto}_prec17.txt", tags=(COORD, VEL))
+    assert ours.times.tolist() == ref.times.tolist()
+    assert contact_starts(ours, PAIR_A[1], 0) == expect_a
+    assert contact_starts(ours, PAIR_B[0], broken_b + 1) == expect_b
+    for tag in (COORD, VEL):
+        x0 = ref.fields[COORD][0] if tag == COORD else 0.0
+        scale = np.abs(ref.fields[tag] - x0).max()
+        assert np.abs(ours.fields[tag] - ref.fields[tag]).max() <= 1e-12 * scale
+    assert _bond_ends(job.parent / f"cmusen_auto{auto}_prec17.txt") == {"5": 0.0, "6": 1.2e-6}
+
+
+def _bond_ends(path: Path) -> dict[str, float]:
+    ends = {}
+    for line in path.read_text().splitlines():
+        w = line.split()
+        if len(w) > 3 and w[0] == "0" and w[3] == "9":
+            ends[w[1]] = float(w[w.index("24") + 2])
+    return ends
+
+
+@pytest.mark.parametrize("every", [10, 130])
+def test_checkpoints_and_resume_keep_the_schedule(tmp_path, monkeypatch, every):
+    """A run with a checkpoint every 10 steps (each a LAMMPS set-up and neighbour-list build),
+    and one stopped at step 130 (pair A released, pair B broken and waiting) and resumed from
+    its restart file: both write the uninterrupted run's result byte for byte."""
+    styles_or_skip()
+    whole = _case(tmp_path / "whole", 0)
+    python_api.run(whole, work=tmp_path / "whole" / "work")
+    cut = _case(tmp_path / "cut", 0)
+    if every == 10:
+        python_api.run(cut, work=cut.parent / "work", checkpoint_every=every)
+    else:
+        run_cut_and_resumed(monkeypatch, cut, cut.parent / "work", every)
+    name = "cmusen_auto0_prec17.txt"
+    assert (cut.parent / name).read_bytes() == (whole.parent / name).read_bytes()
+
+
+def test_job_renders_musens_schedule(tmp_path):
+    """The job's fix musen/verlet: distance VERLET_COEF x the smallest contact radius, the
+    script's VERLET_AUTO, no wall speed (no walls)."""
+    styles_or_skip()
+    for auto in (0, 1):
+        job = _case(tmp_path / f"a{auto}", auto)
+        python_api.translate_job(job, tmp_path / f"job{auto}")
+        script = (tmp_path / f"job{auto}" / "in.lammps").read_text()
+        assert f"musen/verlet 1e-05 auto {'yes' if auto else 'no'} wallspeed 0.0\n" in script
+
+
+@needs_cmusen
+@pytest.mark.parametrize("auto", [0, 1])
+def test_reference_is_cmusens_output(tmp_path, auto):
+    job = _case(tmp_path, auto)
+    done = subprocess.run([CMUSEN, "-t=1", f"-s={job.name}"], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=300)
+    assert done.returncode == 0 and "Error:" not in done.stdout, done.stdout + done.stderr
+    with gzip.open(DATA / f"cmusen_auto{auto}_prec17.txt.gz", "rb") as ref:
+        assert (tmp_path / f"cmusen_auto{auto}_prec17.txt").read_bytes() == ref.read()

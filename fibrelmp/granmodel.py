@@ -235,6 +235,10 @@ class GranularPlan:
     contacts_between_bonded: bool = True    # MUSEN default
     # MUSEN's active EF models, in cmusen's order (each adds its force in turn, before all others)
     external_fields: list[ExternalField] = field(default_factory=list)
+    # MUSEN's contact-list update (fix musen/verlet): Verlet distance = coeff x the smallest
+    # contact radius, auto-adjusted or not (its defaults; a .mdem or VERLET_COEF/AUTO set them)
+    verlet_coeff: float = 2.0
+    verlet_auto: bool = True
     velocity_limit: float | None = None     # MUSEN's particle velocity limit (m/s; None: none)
     # MUSEN's variable time step (MAX_PART_MOVE m, STEP_INC_FACTOR); None: the fixed step
     variable_step: tuple[float, float] | None = None

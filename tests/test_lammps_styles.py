@@ -45,7 +45,8 @@ def test_plugin_registers_its_styles(tmp_path):
                 "bond_musen_elastic": "bond style plugin musen/elastic",
                 "fix_musen_wall_mesh": "fix style plugin musen/wall/mesh",
                 "angle_fibrenet": "angle style plugin fibrenet",
-                "fix_fibrenet_output": "fix style plugin fibrenet/output"}
+                "fix_fibrenet_output": "fix style plugin fibrenet/output",
+                "fix_musen_verlet": "fix style plugin musen/verlet"}
     for stem, line in expected.items():
         assert (line in listing) == (build.SRC / f"{stem}.cpp").exists(), line
     assert "WARNING" not in listing

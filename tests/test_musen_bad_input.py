@@ -316,7 +316,7 @@ def test_kelvin_bond_needs_the_styles(tmp_path):
 
 def test_job_warnings_and_motion(tmp_path):
     path = tmp_path / "job.txt"
-    path.write_text(GOOD + "VERLET_COEF 2\nMODEL_SB_PARAMS CONSIDER_BREAKAGE 0 BIMODULARITY 1\n"
+    path.write_text(GOOD + "VERLET_MAX_CELLS 20\nMODEL_SB_PARAMS CONSIDER_BREAKAGE 0 BIMODULARITY 1\n"
                     "GEOMETRY_MOTION_TIME Plate 0 1 0 0 1 0 0 2 5 6 7\n"
                     "PACK_GEN_POROSITY 1 0.3\n# comment\n")
     (job,) = ms.read_script(path)

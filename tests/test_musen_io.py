@@ -390,7 +390,8 @@ def test_overrides_and_defaults(tmp_path):
                       "model_pp ModelPPHertzMindlin\nMODEL_PW ModelPWHertzMindlin\n"
                       "MATERIAL_PROPERTY DENSITY KF6843H84OPHH3017U3D 3000\n"
                       "INTERACTION_PROPERTY RESTITUTION_COEFFICIENT KYDX71DJATPLUTAHNBZX "
-                      "KF6843H84OPHH3017U3D 0.5\nVERLET_COEF 3\nCONNECTED_PP_CONTACT 0\n")
+                      "KF6843H84OPHH3017U3D 0.5\nVERLET_COEF 3\nVERLET_AUTO 0\nVERLET_MAX_CELLS 9\n"
+                      "CONNECTED_PP_CONTACT 0\n")
     (job,) = ms.read_script(script)
     m = musen.read(SINGLE)
     ms.apply_simulator_settings(m, job)
@@ -398,6 +399,7 @@ def test_overrides_and_defaults(tmp_path):
     assert m.contact(0, 1).restitution == 0.5
     assert (m.plan.dt, m.plan.save_every_time, m.plan.t_end) == (1e-6, 1e-3, 1.0)
     assert m.plan.gravity.tolist() == [0, 0, -9.81] and m.plan.contacts_between_bonded is False
+    assert (m.plan.verlet_coeff, m.plan.verlet_auto) == (3.0, False)     # fix musen/verlet
     kinds = [k for k, _ in m.warnings]
     assert "musen-default-settings" in kinds and "musen-ignored-keyword" in kinds
     out = write(m, tmp_path / "r.txt", frames_from(m, [0.0]))

@@ -37,6 +37,7 @@ from fibrelmp.translate.granular.inlets import LOG_NAME as INLET_LOG
 from fibrelmp.translate.granular.inlets import inlet_commands
 from fibrelmp.translate.granular.spheres import SimulatedSpheres, select_spheres
 from fibrelmp.translate.granular.tiles import TILE_MASS_FACTOR, WallTiles, place_tiles, tile_estimate, tile_types
+from fibrelmp.translate.granular.verlet import VerletSchedule, musen_verlet
 from fibrelmp.translate.granular import models as physics
 from fibrelmp.translate.granular.mesh import MESH_FIX, MESH_FORCES_NAME, MESH_NAME, mesh_rows, write_mesh
 from fibrelmp.translate.granular.walls import (WallPlan, describe_walls, plan_walls, wall_commands,
@@ -217,6 +218,7 @@ class _JobParts:
     var_cmds: list[str]
     frame_columns: list[str]
     geometry: BondGeometry | None
+    verlet: VerletSchedule | None    # fix musen/verlet's settings (None: not needed)
 
 
 def _plan_parts(model: GranularModel) -> _JobParts:
@@ -262,9 +264,19 @@ def _plan_parts(model: GranularModel) -> _JobParts:
     # musen/elastic: each bond's d, L0 (and initial tangential overlap) on its first sphere
     geometry = (bond_geometry(model, bonds, spheres.rows, len(spheres.rows) + len(tiles.x))
                 if bonds.exact and len(bonds.rows) else None)
+    # broken bonds' spheres touch from MUSEN's next contact-list update (fix musen/verlet):
+    # only where contacts between bonded spheres are off (else they touch all along)
+    verlet = None
+    if (geometry is not None and musen_hm and plan.bonds_may_break()
+            and not plan.contacts_between_bonded):
+        verlet = musen_verlet(model)
+        if verlet.approximate:
+            warnings.append(("musen-verlet-schedule", f"MUSEN's contact-list updates, which let "
+                             f"broken bonds' spheres touch, may come at other steps: "
+                             f"{verlet.approximate}"))
     return _JobParts(run, warnings, dom_lo, dom_hi, spheres, wall_plans, mesh, tiles, ntypes, axes,
                      styles, bonds, musen_hm, pair_lines, sb_model, box_cmds + wall_cmds, var_cmds,
-                     frame_columns, geometry)
+                     frame_columns, geometry, verlet)
 
 
 def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> str:
@@ -327,7 +339,7 @@ def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> 
         walls=[(wp.name, wp.description) for wp in parts.wall_plans],
         mesh_fix=MESH_FIX if len(parts.mesh) else None, mesh_forces_name=MESH_FORCES_NAME,
         contacts_name=CONTACTS_NAME, velocity_limit=plan.velocity_limit, pbc_velocity=pbc_velocity,
-        musen_integrator=parts.musen_hm,
+        musen_integrator=parts.musen_hm, verlet=parts.verlet,
         fields=field_commands(model, spheres.rows, spheres.type_of_mat, parts.ntypes),
         variable_step=None if plan.variable_step is None else " ".join(float_text(v) for v in (
             *plan.variable_step, run.dt, plan.save_every_time or 1e300, run.t_end)),

@@ -25,6 +25,7 @@
 
 #include "fix_musen_history.h"
 #include "fix_musen_leapfrog.h"
+#include "fix_musen_verlet.h"
 
 #include "atom.h"
 #include "comm.h"
@@ -551,7 +552,7 @@ BondMusenElastic::BondMusenElastic(LAMMPS *lmp) :
     viscosity(nullptr), diam0(nullptr), len0(nullptr), yield(nullptr),
     first_law{ELASTIC, 1.0, 1, {}}, breaks_fp(nullptr), per_atom_geometry(0), nslots(0), nvalues_per(0),
     update_special(0), pairs_waiting(0), warned_build(0), max_length0(0.0), history(nullptr),
-    history_id(HISTORY_ID)
+    history_id(HISTORY_ID), verlet(nullptr)
 {
   partial_flag = 1;    // broken bonds get type 0 (the neighbor lists then skip them)
   writedata = 0;       // the per-bond geometry is not a bond type's coefficient
@@ -815,15 +816,20 @@ void BondMusenElastic::process_breaks()
     for (const auto &r : rec) utils::print(breaks_fp, "{} {} {}\n", r[0], r[1], r[2]);
     fflush(breaks_fp);
   }
-  if (update_special) {
+  if (update_special && verlet) {
+    // the pair waits for MUSEN's next contact-list update (fix musen/verlet)
+    std::vector<std::pair<tagint, tagint>> pairs;
+    for (const auto &r : rec) pairs.emplace_back((tagint) r[1], (tagint) r[2]);
+    verlet->add_broken(pairs);
+  } else if (update_special) {
     for (const auto &r : rec) forget_special((tagint) r[1], (tagint) r[2]);
     pairs_waiting += nbroken;
   }
 }
 
-/* broken pairs join the contacts at this LAMMPS neighbor-list build; MUSEN adds them at its
-   own contact-list update, which its Verlet-distance rule may place at another step: said
-   once, when it happens (a run without builds after breaks is cmusen's, Example 3) */
+/* without fix musen/verlet: broken pairs join the contacts at this LAMMPS neighbor-list
+   build; MUSEN adds them at its own contact-list update, which its Verlet-distance rule may
+   place at another step: said once, when it happens */
 
 void BondMusenElastic::note_list_build()
 {
@@ -837,13 +843,13 @@ void BondMusenElastic::note_list_build()
   pairs_waiting = 0;
 }
 
-/* a broken bond's spheres are no longer 1-2 neighbours: drop each from the other's special
-   list (owned atoms; the neighbor build reads those).  The pair neighbor list built while
-   they were bonded keeps their pair marked special, so their contact acts from LAMMPS's next
-   neighbor-list build, as MUSEN's acts from its next contact-list update
-   (CVerletList::UpdateList: RemoveSBContacts keeps out only pairs of active bonds; between
-   updates a pair left out stays out).  Acting at once made Example 3's overlapping broken
-   pairs push where cmusen's pass through each other (docs/musen.md). */
+/* without fix musen/verlet (a hand-written input): a broken bond's spheres are no longer 1-2
+   neighbours: drop each from the other's special list (owned atoms; the neighbor build reads
+   those).  The pair neighbor list built while they were bonded keeps their pair marked
+   special, so their contact acts from LAMMPS's next neighbor-list build.  MUSEN's acts from
+   its next contact-list update (CVerletList::UpdateList: RemoveSBContacts keeps out only
+   pairs of active bonds; between updates a pair left out stays out): fix musen/verlet
+   emulates that schedule and takes the pairs over. */
 
 void BondMusenElastic::forget_special(tagint a, tagint b)
 {
@@ -1111,6 +1117,9 @@ void BondMusenElastic::init_style()
                           "laws need each bond type's yield strength (bond_coeff ... yield Y); type {} has none", i);
 
   update_special = (force->special_lj[1] != 1.0 || force->special_coul[1] != 1.0) ? 1 : 0;
+  const auto verlets = modify->get_fix_by_style("^musen/verlet$");
+  if (verlets.size() > 1) error->all(FLERR, "Bond style musen/elastic: more than one fix musen/verlet");
+  verlet = verlets.empty() ? nullptr : static_cast<FixMusenVerlet *>(verlets[0]);
 
   if (!history) {
     Fix *fix = modify->get_fix_by_id(history_id);

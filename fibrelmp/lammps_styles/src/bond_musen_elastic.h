@@ -38,6 +38,10 @@
    limits to 256 characters) or, without the geometry keyword, from the bond type's d and L0.
    L0 <= 0 means "the distance at the first use" (MUSEN's RESET_INITIAL_BOND_LENGTH).
 
+   A broken bond gets type 0.  Where bonded spheres do not touch (special_bonds lj 0), its
+   pair stays special until fix musen/verlet (MUSEN's contact-list updates) releases it;
+   without that fix the pair joins the contacts at LAMMPS's next neighbour-list build.
+
    Several laws (cmusen runs every active SB model: CCPUSimulator::CalculateForcesSB): the
    first law is given by breakage/kelvin, each "then" adds one after it.  Every step each law
    in turn advances the bond's one shared state from where the previous law left it, adds its
@@ -132,6 +136,7 @@ class BondMusenElastic : public Bond {
   double max_length0;        // longest L0 seen (equilibrium_distance)
   class FixMusenHistory *history;
   std::string history_id;
+  class FixMusenVerlet *verlet;    // MUSEN's contact-list schedule for broken pairs (or none)
 
   std::vector<bigint> broken;    // (step, tag left, tag right) found on this rank this call
 

@@ -38,6 +38,7 @@
 #include "error.h"
 #include "fix.h"
 #include "fix_musen_history.h"
+#include "fix_musen_verlet.h"
 #include "force.h"
 #include "memory.h"
 #include "modify.h"
@@ -84,7 +85,7 @@ inline void cross(const double *a, const double *b, double *c)
 
 PairMusenHM::PairMusenHM(LAMMPS *lmp) :
     Pair(lmp), estar(nullptr), gstar(nullptr), restitution(nullptr), alpha(nullptr),
-    mu(nullptr), mu_roll(nullptr), maxrad(nullptr), history(nullptr), only_hertz(nullptr)
+    mu(nullptr), mu_roll(nullptr), maxrad(nullptr), history(nullptr), only_hertz(nullptr), verlet(nullptr)
 {
   // single(): the contact force at the current state, for compute pair/local
   single_enable = 1;
@@ -113,6 +114,11 @@ PairMusenHM::~PairMusenHM()
     memory->destroy(mu_roll);
     delete[] maxrad;
   }
+}
+
+bool PairMusenHM::released(tagint a, tagint b) const
+{
+  return verlet && verlet->any_released() && verlet->released(a, b);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -174,8 +180,9 @@ template <class Laws> void PairMusenHM::contacts(Laws apply)
 
     for (int jj = 0; jj < jnum; jj++) {
       int j = jlist[jj];
-      // MUSEN's "contacts between bonded particles" off: special_bonds lj 0 (checked in init)
-      if (special_lj[sbmask(j)] == 0.0) continue;
+      // MUSEN's "contacts between bonded particles" off: special_bonds lj 0 (checked in init);
+      // a broken bond's pair is special until MUSEN's contact-list update released it
+      if (special_lj[sbmask(j)] == 0.0 && !released(tag[i], tag[j & NEIGHMASK])) continue;
       j &= NEIGHMASK;
       const int jtype = type[j];
 
@@ -392,6 +399,9 @@ void PairMusenHM::init_style()
                         "bonded spheres) or 1 (contact, MUSEN's default), got {}",
                  force->special_lj[k]);
 
+  const auto verlets = modify->get_fix_by_style("^musen/verlet$");
+  verlet = verlets.empty() ? nullptr : static_cast<FixMusenVerlet *>(verlets[0]);
+
   // size-based half list with newton off whatever `newton` says (see the file header)
   neighbor->add_request(this, NeighConst::REQ_SIZE | NeighConst::REQ_NEWTON_OFF);
 
@@ -493,7 +503,7 @@ double PairMusenHM::single(int i, int j, int itype, int jtype, double rsq, doubl
     svector[3 + k] = -cv[k];
   }
   const double r1 = radius[i], r2 = radius[j];
-  if (factor_lj == 0.0 || !((r1 + r2) * (r1 + r2) > rsq)) return 0.0;
+  if ((factor_lj == 0.0 && !released(tag[i], tag[j])) || !((r1 + r2) * (r1 + r2) > rsq)) return 0.0;
   const double overlap = r1 + r2 - std::sqrt(rsq);
   const double equiv_radius = r1 * r2 / (r1 + r2);
   const double equiv_mass = rmass[i] * rmass[j] / (rmass[i] + rmass[j]);

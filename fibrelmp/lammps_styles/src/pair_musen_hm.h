@@ -76,6 +76,11 @@ class PairMusenHM : public Pair {
   double **mu, **mu_roll;     // sliding and rolling friction
   double *maxrad;             // largest radius per type (neighbor cutoff)
   FixMusenHistory *history;
+  class FixMusenVerlet *verlet;    // MUSEN's contact-list schedule (broken bonds' pairs), or none
+
+  // a broken bond's pair the current neighbour list still marks special, already let into
+  // the contacts by MUSEN's contact-list update (fix musen/verlet)
+  bool released(tagint a, tagint b) const;
 
   // the laws in the order they act, and the words that named them (the first: the style's)
   std::vector<std::unique_ptr<musen_pp::Law>> laws;

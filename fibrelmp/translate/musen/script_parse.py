@@ -63,7 +63,6 @@ _EXPORT_KEYS = {"TEXT_EXPORT_OBJECTS": "objectTypes", "TEXT_EXPORT_CONST": "cons
 # keywords cmusen reads that cannot change a fibrelmp run (named warning, then ignored)
 _IGNORED = {
     "LOG_FILE": "fibrelmp prints its log to the terminal",
-    "VERLET_AUTO": "neighbour lists are LAMMPS's", "VERLET_COEF": "neighbour lists are LAMMPS's",
     "VERLET_MAX_CELLS": "neighbour lists are LAMMPS's",
     "SAVE_COLLISIONS": "collisions are not saved", "MONITOR": "monitors are not supported",
     "POSTPROCESS": "post-processing commands are not supported",
@@ -113,6 +112,8 @@ class MusenJob:
     max_part_move: float = 0.0               # MAX_PART_MOVE (0: keep the simulator's)
     step_inc_factor: float = 0.0             # STEP_INC_FACTOR (0: keep the simulator's)
     velocity_limit: float | None = None      # LIMIT_PARTICLE_VELOCITY (<= 0: no limit)
+    verlet_coef: float = 0.0                 # VERLET_COEF (0: keep the file's, as cmusen)
+    verlet_auto: bool | None = None          # VERLET_AUTO
     # STOP_CRITERION lines in order (NONE / BROKEN_BONDS; any replaces a .mdem's criteria) and
     # the last BROKEN_BONDS number (cmusen keeps one value)
     stop_criteria: list[str] = field(default_factory=list)
@@ -495,6 +496,7 @@ _HANDLERS = {
     "VARIABLE_TIME_STEP": _variable_step, "MAX_PART_MOVE": _variable_step_setting("max_part_move"),
     "STEP_INC_FACTOR": _variable_step_setting("step_inc_factor"), "STOP_CRITERION": _stop,
     "LIMIT_PARTICLE_VELOCITY": _velocity_limit,
+    "VERLET_COEF": _number("verlet_coef"), "VERLET_AUTO": _flag("verlet_auto"),
     "MATERIAL_PROPERTY": _material_property, "INTERACTION_PROPERTY": _interaction_property,
     "TEXT_EXPORT_PRECISION": _precision, "TIME_INTERVAL": _time_interval,
     "GEOMETRY_MOTION_TIME": _motion_time, "GEOMETRY_MOTION_FORCE": _motion_force,

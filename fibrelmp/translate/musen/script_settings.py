@@ -217,6 +217,11 @@ def apply_simulator_settings(model: GranularModel, job: MusenJob) -> None:
     _apply_later_contact_models(model, plan)
     if job.connected_pp_contact is not None:
         plan.contacts_between_bonded = job.connected_pp_contact
+    # MUSEN's contact-list schedule (ConsoleSimulator: a coefficient of 0 keeps the file's)
+    if job.verlet_coef:
+        plan.verlet_coeff = job.verlet_coef
+    if job.verlet_auto is not None:
+        plan.verlet_auto = job.verlet_auto
     _refuse_file_settings(model, job)
     if job.velocity_limit is not None:
         plan.velocity_limit = job.velocity_limit if job.velocity_limit > 0 else None

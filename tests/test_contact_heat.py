@@ -66,6 +66,63 @@ def test_temperatures_and_motion_are_cmusens(tmp_path, case):
     assert "musen/heat cp" in script and "d_musen_temperature ghost yes" in script
 
 
+def _scene_heat_capacity(case: str) -> np.ndarray:
+    """m c (J/K) of the case's spheres, from its scene text (radius, material density and
+    heat capacity)."""
+    folder, prefix, _ = CASES[case]
+    lines = (MODELS / folder / f"{prefix}_scene.txt").read_text().splitlines()
+    props = {}
+    for ln in lines:
+        w = ln.split()
+        if w[0] == "32":
+            kv = dict(zip(w[3::2], w[4::2]))
+            props[w[1]] = (float(kv["0"]), float(kv["1"]))
+    mc = []
+    for ln in lines:
+        w = ln.split()
+        if w[:1] == ["0"] and w[3] == "1":        # a sphere: 5 R r, 23 material
+            rho, c = props[w[w.index("23") + 1]]
+            mc.append(4.0 / 3.0 * math.pi * float(w[w.index("5") + 1]) ** 3 * rho * c)
+    return np.array(mc)
+
+
+@pytest.mark.parametrize("case", ["pp", "sb"])
+def test_heat_between_spheres_is_conserved(tmp_path, case):
+    """Heat only moves between spheres (the flux into one is the flux out of the other):
+    sum m c T stays what it was, to rounding, while the temperatures change by tens of K."""
+    styles_or_skip()
+    temp = read_time_points(_run(tmp_path, case)).fields[TEMPERATURE][:, :, 0]
+    mc = _scene_heat_capacity(case)
+    energy = temp[:, :len(mc)] @ mc
+    np.testing.assert_allclose(energy, energy[0], rtol=1e-13)
+    assert np.abs(temp[-1, :2] - temp[0, :2]).min() > 3
+
+
+def test_wall_heat_is_the_numpy_law():
+    """ModelPWHeatTransfer alone (walls without force): the spheres fly straight through the
+    plate z = 0, overlap R - z; MUSEN's scheme in numpy (half a step of the flux at t = 0, its
+    prediction, then T += q(T, x_k)/(m c) dt per step, q = pi R overlap H RESIST (T_wall - T))
+    gives cmusen's saved temperatures."""
+    theirs = read_time_points(MODELS / PW_ALONE[0] / "cmusen_pwa_result_prec17.txt")
+    radius, mc = np.array([1e-3, 7e-4]), _scene_heat_capacity("pw_alone")
+    z0, vz = np.array([1.02e-3, 7.3e-4]), np.array([-0.4, -0.3])
+    dt, wall, h, resist = 1e-6, 1000.0, 1e5, 0.4
+
+    def flux(temp: np.ndarray, z: np.ndarray) -> np.ndarray:
+        overlap = np.maximum(radius - np.abs(z), 0.0)
+        return math.pi * radius * overlap * h * resist * (wall - temp)
+    temp = theirs.fields[TEMPERATURE][0, :2, 0].copy()
+    temp = temp + flux(temp, z0) / mc * dt / 2
+    expected = [theirs.fields[TEMPERATURE][0, :2, 0]]
+    for k in range(400):
+        temp = temp + flux(temp, z0 + vz * k * dt) / mc * dt
+        if (k + 1) % 20 == 0:
+            expected.append(temp.copy())
+    got = theirs.fields[TEMPERATURE][:, :2, 0]
+    np.testing.assert_allclose(got, np.array(expected), rtol=1e-9)
+    assert np.abs(got[-1] - got[0]).min() > 10
+
+
 def test_without_the_heat_model_temperatures_stay(tmp_path):
     """The same collision with Hertz-Mindlin alone keeps every temperature (cmusen differs)."""
     styles_or_skip()

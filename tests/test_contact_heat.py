@@ -135,14 +135,16 @@ def test_without_the_heat_model_temperatures_stay(tmp_path):
     assert TEMPERATURE not in ours.fields or np.all(ours.fields[TEMPERATURE][-1] == ours.fields[TEMPERATURE][0])
 
 
-def test_checkpoint_and_resume_give_the_uninterrupted_run(tmp_path, monkeypatch):
+@pytest.mark.parametrize("folder, prefix, every", [(PP[0], PP[1], 170), (SB[0], SB[1], 1050),
+                                                   ("sb_thermal", "sbt", 1050)])
+def test_checkpoint_and_resume_give_the_uninterrupted_run(tmp_path, monkeypatch, folder, prefix,
+                                                          every):
     styles_or_skip()
     whole, cut = tmp_path / "whole", tmp_path / "cut"
     whole.mkdir()
     cut.mkdir()
-    folder, prefix, _ = PP
     python_api.run(model_job(whole, MODELS / folder, prefix, ""), work=whole / "work")
-    run_cut_and_resumed(monkeypatch, model_job(cut, MODELS / folder, prefix, ""), cut / "work", 170)
+    run_cut_and_resumed(monkeypatch, model_job(cut, MODELS / folder, prefix, ""), cut / "work", every)
     name = f"{prefix}_result_prec17.txt"
     assert (cut / name).read_bytes() == (whole / name).read_bytes()
 
@@ -180,6 +182,31 @@ def test_with_the_air_heat_model_is_refused(tmp_path):
     with pytest.raises(InputError, match="ModelPPHeatConduction together with "
                                          "ModelEFHeatTransfer is not supported"):
         python_api.run(job, work=tmp_path / "work")
+
+
+def test_thermal_bond_is_cmusens(tmp_path):
+    """ModelSBThermal (tests/data/real-outputs/musen/models/sb_thermal): positions, velocities
+    and angular velocities at every saved time within 1e-6 of scale (measured: 1e-15, 1e-13,
+    2e-15); the bonds lengthen as their rest length grows (4 %)."""
+    styles_or_skip()
+    folder, prefix = "sb_thermal", "sbt"
+    python_api.run(model_job(tmp_path, MODELS / folder, prefix, ""), work=tmp_path / "work")
+    ours = read_time_points(tmp_path / f"{prefix}_result_prec17.txt")
+    theirs = read_time_points(MODELS / folder / f"cmusen_{prefix}_result_prec17.txt")
+    np.testing.assert_allclose(ours.times, theirs.times, rtol=1e-12, atol=0)
+    for tag in (COORD, VEL, ANGVEL):
+        a, b = ours.fields[tag][:, :3], theirs.fields[tag][:, :3]
+        np.testing.assert_allclose(a, b, rtol=0, atol=1e-6 * np.abs(b).max())
+    x = theirs.fields[COORD]
+    gap = np.linalg.norm(x[:, 0] - x[:, 1], axis=1)
+    assert gap[-1] > 1.03 * gap[0]
+    script = (tmp_path / "work" / "job2" / "in.lammps").read_text()
+    assert "musen/elastic breakage 1 thermal 100.0 0.5 2.0" in script
+
+
+@needs_cmusen
+def test_thermal_reference_is_cmusens_output(tmp_path):
+    check_reference_is_cmusens_output(tmp_path, MODELS / "sb_thermal", "sbt")
 
 
 def test_bond_heat_conduction_first_is_refused(tmp_path):

@@ -103,7 +103,9 @@ class GranularJob:
 def _bond_style_law(model: GranularModel) -> tuple[str, str]:
     """bond_style musen/elastic's laws; a heat law gets the bonds' thermal conductivity first."""
     from fibrelmp.translate.granular.models.sb_heat_conduction import set_conductivity
+    from fibrelmp.translate.granular.models.sb_thermal import set_expansion
     set_conductivity(model)
+    set_expansion(model)
     return physics.bond_style_law(model.plan)
 
 

@@ -103,13 +103,14 @@ class BondMusenElastic : public Bond {
   };
 
   // MUSEN's SB models this style runs
-  enum Form { ELASTIC = 0, KELVIN, PLASTIC, LINEAR_PLASTIC, CREEP, WEAKENING, AEROGEL, CONCRETE, HEAT };
+  enum Form { ELASTIC = 0, KELVIN, PLASTIC, LINEAR_PLASTIC, CREEP, WEAKENING, AEROGEL, CONCRETE, HEAT, THERMAL };
   // parameters of the plastic laws (Law::p)
   enum { P_FT = 0, P_FC, P_TY, P_RC, P_A, P_M };                  // plastic, creep
   enum { P_KL = 0, P_KU };                                        // linear/plastic
   enum { P_CB = 0, P_BS, P_WF };                                  // weakening
   enum { P_PSC = 0, P_PST, P_SRC, P_SRT, P_BST, P_HRC, P_HRT };   // aerogel
   enum { P_SCALE = 0, P_K };                                      // heat (no force)
+  enum { P_TDIFF = 0, P_MU, P_ALPHA };                            // thermal
   enum { NPARAM = 7 };
 
   struct Law {

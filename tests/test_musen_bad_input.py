@@ -250,7 +250,7 @@ GOOD = ("MODEL_PP ModelPPHertzMindlin\nMODEL_PW ModelPWHertzMindlin\nMODEL_SB Mo
 APPLY_ERRORS = [  # script, line, words: parsed fine, refused when the job is applied
     (GOOD.replace("ModelPPHertzMindlin", "ModelPPSintering"), 1, "ModelPPSintering: this "
      "particle-particle model is not supported; fibrelmp translates ModelPPHertzMindlin, and "
-     "with fibrelmp's LAMMPS styles ModelPPHeatConduction and ModelPPLinearElastic"),
+     "with fibrelmp's LAMMPS styles ModelPPChealNess, ModelPPHeatConduction"),
     (GOOD + "MODEL_EF ModelEFLiquidDiffusion\nMODEL_EF_PARAMS TEMPERATURE 350\n", 8,
      "ModelEFLiquidDiffusion: without FIXED_SEED MUSEN seeds its generators from "
      "std::random_device"),

@@ -248,7 +248,8 @@ GOOD = ("MODEL_PP ModelPPHertzMindlin\nMODEL_PW ModelPWHertzMindlin\nMODEL_SB Mo
         "SIMULATION_STEP 1e-7\nSAVING_STEP 1e-4\nEND_TIME 1e-3\n")
 
 APPLY_ERRORS = [  # script, line, words: parsed fine, refused when the job is applied
-    (GOOD.replace("ModelPPHertzMindlin", "ModelPPSintering"), 1, "ModelPPSintering: this "
+    (GOOD.replace("ModelPPHertzMindlin", "ModelPPSinteringTemperature"), 1,
+     "ModelPPSinteringTemperature: this "
      "particle-particle model is not supported; fibrelmp translates ModelPPHertzMindlin, and "
      "with fibrelmp's LAMMPS styles ModelPPChealNess, ModelPPHeatConduction"),
     (GOOD + "MODEL_EF ModelEFLiquidDiffusion\nMODEL_EF_PARAMS TEMPERATURE 350\n", 8,

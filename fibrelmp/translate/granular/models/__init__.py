@@ -76,6 +76,12 @@ class PhysicsModel:
         raise NotImplementedError(f"{cls.name} is not a particle-particle model")
 
     @classmethod
+    def with_scene(cls, model: GranularModel, params: dict[str, float]) -> dict[str, float]:
+        """What the LAMMPS lines render: ``params`` and what the model takes from the scene
+        (e.g. its materials' surface energy), under keys that are not MUSEN's."""
+        return params
+
+    @classmethod
     def pp_law_words(cls, params: dict[str, float]) -> str:
         """PP models: the law's words after ``then`` in ``pair_style musen/hm`` (NAME
         parameters, musen_pp_law.h), when it acts after another PP model."""
@@ -169,11 +175,11 @@ def pair_style_lines(model: GranularModel, own_styles: bool) -> list[str]:
     """The ``pair_style`` line (and its comment) of the PP models a scene runs: the first
     one's, each later model's law after ``then``."""
     (first, params), *later = chosen_all(model, "PP")
-    lines = first.pair_style_lines(params, own_styles)
+    lines = first.pair_style_lines(first.with_scene(model, params), own_styles)
     if later:
         if not own_styles:
             raise RuntimeError("several PP models need fibrelmp's LAMMPS styles (checked earlier)")
-        lines[-1] += "".join(f" then {m.pp_law_words(p)}" for m, p in later)
+        lines[-1] += "".join(f" then {m.pp_law_words(m.with_scene(model, p))}" for m, p in later)
         lines.insert(-1, LammpsText("# and after it, on each contact (cmusen's order, forces add): "
                                     + ", ".join(m.name for m, _ in later)))
     return lines
@@ -184,8 +190,8 @@ def mesh_law_args(model: GranularModel) -> str:
     ("" for MUSEN's Hertz-Mindlin alone, the fix's default)."""
     laws = chosen_all(model, "PW")
     if len(laws) == 1:
-        return laws[0][0].mesh_law_args(laws[0][1])
-    return "".join(f" law {m.mesh_law_words(p)}" for m, p in laws)
+        return laws[0][0].mesh_law_args(laws[0][0].with_scene(model, laws[0][1]))
+    return "".join(f" law {m.mesh_law_words(m.with_scene(model, p))}" for m, p in laws)
 
 
 def combine_contact_times(plan: GranularPlan, kind: str, later: list[GranularPlan]) -> None:

@@ -1,5 +1,5 @@
-"""ModelPPJKR and ModelPPPopovJKR: MUSEN's adhesive particle-particle contacts, Hertz-Mindlin
-with the elastic normal force replaced by JKR's (the materials' surface energy, MUSEN property
+"""ModelPPJKR (and the base of ModelPPPopovJKR, pp_popov_jkr): MUSEN's adhesive
+particle-particle contacts, Hertz-Mindlin with the elastic normal force replaced by JKR's (the materials' surface energy, MUSEN property
 11) or Popov's JKR fit (the materials' surface TENSION, property 13, as MUSEN's code reads).
 Only with fibrelmp's ``pair_style musen/pp jkr GAMMA`` / ``popov/jkr SIGMA``
 (src/musen_pp_jkr.cpp).  The law takes one value, the equivalent sqrt(p1 p2) of the sphere
@@ -33,7 +33,9 @@ def equivalent_values(model: GranularModel, prop: int) -> set[float]:
     return {math.sqrt(value[a] * value[b]) for a in keys for b in keys}
 
 
-class _AdhesivePP(PhysicsModel):
+class AdhesivePP(PhysicsModel):
+    """A Hertz-Mindlin-shaped PP law with one equivalent material value (not registered)."""
+
     kind = "PP"
     material_property: int
     what: str              # the property, in messages
@@ -77,17 +79,9 @@ class _AdhesivePP(PhysicsModel):
 
 
 @register
-class PPJKR(_AdhesivePP):
+class PPJKR(AdhesivePP):
     name = "ModelPPJKR"
     mdem_key = "8AC39F3E9D054A548CEB9CD44ACFE751"
     needs_styles = "pair_style musen/pp jkr"
     material_property, what, law, positive = SURFACE_ENERGY, "surface energy [J/m2]", "jkr", False
 
-
-@register
-class PPPopovJKR(_AdhesivePP):
-    name = "ModelPPPopovJKR"
-    mdem_key = "7A4C0DAF1F6D44AE925F4DD84563E36F"
-    needs_styles = "pair_style musen/pp popov/jkr"
-    material_property, what, law, positive = (SURFACE_TENSION, "surface tension [N/m]",
-                                              "popov/jkr", True)

@@ -7,6 +7,7 @@ of the same scene bounces both (tests/data/real-outputs/musen/models/pw_jkr/, pw
 from __future__ import annotations
 
 import math
+import os
 import shutil
 import subprocess
 
@@ -14,6 +15,7 @@ import numpy as np
 import pytest
 
 from fibrelmp import python_api
+from fibrelmp._lammps import new_lammps
 from fibrelmp.errors import InputError
 from fibrelmp.translate.musen.text import read_time_points
 
@@ -22,6 +24,7 @@ from .musen_model_checks import (ANGVEL, CMUSEN, COORD, VEL, check_reference_is_
                                  check_refused_without_styles, model_job, needs_cmusen,
                                  styles_or_skip)
 from .test_pp_jkr import _with_property
+from .test_style_musen_pair import plugin_or_skip
 
 JKR = data_path("real-outputs/musen/models/pw_jkr")
 POPOV = data_path("real-outputs/musen/models/pw_popov_jkr")
@@ -110,3 +113,67 @@ def test_hertz_mindlin_reference_is_cmusens_output(tmp_path):
                    timeout=300, check=True)
     assert (tmp_path / "pwhm_result_prec17.txt").read_bytes() == \
         (JKR / "cmusen_pwhm_result_prec17.txt").read_bytes()
+
+
+# ---------------------------------------------------------------- single contacts, numpy
+
+E_STAR, G_STAR = 4.2e10, 9.3e9
+PI = 3.14159265358979323846
+MESH = f"""musen/wall/mesh 1
+laws 1
+1 1 {E_STAR!r} {G_STAR!r} 0.8 0.2 0.01
+geometries 1
+geometry Plate 0 0 0
+triangles 2
+0 1 -0.005 -0.005 0.0 0.005 -0.005 0.0 0.005 0.005 0.0
+0 1 -0.005 -0.005 0.0 0.005 0.005 0.0 -0.005 0.005 0.0
+"""
+
+
+def _wall_force(tmp_path, law: str, overlap: float) -> tuple[float, float]:
+    """(normal force on a sphere resting on the plate, the overlap its position holds) from
+    LAMMPS's first force evaluation."""
+    (tmp_path / "walls.mesh").write_text(MESH)
+    z = R - overlap
+    lmp = new_lammps(["-log", "none", "-screen", "none", "-nocite"])
+    cwd = os.getcwd()
+    os.chdir(tmp_path)
+    try:
+        for c in [f"plugin load {plugin_or_skip()}", "units si", "atom_style sphere",
+                  "boundary f f f", "comm_modify vel yes",
+                  "region box block -0.01 0.01 -0.01 0.01 -0.01 0.01", "create_box 1 box",
+                  f"create_atoms 1 single 0 0 {z!r}", f"set type 1 diameter {2 * R!r} density 2500",
+                  "pair_style zero 0.003", "pair_coeff * *", "fix 1 all nve/sphere",
+                  f"fix w all musen/wall/mesh walls.mesh law {law}", "run 0 post no"]:
+            lmp.command(c)
+        f = np.array(lmp.gather_atoms("f", 1, 3))
+        return float(f[2]), R - z
+    finally:
+        os.chdir(cwd)
+        lmp.close()
+
+
+@pytest.mark.parametrize("overlap", [1e-11, 1e-9, 5e-8, 1e-6])
+def test_wall_normal_forces_are_musens(tmp_path, overlap):
+    """At rest on the plate (rc_n = n, no damping, no tangential force): the force is n F_el
+    with ModelPWJKR's / ModelPWPopovJKR's F_el (R* = R), positive away from the wall."""
+    styles_or_skip()
+    fz, overlap = _wall_force(tmp_path, "jkr 1.0", overlap)
+    a = math.sqrt(R * overlap)
+    jkr = 4.0 * a ** 3 * E_STAR / (3.0 * R) - math.sqrt(8.0 * PI * E_STAR * 1.0 * a ** 3)
+    assert fz == pytest.approx(jkr, rel=1e-9, abs=1e-18)
+    fz, overlap = _wall_force(tmp_path, "popov/jkr 0.7", overlap)
+    adh = 1.5 * 0.7 * PI * R
+    s = (0.4626 * (0.7 / E_STAR) ** 2 * R) ** (1.0 / 3.0)
+    assert fz == pytest.approx(adh * (-1 + 0.12 * (overlap / s + 1) ** (5.0 / 3.0)), rel=1e-9)
+
+
+def test_wall_signs(tmp_path):
+    """Adhesive (towards the wall, -z) at small overlap, repulsive deeper; Popov's jumps to
+    -0.88 Fadh at the edge."""
+    styles_or_skip()
+    small, _ = _wall_force(tmp_path, "jkr 1.0", 1e-9)
+    deep, _ = _wall_force(tmp_path, "jkr 1.0", 1e-6)
+    edge, _ = _wall_force(tmp_path, "popov/jkr 0.7", 1e-18)
+    assert small < 0 < deep
+    assert edge == pytest.approx(-0.88 * 1.5 * 0.7 * PI * R, rel=1e-6)

@@ -230,7 +230,8 @@ def test_cost_per_contact_vs_hertz_mindlin(tmp_path):
     """Rough cost of the persistent contacts per law (printed, not asserted)."""
     plugin = plugin_or_skip()
     for style in ("pair_style musen/hm", "pair_style musen/pp hertz",
-                  "pair_style musen/pp simple/viscoelastic 3e4 0.01"):
+                  "pair_style musen/pp simple/viscoelastic 3e4 0.01", "pair_style musen/pp jkr 1.0",
+                  "pair_style musen/pp popov/jkr 0.7"):
         lmp = persistent_lammps(plugin, style=style)
         try:
             start = time.perf_counter()

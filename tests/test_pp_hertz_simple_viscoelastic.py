@@ -239,3 +239,13 @@ def test_cost_per_contact_vs_hertz_mindlin(tmp_path):
             print(f"{style}: {(time.perf_counter() - start) / 2000 * 1e6:.2f} us/step")
         finally:
             lmp.close()
+
+
+@pytest.mark.parametrize("models", ["MODEL_PP             ModelPPHertz\nMODEL_PP             ModelPPHertzMindlin",
+                                    "MODEL_PP             ModelPPHertzMindlin\nMODEL_PP             ModelPPHertz"])
+def test_hertz_with_another_pp_model_is_an_input_error(tmp_path, models):
+    styles_or_skip()
+    job = model_job(tmp_path, HERTZ, "hertz", "MODEL_PP             ModelPPHertz", models)
+    with pytest.raises(InputError, match="runs ModelPPHertz only as the only PP model") as err:
+        python_api.run(job)
+    assert str(err.value).startswith(f"{job}:11: ")

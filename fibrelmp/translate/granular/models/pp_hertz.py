@@ -16,6 +16,8 @@ class PPHertz(PhysicsModel):
     kind = "PP"
     mdem_key = "B7CBEB0657884100930E6C68E2C438EB"
     needs_styles = "pair_style musen/pp hertz"
+    # with another PP model: refused at the later model's line (script_settings)
+    acts_alone = True
 
     @classmethod
     def pair_style_lines(cls, params: dict[str, float], own_styles: bool) -> list[str]:
@@ -27,8 +29,7 @@ class PPHertz(PhysicsModel):
 
     @classmethod
     def pp_law_words(cls, params: dict[str, float]) -> str:
-        # MUSEN's Hertz reads and writes the collision's tangential force, which the other
-        # PP models also write: fibrelmp keeps one history per contact, so it is refused
+        # refused before rendering (script_settings, acts_alone); kept as a guard
         raise InputError(None, None, f"{cls.name} acts only as the only PP model (it keeps "
                          "MUSEN's tangential force where the others keep the tangential "
                          "overlap); fibrelmp cannot run it together with another PP model")

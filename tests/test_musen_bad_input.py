@@ -248,10 +248,9 @@ GOOD = ("MODEL_PP ModelPPHertzMindlin\nMODEL_PW ModelPWHertzMindlin\nMODEL_SB Mo
         "SIMULATION_STEP 1e-7\nSAVING_STEP 1e-4\nEND_TIME 1e-3\n")
 
 APPLY_ERRORS = [  # script, line, words: parsed fine, refused when the job is applied
-    (GOOD.replace("ModelSBElastic", "ModelSBThermal"), 3, "ModelSBThermal: this solid-bond "
-     "model is not supported; fibrelmp translates ModelSBElastic, and with fibrelmp's LAMMPS "
-     "styles ModelSBAerogel, ModelSBCreep, ModelSBElasticPerfectlyPlastic, ModelSBKelvin, "
-     "ModelSBLinearPlastic, ModelSBPlasticConcrete and ModelSBWeakening"),
+    (GOOD.replace("ModelPPHertzMindlin", "ModelPPSintering"), 1, "ModelPPSintering: this "
+     "particle-particle model is not supported; fibrelmp translates ModelPPHertzMindlin, and "
+     "with fibrelmp's LAMMPS styles ModelPPChealNess, ModelPPHeatConduction"),
     (GOOD + "MODEL_EF ModelEFLiquidDiffusion\nMODEL_EF_PARAMS TEMPERATURE 350\n", 8,
      "ModelEFLiquidDiffusion: without FIXED_SEED MUSEN seeds its generators from "
      "std::random_device"),

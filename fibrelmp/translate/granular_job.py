@@ -100,6 +100,15 @@ class GranularJob:
         return [self.data] + ([self.geometry] if self.geometry is not None else [])
 
 
+def _bond_style_law(model: GranularModel) -> tuple[str, str]:
+    """bond_style musen/elastic's laws; a heat law gets the bonds' thermal conductivity first."""
+    from fibrelmp.translate.granular.models.sb_heat_conduction import set_conductivity
+    from fibrelmp.translate.granular.models.sb_thermal import set_expansion
+    set_conductivity(model)
+    set_expansion(model)
+    return physics.bond_style_law(model.plan)
+
+
 def write_granular_job(model: GranularModel, folder: str | Path) -> GranularJob:
     """Write ``in.lammps`` + ``data.lammps`` for ``model`` into ``folder``."""
     folder = Path(folder)
@@ -325,7 +334,7 @@ def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> 
         musen_bonds=geometry is not None, bond_geometry=geometry, bond_partners=PARTNERS,
         bond_values=VALUES, geometry_fix=GEOMETRY_FIX, geometry_name=GEOMETRY_NAME,
         bond_criterion=int(plan.bond_breakage),
-        bond_law=physics.bond_style_law(plan) if geometry is not None else None,
+        bond_law=_bond_style_law(model) if geometry is not None else None,
         pair_style_lines=physics.pair_style_lines(model, parts.musen_hm),
         sphere_types=[spheres.type_of_mat[m] for m in mats],
         sphere_type_names=[model.materials[m].name for m in mats],

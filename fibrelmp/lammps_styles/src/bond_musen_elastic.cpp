@@ -112,6 +112,7 @@ struct LawInput {
   const double *xl, *xr;    // left sphere, right sphere (the image closest to the left one)
   const double *vl, *vr, *wl, *wr;
   double dt, E, G, mu, Y;   // Y: the bond type's yield strength (plastic, creep)
+  double time;              // MUSEN's time of the evaluation (thermal)
   const BondMusenElastic::Law *law;
 };
 
@@ -331,6 +332,31 @@ void tangential_force(int form, const double *overlap, double kt, double G, doub
     scale(overlap, kt, force);
 }
 
+/* ModelSBThermal's normal damping -MU v_n A E |strain|, capped at the normal force's size */
+void thermal_normal_damping(const LawInput &in, const double *normalVelocity, double A,
+                            double strain, const double *normalForce, double *dampn)
+{
+  using B = BondMusenElastic;
+  const double mu = in.law->p[B::P_MU];
+  for (int k = 0; k < 3; k++) dampn[k] = -mu * normalVelocity[k] * A * in.E * fabs(strain);
+  cap_damping(dampn, length(normalForce), 1.0);
+}
+
+/* ModelSBThermal's tangential damping -MU v_t x overlap (CVector3 *: the cross product) kt,
+   capped at the tangential force's size */
+void thermal_tangential_damping(const LawInput &in, const double *tangentialVelocity,
+                                const double *overlap, double kt, const double *tangentialForce,
+                                double *dampt)
+{
+  using B = BondMusenElastic;
+  const double mu = in.law->p[B::P_MU];
+  double scaled[3], c[3];
+  for (int k = 0; k < 3; k++) scaled[k] = -mu * tangentialVelocity[k];
+  cross(scaled, overlap, c);
+  for (int k = 0; k < 3; k++) dampt[k] = c[k] * kt;
+  cap_damping(dampt, length(tangentialForce), 1.0);
+}
+
 /* One evaluation of MUSEN's solid bond on the state h (FixMusenHistory values, H_* layout).
    advance: MUSEN's CalculateSB (rotate and increment the state by one step of dt);
    otherwise the forces of the stored state (tangential overlap, moments, damping; the
@@ -342,7 +368,10 @@ void musen_law(const LawInput &in, double *h, bool advance, bool fresh, LawOutpu
   using B = BondMusenElastic;
   const int form = in.law->form;
   const bool kelvin = form == B::KELVIN;
-  const bool plastic = form != B::ELASTIC && form != B::KELVIN;
+  // ModelSBThermal: the elastic bond with its rest length growing in time, MU-damped
+  const bool thermal = form == B::THERMAL;
+  const bool damped = kelvin || thermal;
+  const bool plastic = form != B::ELASTIC && form != B::KELVIN && !thermal;
   const double d = h[B::H_DIAMETER], L0 = h[B::H_LENGTH0];
   const double A = MUSEN_PI * d * d / 4;                // CrossCut (SimplifiedScene)
   const double I = MUSEN_PI * d * d * d * d / 64;       // AxialMoment
@@ -364,7 +393,9 @@ void musen_law(const LawInput &in, double *h, bool advance, bool fresh, LawOutpu
   scale(currentContact, dot(currentContact, relativeVelocity), normalVelocity);
   sub(relativeVelocity, normalVelocity, tangentialVelocity);
 
-  const double strain = (dist - L0) / L0;
+  // thermal: dInitLength = InitialLength (1 + THERM_DIFF TimeThermExpCoeff t)
+  const double Lr = thermal ? L0 * (1 + in.law->p[B::P_TDIFF] * in.law->p[B::P_ALPHA] * in.time) : L0;
+  const double strain = (dist - Lr) / Lr;
   double normal_scalar = -1 * A * in.E * strain;
   double normalForce[3];
   double plastic_stress = 0.0;    // plastic, creep: the normal stress after the cap
@@ -427,6 +458,7 @@ void musen_law(const LawInput &in, double *h, bool advance, bool fresh, LawOutpu
       for (int k = 0; k < 3; k++) dampn[k] = normalVelocity[k] * -in.mu * A * in.E * fabs(strain);
       cap_damping(dampn, length(normalForce), in.law->max_damp_ratio);
     }
+    if (thermal) thermal_normal_damping(in, normalVelocity, A, strain, normalForce, dampn);
 
     matvec(M, overlap, tmp);
     scale(tangentialVelocity, in.dt, tmp2);
@@ -448,6 +480,7 @@ void musen_law(const LawInput &in, double *h, bool advance, bool fresh, LawOutpu
       for (int k = 0; k < 3; k++) dampt[k] = tangentialVelocity[k] * -in.mu * ol * kt;
       cap_damping(dampt, length(tangentialForce), in.law->max_damp_ratio);
     }
+    if (thermal) thermal_tangential_damping(in, tangentialVelocity, overlap, kt, tangentialForce, dampt);
 
     matvec(M, nmoment, tmp);
     if (form == B::CONCRETE)    // ModelSBPlasticConcrete: (w_n (dt 2 I G)) / L0
@@ -471,15 +504,25 @@ void musen_law(const LawInput &in, double *h, bool advance, bool fresh, LawOutpu
       for (int k = 0; k < 3; k++) dampt[k] = tangentialVelocity[k] * -in.mu * ol * kt;
       cap_damping(dampt, length(tangentialForce), in.law->max_damp_ratio);
     }
+    if (thermal && fresh) {
+      thermal_normal_damping(in, normalVelocity, A, strain, normalForce, dampn);
+      thermal_tangential_damping(in, tangentialVelocity, overlap, kt, tangentialForce, dampt);
+    }
   }
 
+  if (thermal) {
+    // ModelSBThermal: vNormalForce += damping, TangentialForce += damping, both before
+    // TotalForce, UnsymMoment and its breakage test
+    add(normalForce, dampn, normalForce);
+    add(tangentialForce, dampt, tangentialForce);
+  }
   add(normalForce, tangentialForce, out.total);
   if (kelvin) {
     add(out.total, dampn, out.total);
     add(out.total, dampt, out.total);
   }
   double unsym[3], msum[3];
-  cross(rAC, tangentialForce, unsym);    // MUSEN UnsymMoment: from the elastic part only
+  cross(rAC, tangentialForce, unsym);    // MUSEN UnsymMoment: from the elastic part only (thermal: with its damping)
   add(nmoment, tmoment, msum);
   sub(msum, unsym, out.mleft);           // ConsolidatePart, left:  + (M_n + M_t) - rAC x F_t
   add(msum, unsym, out.mright);          //                 right: - ((M_n + M_t) + rAC x F_t)
@@ -518,7 +561,7 @@ bool musen_breaks(int criterion, const double *h, const LawOutput &out, double s
 const char *law_name(int form)
 {
   static const char *const names[] = {"elastic", "kelvin", "plastic", "linear/plastic", "creep",
-                                      "weakening", "aerogel", "concrete"};
+                                      "weakening", "aerogel", "concrete", "heat", "thermal"};
   return names[form];
 }
 
@@ -656,6 +699,7 @@ bool BondMusenElastic::apply_laws(int i1, int i2, int type, double *h, bool adva
   in.wl = atom->omega[i1];
   in.wr = atom->omega[i2];
   in.dt = update->dt;
+  in.time = update->atime + static_cast<double>(update->ntimestep - update->atimestep) * update->dt;
   in.E = youngs[type];
   in.G = shear[type];
   in.mu = viscosity[type];
@@ -665,6 +709,10 @@ bool BondMusenElastic::apply_laws(int i1, int i2, int type, double *h, bool adva
   double scratch[H_SIZE];
   for (int k = 0; k < nlaws; k++) {
     const Law &law = k == 0 ? first_law : then_laws[k - 1];
+    if (law.form == HEAT) {    // no force, no state: only the heat flux
+      bond_heat(law, i1, i2, h[H_DIAMETER]);
+      continue;
+    }
     in.law = &law;
     double *own = h + H_SIZE + H_LAWSTATE * k;    // law k's copy (k < nlaws - 1)
     double *state = h;
@@ -695,6 +743,22 @@ bool BondMusenElastic::apply_laws(int i1, int i2, int type, double *h, bool adva
     }
   }
   return false;
+}
+
+/* ModelSBHeatConduction::CalculateSB / ConsolidatePart: q = SCALE A K (T_right - T_left) / |x_r -
+   x_l|, A = pi d^2 / 4 (SolidBond.cpp's cross-cut), into the left sphere (i1), out of the right */
+void BondMusenElastic::bond_heat(const Law &law, int i1, int i2, double d)
+{
+  int dim, flag, cols;
+  double *flux = static_cast<double *>(heat_fix->extract("flux", dim));
+  const double *t = atom->dvector[atom->find_custom("musen_temperature", flag, cols)];
+  const double *xl = atom->x[i1], *xr = atom->x[i2];
+  const double bond[3] = {xr[0] - xl[0], xr[1] - xl[1], xr[2] - xl[2]};
+  const double distance = std::sqrt(bond[0] * bond[0] + bond[1] * bond[1] + bond[2] * bond[2]);
+  const double cross_cut = MUSEN_PI * d * d / 4;
+  const double q = law.p[P_SCALE] * cross_cut * law.p[P_K] * (t[i2] - t[i1]) / distance;
+  flux[i1] += q;
+  flux[i2] -= q;    // a ghost's: fix musen/heat sends it back to its owner
 }
 
 bool BondMusenElastic::any_breakage() const
@@ -921,9 +985,15 @@ int BondMusenElastic::parse_law(const std::string &form, int narg, char **arg, L
     n = 7;
   } else if (form == "concrete") {
     law.form = CONCRETE;
+  } else if (form == "heat") {
+    law.form = HEAT;
+    n = 2;
+  } else if (form == "thermal") {
+    law.form = THERMAL;
+    n = 3;
   } else {
     error->all(FLERR, "Bond style musen/elastic: unknown law {} (known: elastic, kelvin, plastic, "
-                      "linear/plastic, creep, weakening, aerogel, concrete)", form);
+                      "linear/plastic, creep, weakening, aerogel, concrete, heat, thermal)", form);
   }
   if (narg < n) utils::missing_cmd_args(FLERR, "bond_style musen/elastic " + form, error);
   double v[NPARAM] = {};
@@ -964,7 +1034,7 @@ void BondMusenElastic::settings(int narg, char **arg)
                           "stress sums) or 2 (each stress term alone), got {}", arg[iarg + 1]);
       iarg += 2;
     } else if (key == "kelvin" || key == "plastic" || key == "linear/plastic" || key == "creep" ||
-               key == "weakening" || key == "aerogel" || key == "concrete") {
+               key == "weakening" || key == "aerogel" || key == "concrete" || key == "thermal") {
       iarg += 1 + parse_law(key, narg - iarg - 1, arg + iarg + 1, first_law);
     } else if (key == "then") {
       // then FORM BREAKAGE [parameters]: one more law
@@ -996,13 +1066,17 @@ void BondMusenElastic::settings(int narg, char **arg)
   }
   // the stress criteria each law has (MUSEN: Kelvin, linear plastic, creep one, weakening its
   // strain test; plastic, aerogel none)
-  auto most_of = [](int form) { return form == ELASTIC ? 2 : (form == PLASTIC || form == AEROGEL) ? 0 : 1; };
+  auto most_of = [](int form) {
+    return form == ELASTIC ? 2 : (form == PLASTIC || form == AEROGEL || form == HEAT) ? 0 : 1;
+  };
   for (const Law &law : then_laws) {
     const int most = most_of(law.form);
     if (law.breakage < 0 || law.breakage > most)
       error->all(FLERR, "Bond style musen/elastic: then {}: breakage must be 0..{}, got {}",
                  law_name(law.form), most, law.breakage);
   }
+  if (first_law.form == HEAT)
+    error->all(FLERR, "Bond style musen/elastic: heat is a later law (then heat 0 SCALE K)");
   const int most = most_of(first_law.form);
   if (first_law.breakage > most)
     error->all(FLERR, "Bond style musen/elastic: {} takes breakage 0..{}, got {}",
@@ -1070,6 +1144,16 @@ void BondMusenElastic::coeff(int narg, char **arg)
 
 void BondMusenElastic::init_style()
 {
+  heat_fix = nullptr;
+  bool heats = first_law.form == HEAT;
+  for (const Law &law : then_laws) heats = heats || law.form == HEAT;
+  if (heats) {
+    const auto found = modify->get_fix_by_style("^musen/heat$");
+    if (found.size() != 1)
+      error->all(FLERR, "Bond style musen/elastic: its heat law needs one fix musen/heat (found {})",
+                 found.size());
+    heat_fix = found[0];
+  }
   timed_breaks = 0;
   for (const auto &fix : modify->get_fix_list()) {
     auto *leapfrog = dynamic_cast<FixMusenLeapfrog *>(fix);

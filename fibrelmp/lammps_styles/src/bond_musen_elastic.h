@@ -103,12 +103,14 @@ class BondMusenElastic : public Bond {
   };
 
   // MUSEN's SB models this style runs
-  enum Form { ELASTIC = 0, KELVIN, PLASTIC, LINEAR_PLASTIC, CREEP, WEAKENING, AEROGEL, CONCRETE };
+  enum Form { ELASTIC = 0, KELVIN, PLASTIC, LINEAR_PLASTIC, CREEP, WEAKENING, AEROGEL, CONCRETE, HEAT, THERMAL };
   // parameters of the plastic laws (Law::p)
   enum { P_FT = 0, P_FC, P_TY, P_RC, P_A, P_M };                  // plastic, creep
   enum { P_KL = 0, P_KU };                                        // linear/plastic
   enum { P_CB = 0, P_BS, P_WF };                                  // weakening
   enum { P_PSC = 0, P_PST, P_SRC, P_SRT, P_BST, P_HRC, P_HRT };   // aerogel
+  enum { P_SCALE = 0, P_K };                                      // heat (no force)
+  enum { P_TDIFF = 0, P_MU, P_ALPHA };                            // thermal
   enum { NPARAM = 7 };
 
   struct Law {
@@ -135,6 +137,8 @@ class BondMusenElastic : public Bond {
   int warned_build;          // the build-schedule warning was printed
   double max_length0;        // longest L0 seen (equilibrium_distance)
   class FixMusenHistory *history;
+  class Fix *heat_fix = nullptr;    // fix musen/heat when a law is heat (init_style)
+  void bond_heat(const Law &law, int i1, int i2, double d);
   std::string history_id;
   class FixMusenVerlet *verlet;    // MUSEN's contact-list schedule for broken pairs (or none)
 

@@ -549,6 +549,15 @@ void FixMusenWallMesh::init()
     auto *leapfrog = dynamic_cast<FixMusenLeapfrog *>(fix);
     if (leapfrog && leapfrog->variable_step()) clock = leapfrog;
   }
+  heat_fix = nullptr;
+  for (const auto &law : pw_laws)
+    if (law->heats()) {
+      const auto heats = modify->get_fix_by_style("^musen/heat$");
+      if (heats.size() != 1)
+        error->all(FLERR, "Fix musen/wall/mesh: its heat law needs one fix musen/heat (found {})",
+                   heats.size());
+      heat_fix = heats[0];
+    }
   // every sphere type in the group needs a law with every wall material in use
   std::vector<char> used(nmat, 0);
   for (int t = 0; t < ntri; t++) used[tmat[t]] = 1;
@@ -1077,6 +1086,14 @@ void FixMusenWallMesh::wall_force(int i, const Candidate &cd, double *hist, doub
       fo[k] += fo_more[k];
       to[k] += to_more[k];
     }
+  }
+  // heat laws (ConsolidatePart: HeatFlux += the contact's), in the laws' order
+  if (heat_fix) {
+    int dim, flag, cols;
+    double *flux = static_cast<double *>(heat_fix->extract("flux", dim));
+    c.temperature = atom->dvector[atom->find_custom("musen_temperature", flag, cols)][i];
+    for (const auto &law : pw_laws)
+      if (law->heats()) flux[i] += law->heat(c);
   }
 }
 

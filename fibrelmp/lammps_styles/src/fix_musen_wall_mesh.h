@@ -162,6 +162,7 @@ class FixMusenWallMesh : public Fix {
   };
   // the particle-wall laws, in the order they act (musen_pw_law.h)
   std::vector<std::unique_ptr<musen_pw::Law>> pw_laws;
+  class Fix *heat_fix = nullptr;    // fix musen/heat when a law heats (init)
   struct Law {
     bool set;
     double estar, gstar, alpha, mu, mur;

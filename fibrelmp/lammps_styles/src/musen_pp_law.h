@@ -34,6 +34,8 @@ struct Contact {
   const double *vt;             // tangential relative velocity
   const double *w1, *w2;        // angular velocities of src and dst
   double dt;
+  // heat laws only (fix musen/heat; zero otherwise): temperatures and thermal conductivities
+  double t1 = 0, t2 = 0, k1 = 0, k2 = 0;
 };
 
 // pair_coeff of the type pair
@@ -47,6 +49,7 @@ struct Materials {
 struct Result {
   double fn[3], ft[3], m1[3], m2[3];
   double fn_len;                // the normal force's signed size, fn = n fn_len (<= 0: repulsive)
+  double heat = 0;              // heat flux into src (W; dst gets -heat), heat laws only
 };
 
 class Law {
@@ -55,6 +58,8 @@ class Law {
   // xi: the collision's tangential overlap (in: the stored one or the previous law's of this
   // step; out: this law's)
   virtual void force(const Contact &c, const Materials &m, double *xi, Result &r) const = 0;
+  // whether the law needs temperatures and gives a heat flux (fix musen/heat)
+  virtual bool heats() const { return false; }
 };
 
 // a law from its parameters; sets why and returns nullptr when they are wrong

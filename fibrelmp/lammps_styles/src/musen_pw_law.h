@@ -28,6 +28,7 @@ struct Contact {
   const double *omega;     // the sphere's angular velocity
   double vel[3];           // v_sphere - v_wall + the wall's rotation velocity at the contact
   double dt;
+  double temperature = 0;  // the sphere's (heat laws only: fix musen/heat)
 };
 
 // the laws line of FILE for the sphere's type and the triangle's material
@@ -45,6 +46,9 @@ class Law {
   // laws each reads what the previous one left this step (MUSEN's one vTangOverlap)
   virtual void force(const Contact &c, const Materials &m, double *hist, double *fo,
                      double *to) const = 0;
+  // heat laws: the heat flux into the sphere (W; fix musen/heat)
+  virtual bool heats() const { return false; }
+  virtual double heat(const Contact &) const { return 0.0; }
 };
 
 // a law from its parameters; sets why and returns nullptr when they are wrong

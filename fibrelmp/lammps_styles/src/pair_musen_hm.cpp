@@ -66,6 +66,7 @@ inline double length(const double *v)
 inline void add_result(musen_pp::Result &sum, const musen_pp::Result &more)
 {
   sum.fn_len += more.fn_len;
+  sum.heat += more.heat;
   for (int k = 0; k < 3; k++) {
     sum.fn[k] += more.fn[k];
     sum.ft[k] += more.ft[k];
@@ -166,6 +167,14 @@ template <class Laws> void PairMusenHM::contacts(Laws apply)
   tagint *tag = atom->tag;
   const int nlocal = atom->nlocal;
   const double *special_lj = force->special_lj;
+  // heat laws (fix musen/heat): temperatures, per-type conductivity, the flux to add to
+  double *temp = nullptr, *flux = nullptr, *conductivity = nullptr;
+  if (heat_fix) {
+    int dim, flag, cols;
+    flux = static_cast<double *>(heat_fix->extract("flux", dim));
+    conductivity = static_cast<double *>(heat_fix->extract("conductivity", dim));
+    temp = atom->dvector[atom->find_custom("musen_temperature", flag, cols)];
+  }
 
   const int inum = list->inum;
   int *ilist = list->ilist;
@@ -212,13 +221,24 @@ template <class Laws> void PairMusenHM::contacts(Laws apply)
       // ---- CalculatePP of each law in turn (MUSEN's order), each continuing xi
       double n[3], cvlen, vn, vt[3];
       kinematics(i, j, cv, n, cvlen, vn, vt);
-      const musen_pp::Contact c{overlap, equiv_radius, equiv_mass, r1, r2, n, vn, vt,
-                                omega[i], omega[j], dt};
+      musen_pp::Contact c{overlap, equiv_radius, equiv_mass, r1, r2, n, vn, vt,
+                          omega[i], omega[j], dt};
+      if (heat_fix) {
+        c.t1 = temp[i];
+        c.t2 = temp[j];
+        c.k1 = conductivity[itype];
+        c.k2 = conductivity[jtype];
+      }
       const musen_pp::Materials mats{estar[itype][jtype], gstar[itype][jtype],
                                      alpha[itype][jtype], mu[itype][jtype],
                                      mu_roll[itype][jtype]};
       musen_pp::Result r;
       apply(c, mats, xi, r);
+      // ConsolidateSrc / ConsolidateDst of a heat law: HeatFlux += / -= the contact's
+      if (heat_fix) {
+        flux[i] += r.heat;
+        if (j < nlocal) flux[j] -= r.heat;
+      }
 
       // ---- ConsolidateSrc / ConsolidateDst
       double ftot[3];
@@ -401,6 +421,16 @@ void PairMusenHM::init_style()
 
   const auto verlets = modify->get_fix_by_style("^musen/verlet$");
   verlet = verlets.empty() ? nullptr : static_cast<FixMusenVerlet *>(verlets[0]);
+
+  heat_fix = nullptr;
+  for (const auto &law : laws)
+    if (law->heats()) {
+      const auto heats = modify->get_fix_by_style("^musen/heat$");
+      if (heats.size() != 1)
+        error->all(FLERR, "pair {}: its heat law needs one fix musen/heat (found {})",
+                   force->pair_style, heats.size());
+      heat_fix = heats[0];
+    }
 
   // size-based half list with newton off whatever `newton` says (see the file header)
   neighbor->add_request(this, NeighConst::REQ_SIZE | NeighConst::REQ_NEWTON_OFF);

@@ -89,6 +89,8 @@ class PairMusenHM : public Pair {
   void set_laws(const std::string &first, int narg, char **arg);
   // the single law when it is hertz/mindlin (called without the list: musen/hm's speed)
   const musen_pp::HertzMindlin *only_hertz;
+  // a heat law among them: fix musen/heat's flux and per-type conductivity (init_style)
+  class Fix *heat_fix = nullptr;
   // every law in turn on one contact; the loop over the contacts with one of those
   void apply_laws(const musen_pp::Contact &c, const musen_pp::Materials &m, double *xi,
                   musen_pp::Result &r) const;

@@ -16,10 +16,20 @@ from fibrelmp.translate.lammps_format import float_text
 
 TEMPERATURE = "d_musen_temperature"      # the frames' column of MUSEN's particle temperature
 HEAT_CAPACITY = 1                        # MUSEN's material property id
+THERMAL_CONDUCTIVITY = 3                 # MUSEN's material property id
+
+
+def contact_heat_models(model: GranularModel) -> list[str]:
+    """The contact and bond models (PP, PW, SB) that carry heat to the spheres (fix musen/heat)."""
+    from fibrelmp.translate.granular import models as physics
+    names = [m.name for kind in ("PP", "PW") for m, _ in physics.chosen_all(model, kind)
+             if getattr(m, "contact_heat", False)]
+    plan = model.plan
+    return names + [law.model for law in (plan.bond_law, *plan.then_bond_laws) if law.form == "heat"]
 
 
 def uses_temperature(model: GranularModel) -> bool:
-    return any(f.heat for f in model.plan.external_fields)
+    return any(f.heat for f in model.plan.external_fields) or bool(contact_heat_models(model))
 
 
 @dataclass
@@ -27,6 +37,7 @@ class FieldCommands:
     temperature: bool                  # a heat model: fix property/atom d_musen_temperature
     set_lines: list[str]               # the scene's temperatures
     fixes: list[tuple[str, str, str]]  # each EF model's (name, fix style, its arguments)
+    heat_args: str = ""                # contact heat models: fix musen/heat's arguments
 
 
 def field_commands(model: GranularModel, rows: np.ndarray, type_of_mat: dict[int, int],
@@ -51,7 +62,33 @@ def field_commands(model: GranularModel, rows: np.ndarray, type_of_mat: dict[int
         if fld.style == "musen/diffusion":
             _check_diffusion(model, rows)
         fixes.append((fld.model, fld.style, args))
-    return FieldCommands(heat, lines, fixes)
+    heat_args = ""
+    contact = contact_heat_models(model)
+    if contact:
+        ef = [f.model for f in model.plan.external_fields if f.heat]
+        if ef:
+            # both would update the temperature (fix musen/field heat and fix musen/heat)
+            raise InputError(model.source, None, f"{contact[0]} together with {ef[0]} is not "
+                             "supported yet")
+        cp = _heat_capacities(model, type_of_mat, ntypes)
+        k = _conductivities(model, type_of_mat, ntypes)
+        heat_args = ("cp " + " ".join(float_text(c) for c in cp) + " k "
+                     + " ".join(float_text(c) for c in k))
+    return FieldCommands(heat, lines, fixes, heat_args)
+
+
+def _conductivities(model: GranularModel, type_of_mat: dict[int, int], ntypes: int) -> list[float]:
+    """Each LAMMPS type's thermal conductivity (its sphere material's; 1 for wall types, unused)."""
+    k = [1.0] * ntypes
+    for m, t in type_of_mat.items():
+        mat = model.materials[m]
+        c = mat.props.get(THERMAL_CONDUCTIVITY, math.nan)
+        if not (c > 0 and math.isfinite(c)):
+            raise InputError(model.source, None, f"material {mat.key} ({mat.name}): the contact "
+                             f"heat model needs its thermal conductivity (property 3) > 0 in "
+                             f"W/(m K), got {c:g}")
+        k[t - 1] = c
+    return k
 
 
 def _check_diffusion(model: GranularModel, rows: np.ndarray) -> None:

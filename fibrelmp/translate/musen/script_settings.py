@@ -106,6 +106,14 @@ def _apply_later_contact_models(model: GranularModel, plan) -> None:
                                  f"{model.models[kind].name}: several {kind} models acting "
                                  "together need fibrelmp's LAMMPS styles, which are not "
                                  f"available here ({styles.how})")
+            # a law that keeps its own contact history (ModelPPHertz: the tangential force)
+            alone = [m for m in (model.models[kind].name, choice.name)
+                     if getattr(physics.find(m), "acts_alone", False)]
+            if alone:
+                raise InputError(choice.source, choice.line, f"{choice.name} after "
+                                 f"{model.models[kind].name}: fibrelmp runs {alone[0]} only as "
+                                 f"the only {kind} model (it keeps MUSEN's tangential force "
+                                 "where the others keep the tangential overlap)")
             own = GranularPlan(dt=plan.dt, t_start=plan.t_start, t_end=plan.t_end)
             physics.find(choice.name).apply(own, choice.parameters, choice.source, choice.line)
             own_plans.append(own)

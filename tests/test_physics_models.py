@@ -61,7 +61,7 @@ def test_parameters_are_cmusens():
 
 
 def test_mdem_key_of_unknown_model_is_empty():
-    assert physics.mdem_key("ModelPPSintering") == ""
+    assert physics.mdem_key("ModelPPNoSuchModel") == ""        # not registered: no key
     assert physics.mdem_key("ModelSBKelvin") == "09405654485642A686561E1FC646DF1E"
 
 

@@ -254,7 +254,7 @@ def test_kinematics_matches_numerical_integration(around_centre):
 
 # ---------------------------------------------------------------------------------------
 # moving walls push spheres
-@pytest.mark.parametrize("representation", ["region", "tiles", "mesh"])
+@pytest.mark.parametrize("representation", ["region", pytest.param("tiles", marks=pytest.mark.tier2), "mesh"])
 def test_moving_plate_pushes_sphere(tmp_path, representation):
     """A plate rising at constant speed V under a resting sphere (gravity): the sphere ends up
     moving with the plate, at the plate height + R - static Hertz overlap."""
@@ -316,7 +316,8 @@ def test_static_plate_triangle_forces_carry_weight(tmp_path, representation):
     assert np.all(f.triangle_velocity == 0)
 
 
-@pytest.mark.parametrize("representation", ["region", "tilted-region", "tiles", "mesh"])
+@pytest.mark.parametrize("representation", ["region", "tilted-region", pytest.param("tiles", marks=pytest.mark.tier2),
+                                            "mesh"])
 def test_rotating_plate_stays_under_sphere(tmp_path, representation):
     """A plate tilting about the y axis through its centre: the sphere resting on it stays at
     distance R - delta from the plate where the frames say the plate is."""

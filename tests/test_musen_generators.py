@@ -91,6 +91,7 @@ def test_small_packing_has_cmusens_statistics(tmp_path):
     _compare(mine, STATS["small_packing"], 1e-7)
 
 
+@pytest.mark.tier2    # long reference comparison: second tier (pytest -m tier2; .ci/run runs it)
 @pytest.mark.parametrize("case, script, diameters", [
     ("example4", "job_example4.txt", [0.002, 0.0022, 0.0024, 0.0025]),
     ("example5_corrected", "job_example5_corrected.txt", [0.0015, 0.0018, 0.0019, 0.0021]),

@@ -121,6 +121,7 @@ def test_real_result_as_scene(agglo_result):
     assert not [w for w in m.warnings if w[0] == "musen-outside-domain"]
 
 
+@pytest.mark.tier2    # long reference comparison: second tier (pytest -m tier2; .ci/run runs it)
 def test_real_prec17_agrees_with_prec6(agglo_result, tmp_path):
     src = data_path("real-outputs", "musen", "agglomerate", "agglo_result_final_prec17.txt.gz")
     dst = tmp_path / "prec17.txt"
@@ -246,6 +247,7 @@ def test_round_trip_agglomerate_bonds_and_removals(tmp_path):
     assert tp.fields[43][:, 0, 0].tolist() == [0, 1e-6, 2e-6]
 
 
+@pytest.mark.tier2    # long reference comparison: second tier (pytest -m tier2; .ci/run runs it)
 def test_writer_matches_real_musen_export(agglo_result, tmp_path):
     """Rebuild frames from MUSEN's own result and write them at precision 6: the sphere and
     bond values must come out as MUSEN wrote them (42/36 are not written by fibrelmp)."""

@@ -29,6 +29,9 @@ from fibrelmp.translate.musen.scene import read_time_points
 
 from .conftest import data_path
 
+# a 2e-4 s agglomerate run (about 2 min): second tier (pytest -m tier2; .ci/run runs it)
+pytestmark = pytest.mark.tier2
+
 G = 9.81
 
 

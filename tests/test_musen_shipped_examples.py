@@ -157,6 +157,7 @@ def test_example1_long_run_within_cmusens_spread(tmp_path):
     compare("example1_long", tmp_path, spread_factor=5.0)
 
 
+@pytest.mark.tier2    # long reference comparison: second tier (pytest -m tier2; .ci/run runs it)
 def test_example3_checkpointed_run_is_the_uninterrupted_one(tmp_path):
     """Example 3 with a checkpoint every 200 steps (write_restart, then a `run 0` set-up with
     its neighbour-list build, at steps 210, 420, ...: across the first breaks at step 222):

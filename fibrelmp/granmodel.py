@@ -233,6 +233,8 @@ class GranularPlan:
     # every active model of a kind; each continues the bond's state and may break it)
     then_bond_laws: list[SolidBondLaw] = field(default_factory=list)
     contacts_between_bonded: bool = True    # MUSEN default
+    # False: spheres never touch each other (a cmusen job with no PP model runs so)
+    particle_contacts: bool = True
     # MUSEN's active EF models, in cmusen's order (each adds its force in turn, before all others)
     external_fields: list[ExternalField] = field(default_factory=list)
     # MUSEN's contact-list update (fix musen/verlet): Verlet distance = coeff x the smallest

@@ -5,7 +5,9 @@ starts (CSimplifiedScene::AddLiquidBond: IsActive(t_start)) stays active, and
 SetObjectActivity(t, true) moves its end up to the save's time t (a scene end of 0.003 in a
 run to 0.005 is written 0.005); a bond whose sphere left the domain is deactivated
 (CPUSimulator: EndActivity = the removal time) and, if still active by its interval at the
-next save, ends there."""
+next save, ends there.  A bond inactive at the start never gets a time point and cmusen's
+result holds it as an object of type 0 (its .mdem; its text export leaves it out): so do
+fibrelmp's writers (``untyped``)."""
 
 from __future__ import annotations
 
@@ -23,6 +25,7 @@ class LiquidBondActivity:
         self.end = np.array([lb.active_end for lb in liquid], np.float64)
         t0 = model.plan.t_start
         self.active = self._by_interval(t0)
+        self.untyped = ~self.active
         rows = {int(i): r for r, i in enumerate(np.asarray(model.spheres.ids).tolist())}
         self.left = np.array([rows[lb.left] for lb in liquid], np.int64)
         self.right = np.array([rows[lb.right] for lb in liquid], np.int64)

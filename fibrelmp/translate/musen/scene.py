@@ -71,8 +71,8 @@ def read(path: str | Path) -> GranularModel:
     if liquid_bonds:
         model_warn.append(("musen-liquid-bonds", f"{len(liquid_bonds)} liquid "
                            "bond(s) (type 13): they exert no force and never break, as in cmusen 1.74.2 "
-                           "(MUSEN e0ff360's ModelLBCapilarViscous is a no-op); the result "
-                           "files keep them, active to the run's end as cmusen writes them"))
+                           "(MUSEN e0ff360's ModelLBCapilarViscous is a no-op); the results "
+                           "hold their activity as cmusen writes it (translate/musen/liquid_bonds.py)"))
     plan = GranularPlan(dt=float("nan"), t_start=t_start, t_end=float("nan"))
     geometries = _scene(scan, plan, record, triangles, ids, types, rows[WALL], path,
                         model_warn)

@@ -237,6 +237,11 @@ class MusenResultWriter(Writer):
 
     def _write_objects(self, out) -> None:
         ids, types, rows = self._objects()
+        # cmusen's result holds a liquid bond inactive at the run's start as an object of
+        # type 0, which its text export leaves out (LiquidBondActivity.untyped)
+        keep = ~((types == 13) & self.liquid.untyped[np.where(types == 13, rows, 0)]) \
+            if len(self.liquid.untyped) else np.ones(len(ids), bool)
+        ids, types, rows = ids[keep], types[keep], rows[keep]
         nt = len(self.times)
         maps = {}
         m = self.model

@@ -165,6 +165,8 @@ class MdemResultWriter(MusenResultWriter):
                 continue
             for i in np.flatnonzero(np.isfinite(end)).tolist():
                 particles[int(ids[i])].activity_end = float(end[i])
+        for i in np.flatnonzero(self.liquid.untyped).tolist():     # as cmusen's result holds it
+            particles[int(liquid_ids[i])].type = 0
 
     def _add_generated(self, particles: Any) -> None:
         """The spheres MUSEN's generators made (rows reserved by translate/granular/inlets.py)

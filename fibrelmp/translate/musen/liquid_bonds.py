@@ -35,8 +35,9 @@ class LiquidBondActivity:
         return (self.start != self.end) & (self.start <= t) & (t <= self.end)
 
     def save(self, t: float, sphere_present: np.ndarray) -> None:
-        """A save at time ``t``; ``sphere_present``: per sphere row, whether it is in the run.
-        A removed sphere's time is taken as this save's, as the writers do for the sphere."""
+        """A save at time ``t``; ``sphere_present``: per sphere row, False once it has left
+        the domain.  A removed sphere's time is taken as this save's, as the writers do for
+        the sphere."""
         if not len(self.end):
             return
         lost = self.active & ~(sphere_present[self.left] & sphere_present[self.right])

@@ -72,7 +72,9 @@ def read(path: str | Path) -> GranularModel:
         model_warn.append(("musen-liquid-bonds", f"{len(liquid_bonds)} liquid "
                            "bond(s) (type 13): they exert no force and never break, as in cmusen 1.74.2 "
                            "(MUSEN e0ff360's ModelLBCapilarViscous is a no-op); the results "
-                           "hold their activity as cmusen writes it (translate/musen/liquid_bonds.py)"))
+                           "hold their activity as cmusen writes it (translate/musen/liquid_bonds.py), "
+                           "except that a sphere leaving the domain ends its liquid bonds at "
+                           "the next save's time, where cmusen writes its removal step's"))
     plan = GranularPlan(dt=float("nan"), t_start=t_start, t_end=float("nan"))
     geometries = _scene(scan, plan, record, triangles, ids, types, rows[WALL], path,
                         model_warn)

@@ -78,6 +78,7 @@ class MusenResultWriter(Writer):
         self.sphere_end = sp.active_end.copy()
         self.bond_end = model.bonds.active_end.copy() if model.bonds is not None else None
         self.liquid = LiquidBondActivity(model)
+        self.removed = np.zeros(sp.count, bool)      # spheres removed during the run so far
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
             self.spool = Path(tempfile.mkdtemp(prefix=f".{self.path.name}.spool.",
@@ -102,7 +103,10 @@ class MusenResultWriter(Writer):
         # a sphere active by its interval but missing from the frame was removed at this save
         gone = ~present & (sp.active_start <= t) & (self.sphere_end > t)
         self.sphere_end[gone] = t
-        self.liquid.save(t, present)
+        # only a sphere leaving the domain ends its liquid bonds (CPUSimulator), not one whose
+        # activity interval ended
+        self.removed |= gone
+        self.liquid.save(t, ~self.removed)
         if self.bond_end is not None and frame.bond_alive is not None:
             dead = ~np.asarray(frame.bond_alive, bool)
             when = (np.asarray(frame.bond_end_time, np.float64) if frame.bond_end_time is not None

@@ -286,8 +286,9 @@ class SourceRecord:
 
 @dataclass
 class LiquidBond:
-    """A MUSEN liquid bond (object type 13), kept for the result files: not simulated (a
-    later issue adds the liquid-bridge model)."""
+    """A MUSEN liquid bond (object type 13): it exerts no force, as in cmusen 1.74.2 (MUSEN
+    e0ff360's ModelLBCapilarViscous is a no-op); kept for the result files, which hold its
+    activity as cmusen writes it (translate/musen/liquid_bonds.py)."""
 
     id: int                    # source id
     left: int                  # the two spheres' source ids

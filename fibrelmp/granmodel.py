@@ -233,6 +233,8 @@ class GranularPlan:
     # every active model of a kind; each continues the bond's state and may break it)
     then_bond_laws: list[SolidBondLaw] = field(default_factory=list)
     contacts_between_bonded: bool = True    # MUSEN default
+    # False: spheres never touch each other (a cmusen job with no PP model runs so)
+    particle_contacts: bool = True
     # MUSEN's active EF models, in cmusen's order (each adds its force in turn, before all others)
     external_fields: list[ExternalField] = field(default_factory=list)
     # MUSEN's contact-list update (fix musen/verlet): Verlet distance = coeff x the smallest
@@ -284,8 +286,9 @@ class SourceRecord:
 
 @dataclass
 class LiquidBond:
-    """A MUSEN liquid bond (object type 13), kept for the result files: not simulated (a
-    later issue adds the liquid-bridge model)."""
+    """A MUSEN liquid bond (object type 13): it exerts no force, as in cmusen 1.74.2 (MUSEN
+    e0ff360's ModelLBCapilarViscous is a no-op); kept for the result files, which hold its
+    activity as cmusen writes it (translate/musen/liquid_bonds.py)."""
 
     id: int                    # source id
     left: int                  # the two spheres' source ids

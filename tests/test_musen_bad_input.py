@@ -147,17 +147,19 @@ def test_scene_warnings(tmp_path, text, kind):
     assert kind in [k for k, _ in m.warnings]
 
 
-def test_liquid_bonds_refused_only_when_simulated(tmp_path):
+def test_liquid_bonds_are_simulated_as_cmusen_does(tmp_path):
+    """MUSEN e0ff360's liquid-bond law is a no-op: a scene with liquid bonds runs (warned);
+    tests/test_lb_capilar_viscous.py compares such a run with cmusen's."""
     text = BASE + "0 4 1 13 5 1 2 0.001 0.002 23 GLASS 24 0 1e+300 2 0\n"
     m = musen.read(scene(tmp_path, text))
     assert m.liquid_bonds[0].id == 4
-    with pytest.raises(InputError, match="liquid bonds"):
-        musen.check_simulable(m)
+    musen.check_simulable(m)
     job = tmp_path / "job.txt"
     job.write_text("MODEL_PP ModelPPHertzMindlin\nMODEL_PW ModelPWHertzMindlin\n"
-                   "MODEL_SB ModelSBElastic\nEND_TIME 1\n")
-    with pytest.raises(InputError, match="liquid bonds"):
-        ms.apply_simulator_settings(m, ms.read_script(job)[0])
+                   "MODEL_SB ModelSBElastic\nMODEL_LB ModelLBCapilarViscous\nEND_TIME 1\n")
+    ms.apply_simulator_settings(m, ms.read_script(job)[0])
+    assert m.models["LB"].name == "ModelLBCapilarViscous"
+    assert "musen-liquid-bond-no-op" in [k for k, _ in m.warnings]
 
 
 def test_time_mismatch_extrapolates_like_musen(tmp_path):
@@ -258,10 +260,10 @@ APPLY_ERRORS = [  # script, line, words: parsed fine, refused when the job is ap
     (GOOD.replace("ModelPPHertzMindlin", "ModelPPHertzMindlln"), 1, "did you mean ModelPPHertzMindlin?"),
     (GOOD.replace("MODEL_PW ModelPWHertzMindlin", "MODEL_PW ModelPPHertz"), 2,
      "is a PP model, given as MODEL_PW"),
-    (GOOD.replace("MODEL_PP ModelPPHertzMindlin\n", ""), 1, "no particle-particle model"),
     (GOOD.replace("MODEL_PW ModelPWHertzMindlin\n", "\n"), 1, "has walls but no MODEL_PW"),
     (GOOD.replace("MODEL_SB ModelSBElastic\n", "\n"), 1, "solid bonds but no MODEL_SB"),
-    (GOOD + "MODEL_LB ModelLBCapilarViscous\n", 7, "liquid-bond model is not supported"),
+    (GOOD + "MODEL_LB ModelLBCapilarViscous\nMODEL_LB_PARAMS CONTACT_ANGLE nan\n", 8,
+     "ModelLBCapilarViscous parameter CONTACT_ANGLE must be finite"),
     (GOOD + "MATERIAL_PROPERTY DENSITY Glass 3000\n", 7, "material 'Glass' has key GLASS"),
     (GOOD + "MATERIAL_PROPERTY POISSON_RATIO GLASS 0.6\n", 7, "Poisson ratio"),
     (GOOD + "INTERACTION_PROPERTY SLIDING_FRICTION GLASS WOOD 0.1\n", 7, "no material with key 'WOOD'"),
@@ -366,7 +368,7 @@ def test_script_mutations_only_input_errors(tmp_path):
 def test_check_reads_model_params_after_a_refused_model(tmp_path):
     """Issue 24: ``check`` said 'no MODEL_EF line before it' of a MODEL_EF_PARAMS line right
     after a (refused) MODEL_EF line: cmusen gives those parameters to that model, so the one
-    error is the model's (now shown with a refused MODEL_LB: every EF model is translated); a
+    error is the model's (now shown with a misspelt MODEL_LB: every LB and EF model is translated); a
     PARAMS line with no model line before it is still an error."""
     from pathlib import Path
 
@@ -378,8 +380,8 @@ def test_check_reads_model_params_after_a_refused_model(tmp_path):
     (tmp_path / "scene.txt").write_bytes((corpus / "scene.txt").read_bytes())
     good = (corpus / "good.txt").read_text()
     assert "MODEL_SB" in good and "MODEL_LB" not in good
-    # (every MUSEN EF model is translated: only liquid-bond models are refused by kind)
-    extra = ("MODEL_LB ModelLBCapilarViscous\nMODEL_LB_PARAMS MIN_THICKNESS 1e-5\n"
+    # (every MUSEN LB and EF model is translated: a misspelt one is refused)
+    extra = ("MODEL_LB ModelLBCapilarViscos\nMODEL_LB_PARAMS MIN_THICKNESS 1e-5\n"
              "MODEL_SB_PARAMS CONSIDER_BREAKAGE 7\n")
     (tmp_path / "job.txt").write_text(good + extra)
     n = good.count("\n")
@@ -388,8 +390,8 @@ def test_check_reads_model_params_after_a_refused_model(tmp_path):
     errors = [line.split("job.txt", 1)[1] for line in result.stderr.splitlines()
               if line.startswith("error:")]
     assert errors == [
-        f":{n + 1}: ModelLBCapilarViscous: this liquid-bond model is not supported; fibrelmp "
-        "translates no liquid-bond model",
+        f":{n + 1}: unknown MUSEN model 'ModelLBCapilarViscos'; did you mean "
+        "ModelLBCapilarViscous?",
         f":{n + 3}: CONSIDER_BREAKAGE must be 0, 1 or 2 (got 7)"], result.stderr
     (tmp_path / "orphan.txt").write_text(good + "MODEL_EF_PARAMS MEDIUM_VISCOSITY 1e-5\n")
     with pytest.raises(InputError, match=f":{n + 1}: MODEL_EF_PARAMS: no MODEL_EF line before it"):

@@ -59,6 +59,7 @@ class Snapshot:
     walls: int
     size: tuple[int, int]
     notes: list[str] = field(default_factory=list)
+    liquid_bonds: int = 0          # line segments drawn for MUSEN liquid bonds
 
     @property
     def points(self) -> int:
@@ -140,7 +141,8 @@ def snapshot(result: str | Path, out: str | Path | None = None, *, frame: int | 
     fig, drawn = draw_frame(scene, width, height, _title(located.path, scene, total, src.time_unit))
     _save(fig, target, force)
     return Snapshot(target, scene.index, total, scene.time, drawn.positions, drawn.sizes,
-                    drawn.bonds, drawn.triangles, (width, height), src.notes + drawn.notes)
+                    drawn.bonds, drawn.triangles, (width, height), src.notes + drawn.notes,
+                    drawn.liquid_bonds)
 
 
 def _check_finite(path: Path, scene) -> None:
@@ -161,4 +163,6 @@ def _title(path: Path, scene, total: int, unit: str) -> str:
         parts.append(f"{len(scene.bonds)} bonds")
     if scene.broken_bonds:
         parts.append(f"{scene.broken_bonds} broken")
+    if len(scene.liquid_bonds):
+        parts.append(f"{len(scene.liquid_bonds)} liquid bonds")
     return "  ·  ".join(p for p in parts if p)

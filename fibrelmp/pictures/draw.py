@@ -21,6 +21,7 @@ MISSING = ("plot and snapshot draw with matplotlib, which is not installed: "
            "pip install 'fibrelmp[plot]' (or pip install matplotlib)")
 WALL_COLOUR = "#8a8f98"
 BOND_COLOUR = "#3a3a3a"
+LIQUID_BOND_COLOUR = "#2f7fd0"
 
 
 def figure(width: int, height: int, dpi: int = 100):
@@ -83,14 +84,17 @@ class DrawnScene:
     triangles: int                     # wall faces drawn (triangles and clipped planes)
     pixels_per_unit: float
     notes: list[str] = field(default_factory=list)
+    liquid_bonds: int = 0              # line segments drawn for MUSEN liquid bonds
 
 
-def _bond_segments(frame: SceneFrame) -> np.ndarray:
-    """(m,2,3) segments; a bond longer than half the box along an axis crosses a periodic
-    boundary (no bond can be that long otherwise): drawn as two halves, one at each end."""
-    if not len(frame.bonds):
+def _bond_segments(frame: SceneFrame, pairs: np.ndarray | None = None) -> np.ndarray:
+    """(m,2,3) segments of ``pairs`` (default: the frame's bonds); a bond longer than half
+    the box along an axis crosses a periodic boundary (no bond can be that long otherwise):
+    drawn as two halves, one at each end."""
+    pairs = frame.bonds if pairs is None else pairs
+    if not len(pairs):
         return np.zeros((0, 2, 3))
-    a, b = frame.position[frame.bonds[:, 0]], frame.position[frame.bonds[:, 1]]
+    a, b = frame.position[pairs[:, 0]], frame.position[pairs[:, 1]]
     d = b - a
     if frame.box is not None:
         length = np.asarray(frame.box[1]) - np.asarray(frame.box[0])
@@ -223,6 +227,10 @@ def draw_frame(frame: SceneFrame, width: int, height: int, title: str, dpi: int 
     if len(segments):
         ax.add_collection3d(Line3DCollection(segments, colors=BOND_COLOUR, linewidths=0.8, alpha=0.8,
                                              zorder=2))
+    liquid = _bond_segments(frame, frame.liquid_bonds)
+    if len(liquid):
+        ax.add_collection3d(Line3DCollection(liquid, colors=LIQUID_BOND_COLOUR, linewidths=1.6,
+                                             linestyles="--", alpha=0.8, zorder=2))
 
     # pixels per data unit: ortho projection with equal scales, so any screen-parallel offset
     # works; measure one along the screen's horizontal
@@ -249,7 +257,8 @@ def draw_frame(frame: SceneFrame, width: int, height: int, title: str, dpi: int 
         ax.legend(handles=handles, loc="lower left", fontsize=8, frameon=False)
     x, y, z = scatter._offsets3d
     drawn = DrawnScene(np.column_stack([np.asarray(x, float), np.asarray(y, float), np.asarray(z, float)]),
-                       np.asarray(scatter.get_sizes(), float), len(segments), triangles, per_unit, notes)
+                       np.asarray(scatter.get_sizes(), float), len(segments), triangles, per_unit, notes,
+                       len(liquid))
     return fig, drawn
 
 
@@ -279,6 +288,10 @@ def _draw_frame_2d(frame: SceneFrame, width: int, height: int, title: str, dpi: 
     segments = _bond_segments(frame)[:, :, :2]
     if len(segments):
         ax.add_collection(LineCollection(segments, colors=BOND_COLOUR, linewidths=0.8))
+    liquid = _bond_segments(frame, frame.liquid_bonds)[:, :, :2]
+    if len(liquid):
+        ax.add_collection(LineCollection(liquid, colors=LIQUID_BOND_COLOUR, linewidths=1.6,
+                                         linestyles="--"))
     lines = 0
     if frame.box is not None:
         b_lo, b_hi = np.asarray(frame.box[0], float)[:2], np.asarray(frame.box[1], float)[:2]
@@ -298,7 +311,7 @@ def _draw_frame_2d(frame: SceneFrame, width: int, height: int, title: str, dpi: 
     ax.tick_params(labelsize=8)
     offsets = np.asarray(circles.get_offsets(), float)
     drawn = DrawnScene(np.column_stack([offsets, frame.position[:, 2]]), 2 * radius, len(segments),
-                       lines, float("nan"), [note] if note else [])
+                       lines, float("nan"), [note] if note else [], len(liquid))
     return fig, drawn
 
 

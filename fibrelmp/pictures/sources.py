@@ -38,6 +38,8 @@ class SceneFrame:
     mass: np.ndarray | None = None      # (n,)
     bonds: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))  # rows, intact
     broken_bonds: int | None = None     # bonds whose activity ended by ``time``
+    # MUSEN liquid bonds active at ``time`` (rows; drawn apart from solid bonds)
+    liquid_bonds: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))
     triangles: np.ndarray | None = None # (k,3,3) wall triangles
     planes: list[tuple[np.ndarray, np.ndarray]] = field(default_factory=list)   # (normal, point)
     box: tuple[np.ndarray, np.ndarray] | None = None      # (lo, hi)

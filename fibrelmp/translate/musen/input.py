@@ -133,10 +133,6 @@ def musen_result_writer(model: "GranularModel", target: str | Path, precision: i
 
 
 def check_musen_runnable(model: GranularModel) -> None:
-    if model.liquid_bonds:
-        raise InputError(model.source, None, "the scene has liquid bonds (type 13), which need a "
-                         "liquid-bridge model fibrelmp does not translate; remove them or export "
-                         "the scene without them")
     plan = model.plan
     for name, value in (("simulation step", plan.dt), ("end time", plan.t_end)):
         if not math.isfinite(value) or value <= 0:

@@ -14,7 +14,8 @@ from fibrelmp.pictures.sources import SceneFrame, Source, kind_indices
 
 def musen_frame(model, index: int, time: float, rows: np.ndarray, position: np.ndarray,
                  velocity: np.ndarray | None, triangles: np.ndarray | None) -> SceneFrame:
-    """A frame of the spheres at ``rows`` of the model (bonds between them, if intact)."""
+    """A frame of the spheres at ``rows`` of the model (bonds between them, if intact, and
+    liquid bonds, while active)."""
     s = model.spheres
     kinds, names = kind_indices([m.name for m in model.materials], s.material[rows])
     bonds, broken = np.zeros((0, 2), np.int64), None
@@ -26,10 +27,19 @@ def musen_frame(model, index: int, time: float, rows: np.ndarray, position: np.n
         ends = where[b.pair]
         bonds = ends[intact & (ends >= 0).all(axis=1)]
         broken = int(np.count_nonzero(b.active_end <= time))
+    liquid = np.zeros((0, 2), np.int64)
+    if model.liquid_bonds:
+        where = {int(s.ids[r]): j for j, r in enumerate(np.asarray(rows).tolist())}
+        # active by the interval the result holds (CPhysicalObject::IsActive, inclusive; an
+        # empty interval is never active), both spheres in the frame
+        liquid = np.array([(where[lb.left], where[lb.right]) for lb in model.liquid_bonds
+                           if lb.active_start != lb.active_end
+                           and lb.active_start <= time <= lb.active_end
+                           and lb.left in where and lb.right in where], np.int64).reshape(-1, 2)
     domain = model.plan.domain
     return SceneFrame(index, time, None, position, s.radius[rows], kinds, names,
                       velocity=velocity, mass=s.mass[rows], bonds=bonds, broken_bonds=broken,
-                      triangles=triangles, box=domain)
+                      triangles=triangles, box=domain, liquid_bonds=liquid)
 
 
 class MusenTextSource(Source):

@@ -70,8 +70,11 @@ def read(path: str | Path) -> GranularModel:
     record = MusenSceneRecord()
     if liquid_bonds:
         model_warn.append(("musen-liquid-bonds", f"{len(liquid_bonds)} liquid "
-                           "bond(s) (type 13) are kept for the result file; simulating them is "
-                           "not supported"))
+                           "bond(s) (type 13): they exert no force and never break, as in cmusen 1.74.2 "
+                           "(MUSEN e0ff360's ModelLBCapilarViscous is a no-op); the results "
+                           "hold their activity as cmusen writes it (translate/musen/liquid_bonds.py), "
+                           "except that a sphere leaving the domain ends its liquid bonds at "
+                           "the next save's time, where cmusen writes its removal step's"))
     plan = GranularPlan(dt=float("nan"), t_start=t_start, t_end=float("nan"))
     geometries = _scene(scan, plan, record, triangles, ids, types, rows[WALL], path,
                         model_warn)
@@ -454,10 +457,8 @@ def domain_warning(model: GranularModel) -> None:
 
 
 def check_simulable(model: GranularModel) -> None:
-    """Raise if the model holds what fibrelmp cannot simulate (liquid bonds)."""
-    if model.liquid_bonds:
-        raise InputError(model.source, None, "the scene has liquid bonds (type 13): simulating "
-                         "them is not supported")
+    """Raise if the model holds what fibrelmp cannot simulate.  Liquid bonds are simulated
+    as cmusen 1.74.2 does: they exert no force (the scene reader warns)."""
 
 
 

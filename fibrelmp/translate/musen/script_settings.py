@@ -360,9 +360,11 @@ def _refuse_file_settings(model: GranularModel, job: MusenJob) -> None:
 def _check_models(model: GranularModel, job: MusenJob, models: dict) -> None:
     """ConsoleSimulator::SimulationPrecheck, made strict where fibrelmp cannot follow."""
     if "PP" not in models:
-        raise InputError(job.path, job.line, f"job {job.index}: no particle-particle model "
-                         "(MODEL_PP ModelPPHertzMindlin); cmusen would run without particle "
-                         "contacts, which fibrelmp does not do")
+        # the pair style still renders the stock law; the template leaves the pairs out
+        model.plan.particle_contacts = False
+        model.warn("musen-no-pp-model", f"{job.path}:{job.line}: job {job.index}: no "
+                   "particle-particle model (MODEL_PP): spheres pass through each other, as "
+                   "in cmusen (its warning: 'Particle-particle contact model is not specified')")
     if model.triangles is not None and model.triangles.count and "PW" not in models:
         raise InputError(job.path, job.line, f"job {job.index}: the scene has walls but no "
                          "MODEL_PW (cmusen: 'Particle-wall contact model is not specified')")

@@ -28,6 +28,7 @@ from fibrelmp.granmodel import GranularFrame, GranularModel
 from fibrelmp.textio import temp_name, write_failure
 from fibrelmp.translate.musen.scene import (ACTIVE_INTERACTIONS, ACTIVE_PROPERTIES, DEFAULT_ACTIVITY_END,
                                PROPERTY_DEFAULTS)
+from fibrelmp.translate.musen.liquid_bonds import LiquidBondActivity
 from fibrelmp.translate.musen.scene_record import scene_record
 from fibrelmp.translate.musen.text_writer import (export_selectors, gather_spool, object_header, scene_line,
                                                   time_point_lines)
@@ -76,6 +77,8 @@ class MusenResultWriter(Writer):
         sp = model.spheres
         self.sphere_end = sp.active_end.copy()
         self.bond_end = model.bonds.active_end.copy() if model.bonds is not None else None
+        self.liquid = LiquidBondActivity(model)
+        self.removed = np.zeros(sp.count, bool)      # spheres removed during the run so far
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
             self.spool = Path(tempfile.mkdtemp(prefix=f".{self.path.name}.spool.",
@@ -100,6 +103,10 @@ class MusenResultWriter(Writer):
         # a sphere active by its interval but missing from the frame was removed at this save
         gone = ~present & (sp.active_start <= t) & (self.sphere_end > t)
         self.sphere_end[gone] = t
+        # only a sphere leaving the domain ends its liquid bonds (CPUSimulator), not one whose
+        # activity interval ended
+        self.removed |= gone
+        self.liquid.save(t, ~self.removed)
         if self.bond_end is not None and frame.bond_alive is not None:
             dead = ~np.asarray(frame.bond_alive, bool)
             when = (np.asarray(frame.bond_end_time, np.float64) if frame.bond_end_time is not None
@@ -229,11 +236,16 @@ class MusenResultWriter(Writer):
         if sel.any():
             liquid = m.liquid_bonds
             start[sel] = [liquid[r].active_start for r in rows[sel]]
-            end[sel] = [liquid[r].active_end for r in rows[sel]]
+            end[sel] = self.liquid.end[rows[sel]]
         return start, end
 
     def _write_objects(self, out) -> None:
         ids, types, rows = self._objects()
+        # cmusen's result holds a liquid bond inactive at the run's start as an object of
+        # type 0, which its text export leaves out (LiquidBondActivity.untyped)
+        keep = ~((types == 13) & self.liquid.untyped[np.where(types == 13, rows, 0)]) \
+            if len(self.liquid.untyped) else np.ones(len(ids), bool)
+        ids, types, rows = ids[keep], types[keep], rows[keep]
         nt = len(self.times)
         maps = {}
         m = self.model

@@ -106,7 +106,7 @@ FIELDS: dict[str, tuple[str, str]] = {
     "ProtoSimulationInfo.stop_criteria": (HONOURED, _STOP),
     "ProtoStopCriteria.*": (HONOURED, _STOP),
     "ProtoParticleInfo.id": (HONOURED, _TEXT),
-    "ProtoParticleInfo.type": (HONOURED, _TEXT + "; liquid bonds are refused by the scene reader"),
+    "ProtoParticleInfo.type": (HONOURED, _TEXT + "; liquid bonds run as cmusen runs them (no force)"),
     "ProtoParticleInfo.compound": (HONOURED, _TEXT),
     "ProtoParticleInfo.encoded_properties": (HONOURED, "radii, bond ends/diameter/length, " + _TEXT),
     "ProtoParticleInfo.activity_start": (HONOURED, "activity interval (`24`), " + _TEXT),
@@ -220,7 +220,7 @@ FIELDS: dict[str, tuple[str, str]] = {
     "ProtoTimeDependentProperties.total_torque": (HONOURED, "bond torque (a bond's state)"),
     "ProtoTimeDependentProperties.temperature": (HONOURED, "spheres' temperature: the start "
                                                  "state of ModelEFHeatTransfer, saved when it runs"),
-    "ProtoTimeDependentProperties.liquid_film_mass": (NOT_SIMULATION, "liquid bonds are refused"),
+    "ProtoTimeDependentProperties.liquid_film_mass": (NOT_SIMULATION, "MUSEN e0ff360's liquid-bond law is a no-op"),
     "ProtoTimeDependentProperties.stress_tensor": (NOT_SIMULATION, "a result (written, not read)"),
 }
 

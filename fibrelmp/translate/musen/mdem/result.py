@@ -156,12 +156,17 @@ class MdemResultWriter(MusenResultWriter):
         self._set_ends(storage.info.particles)
 
     def _set_ends(self, particles: Any) -> None:
-        """Every removed sphere's and broken bond's activity end, exactly."""
-        for ids, end in ((self.sphere_ids, self.sphere_end), (self.bond_ids, self.bond_end)):
+        """Every removed sphere's and broken bond's activity end and every liquid bond's
+        (``LiquidBondActivity``), exactly."""
+        liquid_ids = np.array([lb.id for lb in self.model.liquid_bonds or []], np.int64)
+        for ids, end in ((self.sphere_ids, self.sphere_end), (self.bond_ids, self.bond_end),
+                         (liquid_ids, self.liquid.end)):
             if ids is None or end is None:
                 continue
             for i in np.flatnonzero(np.isfinite(end)).tolist():
                 particles[int(ids[i])].activity_end = float(end[i])
+        for i in np.flatnonzero(self.liquid.untyped).tolist():     # as cmusen's result holds it
+            particles[int(liquid_ids[i])].type = 0
 
     def _add_generated(self, particles: Any) -> None:
         """The spheres MUSEN's generators made (rows reserved by translate/granular/inlets.py)

@@ -35,14 +35,17 @@ def model_job(tmp_path: Path, data: Path, prefix: str, params: str, new_params: 
     return tmp_path / f"job_{prefix}.txt"
 
 
-def check_reference_is_cmusens_output(tmp_path: Path, data: Path, prefix: str) -> None:
+def check_reference_is_cmusens_output(tmp_path: Path, data: Path, prefix: str,
+                                      stored: Path | None = None) -> None:
+    """cmusen rerun on ``data``'s scene and job writes, byte for byte, the stored export
+    (``stored``, by default ``data/cmusen_<prefix>_result_prec17.txt``)."""
     for name in (f"{prefix}_scene.txt", f"job_{prefix}.txt"):
         shutil.copy(data / name, tmp_path)
     done = subprocess.run([CMUSEN, "-t=1", f"-s=job_{prefix}.txt"], cwd=tmp_path, capture_output=True,
                           text=True, timeout=300)
     assert done.returncode == 0 and "Error:" not in done.stdout, done.stdout + done.stderr
     assert (tmp_path / f"{prefix}_result_prec17.txt").read_bytes() == \
-        (data / f"cmusen_{prefix}_result_prec17.txt").read_bytes()
+        (stored or data / f"cmusen_{prefix}_result_prec17.txt").read_bytes()
 
 
 def check_refused_without_styles(job: Path, model: str, line: int, init: Path) -> None:

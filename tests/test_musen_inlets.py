@@ -354,3 +354,78 @@ def test_two_ranks_write_the_serial_results(tmp_path):
     ser, mpi = runs["serial"][0], runs["mpi"][0]
     for name in ("inlet_result_prec17.txt", "inlet_result.mdem", "job_inlet_work/job1/inlets.log"):
         assert (mpi / name).read_bytes() == (ser / name).read_bytes(), name
+
+
+def _prism_volume(storage, sides: int = 12, radius: float = 0.004) -> np.ndarray:
+    """Replace VINLET's triangles with a closed regular prism about the z axis (the shape of
+    MUSEN's cylinder volume) over the same heights; its triangles (n, 3, 3)."""
+    z0, z1 = VOLUME_LO[2], VOLUME_HI[2]
+    a = 2 * np.pi * np.arange(sides) / sides
+    ring = np.c_[radius * np.cos(a), radius * np.sin(a)]
+    tri = []
+    for i in range(sides):
+        p, q = ring[i], ring[(i + 1) % sides]
+        tri += [[[*p, z0], [*q, z0], [*q, z1]], [[*p, z0], [*q, z1], [*p, z1]],
+                [[0, 0, z0], [*q, z0], [*p, z0]], [[0, 0, z1], [*p, z1], [*q, z1]]]
+    tri = np.array(tri, float)
+    volume = storage.info.analysis_volume[0]
+    del volume.triangles[:]
+    for t in tri:
+        pt = volume.triangles.add()
+        for vert, v in zip((pt.vert1, pt.vert2, pt.vert3), t):
+            vert.x, vert.y, vert.z = v
+    return tri
+
+
+def test_triangle_volume_read_and_passed_to_the_fix():
+    """A box volume is passed as its box; any other triangle volume as its triangles."""
+    storage = _storage()
+    assert all(i.triangles is None for i in gen.read_inlets(storage, SCENE))
+    tri = _prism_volume(storage)
+    inlets = gen.read_inlets(storage, SCENE)
+    for inlet in inlets:
+        np.testing.assert_array_equal(inlet.triangles, tri)
+        np.testing.assert_array_equal(inlet.lo, tri.reshape(-1, 3).min(axis=0))
+        np.testing.assert_array_equal(inlet.hi, tri.reshape(-1, 3).max(axis=0))
+
+
+def test_generation_into_a_prism_volume(tmp_path):
+    """cmusen's job with VINLET a 12-sided prism: the spheres of each generation saved on its
+    step hold MUSEN's 15 test points inside the prism (its half-planes, here) and are free of
+    each other; at most as many spheres are made as the schedule asks."""
+    scene = tmp_path / "inlet_scene.mdem"
+    with MdemFile(SCENE) as f:
+        storage = f.storage
+        points = list(f.time_points())
+    _prism_volume(storage)
+    with open(scene, "wb") as fh:
+        writer = MdemWriter(fh)
+        for t, values, masks in points:
+            writer.add(t, values, masks)
+        writer.finish(storage)
+    shutil.copy(DATA / "job_inlet.txt", tmp_path)
+    python_api.run(tmp_path / "job_inlet.txt")
+    res = _spheres((tmp_path / "inlet_result_prec17.txt").read_text())
+    events = gen.generation_schedule(gen.read_generators(_storage()), DT, END)
+    # a full volume drops spheres (max_iterations tries each); most fit
+    assert 0.5 * sum(e.requested for e in events) < len(res["id"]) <= sum(e.requested for e in events)
+    sides, apothem = 12, 0.004 * np.cos(np.pi / 12)
+    face = np.pi * (2 * np.arange(sides) + 1) / sides
+    normal = np.c_[np.cos(face), np.sin(face)]
+    checked = 0
+    for label in {"%g" % e.time for e in events if np.isin(e.time, res["saves"])}:
+        rows = [k for k, s in enumerate(res["start"]) if s == label]
+        pos = np.array([res["first"][k][1] for k in rows])
+        r = np.array([res["r"][k] for k in rows])
+        s = r / 1.73205081
+        offsets = [np.zeros(3)] + [sign * e * r[:, None] for e in np.eye(3) for sign in (1, -1)]
+        offsets += [np.array(d) * s[:, None] for d in ((1, 1, 1), (1, 1, -1), (1, -1, 1), (1, -1, -1),
+                                                       (-1, 1, 1), (-1, 1, -1), (-1, -1, 1), (-1, -1, -1))]
+        for o in offsets:
+            p = pos + o
+            assert (p[:, :2] @ normal.T <= apothem * (1 + 1e-12)).all()
+            assert ((p[:, 2] >= VOLUME_LO[2]) & (p[:, 2] <= VOLUME_HI[2])).all()
+        d = np.linalg.norm(pos[:, None] - pos[None], axis=2) + np.eye(len(r))
+        assert (d >= r[:, None] + r[None] - 1e-15).all()
+        checked += len(rows)
+    assert checked >= 20

@@ -35,7 +35,7 @@ tested with MUSEN's 15-point ray-parity test.  Agglomerates, moving volumes and
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -226,7 +226,8 @@ class Inlet:
     lo: tuple[float, float, float]
     hi: tuple[float, float, float]
     fractions: tuple[tuple[str, float, float], ...]
-    triangles: np.ndarray | None = None        # (n, 3, 3)
+    # (n, 3, 3); not compared (an array has no single truth value; lo/hi tell volumes apart)
+    triangles: np.ndarray | None = field(default=None, compare=False)
 
 
 def _volume(storage: Any, gen: DynamicGenerator,

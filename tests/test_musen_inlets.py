@@ -354,3 +354,99 @@ def test_two_ranks_write_the_serial_results(tmp_path):
     ser, mpi = runs["serial"][0], runs["mpi"][0]
     for name in ("inlet_result_prec17.txt", "inlet_result.mdem", "job_inlet_work/job1/inlets.log"):
         assert (mpi / name).read_bytes() == (ser / name).read_bytes(), name
+
+
+def _prism_volume(storage, sides: int = 12, radius: float = 0.004) -> np.ndarray:
+    """Replace VINLET's triangles with a closed regular prism about the z axis (the shape of
+    MUSEN's cylinder volume) over the same heights; its triangles (n, 3, 3)."""
+    z0, z1 = VOLUME_LO[2], VOLUME_HI[2]
+    a = 2 * np.pi * np.arange(sides) / sides
+    ring = np.c_[radius * np.cos(a), radius * np.sin(a)]
+    tri = []
+    for i in range(sides):
+        p, q = ring[i], ring[(i + 1) % sides]
+        tri += [[[*p, z0], [*q, z0], [*q, z1]], [[*p, z0], [*q, z1], [*p, z1]],
+                [[0, 0, z0], [*q, z0], [*p, z0]], [[0, 0, z1], [*p, z1], [*q, z1]]]
+    tri = np.array(tri, float)
+    volume = storage.info.analysis_volume[0]
+    del volume.triangles[:]
+    for t in tri:
+        pt = volume.triangles.add()
+        for vert, v in zip((pt.vert1, pt.vert2, pt.vert3), t):
+            vert.x, vert.y, vert.z = v
+    return tri
+
+
+def test_triangle_volume_read_and_passed_to_the_fix():
+    """A box volume is passed as its box; any other triangle volume as its triangles."""
+    storage = _storage()
+    assert all(i.triangles is None for i in gen.read_inlets(storage, SCENE))
+    tri = _prism_volume(storage)
+    inlets = gen.read_inlets(storage, SCENE)
+    for inlet in inlets:
+        np.testing.assert_array_equal(inlet.triangles, tri)
+        np.testing.assert_array_equal(inlet.lo, tri.reshape(-1, 3).min(axis=0))
+        np.testing.assert_array_equal(inlet.hi, tri.reshape(-1, 3).max(axis=0))
+
+
+PRISM = data_path("real-outputs/musen/inlet_prism")
+CMUSEN_PRISM_COUNTS = (162, 158)      # the stored run and a rerun (README there)
+
+
+def _fifteen_points_in_prism(res: dict, events: list) -> int:
+    """Assert that every sphere saved on its generation step holds MUSEN's 15 test points
+    inside the 12-sided prism of ``_prism_volume`` (its half-planes) and is free of the
+    others; the number checked."""
+    sides, apothem = 12, 0.004 * np.cos(np.pi / 12)
+    face = np.pi * (2 * np.arange(sides) + 1) / sides
+    normal = np.c_[np.cos(face), np.sin(face)]
+    checked = 0
+    for label in {"%g" % e.time for e in events if np.isin(e.time, res["saves"])}:
+        rows = [k for k, s in enumerate(res["start"]) if s == label]
+        pos = np.array([res["first"][k][1] for k in rows])
+        r = np.array([res["r"][k] for k in rows])
+        s = r / 1.73205081
+        offsets = [np.zeros(3)] + [sign * e * r[:, None] for e in np.eye(3) for sign in (1, -1)]
+        offsets += [np.array(d) * s[:, None] for d in ((1, 1, 1), (1, 1, -1), (1, -1, 1), (1, -1, -1),
+                                                       (-1, 1, 1), (-1, 1, -1), (-1, -1, 1), (-1, -1, -1))]
+        for o in offsets:
+            p = pos + o
+            assert (p[:, :2] @ normal.T <= apothem * (1 + 1e-12)).all()
+            assert ((p[:, 2] >= VOLUME_LO[2]) & (p[:, 2] <= VOLUME_HI[2])).all()
+        d = np.linalg.norm(pos[:, None] - pos[None], axis=2) + np.eye(len(r))
+        assert (d >= r[:, None] + r[None] - 1e-15).all()
+        checked += len(rows)
+    return checked
+
+
+def test_stored_prism_scene_is_the_prism_volume():
+    with MdemFile(PRISM / "inlet_prism_scene.mdem") as f:
+        stored = gen.read_inlets(f.storage, PRISM / "inlet_prism_scene.mdem")
+    storage = _storage()
+    tri = _prism_volume(storage)
+    for inlet in stored:
+        np.testing.assert_array_equal(inlet.triangles, tri)
+
+
+def test_generation_into_a_prism_volume(tmp_path):
+    """cmusen's inlet job with VINLET a 12-sided prism (real cmusen run stored): in cmusen's
+    run and in fibrelmp's, the spheres of each generation saved on its step hold MUSEN's 15
+    test points inside the prism and are free of each other; the first events make the same
+    numbers, the total is within three half-ranges of cmusen's two runs."""
+    events = gen.generation_schedule(gen.read_generators(_storage()), DT, END)
+    with gzip.open(PRISM / "inlet_prism_result_prec17.txt.gz", "rt") as fh:
+        ref = _spheres(fh.read())
+    for name in ("inlet_prism_scene.mdem", "job_inlet_prism.txt"):
+        shutil.copy(PRISM / name, tmp_path)
+    python_api.run(tmp_path / "job_inlet_prism.txt")
+    res = _spheres((tmp_path / "inlet_prism_result_prec17.txt").read_text())
+    assert len(ref["id"]) == CMUSEN_PRISM_COUNTS[0]
+    mid, half = np.mean(CMUSEN_PRISM_COUNTS), np.ptp(CMUSEN_PRISM_COUNTS) / 2
+    assert abs(len(res["id"]) - mid) <= 3 * half
+    assert res["id"] == list(range(10, 10 + len(res["id"])))
+    for out in (ref, res):
+        assert _fifteen_points_in_prism(out, events) >= 20
+        first = [sum(s == "%g" % e.time for s in out["start"]) for e in events[:3]]
+        assert first == [10, 10, 10]
+        # activity starts are cmusen's generation times (6 digits in the text)
+        assert set(out["start"]) <= {"%g" % e.time for e in events}

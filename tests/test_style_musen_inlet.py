@@ -171,3 +171,62 @@ def test_no_sphere_touches_a_wall_triangle(plugin_path, inserted, tmp_path):
     w = _run(plugin_path, tmp_path / "plate", walls="plate")
     assert len(w["id"]) == 600
     assert (np.abs(w["z"]) >= w["radius"]).all()
+
+
+def _prism(sides: int, radius: float, z0: float, z1: float) -> np.ndarray:
+    """A closed regular prism of ``sides`` faces about the z axis (MUSEN's cylinder volume is
+    such a triangulation), triangles (n, 3, 3)."""
+    a = 2 * np.pi * np.arange(sides) / sides
+    ring = np.c_[radius * np.cos(a), radius * np.sin(a)]
+    tri = []
+    for i in range(sides):
+        p, q = ring[i], ring[(i + 1) % sides]
+        tri += [[[*p, z0], [*q, z0], [*q, z1]], [[*p, z0], [*q, z1], [*p, z1]],
+                [[0, 0, z0], [*q, z0], [*p, z0]], [[0, 0, z1], [*p, z1], [*q, z1]]]
+    return np.array(tri, float)
+
+
+def test_triangle_volume_holds_musens_fifteen_points(plugin_path, tmp_path):
+    """With ``volume`` (a 12-sided prism, not a box) every sphere's centre and the 14 points
+    MUSEN tests (at r on the axes and on the diagonals) lie inside the prism, checked with its
+    half-planes here; the spheres are free of each other and reach out to the prism's faces."""
+    sides, radius, z0, z1 = 12, 0.03, -0.02, 0.02
+    tri = _prism(sides, radius, z0, z1)
+    lo, hi = tri.reshape(-1, 3).min(axis=0), tri.reshape(-1, 3).max(axis=0)
+    fractions = " ".join(f"{t} {d} {rho} {s}" for t, d, rho, s in FRACTIONS)
+    box = " ".join(f"{float(a)!r} {float(b)!r}" for a, b in zip(lo, hi))
+    words = " ".join(repr(float(v)) for v in tri.ravel())
+    script = "\n".join([
+        f"plugin load {plugin_path}", "units si", "atom_style sphere", "atom_modify map array",
+        "boundary f f f", "region b block -0.05 0.05 -0.05 0.05 -0.05 0.05", "create_box 2 b",
+        "pair_style zero 0.01", "pair_coeff * *", "neighbor 0.001 bin", "timestep 1e-6",
+        "group spheres empty",
+        f"fix in spheres musen/inlet 11 box {box} tries 50 walls none velocity fixed 0 0 0 "
+        f"fractions 2 {fractions} events 2 1 300 2 300 first_id 1 volume {len(tri)} {words}",
+        "run 2",
+        "write_dump all custom out.dump id type x y z radius modify sort id format float %.17g"])
+    (tmp_path / "v").mkdir()
+    _run_lmp_script(tmp_path / "v", script + "\n", 1)
+    c = next(iter_frames(tmp_path / "v" / "out.dump")).columns
+    x = np.c_[c["x"], c["y"], c["z"]]
+    r = np.asarray(c["radius"])
+    assert len(r) >= 500
+    s = r / 1.73205081
+    offsets = [np.zeros(3)] + [sign * e for e in np.eye(3) for sign in (1, -1)]
+    points = [x + o * r[:, None] for o in offsets]
+    points += [x + np.array(d) * s[:, None] for d in np.array(np.meshgrid([1, -1], [1, -1], [1, -1])).T.reshape(-1, 3)]
+    face = np.pi * (2 * np.arange(sides) + 1) / sides        # outward normals' angles
+    normal = np.c_[np.cos(face), np.sin(face)]
+    apothem = radius * np.cos(np.pi / sides)
+    for p in points:
+        assert (p[:, :2] @ normal.T <= apothem).all()
+        assert ((p[:, 2] >= z0) & (p[:, 2] <= z1)).all()
+    gap = np.linalg.norm(x[:, None] - x[None], axis=2) - (r[:, None] + r[None])
+    np.fill_diagonal(gap, np.inf)
+    assert gap.min() >= 0
+    # the spheres reach the faces (the test is no smaller box): some sphere's axis point lies
+    # within 2 % of the radius of the apothem
+    reach = (x[:, :2] @ normal.T).max(axis=1) + r
+    assert reach.max() > 0.98 * apothem
+    # a box corner outside the prism is never used
+    assert (np.hypot(x[:, 0], x[:, 1]) <= radius).all()

@@ -69,6 +69,73 @@ double triangle_distance2(const double *p, const double *a, const double *b, con
   return dot(q, q);
 }
 
+
+// MUSEN's CInsideVolumeChecker::TryIntersectWithXAxis (InsideVolumeChecker.cpp), the triangle
+// moved so that the tested point is the origin: does the ray along +x cross it, or does the
+// ray pass (within 1e-20) through a vertex or an edge (undefined)?
+void musen_x_ray(const double *p1, const double *p2, const double *p3, bool &crossing, bool &on_edge)
+{
+  const double e = 1e-20;
+  const double c1 = p1[2] * p2[1] - p1[1] * p2[2];
+  const double c2 = p2[2] * p3[1] - p2[1] * p3[2];
+  const double c3 = p3[2] * p1[1] - p3[1] * p1[2];
+  crossing = false;
+  on_edge = true;
+  if (std::fabs(p1[2]) < e && std::fabs(p1[1]) < e) return;
+  if (std::fabs(p2[2]) < e && std::fabs(p2[1]) < e) return;
+  if (std::fabs(p3[2]) < e && std::fabs(p3[1]) < e) return;
+  // MUSEN's conditions as written (&& binds before ||; == after < and >)
+  if (std::fabs(c1) < e && ((std::fabs(p1[1]) < e && ((p1[2] < 0) == (p2[2] > 0))) || ((p1[1] < 0) == (p2[1] > 0)))) return;
+  if (std::fabs(c2) < e && ((std::fabs(p2[1]) < e && ((p2[2] < 0) == (p3[2] > 0))) || ((p2[1] < 0) == (p3[1] > 0)))) return;
+  if (std::fabs(c3) < e && ((std::fabs(p3[1]) < e && ((p3[2] < 0) == (p1[2] > 0))) || ((p3[1] < 0) == (p1[1] > 0)))) return;
+  on_edge = false;
+  if (c1 == 0 || c2 == 0 || c3 == 0) return;
+  crossing = (c1 < 0) == (c2 < 0) && (c1 < 0) == (c3 < 0);
+  if (crossing) {
+    const double A = p1[1] * (p2[2] - p3[2]) + p2[1] * (p3[2] - p1[2]) + p3[1] * (p1[2] - p2[2]);
+    const double D = -(p1[0] * (p2[1] * p3[2] - p3[1] * p2[2]) + p2[0] * (p3[1] * p1[2] - p1[1] * p3[2]) +
+                       p3[0] * (p1[1] * p2[2] - p2[1] * p1[2]));
+    crossing = (A <= 0) == (D <= 0);
+  }
+}
+
+// CInsideVolumeChecker::IsPointInside over all triangles (MUSEN's y-z grid only skips
+// triangles the ray cannot meet): an odd number of crossings; false when undefined
+bool musen_point_inside(const double *x, const std::vector<double> &tri, bool &undefined)
+{
+  int crossings = 0;
+  for (size_t t = 0; t < tri.size() / 9; t++) {
+    double v[9];
+    for (int i = 0; i < 9; i++) v[i] = tri[9 * t + i] - x[i % 3];
+    bool crossing, on_edge;
+    musen_x_ray(v, v + 3, v + 6, crossing, on_edge);
+    if (on_edge) {
+      undefined = true;
+      return false;
+    }
+    crossings += crossing;
+  }
+  return crossings % 2 == 1;
+}
+
+// CInsideVolumeChecker::IsSphereInside, "totally inside": the centre, the 6 points at +-r on
+// the axes and the 8 at r (+-1, +-1, +-1)/sqrt(3) all inside the triangle volume.  An
+// undefined answer (a point on an edge within 1e-20, which MUSEN retries with a rotated point
+// against the unrotated mesh) counts as not inside: another random centre is drawn.
+bool musen_sphere_inside(const double *x, double r, const std::vector<double> &tri)
+{
+  const double s = r / 1.73205081;    // MUSEN's sqrt(3)
+  const double off[15][3] = {{0, 0, 0}, {r, 0, 0}, {-r, 0, 0}, {0, r, 0}, {0, -r, 0}, {0, 0, r},
+                             {0, 0, -r}, {s, s, s}, {s, s, -s}, {s, -s, s}, {s, -s, -s},
+                             {-s, s, s}, {-s, s, -s}, {-s, -s, s}, {-s, -s, -s}};
+  for (const auto &o : off) {
+    const double p[3] = {x[0] + o[0], x[1] + o[1], x[2] + o[2]};
+    bool undefined = false;
+    if (!musen_point_inside(p, tri, undefined) || undefined) return false;
+  }
+  return true;
+}
+
 }    // namespace
 
 FixMusenInlet::FixMusenInlet(LAMMPS *lmp, int narg, char **arg) :
@@ -143,6 +210,13 @@ FixMusenInlet::FixMusenInlet(LAMMPS *lmp, int narg, char **arg) :
         fractions[i].groupbit = group->bitmask[g];
       }
       at += static_cast<int>(fractions.size()) - 1;
+    } else if (strcmp(arg[at], "volume") == 0) {    // N triangles (9 N coordinates)
+      const int ntri = utils::inumeric(FLERR, arg[at + 1], false, lmp);
+      if (ntri < 1) error->all(FLERR, "Fix musen/inlet: volume needs at least one triangle");
+      need(at + 2, 9 * ntri, nullptr);
+      volume.resize(9 * static_cast<size_t>(ntri));
+      for (size_t i = 0; i < volume.size(); i++) volume[i] = utils::numeric(FLERR, arg[at + 2 + i], false, lmp);
+      at += 9 * ntri;
     } else if (strcmp(arg[at], "log") == 0) {
       if (comm->me == 0) {
         log = fopen(arg[at + 1], "a");
@@ -279,7 +353,10 @@ void FixMusenInlet::insert(const Event &event)
     for (int attempt = 0; attempt < tries && !placed; attempt++) {
       for (int k = 0; k < 3; k++) s.x[k] = lo[k] + rng.uniform() * (hi[k] - lo[k]);
       placed = true;
-      for (int k = 0; k < 3; k++) placed = placed && s.x[k] - r >= lo[k] && s.x[k] + r <= hi[k];
+      if (volume.empty())
+        for (int k = 0; k < 3; k++) placed = placed && s.x[k] - r >= lo[k] && s.x[k] + r <= hi[k];
+      else
+        placed = musen_sphere_inside(s.x, r, volume);
       for (size_t j = 0; placed && j < near.size(); j++) {
         double d[3] = {s.x[0] - near[j].x[0], s.x[1] - near[j].x[1], s.x[2] - near[j].x[2]};
         const double reach = r + near[j].r;

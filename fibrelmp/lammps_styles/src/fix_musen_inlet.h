@@ -9,12 +9,15 @@
          fractions K  TYPE DIAMETER DENSITY SHARE  (K times)
          events M  STEP COUNT  (M times, steps ascending)
          [first_id ID] [log FILE] [groups NAME1 .. NAMEK]   (a further group per fraction)
+         [volume N  X1 Y1 Z1 X2 Y2 Z2 X3 Y3 Z3  (N times)]   (a closed triangle volume)
 
    At each listed STEP (MUSEN's generation times, computed by fibrelmp from cmusen's summed
    clock: the fix does not recompute it) it tries to make COUNT spheres.  Per sphere: the
    fraction is MUSEN's next_fraction (the first whose number share among the spheres made so
    far is below its SHARE, else the first), then at most N random centres uniform in the box;
-   a centre is accepted when the sphere lies totally inside the box, overlaps no sphere (sum of
+   a centre is accepted when the sphere lies totally inside the box (with "volume", whose
+   bounding box is BOX: MUSEN's CInsideVolumeChecker test of the triangles instead, the centre
+   and 14 points at distance r inside by the parity of +x ray crossings), overlaps no sphere (sum of
    radii) and touches no triangle of fix musen/wall/mesh WALLFIX.  A sphere that finds no place
    is dropped.  Velocity: the fixed one, or a direction uniform on the unit sphere (rejection
    from the cube, as MUSEN) times MAGNITUDE, one draw per sphere.  Mass 4/3 pi r^3 rho (MUSEN's
@@ -74,6 +77,7 @@ class FixMusenInlet : public Fix {
   };
   std::uint64_t seed;
   double lo[3], hi[3];
+  std::vector<double> volume;    // "volume": its triangles, 9 coordinates each (empty: the box)
   int tries;
   char *wall_id;
   bool random_velocity;

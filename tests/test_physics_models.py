@@ -33,8 +33,9 @@ def test_names_and_kinds_are_musens():
         assert physics.find(m.name) is m
         # MUSEN's keys are 32 upper-case hex digits, but for ModelSBPlasticConcrete's
         # ("...914SS7D..."), ModelPPChealNess's ("...8A4SSSS6D...", 31 characters),
-        # ModelPPHertzMindlinVdW's ("...25A8V04...") and ModelEFLiquidDiffusion's (a 40-digit sha1)
-        key = m.mdem_key.replace("SS", "00").replace("A8V0", "A800")
+        # ModelPPHertzMindlinVdW's ("...25A8V04..."), ModelPPSinteringTemperature's
+        # ("...ADB27XBFBA") and ModelEFLiquidDiffusion's (a 40-digit sha1)
+        key = m.mdem_key.replace("SS", "00").replace("A8V0", "A800").replace("27XB", "270B")
         if m.name == "ModelPPChealNess":
             key += "0"
         assert re.fullmatch(r"[0-9A-F]{32}|[0-9a-f]{40}", key), m.name

@@ -36,6 +36,10 @@ struct Contact {
   double dt;
   // heat laws only (fix musen/heat; zero otherwise): temperatures and thermal conductivities
   double t1 = 0, t2 = 0, k1 = 0, k2 = 0;
+  // laws that keep an initial overlap (keeps_initial_overlap): the contact's stored one (in/out;
+  // nullptr: a contact with no entry), and whether this is MUSEN's time 0
+  double *initial_overlap = nullptr;
+  bool at_time_zero = false;
 };
 
 // pair_coeff of the type pair
@@ -60,6 +64,10 @@ class Law {
   virtual void force(const Contact &c, const Materials &m, double *xi, Result &r) const = 0;
   // whether the law needs temperatures and gives a heat flux (fix musen/heat)
   virtual bool heats() const { return false; }
+  // whether the law reads the temperatures (without a heat flux: d_musen_temperature alone)
+  virtual bool reads_temperature() const { return heats(); }
+  // whether the law keeps a per-contact initial overlap (pair musen/hm's 10th history value)
+  virtual bool keeps_initial_overlap() const { return false; }
 };
 
 // a law from its parameters; sets why and returns nullptr when they are wrong

@@ -174,7 +174,13 @@ template <class Laws> void PairMusenHM::contacts(Laws apply)
     flux = static_cast<double *>(heat_fix->extract("flux", dim));
     conductivity = static_cast<double *>(heat_fix->extract("conductivity", dim));
     temp = atom->dvector[atom->find_custom("musen_temperature", flag, cols)];
+  } else if (temperature_index >= 0) {
+    temp = atom->dvector[temperature_index];
   }
+  const bool keeps_initial = history_values > HISTORY_VALUES;
+  // MUSEN's time of this evaluation (its `_time == 0` rule)
+  const bool at_time_zero =
+      update->atime + static_cast<double>(update->ntimestep - update->atimestep) * dt == 0.0;
 
   const int inum = list->inum;
   int *ilist = list->ilist;
@@ -207,15 +213,18 @@ template <class Laws> void PairMusenHM::contacts(Laws apply)
       // stored tangential overlap (zero for a new contact)
       double *xi_i = nullptr;
       double xi[3] = {0.0, 0.0, 0.0};
+      double initial_overlap = 0.0;
       if (advance) {
         xi_i = history->get(i, tag[j]);
         xi[0] = xi_i[0];
         xi[1] = xi_i[1];
         xi[2] = xi_i[2];
+        if (keeps_initial) initial_overlap = xi_i[HISTORY_VALUES];
       } else if (const double *found = history->find(i, tag[j])) {
         xi[0] = found[0];
         xi[1] = found[1];
         xi[2] = found[2];
+        if (keeps_initial) initial_overlap = found[HISTORY_VALUES];
       }
 
       // ---- CalculatePP of each law in turn (MUSEN's order), each continuing xi
@@ -223,9 +232,15 @@ template <class Laws> void PairMusenHM::contacts(Laws apply)
       kinematics(i, j, cv, n, cvlen, vn, vt);
       musen_pp::Contact c{overlap, equiv_radius, equiv_mass, r1, r2, n, vn, vt,
                           omega[i], omega[j], dt};
-      if (heat_fix) {
+      if (keeps_initial) {
+        c.initial_overlap = &initial_overlap;
+        c.at_time_zero = at_time_zero;
+      }
+      if (temp) {
         c.t1 = temp[i];
         c.t2 = temp[j];
+      }
+      if (heat_fix) {
         c.k1 = conductivity[itype];
         c.k2 = conductivity[jtype];
       }
@@ -261,6 +276,7 @@ template <class Laws> void PairMusenHM::contacts(Laws apply)
           xi_i[3 + k] = r.fn[k];
           xi_i[6 + k] = r.ft[k];
         }
+        if (keeps_initial) xi_i[HISTORY_VALUES] = initial_overlap;
         if (j < nlocal) {
           double *xi_j = history->get(j, tag[i]);
           for (int k = 0; k < 3; k++) {
@@ -268,6 +284,7 @@ template <class Laws> void PairMusenHM::contacts(Laws apply)
             xi_j[3 + k] = -r.fn[k];
             xi_j[6 + k] = -r.ft[k];
           }
+          if (keeps_initial) xi_j[HISTORY_VALUES] = initial_overlap;
         }
       }
 
@@ -324,6 +341,9 @@ void PairMusenHM::set_laws(const std::string &first, int narg, char **arg)
     if (!law) error->all(FLERR, "pair {}: {}", force->pair_style, why);
     laws.push_back(std::move(law));
   }
+  history_values = HISTORY_VALUES;
+  for (const auto &law : laws)
+    if (law->keeps_initial_overlap()) history_values = HISTORY_VALUES + 1;
   only_hertz = laws.size() == 1 ? dynamic_cast<const musen_pp::HertzMindlin *>(laws[0].get())
                                 : nullptr;
 }
@@ -432,6 +452,17 @@ void PairMusenHM::init_style()
       heat_fix = heats[0];
     }
 
+  // a law that reads temperatures without a heat flux: d_musen_temperature alone
+  temperature_index = -1;
+  for (const auto &law : laws)
+    if (law->reads_temperature() && !law->heats()) {
+      int flag, cols;
+      temperature_index = atom->find_custom("musen_temperature", flag, cols);
+      if (temperature_index < 0 || flag != 1 || cols != 0)
+        error->all(FLERR, "pair {}: its law reads the spheres' temperatures: define fix "
+                          "property/atom d_musen_temperature", force->pair_style);
+    }
+
   // size-based half list with newton off whatever `newton` says (see the file header)
   neighbor->add_request(this, NeighConst::REQ_SIZE | NeighConst::REQ_NEWTON_OFF);
 
@@ -439,9 +470,9 @@ void PairMusenHM::init_style()
     Fix *found = modify->get_fix_by_id(HISTORY_ID);
     if (!found)
       found = modify->add_fix(std::string(HISTORY_ID) + " all MUSEN/HISTORY " +
-                              std::to_string(HISTORY_VALUES));
+                              std::to_string(history_values));
     history = dynamic_cast<FixMusenHistory *>(found);
-    if (!history || history->nvalues() != HISTORY_VALUES)
+    if (!history || history->nvalues() != history_values)
       error->all(FLERR, "pair musen/hm: fix ID {} exists but is not its MUSEN/HISTORY fix",
                  HISTORY_ID);
   }
@@ -546,8 +577,12 @@ double PairMusenHM::single(int i, int j, int itype, int jtype, double rsq, doubl
 
   double n[3], cvlen, vn, vt[3];
   kinematics(i, j, cv, n, cvlen, vn, vt);
-  const musen_pp::Contact c{overlap, equiv_radius, equiv_mass, r1, r2, n, vn, vt,
-                            atom->omega[i], atom->omega[j], update->dt};
+  musen_pp::Contact c{overlap, equiv_radius, equiv_mass, r1, r2, n, vn, vt,
+                      atom->omega[i], atom->omega[j], update->dt};
+  if (temperature_index >= 0) {
+    c.t1 = atom->dvector[temperature_index][i];
+    c.t2 = atom->dvector[temperature_index][j];
+  }
   const musen_pp::Materials mats{estar[itype][jtype], gstar[itype][jtype], alpha[itype][jtype],
                                  mu[itype][jtype], mu_roll[itype][jtype]};
   double xi[3] = {0.0, 0.0, 0.0};    // a new contact's

@@ -68,6 +68,8 @@ class PairMusenHM : public Pair {
   // per contact: tangential overlap xi (3), the last step's normal and tangential force on
   // the atom (3 + 3, for single())
   static constexpr int HISTORY_VALUES = 9;
+  // a law that keeps an initial overlap adds it as a 10th value (set_laws)
+  int history_values = HISTORY_VALUES;
 
  protected:
   double **estar, **gstar;    // effective moduli per type pair
@@ -91,6 +93,8 @@ class PairMusenHM : public Pair {
   const musen_pp::HertzMindlin *only_hertz;
   // a heat law among them: fix musen/heat's flux and per-type conductivity (init_style)
   class Fix *heat_fix = nullptr;
+  // d_musen_temperature's index for a law that reads temperatures without heat (or -1)
+  int temperature_index = -1;
   // every law in turn on one contact; the loop over the contacts with one of those
   void apply_laws(const musen_pp::Contact &c, const musen_pp::Materials &m, double *xi,
                   musen_pp::Result &r) const;

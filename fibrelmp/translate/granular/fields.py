@@ -28,8 +28,15 @@ def contact_heat_models(model: GranularModel) -> list[str]:
     return names + [law.model for law in (plan.bond_law, *plan.then_bond_laws) if law.form == "heat"]
 
 
+def _pp_reads_temperature(model: GranularModel) -> bool:
+    """A PP law that reads the temperatures without carrying heat (ModelPPSinteringTemperature)."""
+    from fibrelmp.translate.granular import models as physics
+    return any(getattr(m, "reads_temperature", False) for m, _ in physics.chosen_all(model, "PP"))
+
+
 def uses_temperature(model: GranularModel) -> bool:
-    return any(f.heat for f in model.plan.external_fields) or bool(contact_heat_models(model))
+    return (any(f.heat for f in model.plan.external_fields) or bool(contact_heat_models(model))
+            or _pp_reads_temperature(model))
 
 
 @dataclass
@@ -38,6 +45,8 @@ class FieldCommands:
     set_lines: list[str]               # the scene's temperatures
     fixes: list[tuple[str, str, str]]  # each EF model's (name, fix style, its arguments)
     heat_args: str = ""                # contact heat models: fix musen/heat's arguments
+    # a contact law reads the temperatures of ghost spheres (fix property/atom ... ghost yes)
+    ghost_temperature: bool = False
 
 
 def field_commands(model: GranularModel, rows: np.ndarray, type_of_mat: dict[int, int],
@@ -74,7 +83,8 @@ def field_commands(model: GranularModel, rows: np.ndarray, type_of_mat: dict[int
         k = _conductivities(model, type_of_mat, ntypes)
         heat_args = ("cp " + " ".join(float_text(c) for c in cp) + " k "
                      + " ".join(float_text(c) for c in k))
-    return FieldCommands(heat, lines, fixes, heat_args)
+    return FieldCommands(heat, lines, fixes, heat_args,
+                         ghost_temperature=bool(heat_args) or _pp_reads_temperature(model))
 
 
 def _conductivities(model: GranularModel, type_of_mat: dict[int, int], ntypes: int) -> list[float]:

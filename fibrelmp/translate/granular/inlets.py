@@ -5,12 +5,15 @@ for the job's step and end time, each fraction's LAMMPS type, diameter and densi
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from fibrelmp.errors import InputError
 from fibrelmp.granmodel import GranularModel
-from fibrelmp.translate.musen.mdem.generators import Inlet
+
+if TYPE_CHECKING:       # the type only: translate/ must not import the format homes
+    from fibrelmp.translate.musen.mdem.generators import Inlet
 
 INLET_SEED = 20260          # the job's seed: generator k uses INLET_SEED + k (docs/musen.md §6)
 LOG_NAME = "inlets.log"     # fix musen/inlet: "STEP ID" per inserted sphere

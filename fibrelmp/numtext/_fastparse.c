@@ -851,3 +851,78 @@ int64_t fp_mdem_encode(double time, const double *vals, const uint32_t *mask, in
     }
     return (int64_t)(o - out);
 }
+
+/* ---- MUSEN .mdem block descriptors (field 3 of ProtoSimulationStorage) -------------------
+   A ProtoBlockDescriptor is "1: double start_time, 2: int64 offset_in_file, 3: int32 size,
+   4: int32 uncompressed_size, 5: enum format".  fp_mdem_blocks walks the top level of a
+   serialized ProtoSimulationStorage and, for each descriptor record (in wire order), stores
+   start[i] and ints[4 i + 0..3] = offset, size, uncompressed size, format, converted as
+   protobuf converts them (the last occurrence of a field wins; int32 fields keep the low 32
+   bits, sign-extended).  Consecutive descriptor records are merged into byte spans
+   [spans[2 j], spans[2 j + 1]) so that the caller can cut them out of the message.
+   With cap == 0 it only counts.  Returns the number of descriptors (and *nspans), or -1 on
+   anything protobuf might read otherwise (malformed wire data, groups, a descriptor field of
+   an unexpected number or wire type): the caller then parses the message with protobuf. */
+static int pb_descriptor(const unsigned char *p, const unsigned char *end, double *start,
+                         int64_t *ints)
+{
+    double t = 0.0;
+    int64_t v[4] = {0, 0, 0, 0};
+    while (p < end) {
+        uint64_t tag, x;
+        if (pb_varint(&p, end, &tag)) return -1;
+        int f = (int)(tag >> 3), wt = (int)(tag & 7);
+        if (f == 1 && wt == 1) {
+            if (end - p < 8) return -1;
+            t = pb_double(p);
+            p += 8;
+        } else if (f >= 2 && f <= 5 && wt == 0) {
+            if (pb_varint(&p, end, &x)) return -1;
+            v[f - 2] = f == 2 ? (int64_t)x : (int64_t)(int32_t)(uint32_t)x;
+        } else {
+            return -1;
+        }
+    }
+    if (start) {
+        *start = t;
+        memcpy(ints, v, sizeof v);
+    }
+    return 0;
+}
+
+int64_t fp_mdem_blocks(const unsigned char *buf, int64_t len, double *start, int64_t *ints,
+                       int64_t cap, int64_t *spans, int64_t *nspans)
+{
+    const unsigned char *p = buf, *end = buf + len;
+    int64_t n = 0, m = 0, last_end = -1;
+    while (p < end) {
+        const unsigned char *rec = p;
+        uint64_t tag, size;
+        if (pb_varint(&p, end, &tag)) return -1;
+        int f = (int)(tag >> 3), wt = (int)(tag & 7);
+        if (f == 0) return -1;
+        if (f != 3) {
+            if (pb_skip(&p, end, wt)) return -1;
+            continue;
+        }
+        if (wt != 2 || pb_varint(&p, end, &size) || (uint64_t)(end - p) < size) return -1;
+        int fill = cap > 0;
+        if (fill && n >= cap) return -1;
+        if (pb_descriptor(p, p + size, fill ? start + n : NULL, fill ? ints + 4 * n : NULL))
+            return -1;
+        p += size;
+        if (fill) {
+            if (last_end == (int64_t)(rec - buf)) {
+                spans[2 * (m - 1) + 1] = (int64_t)(p - buf);
+            } else {
+                spans[2 * m] = (int64_t)(rec - buf);
+                spans[2 * m + 1] = (int64_t)(p - buf);
+                m++;
+            }
+        }
+        last_end = (int64_t)(p - buf);
+        n++;
+    }
+    if (nspans) *nspans = m;
+    return n;
+}

@@ -147,6 +147,8 @@ def _open(lib: Path) -> ctypes.CDLL:
         dll.fp_mdem_decode.restype = ctypes.c_int
         dll.fp_mdem_encode.argtypes = [ctypes.c_double, ptr, ptr, i64, ptr, i64]
         dll.fp_mdem_encode.restype = i64
+        dll.fp_mdem_blocks.argtypes = [ptr, i64, ptr, ptr, i64, ptr, ptr]
+        dll.fp_mdem_blocks.restype = i64
     except (OSError, AttributeError) as exc:
         raise _Unavailable(f"cannot load: {exc}") from exc
     # self-check against Python's correctly rounded conversions before trusting it
@@ -468,3 +470,27 @@ def mdem_encode(time: float, values: np.ndarray, masks: np.ndarray) -> bytes | N
     if size < 0:
         raise ValueError("time point buffer too small")
     return out[:size].tobytes()
+
+
+def mdem_blocks(raw: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """The block descriptors (field 3) of a serialized ``ProtoSimulationStorage``, as protobuf
+    reads them: (start times (k,), integers (k, 4): offset, size, uncompressed size, format;
+    byte spans (m, 2) of the descriptor records in ``raw``).  None without the C library or
+    when the message holds anything unusual (see fp_mdem_blocks): then parse it with protobuf."""
+    lib = library()
+    if lib is None or sys.byteorder != "little":
+        return None
+    buf = np.frombuffer(raw, np.uint8)
+    if not buf.size:
+        buf = np.zeros(1, np.uint8)
+    n = lib.fp_mdem_blocks(buf.ctypes.data, len(raw), None, None, 0, None, None)
+    if n < 0:
+        return None
+    start = np.zeros(max(n, 1))
+    ints = np.zeros((max(n, 1), 4), np.int64)
+    spans = np.zeros((max(n, 1), 2), np.int64)
+    nspans = ctypes.c_int64(0)
+    if n and lib.fp_mdem_blocks(buf.ctypes.data, len(raw), start.ctypes.data, ints.ctypes.data, n,
+                                spans.ctypes.data, ctypes.addressof(nspans)) != n:
+        return None
+    return start[:n], ints[:n], spans[:nspans.value]

@@ -98,7 +98,7 @@ def read_generator_scene(path: Path) -> Scene:
     from fibrelmp.translate.musen.mdem.document import MdemFile
 
     with MdemFile(path) as mdem:
-        storage = mdem.storage
+        storage = mdem.scene
         first = next(iter(mdem.time_points()), None)
     n = len(storage.info.particles)
     values = np.zeros((n, timepoints.NCOLS))

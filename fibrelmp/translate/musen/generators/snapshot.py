@@ -45,7 +45,7 @@ def snapshot(source: Path, job) -> Scene:
 
     t = job.snapshot_time
     with MdemFile(source) as mdem:
-        storage = mdem.storage
+        storage = mdem.scene
         times = mdem.times()
         left, right = _pair(mdem, t)
     if left is None or (left[0] < t and right is None):

@@ -43,7 +43,7 @@ class MdemDocument(DocumentFormat):
         from fibrelmp.translate.musen.mdem.document import MdemFile
 
         mdem = MdemFile(path)
-        return Document(Path(path), mdem.storage, mdem.time_points, mdem)
+        return Document(Path(path), mdem.scene, mdem.time_points, mdem)
 
     @staticmethod
     def writer(target: Path, precision: int | None = None, *, force: bool = False) -> Writer:

@@ -12,14 +12,17 @@ times and begin/end time of what was written.  Memory holds one time point at a 
 
 from __future__ import annotations
 
+import contextlib
 import os
 import zlib
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, BinaryIO, Iterator
 
 import numpy as np
 
 from fibrelmp.errors import InputError
+from fibrelmp.numtext import fast
 from fibrelmp.translate.musen.mdem import bounds, timepoints
 from fibrelmp.translate.musen.mdem.container import Container, ContainerWriter, Layout
 from fibrelmp.translate.musen.mdem.messages import new
@@ -45,37 +48,94 @@ def _inflate(data: bytes, limit: int | None, what: str, path: Path,
     return out
 
 
+@dataclass(frozen=True)
+class BlockIndex:
+    """The file's block descriptors (``ProtoBlockDescriptor``, in file order) as arrays: a
+    million time points cost a few arrays, not a million protobuf messages."""
+
+    start_time: np.ndarray                 # (k,) float64
+    offset: np.ndarray                     # (k,) int64: in the time-dependent file thread
+    size: np.ndarray                       # (k,) int64: stored bytes
+    uncompressed_size: np.ndarray          # (k,) int64
+    format: np.ndarray                     # (k,) int64: PLAIN, ZIPPED (or 0 for empty)
+
+    @classmethod
+    def of_messages(cls, blocks: Any) -> "BlockIndex":
+        """From parsed ``ProtoBlockDescriptor`` messages (the path without the C helpers)."""
+        ints = np.array([(d.offset_in_file, d.size, d.uncompressed_size, d.format) for d in blocks],
+                        np.int64).reshape(-1, 4)
+        return cls(np.array([d.start_time for d in blocks], float), *ints.T)
+
+    def __len__(self) -> int:
+        return len(self.start_time)
+
+
 class MdemFile:
-    """An open ``.mdem`` file (use as a context manager, or ``close()``)."""
+    """An open ``.mdem`` file (use as a context manager, or ``close()``).
+
+    ``scene`` is the ``ProtoSimulationStorage`` without its block descriptors, which are in
+    ``blocks`` (a ``BlockIndex``); ``storage`` is the whole message, parsed when first asked
+    for.  ``time_points()`` streams every time point; ``count()`` and ``time_point(i)`` find
+    one without decoding the others (see ``_locate``)."""
 
     def __init__(self, path: str | os.PathLike):
-        from google.protobuf.message import DecodeError
-
         self.path = Path(path)
         self.container = Container(self.path)
+        self._storage: Any = None
+        self._points: _PointIndex | None = None
         try:
             packed = self.container.read(0, 0, self.container.sizes[0])
-            raw = _inflate(packed, bounds.scene_limit(len(packed)), "the scene (file thread 0)",
-                           self.path, f"a MUSEN scene of {len(packed)} stored bytes decompresses "
-                           f"to ({bounds.SCENE_RATIO}x + {bounds.SCENE_SLACK >> 20} MiB)")
-            self._check_scene_messages(raw, len(packed))
-            try:
-                self.storage: Any = new("ProtoSimulationStorage", raw)
-            except DecodeError:
-                raise InputError(self.path, None, "corrupt .mdem file: the scene message cannot "
-                                 "be decoded") from None
+            raw = self._inflate_scene(packed)
+            split = fast.mdem_blocks(raw)
+            if split is None:               # no C helpers, or an unusual message: protobuf
+                self._check_scene_messages(raw, len(packed), 0)
+                self._storage = self._parse(raw)
+                self.scene: Any = self._storage
+                self.blocks = BlockIndex.of_messages(self.scene.data_blocks)
+            else:
+                start, ints, spans = split
+                rest = _cut(raw, spans)
+                self._check_scene_messages(rest, len(packed), len(start))
+                self.scene = self._parse(rest)
+                self.blocks = BlockIndex(start, *ints.T.copy())
             self._check_blocks()
             self._check_layout()
         except BaseException:
             self.container.close()
             raise
 
-    def _check_scene_messages(self, raw: bytes, stored: int) -> None:
+    def _inflate_scene(self, packed: bytes) -> bytes:
+        return _inflate(packed, bounds.scene_limit(len(packed)), "the scene (file thread 0)",
+                        self.path, f"a MUSEN scene of {len(packed)} stored bytes decompresses "
+                        f"to ({bounds.SCENE_RATIO}x + {bounds.SCENE_SLACK >> 20} MiB)")
+
+    def _parse(self, raw: bytes) -> Any:
+        from google.protobuf.message import DecodeError
+
+        try:
+            return new("ProtoSimulationStorage", raw)
+        except DecodeError:
+            raise InputError(self.path, None, "corrupt .mdem file: the scene message cannot "
+                             "be decoded") from None
+
+    @property
+    def storage(self) -> Any:
+        """The whole ``ProtoSimulationStorage`` (with its block descriptors), parsed at the
+        first use (checked against the memory bounds when the file was opened)."""
+        if self._storage is None:
+            packed = self.container.read(0, 0, self.container.sizes[0])
+            self._storage = self._parse(self._inflate_scene(packed))
+        return self._storage
+
+    def _check_scene_messages(self, raw: bytes, stored: int, descriptors: int) -> None:
         """Count the scene's messages on the wire before protobuf allocates them (~80 bytes
-        each, from 2 bytes of wire): at most ``bounds.message_budget`` of its stored size."""
+        each, from 2 bytes of wire): at most ``bounds.message_budget`` of its stored size,
+        ``descriptors`` (block descriptors already cut out of ``raw``) included."""
         budget = bounds.message_budget(stored)
         try:
-            bounds.count_messages(raw, "ProtoSimulationStorage", budget)
+            if descriptors > budget:
+                raise bounds.TooMany(f"more than {budget} messages")
+            bounds.count_messages(raw, "ProtoSimulationStorage", budget - descriptors)
         except bounds.TooMany:
             raise InputError(self.path, None, f"corrupt .mdem file: the scene (file thread 0, "
                              f"{stored} bytes stored) lists more than {budget} objects and other "
@@ -88,56 +148,64 @@ class MdemFile:
                              f"be decoded ({exc})") from None
 
     def _check_blocks(self) -> None:
-        size = self.container.sizes[1]
-        if not len(self.storage.data_blocks):
+        """Every descriptor checked at once (numpy); the first bad block is reported."""
+        b, size = self.blocks, self.container.sizes[1]
+        if not len(b):
             raise InputError(self.path, None, "corrupt .mdem file: it lists no time-point blocks")
-        for i, d in enumerate(self.storage.data_blocks):
-            if d.offset_in_file < 0 or d.size < 0 or d.offset_in_file + d.size > size:
+        outside = (b.offset < 0) | (b.size < 0) | (b.offset > size - b.size)
+        bad_size = (b.uncompressed_size < 0) | ((b.format == ZIPPED) & (b.size != 0)
+                                                & (b.uncompressed_size == 0))
+        bad_format = (b.format != PLAIN) & (b.format != ZIPPED) & (b.size != 0)
+        wrong = np.flatnonzero(outside | bad_size | bad_format)
+        if len(wrong):
+            i = int(wrong[0])
+            offset, stored = int(b.offset[i]), int(b.size[i])
+            if outside[i]:
                 raise InputError(self.path, None, f"truncated .mdem file: time-point block {i} "
-                                 f"(bytes {d.offset_in_file}..{d.offset_in_file + d.size} of the "
-                                 f"time-dependent data) lies beyond its end ({size} bytes)")
-            if d.uncompressed_size < 0 or (d.format == ZIPPED and d.size and not d.uncompressed_size):
+                                 f"(bytes {offset}..{offset + stored} of the time-dependent "
+                                 f"data) lies beyond its end ({size} bytes)")
+            if bad_size[i]:
                 raise InputError(self.path, None, f"corrupt .mdem file: time-point block {i} has "
-                                 f"uncompressed size {d.uncompressed_size}")
-            if d.format not in (PLAIN, ZIPPED) and d.size:
-                raise InputError(self.path, None, f"unsupported .mdem file: time-point block {i} "
-                                 f"has storage format {d.format}")
-        self.block_times = [d.start_time for d in self.storage.data_blocks]
+                                 f"uncompressed size {int(b.uncompressed_size[i])}")
+            raise InputError(self.path, None, f"unsupported .mdem file: time-point block {i} "
+                             f"has storage format {int(b.format[i])}")
+        self.block_times = b.start_time
         self._block_limits = self._check_block_sizes()
 
-    def _check_block_sizes(self) -> list[int]:
+    def _check_block_sizes(self) -> np.ndarray:
         """The most bytes each time-point block may decompress to: its declared size, which
         must fit both zlib's largest expansion of its stored bytes and what its time points
         can hold for the scene's objects (``bounds.block_bound``); checked for every block
         here, before any is decompressed."""
-        entries = len(self.storage.info.particles)
+        b = self.blocks
+        entries = len(self.info.particles)
         # distinct: MUSEN writes one time point per time (and one per block)
-        saved = np.unique(np.array(self.storage.info.savedTimePoints, dtype=float))
+        saved = self._saved = _distinct(np.asarray(self.info.savedTimePoints, dtype=float))
         # a block holds the saved times from its start up to the next block's (one where the
         # file lists no saved times)
-        starts = np.array(self.block_times + [np.inf])
-        counts = (np.searchsorted(saved, starts[1:]) - np.searchsorted(saved, starts[:-1])
-                  if saved.size else np.ones(len(self.block_times), int))
-        limits = []
-        self._block_points = []
-        for i, d in enumerate(self.storage.data_blocks):
-            points = max(int(counts[i]), 1)
-            self._block_points.append(points)
-            need = bounds.block_bound(entries, points)
-            if d.format != ZIPPED:
-                limits.append(d.size)
-                continue
-            where = f"corrupt .mdem file: time-point block {i} declares {d.uncompressed_size} bytes"
-            if d.uncompressed_size > bounds.ZLIB_MAX_RATIO * d.size + 64:
-                raise InputError(self.path, None, f"{where} from {d.size} stored bytes, more than "
-                                 f"zlib can expand them to ({bounds.ZLIB_MAX_RATIO}x)")
-            if d.uncompressed_size > need:
-                raise InputError(self.path, None, f"{where}, more than {points} time "
-                                 f"point(s) of a scene of {entries} objects can take (at most "
-                                 f"{need} bytes: {bounds.MAX_ENTRY} per object entry); refused "
-                                 "before decompressing it")
-            limits.append(d.uncompressed_size)
-        return limits
+        self._saved_before = np.searchsorted(saved, b.start_time)    # saved times before each
+        counts = (np.diff(np.append(self._saved_before, len(saved)))
+                  if saved.size else np.ones(len(b), np.int64))
+        self._block_points = np.maximum(counts, 1)
+        # float: exact below 2**53, and a declared size (int32) above it is never refused
+        need = self._block_points * float(bounds.block_bound(entries, 1))
+        zipped = b.format == ZIPPED
+        too_zipped = zipped & (b.uncompressed_size > bounds.ZLIB_MAX_RATIO * b.size + 64)
+        too_many = zipped & (b.uncompressed_size > need)
+        wrong = np.flatnonzero(too_zipped | too_many)
+        if len(wrong):
+            i = int(wrong[0])
+            where = (f"corrupt .mdem file: time-point block {i} declares "
+                     f"{int(b.uncompressed_size[i])} bytes")
+            if too_zipped[i]:
+                raise InputError(self.path, None, f"{where} from {int(b.size[i])} stored bytes, "
+                                 f"more than zlib can expand them to ({bounds.ZLIB_MAX_RATIO}x)")
+            points = int(self._block_points[i])
+            raise InputError(self.path, None, f"{where}, more than {points} time "
+                             f"point(s) of a scene of {entries} objects can take (at most "
+                             f"{bounds.block_bound(entries, points)} bytes: {bounds.MAX_ENTRY} "
+                             "per object entry); refused before decompressing it")
+        return np.where(zipped, b.uncompressed_size, b.size)
 
     def _check_layout(self) -> None:
         """Files of header version 0 may keep the oldest time-point layout (Euler angles,
@@ -157,7 +225,7 @@ class MdemFile:
     # -- scene ----------------------------------------------------------------------------
     @property
     def info(self) -> Any:
-        return self.storage.info
+        return self.scene.info
 
     @property
     def version(self) -> int:
@@ -173,15 +241,13 @@ class MdemFile:
     # -- time points ----------------------------------------------------------------------
     def block_raw(self, index: int) -> bytes:
         """Compressed bytes of time-point block ``index`` as stored."""
-        d = self.storage.data_blocks[index]
-        return self.container.read(1, d.offset_in_file, d.size)
+        return self.container.read(1, int(self.blocks.offset[index]), int(self.blocks.size[index]))
 
     def block_bytes(self, index: int) -> bytes:
         """The serialized ``ProtoBlockOfTimePoints`` of block ``index``."""
-        d = self.storage.data_blocks[index]
         raw = self.block_raw(index)
-        if d.format == ZIPPED:
-            raw = _inflate(raw, self._block_limits[index], f"time-point block {index}", self.path)
+        if self.blocks.format[index] == ZIPPED:
+            raw = _inflate(raw, int(self._block_limits[index]), f"time-point block {index}", self.path)
         return raw
 
     def block(self, index: int) -> Any:
@@ -198,25 +264,61 @@ class MdemFile:
         """Every stored time point in order: (time, values (n, 34), masks (n,)) -- see
         ``timepoints`` -- one time point in memory at a time (blocks are decompressed as
         they are read); ``decode=False`` gives (time,)."""
+        for index in range(len(self.blocks)):
+            with self._block_errors(index):
+                for payload in self._point_payloads(index):
+                    yield self._decode(payload) if decode else (timepoints.time_of(payload),)
+
+    def count(self) -> int:
+        """The number of time points ``time_points()`` gives (see ``_locate``)."""
+        return self._point_index().total
+
+    def time_point(self, index: int) -> tuple[float, np.ndarray, np.ndarray]:
+        """Time point ``index`` (0 <= index < ``count()``) as ``time_points()`` gives it,
+        decoding only the block that holds it."""
+        for _ in range(2):
+            points = self._point_index()
+            if not 0 <= index < points.total:
+                raise IndexError(f"time point {index} of {points.total}")
+            block = int(np.searchsorted(points.first, index, "right")) - 1
+            wanted, held, found = index - int(points.first[block]), 0, None
+            with self._block_errors(block):
+                for payload in self._point_payloads(block):
+                    if held == wanted:
+                        found = self._decode(payload)
+                    held += 1
+            if points.counted or (found is not None and held == points.held(block)
+                                  and found[0] == points.times[index]):
+                return found
+            self._points = _PointIndex.counted(self)     # the saved times misled: count
+        raise AssertionError("a counted index always finds its time point")
+
+    def _point_index(self) -> "_PointIndex":
+        if self._points is None:
+            self._points = _PointIndex.of_saved_times(self) or _PointIndex.counted(self)
+        return self._points
+
+    def _decode(self, payload: bytes) -> tuple[float, np.ndarray, np.ndarray]:
         # entries of removed trailing objects may outlast the object list a little; far more
         # is a hostile file (each empty entry costs 2 bytes, 276 decoded)
-        most = bounds.objects_per_point(len(self.info.particles))
-        for index in range(len(self.storage.data_blocks)):
-            try:
-                for payload in self._point_payloads(index):
-                    yield timepoints.decode(payload, most) if decode else (timepoints.time_of(payload),)
-            except ValueError as exc:
-                raise InputError(self.path, None, f"corrupt .mdem file: time-point block "
-                                 f"{index}: {exc}") from None
+        return timepoints.decode(payload, bounds.objects_per_point(len(self.info.particles)))
+
+    @contextlib.contextmanager
+    def _block_errors(self, index: int) -> Iterator[None]:
+        try:
+            yield
+        except ValueError as exc:
+            raise InputError(self.path, None, f"corrupt .mdem file: time-point block "
+                             f"{index}: {exc}") from None
 
     def _point_payloads(self, index: int) -> Iterator[bytes]:
         """The serialized time points of block ``index`` (field 2 of its
         ``ProtoBlockOfTimePoints``; other fields skipped), decompressed as they are read: at
         most ``bounds.block_bound(n, 1)`` bytes each and as many as the block's saved times."""
-        d = self.storage.data_blocks[index]
-        stream = _BlockStream(self.block_raw(index), d.format == ZIPPED, self._block_limits[index],
-                              f"time-point block {index}", self.path)
+        stream = _BlockStream(self.block_raw(index), self.blocks.format[index] == ZIPPED,
+                              int(self._block_limits[index]), f"time-point block {index}", self.path)
         most_bytes = bounds.block_bound(len(self.info.particles), 1)
+        most_points = int(self._block_points[index])
         points = 0
         while not stream.done():
             tag = stream.varint()
@@ -232,8 +334,8 @@ class MdemFile:
                     raise ValueError(f"a time point of {size} bytes, more than the scene's "
                                      f"{len(self.info.particles)} objects can take ({most_bytes})")
                 points += 1
-                if points > self._block_points[index]:
-                    raise ValueError(f"more than the {self._block_points[index]} time point(s) "
+                if points > most_points:
+                    raise ValueError(f"more than the {most_points} time point(s) "
                                      "the file's saved times place in it")
                 yield stream.read(size)
             elif wire == 0:
@@ -245,29 +347,19 @@ class MdemFile:
 
     # -- whole file -----------------------------------------------------------------------
     def copy_to(self, fh: BinaryIO) -> None:
-        """Write this file again: every message re-serialized, every block re-compressed
-        (MUSEN's zlib level 1), at the offsets they had; the result equals the input byte
-        for byte (tests show it)."""
+        """Write this file again, every block at the offset it had: the result equals the
+        input byte for byte (tests show it).  Every block is read through (one time point in
+        memory at a time, so that a block of garbage is refused before it is decompressed
+        whole) and decoded by protobuf before its stored bytes are written."""
         layout: Layout = self.container.layout()
         out = ContainerWriter(fh, layout)
-        for index, d in enumerate(self.storage.data_blocks):
-            # read through once a time point at a time (one in memory), so that a block of
-            # garbage is refused before it is decompressed whole
-            try:
+        for index in range(len(self.blocks)):
+            with self._block_errors(index):
                 for _ in self._point_payloads(index):
                     pass
-            except ValueError as exc:
-                raise InputError(self.path, None, f"corrupt .mdem file: time-point block "
-                                 f"{index}: {exc}") from None
-            stored = self.block_raw(index)
-            block = self.block(index).SerializeToString()
-            again = zlib.compress(block, _LEVEL) if d.format == ZIPPED else block
-            # another zlib (or level) than MUSEN's gives other bytes for the same message:
-            # then the stored bytes, which hold the same message, are written
-            out.write(1, d.offset_in_file, again if again == stored else stored)
-        stored = self.container.read(0, 0, self.container.sizes[0])
-        again = zlib.compress(self.storage.SerializeToString(), _LEVEL)
-        out.write(0, 0, again if again == stored else stored)
+            self.block(index)
+            out.write(1, int(self.blocks.offset[index]), self.block_raw(index))
+        out.write(0, 0, self.container.read(0, 0, self.container.sizes[0]))
         out.finish()
 
     def close(self) -> None:
@@ -278,6 +370,66 @@ class MdemFile:
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+@dataclass(frozen=True)
+class _PointIndex:
+    """Where each time point lies: block b holds time points first[b] .. first[b + 1] - 1.
+
+    ``of_saved_times``: from the file's saved times (``savedTimePoints``, MUSEN's own list of
+    time points) and the blocks' start times, without reading a block -- when they agree as
+    MUSEN writes them (each block starts at a saved time; times increase).  A block read
+    through this index is checked (its number of time points, the time found); if they
+    disagree the index is rebuilt by ``counted``: every block's time points counted (read
+    through, not decoded), as exact as ``time_points()`` and as slow."""
+
+    first: np.ndarray              # (blocks + 1,) int64
+    times: np.ndarray | None       # (total,) the saved times (None when counted)
+    counted: bool
+
+    @property
+    def total(self) -> int:
+        return int(self.first[-1])
+
+    def held(self, block: int) -> int:
+        return int(self.first[block + 1] - self.first[block])
+
+    @classmethod
+    def of_saved_times(cls, mdem: MdemFile) -> "_PointIndex | None":
+        saved, starts = mdem._saved, mdem.blocks.start_time
+        if not saved.size or not np.isfinite(saved).all() or not np.isfinite(starts).all() \
+                or (np.diff(starts) <= 0).any():
+            return None
+        first = mdem._saved_before
+        if first[0] != 0 or first[-1] >= len(saved) or (saved[first] != starts).any():
+            return None
+        return cls(np.append(first, len(saved)).astype(np.int64), saved, False)
+
+    @classmethod
+    def counted(cls, mdem: MdemFile) -> "_PointIndex":
+        held = np.zeros(len(mdem.blocks), np.int64)
+        for index in range(len(mdem.blocks)):
+            with mdem._block_errors(index):
+                held[index] = sum(1 for _ in mdem._point_payloads(index))
+        return cls(np.concatenate([[0], np.cumsum(held)]).astype(np.int64), None, True)
+
+
+def _distinct(times: np.ndarray) -> np.ndarray:
+    """The distinct values of ``times``, sorted (without sorting what already is)."""
+    return times if (np.diff(times) > 0).all() else np.unique(times)
+
+
+def _cut(raw: bytes, spans: np.ndarray) -> bytes:
+    """``raw`` without the byte ranges ``spans`` (sorted, disjoint)."""
+    if not len(spans):
+        return raw
+    parts, at = [], 0
+    with memoryview(raw) as view:
+        for start, end in spans.tolist():
+            parts.append(view[at:start])
+            at = end
+        parts.append(view[at:])
+        return b"".join(parts)
 
 
 class MdemWriter:

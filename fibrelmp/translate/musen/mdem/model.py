@@ -6,7 +6,7 @@ from __future__ import annotations
 import os
 import tempfile
 from pathlib import Path
-from typing import Iterator
+from typing import TYPE_CHECKING, Iterator
 
 import numpy as np
 
@@ -15,22 +15,28 @@ from fibrelmp.formatbase import Reader
 from fibrelmp.granmodel import GranularFrame, GranularModel
 from fibrelmp.translate.musen.scene_record import scene_record
 
+if TYPE_CHECKING:
+    from fibrelmp.translate.musen.mdem.document import MdemFile
 
-def read_scene(path: str | os.PathLike) -> GranularModel:
+
+def read_scene(path: str | os.PathLike, mdem: MdemFile | None = None) -> GranularModel:
     """The scene of a ``.mdem`` file at its first saved time point, where MUSEN's simulator
     starts (it clears every later time point before simulating).  The scene is written as
     MUSEN's text export (17 digits: every double exactly) and read by the text scene reader,
-    so both forms of a scene give the same model."""
-    from fibrelmp.translate.musen import scene
+    so both forms of a scene give the same model.  ``mdem``: the file already open."""
     from fibrelmp.translate.musen.mdem.document import MdemFile
+
+    if mdem is None:
+        with MdemFile(path) as opened:
+            return read_scene(path, opened)
+    from fibrelmp.translate.musen import scene
+    from fibrelmp.translate.musen.mdem.fields import check_settings
     from fibrelmp.translate.musen.mdem.generators import generation_schedule, read_inlets
     from fibrelmp.translate.musen.mdem.text_export import export
 
-    from fibrelmp.translate.musen.mdem.fields import check_settings
-
     path = Path(path)
-    with MdemFile(path) as mdem, tempfile.TemporaryDirectory(prefix="fibrelmp-mdem-") as tmp:
-        ignored = check_settings(mdem.storage, path)
+    with tempfile.TemporaryDirectory(prefix="fibrelmp-mdem-") as tmp:
+        ignored = check_settings(mdem.scene, path)
         text = Path(tmp) / f"{path.stem}.txt"
         with open(text, "w", newline="\n") as out:
             export(mdem, out, precision=17, spool_dir=Path(tmp), times_limit=1)
@@ -39,10 +45,10 @@ def read_scene(path: str | os.PathLike) -> GranularModel:
         except InputError as exc:
             where = f" (its text form, line {exc.line})" if exc.line else ""
             raise InputError(path, None, f"{exc.message}{where}") from None
-        _settings(model, mdem.storage.modules_data)
-        _refused_settings(model, mdem.storage)
+        _settings(model, mdem.scene.modules_data)
+        _refused_settings(model, mdem.scene)
         # inlets: checked here, scheduled for the job's step and end time by the translation
-        inlets = model.plan.inlets = read_inlets(mdem.storage, path)
+        inlets = model.plan.inlets = read_inlets(mdem.scene, path)
         model.plan.inlet_schedule = (lambda dt, t_end: generation_schedule(
             [i.generator for i in inlets], dt, t_end))
     model.warnings.extend(ignored)
@@ -120,7 +126,7 @@ class MdemReader(Reader):
     """A ``.mdem`` file through the abstract Reader: ``read()`` the scene (``read_scene``),
     iterating its saved time points as ``GranularFrame``s, one block in memory at a time
     (spheres and bonds with an empty entry, MUSEN's mark of inactive objects, are absent /
-    not alive)."""
+    not alive); ``frames_of`` gives the frames of an open file by number."""
 
     format = "mdem"
     what = "MUSEN .mdem file"
@@ -130,39 +136,60 @@ class MdemReader(Reader):
 
     def __iter__(self) -> Iterator[GranularFrame]:
         from fibrelmp.translate.musen.mdem.document import MdemFile
-        from fibrelmp.translate.musen.mdem.objects import SOLID_BOND, SPHERE, WALL, read_objects
-        from fibrelmp.translate.musen.mdem.timepoints import columns
 
         with MdemFile(self.path) as mdem:
-            obj = read_objects(mdem.info, mdem.version, self.path)
-            spheres = obj.ids[obj.types == SPHERE]
-            bonds = obj.ids[obj.types == SOLID_BOND]
-            walls = obj.ids[obj.types == WALL]
-            q = columns("quaternion").start
+            frames = MdemFrames(mdem)
             for step, (time, values, masks) in enumerate(mdem.time_points()):
-                n = len(values)
-                live = np.flatnonzero((spheres < n) & (masks[np.minimum(spheres, n - 1)] != 0)
-                                      if n else np.zeros(0, bool))
-                v = values[spheres[live]]
-                frame = GranularFrame(time=time, step=step, sphere_rows=live,
-                                      position=v[:, columns("coord")], velocity=v[:, columns("vel")],
-                                      omega=v[:, columns("angle_vel")], force=v[:, columns("force")],
-                                      quaternion=v[:, columns("quaternion")])
-                if len(bonds):
-                    b = np.zeros((len(bonds), values.shape[1]))
-                    inside = bonds < n
-                    b[inside] = values[bonds[inside]]
-                    frame.bond_alive = np.zeros(len(bonds), bool)
-                    frame.bond_alive[inside] = masks[bonds[inside]] != 0
-                    frame.bond_force = b[:, columns("force")]
-                    frame.bond_tangential_overlap = b[:, columns("angle_vel")]
-                    frame.bond_torque = b[:, columns("total_torque").start]
-                if len(walls):
-                    w = np.zeros((len(walls), values.shape[1]))      # absent entries: zeros
-                    inside = walls < n
-                    w[inside] = values[walls[inside]]
-                    frame.triangle_vertices = np.stack(
-                        [w[:, columns("coord")], w[:, q:q + 3], w[:, columns("angle_vel")]], axis=1)
-                    frame.triangle_velocity = w[:, columns("vel")]
-                    frame.triangle_force = w[:, columns("force")]
-                yield frame
+                yield frames.frame(step, time, values, masks)
+
+
+class MdemFrames:
+    """The time points of an open ``MdemFile`` as ``GranularFrame``s: ``count()``, and
+    ``at(i)``, which decodes only the block holding time point ``i``."""
+
+    def __init__(self, mdem: MdemFile):
+        from fibrelmp.translate.musen.mdem.objects import SOLID_BOND, SPHERE, WALL, read_objects
+
+        self.mdem = mdem
+        obj = read_objects(mdem.info, mdem.version, mdem.path)
+        self.spheres = obj.ids[obj.types == SPHERE]
+        self.bonds = obj.ids[obj.types == SOLID_BOND]
+        self.walls = obj.ids[obj.types == WALL]
+
+    def count(self) -> int:
+        return self.mdem.count()
+
+    def at(self, index: int) -> GranularFrame:
+        return self.frame(index, *self.mdem.time_point(index))
+
+    def frame(self, step: int, time: float, values: np.ndarray, masks: np.ndarray) -> GranularFrame:
+        from fibrelmp.translate.musen.mdem.timepoints import columns
+
+        spheres, bonds, walls = self.spheres, self.bonds, self.walls
+        q = columns("quaternion").start
+        n = len(values)
+        live = np.flatnonzero((spheres < n) & (masks[np.minimum(spheres, n - 1)] != 0)
+                              if n else np.zeros(0, bool))
+        v = values[spheres[live]]
+        frame = GranularFrame(time=time, step=step, sphere_rows=live,
+                              position=v[:, columns("coord")], velocity=v[:, columns("vel")],
+                              omega=v[:, columns("angle_vel")], force=v[:, columns("force")],
+                              quaternion=v[:, columns("quaternion")])
+        if len(bonds):
+            b = np.zeros((len(bonds), values.shape[1]))
+            inside = bonds < n
+            b[inside] = values[bonds[inside]]
+            frame.bond_alive = np.zeros(len(bonds), bool)
+            frame.bond_alive[inside] = masks[bonds[inside]] != 0
+            frame.bond_force = b[:, columns("force")]
+            frame.bond_tangential_overlap = b[:, columns("angle_vel")]
+            frame.bond_torque = b[:, columns("total_torque").start]
+        if len(walls):
+            w = np.zeros((len(walls), values.shape[1]))      # absent entries: zeros
+            inside = walls < n
+            w[inside] = values[walls[inside]]
+            frame.triangle_vertices = np.stack(
+                [w[:, columns("coord")], w[:, q:q + 3], w[:, columns("angle_vel")]], axis=1)
+            frame.triangle_velocity = w[:, columns("vel")]
+            frame.triangle_force = w[:, columns("force")]
+        return frame

@@ -126,7 +126,7 @@ class MdemResultWriter(MusenResultWriter):
         source = scene_record(self.model).mdem_source
         if source is not None:
             with MdemFile(source) as mdem:
-                storage = mdem.storage
+                storage = mdem.scene
             self._set_activity(storage)
             self._set_scene(storage)
         else:

@@ -180,27 +180,27 @@ def export(mdem: MdemFile, out: IO[str], precision: int = 6,
     by default) what is written, as ``CExportAsText`` filters."""
     sel = export_selectors(selectors)
     obj = read_objects(mdem.info, mdem.version, mdem.path)
-    compounds = {c.uniqueKey for c in mdem.storage.modules_data.materials_database.compound}
+    compounds = {c.uniqueKey for c in mdem.scene.modules_data.materials_database.compound}
     saved = np.array(mdem.info.savedTimePoints, float)
     if saved.size == 0:
         saved = mdem.times()
-    chosen = [t for t in saved.tolist()
-              if time_interval is None or time_interval[0] <= t <= time_interval[1]]
-    if times_limit is not None:
-        chosen = chosen[:times_limit]
+    if time_interval is not None:
+        saved = saved[(time_interval[0] <= saved) & (saved <= time_interval[1])]
+    chosen = saved[:times_limit].tolist()
     keep = _filter(obj, sel, chosen)
     index = {t: np.flatnonzero((obj.types == t) & keep) for t in (SPHERE, SOLID_BOND, WALL, LIQUID_BOND)}
     with tempfile.TemporaryDirectory(prefix=".mdem-export.", dir=spool_dir) as tmp:
         spools = {t: open(Path(tmp) / f"{t}.bin", "w+b") for t in _WIDTH if _WIDTH[t]}
         times: list[float] = []
-        wanted = set(chosen)
+        wanted, done = set(chosen), set()          # sets: a million time points stay linear
         try:
             for time, values, _ in mdem.time_points():
-                if time not in wanted or time in times:
+                if time not in wanted or time in done:
                     continue
                 for t, block in td_blocks(obj, values, index).items():
                     spools[t].write(np.ascontiguousarray(block).tobytes())
                 times.append(time)
+                done.add(time)
                 if len(times) == len(wanted):
                     break
             for fh in spools.values():
@@ -209,7 +209,7 @@ def export(mdem: MdemFile, out: IO[str], precision: int = 6,
         finally:
             for fh in spools.values():
                 fh.close()
-    out.write("".join(scene_lines(mdem.storage, sel)))
+    out.write("".join(scene_lines(mdem.scene, sel)))
     return times
 
 

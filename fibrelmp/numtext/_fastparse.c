@@ -856,15 +856,15 @@ int64_t fp_mdem_encode(double time, const double *vals, const uint32_t *mask, in
    A ProtoBlockDescriptor is "1: double start_time, 2: int64 offset_in_file, 3: int32 size,
    4: int32 uncompressed_size, 5: enum format".  fp_mdem_blocks walks the top level of a
    serialized ProtoSimulationStorage and, for each descriptor record (in wire order), stores
-   start[i] and ints[4 i + 0..3] = offset, size, uncompressed size, format, converted as
+   start[i] and ints[k cap + i] (k = 0..3) = offset, size, uncompressed size, format, as
    protobuf converts them (the last occurrence of a field wins; int32 fields keep the low 32
    bits, sign-extended).  Consecutive descriptor records are merged into byte spans
    [spans[2 j], spans[2 j + 1]) so that the caller can cut them out of the message.
-   With cap == 0 it only counts.  Returns the number of descriptors (and *nspans), or -1 on
+   With cap == 0 it only counts (descriptors, and spans in *nspans).  Returns the number of descriptors (and *nspans), or -1 on
    anything protobuf might read otherwise (malformed wire data, groups, a descriptor field of
    an unexpected number or wire type): the caller then parses the message with protobuf. */
 static int pb_descriptor(const unsigned char *p, const unsigned char *end, double *start,
-                         int64_t *ints)
+                         int64_t *ints, int64_t stride)
 {
     double t = 0.0;
     int64_t v[4] = {0, 0, 0, 0};
@@ -885,7 +885,7 @@ static int pb_descriptor(const unsigned char *p, const unsigned char *end, doubl
     }
     if (start) {
         *start = t;
-        memcpy(ints, v, sizeof v);
+        for (int k = 0; k < 4; k++) ints[k * stride] = v[k];
     }
     return 0;
 }
@@ -908,17 +908,17 @@ int64_t fp_mdem_blocks(const unsigned char *buf, int64_t len, double *start, int
         if (wt != 2 || pb_varint(&p, end, &size) || (uint64_t)(end - p) < size) return -1;
         int fill = cap > 0;
         if (fill && n >= cap) return -1;
-        if (pb_descriptor(p, p + size, fill ? start + n : NULL, fill ? ints + 4 * n : NULL))
+        if (pb_descriptor(p, p + size, fill ? start + n : NULL, fill ? ints + n : NULL, cap))
             return -1;
         p += size;
-        if (fill) {
-            if (last_end == (int64_t)(rec - buf)) {
-                spans[2 * (m - 1) + 1] = (int64_t)(p - buf);
-            } else {
+        if (last_end == (int64_t)(rec - buf)) {
+            if (fill) spans[2 * (m - 1) + 1] = (int64_t)(p - buf);
+        } else {
+            if (fill) {
                 spans[2 * m] = (int64_t)(rec - buf);
                 spans[2 * m + 1] = (int64_t)(p - buf);
-                m++;
             }
+            m++;
         }
         last_end = (int64_t)(p - buf);
         n++;

@@ -474,7 +474,7 @@ def mdem_encode(time: float, values: np.ndarray, masks: np.ndarray) -> bytes | N
 
 def mdem_blocks(raw: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
     """The block descriptors (field 3) of a serialized ``ProtoSimulationStorage``, as protobuf
-    reads them: (start times (k,), integers (k, 4): offset, size, uncompressed size, format;
+    reads them: (start times (k,), integers (4, k): offsets, sizes, uncompressed sizes, formats;
     byte spans (m, 2) of the descriptor records in ``raw``).  None without the C library or
     when the message holds anything unusual (see fp_mdem_blocks): then parse it with protobuf."""
     lib = library()
@@ -483,14 +483,14 @@ def mdem_blocks(raw: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
     buf = np.frombuffer(raw, np.uint8)
     if not buf.size:
         buf = np.zeros(1, np.uint8)
-    n = lib.fp_mdem_blocks(buf.ctypes.data, len(raw), None, None, 0, None, None)
+    nspans = ctypes.c_int64(0)
+    n = lib.fp_mdem_blocks(buf.ctypes.data, len(raw), None, None, 0, None, ctypes.addressof(nspans))
     if n < 0:
         return None
     start = np.zeros(max(n, 1))
-    ints = np.zeros((max(n, 1), 4), np.int64)
-    spans = np.zeros((max(n, 1), 2), np.int64)
-    nspans = ctypes.c_int64(0)
+    ints = np.zeros((4, max(n, 1)), np.int64)
+    spans = np.zeros((max(nspans.value, 1), 2), np.int64)
     if n and lib.fp_mdem_blocks(buf.ctypes.data, len(raw), start.ctypes.data, ints.ctypes.data, n,
                                 spans.ctypes.data, ctypes.addressof(nspans)) != n:
         return None
-    return start[:n], ints[:n], spans[:nspans.value]
+    return start[:n], ints[:, :n], spans[:nspans.value]

@@ -84,20 +84,21 @@ class MdemFile:
         self._storage: Any = None
         self._points: _PointIndex | None = None
         try:
-            packed = self.container.read(0, 0, self.container.sizes[0])
-            raw = self._inflate_scene(packed)
+            stored = self.container.sizes[0]
+            raw = self._inflate_scene(self.container.read(0, 0, stored))
             split = fast.mdem_blocks(raw)
             if split is None:               # no C helpers, or an unusual message: protobuf
-                self._check_scene_messages(raw, len(packed), 0)
+                self._check_scene_messages(raw, stored, 0)
                 self._storage = self._parse(raw)
                 self.scene: Any = self._storage
                 self.blocks = BlockIndex.of_messages(self.scene.data_blocks)
             else:
                 start, ints, spans = split
-                rest = _cut(raw, spans)
-                self._check_scene_messages(rest, len(packed), len(start))
-                self.scene = self._parse(rest)
-                self.blocks = BlockIndex(start, *ints.T.copy())
+                raw = _cut(raw, spans)      # memory: the descriptors' bytes are let go
+                self._check_scene_messages(raw, stored, len(start))
+                self.scene = self._parse(raw)
+                self.blocks = BlockIndex(start, *ints)
+            del raw
             self._check_blocks()
             self._check_layout()
         except BaseException:
@@ -183,7 +184,9 @@ class MdemFile:
         saved = self._saved = _distinct(np.asarray(self.info.savedTimePoints, dtype=float))
         # a block holds the saved times from its start up to the next block's (one where the
         # file lists no saved times)
-        self._saved_before = np.searchsorted(saved, b.start_time)    # saved times before each
+        # saved times before each block's start (MUSEN: one block per saved time, no search)
+        self._saved_before = (np.arange(len(b)) if np.array_equal(saved, b.start_time)
+                              else np.searchsorted(saved, b.start_time))
         counts = (np.diff(np.append(self._saved_before, len(saved)))
                   if saved.size else np.ones(len(b), np.int64))
         self._block_points = np.maximum(counts, 1)
@@ -274,24 +277,30 @@ class MdemFile:
         return self._point_index().total
 
     def time_point(self, index: int) -> tuple[float, np.ndarray, np.ndarray]:
-        """Time point ``index`` (0 <= index < ``count()``) as ``time_points()`` gives it,
-        decoding only the block that holds it."""
-        for _ in range(2):
-            points = self._point_index()
-            if not 0 <= index < points.total:
-                raise IndexError(f"time point {index} of {points.total}")
-            block = int(np.searchsorted(points.first, index, "right")) - 1
-            wanted, held, found = index - int(points.first[block]), 0, None
-            with self._block_errors(block):
-                for payload in self._point_payloads(block):
-                    if held == wanted:
-                        found = self._decode(payload)
-                    held += 1
-            if points.counted or (found is not None and held == points.held(block)
-                                  and found[0] == points.times[index]):
-                return found
-            self._points = _PointIndex.counted(self)     # the saved times misled: count
-        raise AssertionError("a counted index always finds its time point")
+        """Time point ``index`` (0 <= index < ``count()``), decoding only the block that
+        holds it (see ``_PointIndex``)."""
+        points = self._point_index()
+        if not 0 <= index < points.total:
+            raise IndexError(f"time point {index} of {points.total}")
+        block = int(np.searchsorted(points.first, index, "right")) - 1
+        wanted, held, found = index - int(points.first[block]), 0, None
+        with self._block_errors(block):
+            for payload in self._point_payloads(block):
+                if held == wanted:
+                    found = self._decode(payload)
+                held += 1
+        if points.counted:                  # counted from these very blocks: always found
+            assert found is not None, "a counted index finds its time points"
+            return found
+        expected = points.times[index]
+        if found is None or held != points.held(block) or found[0] != expected:
+            got = "" if found is None else f", the {wanted + 1}. at {found[0]!r} s"
+            raise InputError(self.path, None, f"corrupt .mdem file: time-point block {block} "
+                             f"holds {held} time point(s){got}, where the file's saved times "
+                             f"(savedTimePoints) place {points.held(block)} from "
+                             f"{points.times[points.first[block]]!r} s (time point {index} at "
+                             f"{expected!r} s)")
+        return found
 
     def _point_index(self) -> "_PointIndex":
         if self._points is None:
@@ -377,11 +386,13 @@ class _PointIndex:
     """Where each time point lies: block b holds time points first[b] .. first[b + 1] - 1.
 
     ``of_saved_times``: from the file's saved times (``savedTimePoints``, MUSEN's own list of
-    time points) and the blocks' start times, without reading a block -- when they agree as
-    MUSEN writes them (each block starts at a saved time; times increase).  A block read
-    through this index is checked (its number of time points, the time found); if they
-    disagree the index is rebuilt by ``counted``: every block's time points counted (read
-    through, not decoded), as exact as ``time_points()`` and as slow."""
+    time points, distinct) and the blocks' start times, without reading a block -- when they
+    agree as MUSEN writes them (each block starts at a saved time; times increase): time
+    point i is then the one saved at time i, as MUSEN numbers them.  The block read for it is
+    checked (its number of time points, the time found) and a disagreement is an InputError
+    (a file whose blocks hold other time points than its saved times list).  Else
+    ``counted``: every block's time points counted (read through, not decoded), the numbering
+    of ``time_points()``, as slow as reading them all."""
 
     first: np.ndarray              # (blocks + 1,) int64
     times: np.ndarray | None       # (total,) the saved times (None when counted)

@@ -11,8 +11,15 @@ Each step runs in its own Python process (so its peak resident memory, ru_maxrss
 Memory must not grow with the number of saves: the write and read steps also run with 10
 saves, and the script prints both peaks.
 
-    python benchmarks/mdem_io.py                      # 100k spheres x 50 saves (~2 min)
-    python benchmarks/mdem_io.py --spheres 20000 --saves 10
+Frames of a long result (issue 28): a .mdem of one sphere and ``--points`` time points (one
+block each, as MUSEN saves; written by ``MdemWriter``), then frame 0, the middle frame and the
+last one read as ``snapshot`` reads them (``MdemSource``: the scene, the block index, the one
+block), each in its own process, against one pass of the full decode (every time point
+decoded: what finding a frame cost before, once to count the frames and once more up to it).
+
+    python benchmarks/mdem_io.py                      # 100k spheres x 50 saves, 1e6 points (~4 min)
+    python benchmarks/mdem_io.py --spheres 20000 --saves 10 --points 100000
+    python benchmarks/mdem_io.py --saves 0 --points 1000000     # the frames only
 """
 
 from __future__ import annotations
@@ -53,7 +60,12 @@ def frames(m):
                             position=s.position + 1e-6 * k, velocity=s.velocity, omega=s.omega,
                             force=rng.normal(size=(n, 3)), quaternion=s.quaternion)
 
-start = time.perf_counter()
+if kind in ("frame-lazy", "full-decode"):       # imports are not what is measured
+    import fibrelmp.translate.musen.mdem.pictures  # noqa: F401
+    import fibrelmp.translate.musen.mdem.text_export  # noqa: F401
+    import fibrelmp.translate.musen.scene  # noqa: F401
+
+start, cpu = time.perf_counter(), time.process_time()
 if kind in ("write-mdem", "write-text"):
     m = model()
     if kind == "write-mdem":
@@ -80,8 +92,32 @@ elif kind == "scene-mdem":
 elif kind == "export-mdem":
     from fibrelmp.python_api import convert_file
     convert_file(folder / f"r{saves}.mdem", folder / f"export{saves}.txt", force=True)
+elif kind == "write-long":                       # n time points of one sphere (saves: unused)
+    from fibrelmp.translate.musen.mdem.document import MdemFile, MdemWriter
+    from fibrelmp.translate.musen.mdem.result import MdemResultWriter
+    n_points, n, saves = n, 1, 1
+    m = model()
+    first = MdemResultWriter(m, folder / "scene.mdem")
+    first.add(next(frames(m)))
+    first.close()
+    with MdemFile(folder / "scene.mdem") as scene:
+        storage = scene.scene
+        _, values, masks = scene.time_point(0)
+    with open(folder / "long.mdem", "w+b") as fh:
+        w = MdemWriter(fh)
+        for k in range(n_points):
+            values[:, 0] = 1e-6 * k
+            w.add(1e-4 * k, values, masks)
+        w.finish(storage)
+elif kind == "frame-lazy":                       # saves: the frame
+    from fibrelmp.translate.musen.mdem.pictures import MdemSource
+    MdemSource(folder / "long.mdem").frame(saves)
+elif kind == "full-decode":
+    from fibrelmp.translate.musen.mdem.document import MdemFile
+    with MdemFile(folder / "long.mdem") as mdem:
+        count = sum(1 for _ in mdem.time_points())
 seconds = time.perf_counter() - start
-print(json.dumps({"seconds": seconds,
+print(json.dumps({"seconds": seconds, "cpu": time.process_time() - cpu,
                   "peak_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
 '''
 
@@ -92,18 +128,41 @@ def step(kind: str, folder: Path, spheres: int, saves: int, env: dict) -> dict:
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
+def frames(folder: Path, points: int, env: dict) -> None:
+    """Frames 0, middle and last of a result of ``points`` time points: ``snapshot``'s reading
+    against one pass of the full decode."""
+    wrote = step("write-long", folder, points, 0, env)
+    size = (folder / "long.mdem").stat().st_size / 2**20
+    print(f"  long result: {points} time points of 1 sphere, {size:.1f} MB, written in "
+          f"{wrote['seconds']:.1f} s")
+    full = step("full-decode", folder, points, 0, env)
+    print(f"  full decode, one pass:  {full['seconds']:7.2f} s (cpu {full['cpu']:6.2f} s), "
+          f"peak {full['peak_mb']:6.1f} MB")
+    for name, index in (("first", 0), ("middle", points // 2), ("last", points - 1)):
+        lazy = step("frame-lazy", folder, points, index, env)
+        print(f"  frame {index:8d} ({name:6s}): {lazy['seconds']:7.3f} s (cpu {lazy['cpu']:6.3f} s), "
+              f"peak {lazy['peak_mb']:6.1f} MB; full decode pass / this: "
+              f"{full['seconds'] / lazy['seconds']:.0f}x (cpu {full['cpu'] / lazy['cpu']:.0f}x)")
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--spheres", type=int, default=100_000)
     parser.add_argument("--saves", type=int, default=50)
     parser.add_argument("--few", type=int, default=10, help="saves of the memory comparison")
     parser.add_argument("--export", action="store_true", help="also convert the .mdem to text")
+    parser.add_argument("--points", type=int, default=1_000_000,
+                        help="time points of the long result whose frames are read (0: none)")
     args = parser.parse_args()
     env = dict(os.environ)
-    print(f"mdem_io: {args.spheres} spheres x {args.saves} saves; load {os.getloadavg()[0]:.2f}; "
-          f"{time.strftime('%Y-%m-%d %H:%M')}")
+    print(f"mdem_io: {args.spheres} spheres x {args.saves} saves, {args.points} time points; "
+          f"load {os.getloadavg()[0]:.2f}; {time.strftime('%Y-%m-%d %H:%M')}")
     with tempfile.TemporaryDirectory(prefix="mdem-bench-") as tmp:
         folder = Path(tmp)
+        if args.points:
+            frames(folder, args.points, env)
+        if not args.saves:
+            return 0
         rows = {}
         for saves in (args.few, args.saves):
             for kind in ("write-mdem", "read-mdem", "write-text", "read-text"):

@@ -258,3 +258,37 @@ def test_saved_times_that_misplace_a_time_point_are_refused(tmp_path):
         with pytest.raises(InputError, match=r"block 0 holds 1 time point\(s\), where the file's "
                                              r"saved times \(savedTimePoints\) place 2"):
             mdem.time_point(1)
+
+
+# -- text of results with many saves: object lines written in pieces -------------------------
+def test_text_export_in_pieces_is_cmusens_export(tmp_path, monkeypatch):
+    """With lines written a few saves at a time (what a result of many saves gets, so that
+    memory holds a piece, not a line), fibrelmp's text of cmusen's .mdem is still cmusen's own
+    17-digit export, byte for byte."""
+    from fibrelmp import python_api
+    from fibrelmp.translate.musen.mdem import text_export
+
+    monkeypatch.setattr(text_export, "_CHUNK_VALUES", 70)          # 2 saves per piece
+    out = tmp_path / "bounce.txt"
+    python_api.convert_file(BOUNCE, out, precision=17)
+    assert out.read_bytes() == (BOUNCE.parent / "bounce_result_prec17.txt").read_bytes()
+
+
+def test_result_writer_in_pieces_writes_the_same_text(tmp_path, monkeypatch):
+    """The text result writer (``run``, ``post --to musen``): the same file whole or in pieces
+    (cmusen's bounce: a sphere and 12 wall triangles, 102 saves)."""
+    from fibrelmp.translate.musen import writer
+    from fibrelmp.translate.musen.mdem.model import MdemReader
+
+    def write(path: Path) -> bytes:
+        reader = MdemReader(BOUNCE)
+        w = writer.MusenResultWriter(reader.read(), path, precision=17)
+        for frame in reader:
+            w.add(frame)
+        w.close()
+        return path.read_bytes()
+
+    whole = write(tmp_path / "whole.txt")
+    monkeypatch.setattr(writer, "_VALUES_PER_CHUNK", 50)           # 2 saves per piece
+    assert writer.long_lines(102, 19, 50) == 2
+    assert write(tmp_path / "pieces.txt") == whole

@@ -70,9 +70,15 @@ def object_header(const: dict[str, bool], oid: int, otype: int, geometry: str, k
     return h
 
 
-def gather_spool(fh: IO[bytes], count: int, width: int, nt: int, rows: np.ndarray) -> np.ndarray:
+def gather_spool(fh: IO[bytes], count: int, width: int, nt: int, rows: np.ndarray,
+                 steps: slice | None = None) -> np.ndarray:
     """(len(rows), nt, width) from a float64 spool laid out (nt, count, width): one read of
-    the row span per save (rows of one type come in id order, so the span is tight)."""
+    the row span per save (rows of one type come in id order, so the span is tight).  With
+    ``steps``, only those saves: (len(rows), saves in steps, width), read through a memory
+    map (a long line's piece; no Python loop over the saves)."""
+    if steps is not None:
+        spool = np.memmap(fh, np.float64, "r", shape=(nt, count, width))
+        return np.ascontiguousarray(spool[steps][:, rows].transpose(1, 0, 2))
     lo, hi = int(rows.min()), int(rows.max()) + 1
     out = np.empty((len(rows), nt, width))
     for k in range(nt):
@@ -91,13 +97,7 @@ def time_point_lines(heads: Sequence[str], fields: Sequence[Field], flags: dict[
     nt = len(times)
     if nt == 0:
         return [h + "\n" for h in heads]
-    cols: list[int] = []
-    tpl, start = f"2 %.{precision}g ", 0
-    for flag, tag, width in fields:
-        if flags[flag]:
-            cols.extend(range(start, start + width))
-            tpl += f"{tag} " + f"%.{precision}g " * width
-        start += width
+    cols, tpl = _time_point_template(fields, flags, precision)
     values = np.empty((len(heads), nt, 1 + len(cols)))
     values[:, :, 0] = times
     if cols:
@@ -105,3 +105,44 @@ def time_point_lines(heads: Sequence[str], fields: Sequence[Field], flags: dict[
     # one C-level % for the whole chunk of objects
     text = ((tpl * nt + "\n") * len(heads)) % tuple(values.ravel().tolist())
     return [h + body + "\n" for h, body in zip(heads, text.split("\n"))]
+
+
+def _time_point_template(fields: Sequence[Field], flags: dict[str, bool],
+                         precision: int) -> tuple[list[int], str]:
+    """(spool columns, %-template of one time point) of the fields ``flags`` selects."""
+    cols: list[int] = []
+    tpl, start = f"2 %.{precision}g ", 0
+    for flag, tag, width in fields:
+        if flags[flag]:
+            cols.extend(range(start, start + width))
+            tpl += f"{tag} " + f"%.{precision}g " * width
+        start += width
+    return cols, tpl
+
+
+def long_lines(nt: int, values_per_save: int, most_values: int) -> int | None:
+    """Saves per piece when even 16 object lines of ``nt`` saves would hold more than
+    ``most_values`` numbers (then lines are written one at a time, in pieces:
+    ``write_long_line``), else None (chunks of whole lines: ``time_point_lines``)."""
+    if 16 * nt * values_per_save <= most_values:
+        return None
+    return max(1, most_values // values_per_save)
+
+
+def write_long_line(out: IO[str], head: str, fields: Sequence[Field], flags: dict[str, bool],
+                    times: Sequence[float], precision: int, piece: int,
+                    values_of: Callable[[list[int], slice], np.ndarray]) -> None:
+    """One object line of ``time_point_lines`` written to ``out`` ``piece`` saves at a time
+    (the same text; memory holds one piece); ``values_of(columns, steps)`` gives the selected
+    spool columns of those saves as (saves, len(columns))."""
+    out.write(head)
+    cols, tpl = _time_point_template(fields, flags, precision)
+    times = np.asarray(times, float)
+    for lo in range(0, len(times), piece):
+        steps = slice(lo, min(len(times), lo + piece))
+        values = np.empty((steps.stop - lo, 1 + len(cols)))
+        values[:, 0] = times[steps]
+        if cols:
+            values[:, 1:] = values_of(cols, steps)
+        out.write((tpl * len(values)) % tuple(values.ravel().tolist()))
+    out.write("\n")

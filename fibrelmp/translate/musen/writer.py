@@ -30,8 +30,8 @@ from fibrelmp.translate.musen.scene import (ACTIVE_INTERACTIONS, ACTIVE_PROPERTI
                                PROPERTY_DEFAULTS)
 from fibrelmp.translate.musen.liquid_bonds import LiquidBondActivity
 from fibrelmp.translate.musen.scene_record import scene_record
-from fibrelmp.translate.musen.text_writer import (export_selectors, gather_spool, object_header, scene_line,
-                                                  time_point_lines)
+from fibrelmp.translate.musen.text_writer import (export_selectors, gather_spool, long_lines, object_header,
+                                                  scene_line, time_point_lines, write_long_line)
 
 # per type: (flag, tag, width) in the exporter's order, and the spooled column block.
 # Spheres: principal stresses (42) and the stress tensor (36) are never written (fibrelmp
@@ -254,6 +254,11 @@ class MusenResultWriter(Writer):
                                    ("w", 0 if m.triangles is None else m.triangles.count, 16)):
             if nt and count:
                 maps[name] = (self.spool / f"{name}.bin", count, width)
+        piece = long_lines(nt, 19, _VALUES_PER_CHUNK)
+        if piece is not None:               # many saves: one line at a time, in pieces
+            for i in range(len(ids)):
+                self._long_line(out, int(types[i]), ids[i:i + 1], rows[i:i + 1], maps, piece)
+            return
         # objects per chunk: about _VALUES_PER_CHUNK numbers in memory whatever the saves
         chunk = max(16, min(_CHUNK, _VALUES_PER_CHUNK // max(1, nt * 19)))
         for lo in range(0, len(ids), chunk):
@@ -277,6 +282,18 @@ class MusenResultWriter(Writer):
 
         return time_point_lines(self._headers(otype, ids, rows), spec, self.sel.get(group, {}),
                                 self.times, self.precision, values_of)
+
+    def _long_line(self, out, otype: int, ids: np.ndarray, rows: np.ndarray, maps, piece: int) -> None:
+        spec, group, name = {1: (_SPHERE, "tdPropsPart", "s"), 9: (_BOND, "tdPropsBond", "b"),
+                             14: (_WALL, "tdPropsWall", "w"), 13: ((), "", "")}[otype]
+
+        def values_of(cols: list[int], steps: slice) -> np.ndarray:
+            path, count, width = maps[name]
+            with open(path, "rb") as fh:
+                return gather_spool(fh, count, width, len(self.times), rows, steps)[0][:, cols]
+
+        write_long_line(out, self._headers(otype, ids, rows)[0], spec, self.sel.get(group, {}),
+                        self.times, self.precision, piece, values_of)
 
     def _headers(self, otype: int, ids: np.ndarray, rows: np.ndarray) -> list[str]:
         m = self.model

@@ -27,8 +27,8 @@ from fibrelmp.translate.musen.mdem import timepoints as tp
 from fibrelmp.translate.musen.mdem.document import MdemFile
 from fibrelmp.translate.musen.mdem.objects import (LIQUID_BOND, SOLID_BOND, SPHERE, WALL, Objects,
                                                    read_objects)
-from fibrelmp.translate.musen.text_writer import (export_selectors, gather_spool, object_header, scene_line,
-                                                  time_point_lines)
+from fibrelmp.translate.musen.text_writer import (export_selectors, gather_spool, long_lines, object_header,
+                                                  scene_line, time_point_lines, write_long_line)
 from fibrelmp.translate.musen.text_writer import number_text as g
 
 # material property ids MUSEN exports (DefinesMDB.h _MUSEN_ACTIVE_PROPERTIES/_INTERACTIONS)
@@ -236,6 +236,18 @@ def _write_objects(out, obj: Objects, index, keep, spools, times, precision: int
     for t, rows in index.items():
         where[rows] = np.arange(len(rows))
     kept = np.flatnonzero(keep)
+    piece = long_lines(nt, 31, _CHUNK_VALUES)
+    if piece is not None:                   # many saves: one line at a time, in pieces
+        for r in kept.tolist():
+            t = int(kinds[r])
+            group, fields = _TEMPLATES[t]
+
+            def piece_of(cols: list[int], steps: slice, t: int = t, r: int = r) -> np.ndarray:
+                return gather_spool(spools[t], len(index[t]), _WIDTH[t], nt, where[[r]], steps)[0][:, cols]
+
+            write_long_line(out, _headers(obj, np.array([r]), t, compounds, sel["constProps"])[0],
+                            fields, sel.get(group, {}), times, int(precision), piece, piece_of)
+        return
     for lo in range(0, len(kept), chunk):
         sl = kept[lo:lo + chunk]
         lines = np.empty(len(sl), dtype=object)

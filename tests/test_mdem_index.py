@@ -292,3 +292,36 @@ def test_result_writer_in_pieces_writes_the_same_text(tmp_path, monkeypatch):
     monkeypatch.setattr(writer, "_VALUES_PER_CHUNK", 50)           # 2 saves per piece
     assert writer.long_lines(102, 19, 50) == 2
     assert write(tmp_path / "pieces.txt") == whole
+
+
+# -- writing: the descriptors of many time points as arrays ----------------------------------
+@needs_c
+@pytest.mark.parametrize("unknown", [False, True], ids=["scene", "scene-with-unknown-field"])
+def test_writer_descriptors_are_what_protobuf_writes(tmp_path, monkeypatch, unknown):
+    """MdemWriter keeps each block's descriptor in arrays and serializes them with the C
+    helper: the file is byte for byte the one protobuf's own serialization gives (times with
+    -0.0 and 0, offsets past 2**32; a scene with an unknown top-level field keeps protobuf's
+    order through protobuf)."""
+    def write(path: Path) -> bytes:
+        with open(path, "w+b") as fh:
+            out = MdemWriter(fh)
+            for k, t in enumerate([-0.0, 0.0, 1e-3, 2.5e-3]):
+                out.add(t, np.full((2, tp.NCOLS), k - 1.5), np.full(2, tp.bit("coord", "force"), np.uint32))
+            out.offsets[-1] += 1 << 33               # a descriptor protobuf writes in 5+ bytes
+            with MdemFile(ONE_GLASS_SPHERE) as scene:
+                storage = new("ProtoSimulationStorage")
+                storage.CopyFrom(scene.scene)
+            if unknown:
+                storage.MergeFromString(b"\xa0\x06\x07")         # field 100, varint 7
+            out.finish(storage)
+        return path.read_bytes()
+
+    used = []
+    real = fast.mdem_put_blocks
+    monkeypatch.setattr(document.fast, "mdem_put_blocks", lambda *a: used.append(1) or real(*a))
+    fast_bytes = write(tmp_path / "c.mdem")
+    assert used == ([] if unknown else [1])
+    monkeypatch.setattr(document.fast, "mdem_put_blocks", lambda *a: None)
+    assert write(tmp_path / "protobuf.mdem") == fast_bytes
+    with MdemFile(ONE_GLASS_SPHERE) as scene:
+        assert document._top_fields(scene.scene.SerializeToString()) == {1, 2}

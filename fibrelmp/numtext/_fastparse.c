@@ -926,3 +926,35 @@ int64_t fp_mdem_blocks(const unsigned char *buf, int64_t len, double *start, int
     if (nspans) *nspans = m;
     return n;
 }
+
+/* Serialize n ProtoBlockDescriptors as field-3 records of a ProtoSimulationStorage, byte for
+   byte as protobuf writes them (fields in number order; a double unless its bits are all
+   zero, an integer unless 0; int32 values sign-extended to 64 bits; format kZippedProtoBuff
+   or the given fmt).  Returns the bytes written, or -1 if cap is too small. */
+int64_t fp_mdem_put_blocks(const double *start, const int64_t *offset, const int64_t *size,
+                           const int64_t *raw, int64_t fmt, int64_t n, unsigned char *out,
+                           int64_t cap)
+{
+    unsigned char *o = out, *end = out + cap;
+    for (int64_t i = 0; i < n; i++) {
+        unsigned char body[64], *b = body;
+        if (nonzero(start[i])) {
+            *b++ = 0x09;
+            memcpy(b, start + i, 8);
+            b += 8;
+        }
+        const int64_t ints[4] = {offset[i], size[i], raw[i], fmt};
+        for (int f = 0; f < 4; f++) {
+            if (!ints[f]) continue;
+            *b++ = (unsigned char)((f + 2) << 3);
+            b = pb_put_varint(b, (uint64_t)ints[f]);
+        }
+        int64_t len = b - body;
+        if (end - o < 2 + len) return -1;
+        *o++ = 0x1a;                    /* field 3, length-delimited */
+        *o++ = (unsigned char)len;      /* < 128 */
+        memcpy(o, body, (size_t)len);
+        o += len;
+    }
+    return (int64_t)(o - out);
+}

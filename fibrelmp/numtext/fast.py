@@ -149,6 +149,8 @@ def _open(lib: Path) -> ctypes.CDLL:
         dll.fp_mdem_encode.restype = i64
         dll.fp_mdem_blocks.argtypes = [ptr, i64, ptr, ptr, i64, ptr, ptr]
         dll.fp_mdem_blocks.restype = i64
+        dll.fp_mdem_put_blocks.argtypes = [ptr, ptr, ptr, ptr, i64, i64, ptr, i64]
+        dll.fp_mdem_put_blocks.restype = i64
     except (OSError, AttributeError) as exc:
         raise _Unavailable(f"cannot load: {exc}") from exc
     # self-check against Python's correctly rounded conversions before trusting it
@@ -494,3 +496,22 @@ def mdem_blocks(raw: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
                                 spans.ctypes.data, ctypes.addressof(nspans)) != n:
         return None
     return start[:n], ints[:, :n], spans[:nspans.value]
+
+
+def mdem_put_blocks(start: np.ndarray, offset: np.ndarray, size: np.ndarray, raw: np.ndarray,
+                    fmt: int) -> bytes | None:
+    """Block descriptors (all of format ``fmt``) serialized as the field-3 records of a
+    ``ProtoSimulationStorage``, as protobuf writes them; None without the C library."""
+    lib = library()
+    if lib is None or sys.byteorder != "little":
+        return None
+    start = np.ascontiguousarray(start, np.float64)
+    offset, size, raw = (np.ascontiguousarray(a, np.int64) for a in (offset, size, raw))
+    n = len(start)
+    cap = 56 * n + 1
+    out = np.empty(cap, np.uint8)
+    written = lib.fp_mdem_put_blocks(start.ctypes.data, offset.ctypes.data, size.ctypes.data,
+                                     raw.ctypes.data, int(fmt), n, out.ctypes.data, cap)
+    if written < 0:
+        raise ValueError("descriptor buffer too small")
+    return out[:written].tobytes()

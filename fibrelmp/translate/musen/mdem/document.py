@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+from array import array
 import zlib
 from dataclasses import dataclass
 from pathlib import Path
@@ -445,40 +446,69 @@ def _cut(raw: bytes, spans: np.ndarray) -> bytes:
 
 class MdemWriter:
     """Writes a new ``.mdem`` to an open binary file: ``add`` time points (each compressed
-    and written at once), then ``finish(storage)`` with the scene message."""
+    and written at once), then ``finish(storage)`` with the scene message.  Memory holds one
+    time point and 32 bytes per time point written (its block descriptor, in arrays)."""
 
     def __init__(self, fh: BinaryIO):
         self.out = ContainerWriter(fh)
         self.out._block(0, 0)              # the scene's first block first, as MUSEN places it
         self.end = 0                       # bytes of time-dependent data written
-        self.blocks: list[tuple[float, int, int, int]] = []   # time, offset, size, raw size
+        # per block: time, offset, stored size, raw size
+        self.times, self.offsets, self.sizes, self.raw_sizes = (array("d"), array("q"), array("q"),
+                                                                 array("q"))
 
     def add(self, time: float, values: np.ndarray, masks: np.ndarray) -> None:
         """One time point (one block, as MUSEN's simulator saves)."""
         block = _field2(timepoints.encode(time, values, masks))   # ProtoBlockOfTimePoints
         packed = zlib.compress(block, _LEVEL)
         self.out.write(1, self.end, packed)
-        self.blocks.append((float(time), self.end, len(packed), len(block)))
+        self.times.append(float(time))
+        self.offsets.append(self.end)
+        self.sizes.append(len(packed))
+        self.raw_sizes.append(len(block))
         self.end += len(packed)
 
     def finish(self, storage: Any) -> None:
         """Write ``storage`` (its block descriptors, saved times and begin/end time are set
         to what ``add`` wrote) and the headers."""
-        if not self.blocks:                                # MUSEN files always have a block
+        if not self.times:                                 # MUSEN files always have a block
             self.add(0.0, np.zeros((0, timepoints.NCOLS)), np.zeros(0, np.uint32))
+        times = np.frombuffer(self.times, float)
         del storage.data_blocks[:]
         info = storage.info
         del info.savedTimePoints[:]
-        for time, offset, size, raw in self.blocks:
-            d = storage.data_blocks.add()
-            d.start_time, d.offset_in_file, d.size, d.uncompressed_size = time, offset, size, raw
-            d.format = ZIPPED
-            info.savedTimePoints.append(time)
-        times = [b[0] for b in self.blocks]
-        info.begin_time = min(0.0, min(times))
-        info.end_time = max(times)
-        self.out.write(0, 0, zlib.compress(storage.SerializeToString(), _LEVEL))
+        info.savedTimePoints.extend(times)
+        info.begin_time = min(0.0, min(self.times))
+        info.end_time = max(self.times)
+        scene = storage.SerializeToString()
+        # the descriptors follow the scene's fields 1 and 2 as protobuf orders them (unless
+        # the scene carries unknown fields, which protobuf writes last: then protobuf)
+        records = (fast.mdem_put_blocks(times, self.offsets, self.sizes, self.raw_sizes, ZIPPED)
+                   if _top_fields(scene) <= {1, 2} else None)
+        if records is None:
+            for d in zip(times.tolist(), self.offsets, self.sizes, self.raw_sizes):
+                storage.data_blocks.add(start_time=d[0], offset_in_file=d[1], size=d[2],
+                                        uncompressed_size=d[3], format=ZIPPED)
+            scene, records = storage.SerializeToString(), b""
+        self.out.write(0, 0, zlib.compress(scene + records, _LEVEL))
         self.out.finish()
+
+
+def _top_fields(message: bytes) -> set[int]:
+    """The field numbers at the top level of a serialized message (a scene: a few records)."""
+    numbers, at = set(), 0
+    while at < len(message):
+        tag, at = _varint(message, at)
+        numbers.add(tag >> 3)
+        wire = tag & 7
+        if wire == 0:
+            _, at = _varint(message, at)
+        elif wire == 2:
+            size, at = _varint(message, at)
+            at += size
+        else:
+            at += {1: 8, 5: 4}.get(wire, len(message))
+    return numbers
 
 
 class _BlockStream:

@@ -222,17 +222,20 @@ def _small(path: Path, saved: list[float] | None) -> Path:
         storage = new("ProtoSimulationStorage")
         for _ in range(2):
             storage.info.particles.add(type=1, encoded_properties=b"\0" * 16)
-        real = out.finish
-
-        def finish(s):
-            real(s)
-            if saved is not None:                   # written again with other saved times
-                del s.info.savedTimePoints[:]
-                s.info.savedTimePoints.extend(saved)
-                out.out.sizes[0] = 0
-                out.out.write(0, 0, zlib.compress(s.SerializeToString(), 1))
-                out.out.finish()
-        finish(storage)
+        out.finish(storage)
+    if saved is not None:                           # written again with other saved times
+        with MdemFile(path) as mdem:
+            storage = mdem.storage
+            blocks = [mdem.block_raw(i) for i in range(len(mdem.blocks))]
+        del storage.info.savedTimePoints[:]
+        storage.info.savedTimePoints.extend(saved)
+        with open(path, "w+b") as fh:
+            w = ContainerWriter(fh)
+            w._block(0, 0)
+            for d, raw in zip(storage.data_blocks, blocks):
+                w.write(1, d.offset_in_file, raw)
+            w.write(0, 0, zlib.compress(storage.SerializeToString(), 1))
+            w.finish()
     return path
 
 

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 import tempfile
+from array import array
 from pathlib import Path
 from typing import IO, Any
 
@@ -186,21 +187,25 @@ def export(mdem: MdemFile, out: IO[str], precision: int = 6,
         saved = mdem.times()
     if time_interval is not None:
         saved = saved[(time_interval[0] <= saved) & (saved <= time_interval[1])]
-    chosen = saved[:times_limit].tolist()
+    chosen = np.asarray(saved[:times_limit], float)
     keep = _filter(obj, sel, chosen)
     index = {t: np.flatnonzero((obj.types == t) & keep) for t in (SPHERE, SOLID_BOND, WALL, LIQUID_BOND)}
     with tempfile.TemporaryDirectory(prefix=".mdem-export.", dir=spool_dir) as tmp:
         spools = {t: open(Path(tmp) / f"{t}.bin", "w+b") for t in _WIDTH if _WIDTH[t]}
-        times: list[float] = []
-        wanted, done = set(chosen), set()          # sets: a million time points stay linear
+        # the chosen times, distinct and sorted, and which were written: arrays, as a
+        # million saves would take ~100 MB of Python floats in sets (NaN is never found)
+        wanted = np.unique(chosen)
+        done = np.zeros(len(wanted), bool)
+        times = array("d")
         try:
             for time, values, _ in mdem.time_points():
-                if time not in wanted or time in done:
+                at = int(np.searchsorted(wanted, time))
+                if at == len(wanted) or wanted[at] != time or done[at]:
                     continue
                 for t, block in td_blocks(obj, values, index).items():
                     spools[t].write(np.ascontiguousarray(block).tobytes())
                 times.append(time)
-                done.add(time)
+                done[at] = True
                 if len(times) == len(wanted):
                     break
             for fh in spools.values():
@@ -210,17 +215,17 @@ def export(mdem: MdemFile, out: IO[str], precision: int = 6,
             for fh in spools.values():
                 fh.close()
     out.write("".join(scene_lines(mdem.scene, sel)))
-    return times
+    return times.tolist()
 
 
-def _filter(obj: Objects, sel: dict, times: list[float]) -> np.ndarray:
+def _filter(obj: Objects, sel: dict, times: np.ndarray) -> np.ndarray:
     """CExportAsText::FilterObjects (type and activity; only when a selector is off)."""
     if all(all(group.values()) for group in sel.values()):
         return np.ones(obj.count, bool)
     kinds = sel["objectTypes"]
     keep = (((obj.types == SPHERE) & kinds["particles"]) | ((obj.types == SOLID_BOND) & kinds["bonds"])
             | ((obj.types == WALL) & kinds["walls"]))
-    if times and any(any(sel[g].values()) for g in ("tdPropsPart", "tdPropsBond", "tdPropsWall")):
+    if len(times) and any(any(sel[g].values()) for g in ("tdPropsPart", "tdPropsBond", "tdPropsWall")):
         keep &= ~((times[-1] < obj.start) | (times[0] > obj.end))
     return keep
 

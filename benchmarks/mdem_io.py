@@ -17,7 +17,7 @@ last one read as ``snapshot`` reads them (``MdemSource``: the scene, the block i
 block), each in its own process, against one pass of the full decode (every time point
 decoded: what finding a frame cost before, once to count the frames and once more up to it).
 
-    python benchmarks/mdem_io.py                      # 100k spheres x 50 saves, 1e6 points (~4 min)
+    python benchmarks/mdem_io.py                      # 100k spheres x 50 saves, 1e6 points (~6 min)
     python benchmarks/mdem_io.py --spheres 20000 --saves 10 --points 100000
     python benchmarks/mdem_io.py --saves 0 --points 1000000     # the frames only
 """

@@ -65,7 +65,7 @@ BENCHES = [
           ["--steps", "100", "--repeat", "1"]),
     Bench("mdem_io", "reading 100k spheres x 50 saves: MUSEN .mdem / MUSEN text (fibrelmp's readers)",
           r"mdem/text read time ratio: ([0-9.]+)", "<= 1.0",
-          ["--spheres", "20000", "--saves", "10", "--few", "5"]),
+          ["--spheres", "20000", "--saves", "10", "--few", "5", "--points", "20000"]),
     Bench("vs_real_codes", "real FibreNet, 2 PoCL threads / best fibrelmp 1|2 ranks (worst of 5k/50k/260k)",
           r"worst FibreNet ratio, real / best fibrelmp: ([0-9.]+)", ">= 1.5", ["--quick", "--repeat", "1"],
           needs="FIBRELMP_FIBRENET"),

@@ -17,7 +17,7 @@ import pytest
 
 from fibrelmp.errors import InputError
 from fibrelmp.numtext import fast
-from fibrelmp.translate.musen.mdem import document
+from fibrelmp.translate.musen.mdem import blockindex, document
 from fibrelmp.translate.musen.mdem import timepoints as tp
 from fibrelmp.translate.musen.mdem.container import ContainerWriter
 from fibrelmp.translate.musen.mdem.document import BlockIndex, MdemFile, MdemWriter
@@ -39,7 +39,7 @@ def _same_point(a, b) -> None:
 
 def _as_protobuf_reads(monkeypatch) -> None:
     """MdemFile without the C scan: the scene message parsed whole by protobuf."""
-    monkeypatch.setattr(document.fast, "mdem_blocks", lambda raw: None)
+    monkeypatch.setattr(document.fast, "mdem_blocks", lambda raw, most: None)
 
 
 @pytest.mark.parametrize("path", MDEM_FILES, ids=lambda p: p.name)
@@ -106,20 +106,22 @@ def test_descriptor_scan_edge_cases_match_protobuf():
     d2 = _descriptor(start_time=1.5, offset_in_file=-7, size=9) + _descriptor(size=11, format=7)
     raw = _field(3, d1) + head + _field(3, d2) + _field(3, b"")
     storage = new("ProtoSimulationStorage", raw)
-    start, ints, spans = fast.mdem_blocks(raw)
+    start, ints, spans = fast.mdem_blocks(raw, 3)
+    with pytest.raises(OverflowError):
+        fast.mdem_blocks(raw, 2)
     want = BlockIndex.of_messages(storage.data_blocks)
     assert start.tobytes() == want.start_time.tobytes()
     assert [list(r) for r in ints] == [list(getattr(want, n)) for n in
                                        ("offset", "size", "uncompressed_size", "format")]
     assert list(ints[1]) == [-5, 11, 0] and ints[0][1] == -7
     assert spans.tolist() == [[0, 2 + len(d1)], [2 + len(d1) + len(head), len(raw)]]
-    rest = document._cut(raw, spans)
+    rest = blockindex.cut(raw, spans)
     assert rest == head
     for odd in (_field(3, d1 + b"\x30\x01"),                 # field 6 in a descriptor
                 _field(3, b"\x09\x01"),                      # start_time cut short
                 b"\x19" + bytes(8),                          # field 3 as a double
                 head[:-1]):                                  # the message cut short
-        assert fast.mdem_blocks(odd) is None
+        assert fast.mdem_blocks(odd, 10) is None
 
 
 # -- a million time points ------------------------------------------------------------------
@@ -328,3 +330,30 @@ def test_writer_descriptors_are_what_protobuf_writes(tmp_path, monkeypatch, unkn
     assert write(tmp_path / "protobuf.mdem") == fast_bytes
     with MdemFile(ONE_GLASS_SPHERE) as scene:
         assert document._top_fields(scene.scene.SerializeToString()) == {1, 2}
+
+
+@pytest.mark.parametrize("scan", [True, False], ids=["c-scan", "protobuf"])
+def test_a_scene_of_millions_of_empty_descriptors_is_refused_before_allocating(tmp_path, monkeypatch,
+                                                                               scan):
+    """10 MB of empty block descriptors zip to 10 kB: the scan counts them against the scene's
+    message budget before it allocates arrays for them (5 million x 40 bytes), as
+    ``count_messages`` does before protobuf parses them."""
+    if scan and fast.library() is None:
+        pytest.skip("the C helpers are not available")
+    if not scan:
+        _as_protobuf_reads(monkeypatch)
+    path = _small(tmp_path / "s.mdem", None)
+    with MdemFile(path) as mdem:
+        storage = mdem.storage
+        blocks = [mdem.block_raw(i) for i in range(len(mdem.blocks))]
+    scene = storage.SerializeToString() + b"\x1a\x00" * 5_000_000
+    with open(path, "w+b") as fh:
+        w = ContainerWriter(fh)
+        w._block(0, 0)
+        for d, raw in zip(storage.data_blocks, blocks):
+            w.write(1, d.offset_in_file, raw)
+        w.write(0, 0, zlib.compress(scene, 9))
+        w.finish()
+    assert path.stat().st_size < 100_000
+    with pytest.raises(InputError, match="lists more than 10.* objects and other entries"):
+        MdemFile(path)

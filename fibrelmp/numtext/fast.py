@@ -474,11 +474,12 @@ def mdem_encode(time: float, values: np.ndarray, masks: np.ndarray) -> bytes | N
     return out[:size].tobytes()
 
 
-def mdem_blocks(raw: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+def mdem_blocks(raw: bytes, most: int) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
     """The block descriptors (field 3) of a serialized ``ProtoSimulationStorage``, as protobuf
     reads them: (start times (k,), integers (4, k): offsets, sizes, uncompressed sizes, formats;
     byte spans (m, 2) of the descriptor records in ``raw``).  None without the C library or
-    when the message holds anything unusual (see fp_mdem_blocks): then parse it with protobuf."""
+    when the message holds anything unusual (see fp_mdem_blocks): then parse it with protobuf.
+    OverflowError, before anything is allocated, if there are more than ``most``."""
     lib = library()
     if lib is None or sys.byteorder != "little":
         return None
@@ -489,6 +490,8 @@ def mdem_blocks(raw: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
     n = lib.fp_mdem_blocks(buf.ctypes.data, len(raw), None, None, 0, None, ctypes.addressof(nspans))
     if n < 0:
         return None
+    if n > most:
+        raise OverflowError(f"{n} block descriptors, more than {most}")
     start = np.zeros(max(n, 1))
     ints = np.zeros((4, max(n, 1)), np.int64)
     spans = np.zeros((max(nspans.value, 1), 2), np.int64)

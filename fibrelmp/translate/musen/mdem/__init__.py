@@ -5,6 +5,7 @@ Layers, bottom up (each module says more):
 * ``container``  the block file (headers, two file threads, blocks of growing size);
 * ``messages``   the protobuf messages, defined from their field numbers;
 * ``document``   ``MdemFile`` (scene message + time points, read lazily) and ``MdemWriter``;
+* ``blockindex`` the block descriptors as arrays, and which block holds time point i;
 * ``timepoints`` time points <-> numpy arrays (a C fast path for large scenes);
 * ``objects``    spheres, bonds and walls of a scene as arrays;
 * ``text_export`` MUSEN text exactly as MUSEN's EXPORT_TO_TEXT writes it;

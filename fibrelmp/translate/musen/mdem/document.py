@@ -1,9 +1,10 @@
 """A MUSEN ``.mdem`` file as a scene message plus a stream of time points.
 
 ``MdemFile`` opens a file: the time-independent ``ProtoSimulationStorage`` (scene, materials,
-geometries, models, block descriptors) is decoded at once; time points are decoded one block
-at a time when asked for, so memory does not grow with their number.  ``copy_to`` writes the
-file back unchanged (same layout, same bytes).
+geometries, models) is decoded at once, its block descriptors into arrays (``BlockIndex``: a
+million time points are a million blocks); time points are decoded one block at a time when
+asked for, all in order or one by number, so memory does not grow with their number beyond
+that index.  ``copy_to`` writes the file back unchanged (same layout, same bytes).
 
 ``MdemWriter`` writes a new file: time points are compressed and written as they come (one
 block each, as MUSEN saves them), the scene message at the end, with the descriptors, saved
@@ -14,9 +15,8 @@ from __future__ import annotations
 
 import contextlib
 import os
-from array import array
 import zlib
-from dataclasses import dataclass
+from array import array
 from pathlib import Path
 from typing import Any, BinaryIO, Iterator
 
@@ -25,6 +25,7 @@ import numpy as np
 from fibrelmp.errors import InputError
 from fibrelmp.numtext import fast
 from fibrelmp.translate.musen.mdem import bounds, timepoints
+from fibrelmp.translate.musen.mdem.blockindex import BlockIndex, PointIndex, cut, distinct
 from fibrelmp.translate.musen.mdem.container import Container, ContainerWriter, Layout
 from fibrelmp.translate.musen.mdem.messages import new
 
@@ -49,28 +50,6 @@ def _inflate(data: bytes, limit: int | None, what: str, path: Path,
     return out
 
 
-@dataclass(frozen=True)
-class BlockIndex:
-    """The file's block descriptors (``ProtoBlockDescriptor``, in file order) as arrays: a
-    million time points cost a few arrays, not a million protobuf messages."""
-
-    start_time: np.ndarray                 # (k,) float64
-    offset: np.ndarray                     # (k,) int64: in the time-dependent file thread
-    size: np.ndarray                       # (k,) int64: stored bytes
-    uncompressed_size: np.ndarray          # (k,) int64
-    format: np.ndarray                     # (k,) int64: PLAIN, ZIPPED (or 0 for empty)
-
-    @classmethod
-    def of_messages(cls, blocks: Any) -> "BlockIndex":
-        """From parsed ``ProtoBlockDescriptor`` messages (the path without the C helpers)."""
-        ints = np.array([(d.offset_in_file, d.size, d.uncompressed_size, d.format) for d in blocks],
-                        np.int64).reshape(-1, 4)
-        return cls(np.array([d.start_time for d in blocks], float), *ints.T)
-
-    def __len__(self) -> int:
-        return len(self.start_time)
-
-
 class MdemFile:
     """An open ``.mdem`` file (use as a context manager, or ``close()``).
 
@@ -83,11 +62,14 @@ class MdemFile:
         self.path = Path(path)
         self.container = Container(self.path)
         self._storage: Any = None
-        self._points: _PointIndex | None = None
+        self._points: PointIndex | None = None
         try:
             stored = self.container.sizes[0]
             raw = self._inflate_scene(self.container.read(0, 0, stored))
-            split = fast.mdem_blocks(raw)
+            try:                            # the count is bounded before arrays are made
+                split = fast.mdem_blocks(raw, bounds.message_budget(stored))
+            except OverflowError:
+                raise self._too_many(stored) from None
             if split is None:               # no C helpers, or an unusual message: protobuf
                 self._check_scene_messages(raw, stored, 0)
                 self._storage = self._parse(raw)
@@ -95,7 +77,7 @@ class MdemFile:
                 self.blocks = BlockIndex.of_messages(self.scene.data_blocks)
             else:
                 start, ints, spans = split
-                raw = _cut(raw, spans)      # memory: the descriptors' bytes are let go
+                raw = cut(raw, spans)      # memory: the descriptors' bytes are let go
                 self._check_scene_messages(raw, stored, len(start))
                 self.scene = self._parse(raw)
                 self.blocks = BlockIndex(start, *ints)
@@ -139,15 +121,18 @@ class MdemFile:
                 raise bounds.TooMany(f"more than {budget} messages")
             bounds.count_messages(raw, "ProtoSimulationStorage", budget - descriptors)
         except bounds.TooMany:
-            raise InputError(self.path, None, f"corrupt .mdem file: the scene (file thread 0, "
-                             f"{stored} bytes stored) lists more than {budget} objects and other "
-                             f"entries, more than a MUSEN file of its size holds (at most "
-                             f"{bounds.MESSAGES_PER_BYTE} per stored byte + "
-                             f"{bounds.MESSAGES_SLACK}; each costs ~80 bytes of memory); "
-                             "refused before allocating them") from None
+            raise self._too_many(stored) from None
         except ValueError as exc:
             raise InputError(self.path, None, f"corrupt .mdem file: the scene message cannot "
                              f"be decoded ({exc})") from None
+
+    def _too_many(self, stored: int) -> InputError:
+        return InputError(self.path, None, f"corrupt .mdem file: the scene (file thread 0, "
+                          f"{stored} bytes stored) lists more than {bounds.message_budget(stored)} "
+                          f"objects and other entries, more than a MUSEN file of its size holds "
+                          f"(at most {bounds.MESSAGES_PER_BYTE} per stored byte + "
+                          f"{bounds.MESSAGES_SLACK}; each costs ~80 bytes of memory); refused "
+                          "before allocating them")
 
     def _check_blocks(self) -> None:
         """Every descriptor checked at once (numpy); the first bad block is reported."""
@@ -171,7 +156,6 @@ class MdemFile:
                                  f"uncompressed size {int(b.uncompressed_size[i])}")
             raise InputError(self.path, None, f"unsupported .mdem file: time-point block {i} "
                              f"has storage format {int(b.format[i])}")
-        self.block_times = b.start_time
         self._block_limits = self._check_block_sizes()
 
     def _check_block_sizes(self) -> np.ndarray:
@@ -182,7 +166,7 @@ class MdemFile:
         b = self.blocks
         entries = len(self.info.particles)
         # distinct: MUSEN writes one time point per time (and one per block)
-        saved = self._saved = _distinct(np.asarray(self.info.savedTimePoints, dtype=float))
+        saved = self._saved = distinct(np.asarray(self.info.savedTimePoints, dtype=float))
         # a block holds the saved times from its start up to the next block's (one where the
         # file lists no saved times)
         # saved times before each block's start (MUSEN: one block per saved time, no search)
@@ -279,7 +263,7 @@ class MdemFile:
 
     def time_point(self, index: int) -> tuple[float, np.ndarray, np.ndarray]:
         """Time point ``index`` (0 <= index < ``count()``), decoding only the block that
-        holds it (see ``_PointIndex``)."""
+        holds it (see ``PointIndex``)."""
         points = self._point_index()
         if not 0 <= index < points.total:
             raise IndexError(f"time point {index} of {points.total}")
@@ -303,9 +287,9 @@ class MdemFile:
                              f"{expected!r} s)")
         return found
 
-    def _point_index(self) -> "_PointIndex":
+    def _point_index(self) -> "PointIndex":
         if self._points is None:
-            self._points = _PointIndex.of_saved_times(self) or _PointIndex.counted(self)
+            self._points = PointIndex.of_saved_times(self) or PointIndex.counted(self)
         return self._points
 
     def _decode(self, payload: bytes) -> tuple[float, np.ndarray, np.ndarray]:
@@ -380,68 +364,6 @@ class MdemFile:
 
     def __exit__(self, *exc) -> None:
         self.close()
-
-
-@dataclass(frozen=True)
-class _PointIndex:
-    """Where each time point lies: block b holds time points first[b] .. first[b + 1] - 1.
-
-    ``of_saved_times``: from the file's saved times (``savedTimePoints``, MUSEN's own list of
-    time points, distinct) and the blocks' start times, without reading a block -- when they
-    agree as MUSEN writes them (each block starts at a saved time; times increase): time
-    point i is then the one saved at time i, as MUSEN numbers them.  The block read for it is
-    checked (its number of time points, the time found) and a disagreement is an InputError
-    (a file whose blocks hold other time points than its saved times list).  Else
-    ``counted``: every block's time points counted (read through, not decoded), the numbering
-    of ``time_points()``, as slow as reading them all."""
-
-    first: np.ndarray              # (blocks + 1,) int64
-    times: np.ndarray | None       # (total,) the saved times (None when counted)
-    counted: bool
-
-    @property
-    def total(self) -> int:
-        return int(self.first[-1])
-
-    def held(self, block: int) -> int:
-        return int(self.first[block + 1] - self.first[block])
-
-    @classmethod
-    def of_saved_times(cls, mdem: MdemFile) -> "_PointIndex | None":
-        saved, starts = mdem._saved, mdem.blocks.start_time
-        if not saved.size or not np.isfinite(saved).all() or not np.isfinite(starts).all() \
-                or (np.diff(starts) <= 0).any():
-            return None
-        first = mdem._saved_before
-        if first[0] != 0 or first[-1] >= len(saved) or (saved[first] != starts).any():
-            return None
-        return cls(np.append(first, len(saved)).astype(np.int64), saved, False)
-
-    @classmethod
-    def counted(cls, mdem: MdemFile) -> "_PointIndex":
-        held = np.zeros(len(mdem.blocks), np.int64)
-        for index in range(len(mdem.blocks)):
-            with mdem._block_errors(index):
-                held[index] = sum(1 for _ in mdem._point_payloads(index))
-        return cls(np.concatenate([[0], np.cumsum(held)]).astype(np.int64), None, True)
-
-
-def _distinct(times: np.ndarray) -> np.ndarray:
-    """The distinct values of ``times``, sorted (without sorting what already is)."""
-    return times if (np.diff(times) > 0).all() else np.unique(times)
-
-
-def _cut(raw: bytes, spans: np.ndarray) -> bytes:
-    """``raw`` without the byte ranges ``spans`` (sorted, disjoint)."""
-    if not len(spans):
-        return raw
-    parts, at = [], 0
-    with memoryview(raw) as view:
-        for start, end in spans.tolist():
-            parts.append(view[at:start])
-            at = end
-        parts.append(view[at:])
-        return b"".join(parts)
 
 
 class MdemWriter:

@@ -72,9 +72,9 @@ class MdemFile:
                 raise self._too_many(stored) from None
             if split is None:               # no C helpers, or an unusual message: protobuf
                 self._check_scene_messages(raw, stored, 0)
-                self._storage = self._parse(raw)
-                self.scene: Any = self._storage
+                self.scene: Any = self._parse(raw)
                 self.blocks = BlockIndex.of_messages(self.scene.data_blocks)
+                self.scene.ClearField("data_blocks")       # as the scan leaves it
             else:
                 start, ints, spans = split
                 raw = cut(raw, spans)      # memory: the descriptors' bytes are let go

@@ -34,7 +34,9 @@ PW = ("pw_heat_transfer", "pwh", "ModelPWHeatTransfer WALL_TEMPERATURE 1000 "
 # ModelPWHeatTransfer as the only PW model: walls without force that still heat (as cmusen)
 PW_ALONE = ("pw_heat_transfer", "pwa", PW[2])
 SB = ("sb_heat_conduction", "sbh", "ModelSBHeatConduction CONDUCTION_SCALING_FACTOR 1.5")
-CASES = {"pp": PP, "pw": PW, "pw_alone": PW_ALONE, "sb": SB}
+# ModelEFHeatTransfer together with ModelPPHeatConduction: one flux, EF first, one update
+EF_PP = ("ef_pp_heat", "efph", "ModelEFHeatTransfer AIR_TEMPERATURE_INIT 500")
+CASES = {"pp": PP, "pw": PW, "pw_alone": PW_ALONE, "sb": SB, "ef_pp": EF_PP}
 
 
 def _run(tmp_path: Path, case: str, params: str | None = None) -> Path:
@@ -136,6 +138,7 @@ def test_without_the_heat_model_temperatures_stay(tmp_path):
 
 
 @pytest.mark.parametrize("folder, prefix, every", [(PP[0], PP[1], 170), (SB[0], SB[1], 1050),
+                                                   (EF_PP[0], EF_PP[1], 170),
                                                    ("sb_thermal", "sbt", 1050)])
 def test_checkpoint_and_resume_give_the_uninterrupted_run(tmp_path, monkeypatch, folder, prefix,
                                                           every):
@@ -172,16 +175,37 @@ def test_lmp_replays_the_run_bitwise(tmp_path):
     assert (replay / "frames.dump").read_bytes() == (ran / "frames.dump").read_bytes()
 
 
-def test_with_the_air_heat_model_is_refused(tmp_path):
-    """fix musen/field heat and fix musen/heat would both update the temperature: refused."""
+def test_air_and_contact_heat_add_into_one_flux(tmp_path):
+    """ModelEFHeatTransfer with ModelPPHeatConduction (models/ef_pp_heat): fix musen/heat owns
+    the flux, fix musen/field heat (defined after it) adds the air's first, the contact law
+    then; the far sphere (no contact) follows the air alone, the touching ones both.  Against
+    cmusen in test_temperatures_and_motion_are_cmusens; here: the far sphere's temperatures
+    are MUSEN's air law in numpy (half a step at t = 0, then a full step per step), and the
+    touching spheres moved further from that law than the contact alone explains."""
     styles_or_skip()
-    folder, prefix, params = PP
-    job = model_job(tmp_path, MODELS / folder, prefix, params)
-    job.write_text(job.read_text().replace("SIMULATION_STEP", "MODEL_EF             "
-                                           "ModelEFHeatTransfer\nSIMULATION_STEP"))
-    with pytest.raises(InputError, match="ModelPPHeatConduction together with "
-                                         "ModelEFHeatTransfer is not supported"):
-        python_api.run(job, work=tmp_path / "work")
+    ours = read_time_points(_run(tmp_path, "ef_pp"))
+    script = (tmp_path / "work" / "job2" / "in.lammps").read_text()
+    assert script.count("musen/heat cp") == 1
+    assert script.index("musen/heat cp") < script.index("musen/field heat")
+    mc = _scene_heat_capacity("ef_pp")
+    radius, dt = 5e-4, 1e-6
+
+    def air_flux(temp: float, t: float) -> float:
+        air = 800.0 if t > 2e-4 else 500.0 + t * (800.0 - 500.0) / 2e-4
+        surface = math.pi * radius ** 2
+        return 1.2 * (2e4 * surface * (air - temp) + 1e-7 * surface * (air ** 4 - temp ** 4))
+    temp = 700.0 + air_flux(700.0, 0.0) / mc[2] * dt / 2
+    expected = [700.0]
+    for k in range(400):
+        temp = temp + air_flux(temp, k * dt) / mc[2] * dt
+        if (k + 1) % 20 == 0:
+            expected.append(temp)
+    got = ours.fields[TEMPERATURE][:, 2, 0]
+    np.testing.assert_allclose(got, expected, rtol=1e-12)
+    assert got[-1] - got[0] > 10
+    alone = read_time_points(MODELS / PP[0] / "cmusen_phc_result_prec17.txt").fields[TEMPERATURE]
+    # the air moves the touching spheres by tens of K more than the contact alone
+    assert np.abs(ours.fields[TEMPERATURE][-1, :2, 0] - alone[-1, :2, 0]).min() > 50
 
 
 def test_thermal_bond_is_cmusens(tmp_path):

@@ -139,6 +139,7 @@ def test_without_the_heat_model_temperatures_stay(tmp_path):
 
 @pytest.mark.parametrize("folder, prefix, every", [(PP[0], PP[1], 170), (SB[0], SB[1], 1050),
                                                    (EF_PP[0], EF_PP[1], 170),
+                                                   ("sb_thermal_break", "sbtb", 300),
                                                    ("sb_thermal", "sbt", 1050)])
 def test_checkpoint_and_resume_give_the_uninterrupted_run(tmp_path, monkeypatch, folder, prefix,
                                                           every):
@@ -226,6 +227,46 @@ def test_thermal_bond_is_cmusens(tmp_path):
     assert gap[-1] > 1.03 * gap[0]
     script = (tmp_path / "work" / "job2" / "in.lammps").read_text()
     assert "musen/elastic breakage 1 thermal 100.0 0.5 2.0" in script
+
+
+def test_thermal_bond_breaks_as_in_cmusen(tmp_path):
+    """ModelSBThermal with ModelSBHeatConduction (models/sb_thermal_break): the bond's rest
+    length grows at THERM_DIFF alpha = 200 /s (MUSEN's 'thermal' rule: the strength does not
+    depend on temperature), the spheres at rest lag behind, overshoot into tension and the bond
+    breaks in its first tension, at cmusen's time to the step (4.47e-5 s); heat flows from
+    the hot sphere to the cold one until then and stops.  Positions, velocities, temperatures
+    at every saved time within 1e-6 of scale (measured: positions and temperatures bit for
+    bit, velocities 3e-15)."""
+    from fibrelmp.translate.musen.scene import read
+    styles_or_skip()
+    folder, prefix = "sb_thermal_break", "sbtb"
+    python_api.run(model_job(tmp_path, MODELS / folder, prefix, ""), work=tmp_path / "work")
+    script = (tmp_path / "work" / "job2" / "in.lammps").read_text()
+    assert "thermal 100.0 0.1 2.0" in script and "heat 0 1.5 10.0" in script
+    ours_path = tmp_path / f"{prefix}_result_prec17.txt"
+    theirs_path = MODELS / folder / f"cmusen_{prefix}_result_prec17.txt"
+    ours, theirs = read_time_points(ours_path), read_time_points(theirs_path)
+    np.testing.assert_allclose(ours.times, theirs.times, rtol=1e-12, atol=0)
+    x0 = theirs.fields[COORD][0, :2]
+    for tag in (COORD, VEL, TEMPERATURE):
+        a, b = ours.fields[tag][:, :2], theirs.fields[tag][:, :2]
+        if tag == COORD:     # of the displacement
+            a, b = a - x0, b - x0
+        np.testing.assert_allclose(a, b, rtol=0, atol=1e-6 * np.abs(b).max())
+    end = read(theirs_path).bonds.active_end
+    assert np.array_equal(end, [4.47e-5])       # the case is what its README says
+    assert np.array_equal(read(ours_path).bonds.active_end, end)
+    temp = theirs.fields[TEMPERATURE][:, :2, 0]
+    broken = theirs.times > end[0]
+    assert np.all(temp[broken] == temp[broken][0]) and temp[0, 0] - temp[broken][0, 0] > 20
+    # the bond was in tension when it broke: the spheres fly apart at a constant speed
+    gap = np.diff(theirs.fields[COORD][:, :2, 0], axis=1)[:, 0]
+    assert gap[-1] > 0.8e-3 * 1.02 and np.allclose(np.diff(gap[broken]), np.diff(gap[broken])[0])
+
+
+@needs_cmusen
+def test_thermal_break_reference_is_cmusens_output(tmp_path):
+    check_reference_is_cmusens_output(tmp_path, MODELS / "sb_thermal_break", "sbtb")
 
 
 @needs_cmusen

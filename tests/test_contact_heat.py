@@ -393,3 +393,29 @@ def test_cost_per_contact_against_hertz_mindlin(plugin_path):
 def test_reference_is_cmusens_output(tmp_path, case):
     folder, prefix, _ = CASES[case]
     check_reference_is_cmusens_output(tmp_path, MODELS / folder, prefix)
+
+
+@pytest.mark.parametrize("fixes, message", [
+    (["fix air all musen/field heat 500 800 1 1e4 0 1"], "needs one fix musen/heat"),
+    (["fix air all musen/field heat 500 800 1 1e4 0 1", "fix heat all musen/heat cp 10"],
+     "must be defined after fix musen/heat"),
+    (["fix heat all musen/heat cp 10", "pair_style musen/hm then heat/conduction 1.5 0.3 0.01 0.03",
+      "pair_coeff * * 2.6e7 1e7 0.7 0.3 0.05"], "needs the conductivities"),
+])
+def test_the_flux_owner_is_required_before_its_contributors(plugin_path, fixes, message):
+    """fix musen/heat clears the flux in its pre_force: an EF heat fix defined before it would
+    have its flux cleared (LAMMPS calls pre_force in definition order), so that is an error, as
+    is a heat field without the owner and a contact heat law without the conductivities."""
+    lmp = new_lammps(["-log", "none", "-screen", "none", "-nocite"])
+    try:
+        for c in [f"plugin load {plugin_path}", "units si", "atom_style sphere", "boundary f f f",
+                  "comm_modify vel yes", "fix fl_t all property/atom d_musen_temperature ghost yes",
+                  "region box block -0.01 0.01 -0.01 0.01 -0.01 0.01", "create_box 1 box",
+                  "create_atoms 1 single 0 0 0", "set atom 1 diameter 1e-3 density 2500",
+                  "pair_style musen/hm", "pair_coeff * * 2.6e7 1e7 0.7 0.3 0.05", *fixes,
+                  "timestep 1e-6"]:
+            lmp.command(c)
+        with pytest.raises(Exception, match=message):
+            lmp.command("run 1 post no")
+    finally:
+        lmp.close()

@@ -1,20 +1,25 @@
 """What every MUSEN model's test module shares (tests/test_<kind>_<model>.py): its case in
 tests/data/real-outputs/musen/models/<model>/ (``<prefix>_scene.txt``, the cmusen job script
 ``job_<prefix>.txt`` and cmusen's 17-digit result ``cmusen_<prefix>_result_prec17.txt``), the
-job with other parameters, the opt-in rerun of the real cmusen, and the refusal without
-fibrelmp's LAMMPS styles."""
+job with other parameters, the comparison with cmusen's result at every saved time, the opt-in
+rerun of the real cmusen, the refusal without fibrelmp's LAMMPS styles, and the bitwise checks
+of a checkpointed and resumed run and of the ``lmp -in`` replay."""
 
 from __future__ import annotations
 
 import os
 import shutil
 import subprocess
+import sys
+from collections.abc import Callable, Mapping
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from fibrelmp import lammps_styles, python_api
 from fibrelmp.errors import InputError
+from fibrelmp.translate.musen.text import TimePoints, read_time_points
 
 CMUSEN = os.environ.get("FIBRELMP_CMUSEN")
 needs_cmusen = pytest.mark.skipif(not CMUSEN, reason="set FIBRELMP_CMUSEN to the real cmusen")
@@ -33,6 +38,36 @@ def model_job(tmp_path: Path, data: Path, prefix: str, params: str, new_params: 
     job = (data / f"job_{prefix}.txt").read_text()
     (tmp_path / f"job_{prefix}.txt").write_text(job if new_params is None else job.replace(params, new_params))
     return tmp_path / f"job_{prefix}.txt"
+
+
+def check_result_is_cmusens(ours: Path, theirs: Path, scales: Mapping[int, float | None],
+                            rel: float = 1e-6, rows: slice | list[int] | np.ndarray = slice(None),
+                            ) -> tuple[TimePoints, TimePoints]:
+    """fibrelmp's text result ``ours`` has the time points (to 1e-12) and objects of cmusen's
+    17-digit result ``theirs``, and at every time point each field (MUSEN tag) of ``scales``
+    of the objects ``rows`` is within ``rel`` of its scale of cmusen's: the scale given, or
+    for None the largest magnitude of cmusen's values there.  Returns both results read."""
+    ours_points, theirs_points = read_time_points(ours), read_time_points(theirs)
+    np.testing.assert_allclose(ours_points.times, theirs_points.times, rtol=1e-12, atol=0)
+    assert np.array_equal(ours_points.ids, theirs_points.ids)
+    for tag, scale in scales.items():
+        want = theirs_points.fields[tag][:, rows]
+        bar = np.abs(want).max() if scale is None else scale
+        np.testing.assert_allclose(ours_points.fields[tag][:, rows], want, rtol=0, atol=rel * bar)
+    return ours_points, theirs_points
+
+
+def check_run_is_cmusens(tmp_path: Path, job: Path, data: Path, prefix: str, lammps_line: str,
+                         scales: Mapping[int, float | None], rel: float = 1e-6,
+                         rows: slice | list[int] | np.ndarray = slice(None),
+                         ) -> tuple[TimePoints, TimePoints]:
+    """Run ``job`` (staged in ``tmp_path``, work folder ``tmp_path/work``): the rendered
+    LAMMPS script holds ``lammps_line`` and the result is cmusen's
+    ``data/cmusen_<prefix>_result_prec17.txt`` as :func:`check_result_is_cmusens` says."""
+    python_api.run(job, work=tmp_path / "work")
+    assert lammps_line in (tmp_path / "work" / "job2" / "in.lammps").read_text()
+    return check_result_is_cmusens(tmp_path / f"{prefix}_result_prec17.txt",
+                                   data / f"cmusen_{prefix}_result_prec17.txt", scales, rel, rows)
 
 
 def check_reference_is_cmusens_output(tmp_path: Path, data: Path, prefix: str,
@@ -74,3 +109,42 @@ def run_cut_and_resumed(monkeypatch: pytest.MonkeyPatch, job: Path, work: Path, 
         python_api.run(job, work=work, checkpoint_every=every)
     monkeypatch.setattr(checkpoint.Checkpointing, "write", write)
     python_api.run(job, work=work, resume=True)
+
+
+def check_resume_is_bitwise(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                            make_job: Callable[[Path], Path], results: str | tuple[str, ...],
+                            every: int) -> Path:
+    """The job ``make_job(folder)`` stages in a folder, run whole in ``tmp_path/whole`` and
+    cut after its first checkpoint (every ``every`` steps) and resumed in ``tmp_path/cut``,
+    writes each of ``results`` (files next to the job) byte for byte the same.  Returns the
+    whole run's folder."""
+    styles_or_skip()
+    whole, cut = tmp_path / "whole", tmp_path / "cut"
+    whole.mkdir()
+    cut.mkdir()
+    python_api.run(make_job(whole), work=whole / "work")
+    run_cut_and_resumed(monkeypatch, make_job(cut), cut / "work", every)
+    for name in (results,) if isinstance(results, str) else results:
+        assert (cut / name).read_bytes() == (whole / name).read_bytes(), name
+    return whole
+
+
+def check_lmp_replay_is_bitwise(tmp_path: Path, make_job: Callable[[Path], Path]) -> None:
+    """The job ``make_job(tmp_path)`` stages, run by fibrelmp, then its rendered job folder
+    run again by the wheel's ``lmp`` executable (``lmp -in in.lammps``): the same frames
+    dump, byte for byte."""
+    from fibrelmp._lammps import lmp_executable_env
+
+    styles_or_skip()
+    lmp = Path(sys.executable).parent / "lmp"
+    if not lmp.exists():
+        pytest.skip(f"no lmp executable next to {sys.executable}")
+    python_api.run(make_job(tmp_path), work=tmp_path / "work")
+    ran, replay = tmp_path / "work" / "job2", tmp_path / "replay"
+    shutil.copytree(ran, replay)
+    (replay / "frames.dump").unlink()
+    proc = subprocess.run([str(lmp), "-in", "in.lammps", "-log", "none", "-screen", "none", "-nocite"],
+                          cwd=replay, env=lmp_executable_env(), capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert (replay / "frames.dump").read_bytes() == (ran / "frames.dump").read_bytes()

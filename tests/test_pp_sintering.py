@@ -21,8 +21,8 @@ from fibrelmp.translate.musen.text import read_time_points
 
 from .conftest import data_path
 from .musen_model_checks import (ANGVEL, COORD, VEL, check_reference_is_cmusens_output,
-                                 check_refused_without_styles, model_job, needs_cmusen,
-                                 run_cut_and_resumed, styles_or_skip)
+                                 check_refused_without_styles, check_resume_is_bitwise,
+                                 check_run_is_cmusens, model_job, needs_cmusen, styles_or_skip)
 
 DATA = data_path("real-outputs/musen/models/pp_sintering")
 PARAMS = "MODEL_PP_PARAMS      DIFFUSION 1e-12 VISCOUS_PARAMETER 0.01"
@@ -35,16 +35,10 @@ def _job(tmp_path: Path, new_params: str | None = None) -> Path:
 
 def test_sintering_pair_is_cmusens(tmp_path):
     styles_or_skip()
-    python_api.run(_job(tmp_path), work=tmp_path / "work")
-    ours = read_time_points(tmp_path / "sinter_result_prec17.txt")
-    theirs = read_time_points(DATA / "cmusen_sinter_result_prec17.txt")
-    np.testing.assert_allclose(ours.times, theirs.times, rtol=1e-12, atol=0)
-    assert np.array_equal(ours.ids, theirs.ids)
-    assert "pair_style      musen/sintering 1e-12 0.01 0.5" in \
-        (tmp_path / "work" / "job2" / "in.lammps").read_text()
     # 1e-6 of each quantity's scale (measured: 7e-16 of the velocity scale)
-    for tag, scale in ((COORD, 1e-3), (VEL, 1e-2), (ANGVEL, 20.0)):
-        np.testing.assert_allclose(ours.fields[tag], theirs.fields[tag], rtol=0, atol=1e-6 * scale)
+    check_run_is_cmusens(tmp_path, _job(tmp_path), DATA, "sinter",
+                         "pair_style      musen/sintering 1e-12 0.01 0.5",
+                         {COORD: 1e-3, VEL: 1e-2, ANGVEL: 20.0})
 
 
 def test_the_reference_tells_sintering_from_hertz_mindlin():
@@ -200,11 +194,4 @@ def test_refused_without_fibrelmps_styles(tmp_path):
 
 
 def test_checkpointed_and_resumed_run_is_bitwise_the_same(tmp_path, monkeypatch):
-    styles_or_skip()
-    (tmp_path / "whole").mkdir()
-    python_api.run(_job(tmp_path / "whole"), work=tmp_path / "whole" / "work")
-    cut = tmp_path / "cut"
-    cut.mkdir()
-    run_cut_and_resumed(monkeypatch, _job(cut), cut / "work", 2010)
-    assert (cut / "sinter_result_prec17.txt").read_bytes() == \
-        (tmp_path / "whole" / "sinter_result_prec17.txt").read_bytes()
+    check_resume_is_bitwise(tmp_path, monkeypatch, _job, "sinter_result_prec17.txt", 2010)

@@ -22,8 +22,8 @@ from fibrelmp.errors import InputError, RunError
 from fibrelmp.translate.musen.scene import read, read_time_points
 
 from .conftest import data_path
-from .musen_model_checks import (CMUSEN, check_refused_without_styles, needs_cmusen,
-                                 run_cut_and_resumed, styles_or_skip)
+from .musen_model_checks import (CMUSEN, check_refused_without_styles, check_resume_is_bitwise,
+                                 needs_cmusen, styles_or_skip)
 
 MODELS = data_path("real-outputs", "musen", "models")
 TAGS = (12, 15, 16)    # position, velocity, angular velocity
@@ -129,14 +129,8 @@ def test_checkpoint_and_resume_keep_the_plastic_state(tmp_path, monkeypatch):
     """The plastic strain and last normal stress are in the bond's history (restart file): a
     creep run stopped after a checkpoint while the bonds are yielded and creeping, then
     resumed, writes the uninterrupted run's result byte for byte."""
-    styles_or_skip()
-    (tmp_path / "whole").mkdir()
-    python_api.run(_case_folder(tmp_path / "whole", "creep"), work=tmp_path / "whole" / "work")
-    cut = tmp_path / "cut"
-    cut.mkdir()
-    run_cut_and_resumed(monkeypatch, _case_folder(cut, "creep"), cut / "work", 1503)
-    assert ((cut / "creep_result_prec17.txt").read_bytes()
-            == (tmp_path / "whole" / "creep_result_prec17.txt").read_bytes())
+    check_resume_is_bitwise(tmp_path, monkeypatch, lambda at: _case_folder(at, "creep"),
+                            "creep_result_prec17.txt", 1503)
 
 
 @pytest.mark.parametrize("params,word", [

@@ -10,7 +10,6 @@ from __future__ import annotations
 import math
 import shutil
 import subprocess
-import time
 from pathlib import Path
 
 import numpy as np
@@ -25,7 +24,8 @@ from .conftest import data_path
 from .musen_model_checks import (ANGVEL, CMUSEN, COORD, VEL, check_lmp_replay_is_bitwise,
                                  check_reference_is_cmusens_output, check_refused_without_styles,
                                  check_result_is_cmusens, check_resume_is_bitwise,
-                                 check_run_is_cmusens, model_job, needs_cmusen, styles_or_skip)
+                                 check_run_is_cmusens, model_job, needs_cmusen,
+                                 print_per_contact_cost, styles_or_skip)
 
 DATA = data_path("real-outputs/musen/models/pp_sintering_temperature")
 PARAMS = ("MODEL_PP_PARAMS      GRAINBOUND_DIFFUSION 1.3e-8 VISCOUS_PARAMETER 0.01 ATOMIC_VOLUME "
@@ -225,27 +225,12 @@ def test_per_contact_cost_against_hertz_mindlin():
     """A rough figure, printed (pytest -s): the same dense packing with musen/hm and this law."""
     styles_or_skip()
     words = " ".join(repr(LAW[k]) for k in ("db", "eta", "omega", "q", "tmin", "cmax", "gamma"))
-    seconds = {}
-    for style in ("musen/hm", f"musen/pp sintering/temperature {words}"):
-        lmp = new_lammps(["-log", "none", "-screen", "none", "-nocite"])
-        try:
-            for c in [f"plugin load {lammps_styles.plugin().path}", "units si", "atom_style sphere",
-                      "boundary p p p", "newton off", "comm_modify vel yes",
-                      "fix temps all property/atom d_musen_temperature",
-                      "lattice sc 0.00199", "region box block 0 12 0 12 0 12", "create_box 1 box",
-                      "create_atoms 1 box", f"set group all diameter {2e-3!r} density {RHO!r}",
-                      "set group all d_musen_temperature 500.0",
-                      "velocity all create 1e-9 4 loop geom",
-                      f"pair_style {style}", f"pair_coeff 1 1 {E_STAR} {G_STAR} {REST} {MU} {MU_R}",
-                      "neighbor 0.0005 bin", f"timestep {DT!r}", "fix integrate all nve/sphere",
-                      "run 0 post no"]:
-                lmp.command(c)
-            start = time.perf_counter()
-            lmp.command("run 200 post no")
-            seconds[" ".join(style.split()[:2])] = time.perf_counter() - start
-        finally:
-            lmp.close()
-    print("seconds for 200 steps, 1728 spheres, ~5000 contacts:", seconds)
+    print_per_contact_cost({"musen/hm": "musen/hm",
+                            "musen/pp sintering/temperature": f"musen/pp sintering/temperature {words}"},
+                           f"{E_STAR} {G_STAR} {REST} {MU} {MU_R}", RHO, DT,
+                           before_box=("fix temps all property/atom d_musen_temperature",),
+                           after_atoms=("set group all d_musen_temperature 500.0",
+                                        "velocity all create 1e-9 4 loop geom"))
 
 
 @pytest.mark.parametrize("new_params,match", [

@@ -92,6 +92,19 @@ def check_refused_without_styles(job: Path, model: str, line: int, init: Path) -
     assert not init.exists()
 
 
+def check_other_contact_radius_is_refused(job: Path, scene: Path, line: int, contact_radius: str,
+                                          count: int = 1) -> None:
+    """The first ``count`` (-1: every) sphere of radius 1 mm in ``scene`` given the contact
+    radius ``contact_radius``: the law cannot hold it (a LAMMPS sphere has one radius), an
+    InputError at the job's model line ``line``."""
+    text = scene.read_text()
+    assert "5 0.001 0.001 23" in text
+    scene.write_text(text.replace("5 0.001 0.001 23", f"5 0.001 {contact_radius} 23", count))
+    with pytest.raises(InputError, match="contact radius equals their radius") as err:
+        python_api.run(job)
+    assert str(err.value).startswith(f"{job}:{line}: ")
+
+
 def run_cut_and_resumed(monkeypatch: pytest.MonkeyPatch, job: Path, work: Path, every: int) -> None:
     """Run ``job`` with a checkpoint every ``every`` steps, stopped after its first checkpoint
     (as if SIGTERM came), then resumed to the end."""

@@ -18,8 +18,8 @@ from fibrelmp.translate.musen.scene import read
 from fibrelmp.translate.musen.text import read_time_points
 
 from .conftest import data_path
-from .musen_model_checks import (check_reference_is_cmusens_output, check_resume_is_bitwise, model_job,
-                                 needs_cmusen, styles_or_skip)
+from .musen_model_checks import (check_reference_is_cmusens_output, check_resume_is_bitwise,
+                                 model_job, needs_cmusen, styles_or_skip)
 
 DATA = data_path("real-outputs/musen/force_walls")
 COORD, VEL, FORCE, WALL = 12, 15, 20, 44       # MUSEN text tags

@@ -27,8 +27,8 @@ from fibrelmp.translate.musen.scene_record import scene_record
 from fibrelmp.translate.musen.text import read_time_points
 
 from .conftest import data_path
-from .musen_model_checks import (ANGVEL, COORD, VEL, check_refused_without_styles, check_resume_is_bitwise,
-                                 needs_cmusen, styles_or_skip)
+from .musen_model_checks import (ANGVEL, COORD, VEL, check_refused_without_styles,
+                                 check_resume_is_bitwise, needs_cmusen, styles_or_skip)
 
 DATA = data_path("real-outputs/musen/several_models")
 # each case's source: a text scene, or a .mdem whose model list names a model twice (MUSEN

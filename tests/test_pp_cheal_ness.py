@@ -12,9 +12,9 @@ from fibrelmp import python_api
 from fibrelmp.errors import InputError
 
 from .conftest import data_path
-from .musen_model_checks import (ANGVEL, COORD, VEL, check_reference_is_cmusens_output,
-                                 check_refused_without_styles, check_result_is_cmusens, model_job,
-                                 needs_cmusen, styles_or_skip)
+from .musen_model_checks import (ANGVEL, COORD, VEL, check_other_contact_radius_is_refused,
+                                 check_reference_is_cmusens_output, check_refused_without_styles,
+                                 check_result_is_cmusens, model_job, needs_cmusen, styles_or_skip)
 
 DATA = data_path("real-outputs/musen/models/pp_cheal_ness")
 HERTZ = data_path("real-outputs/musen/models/pp_hertz_mindlin_liquid/"
@@ -48,12 +48,7 @@ def test_non_positive_min_thickness_is_refused(tmp_path):
 def test_contact_radius_other_than_radius_is_refused(tmp_path):
     """There cmusen's lubrication acts between the contact radii; LAMMPS holds one radius."""
     styles_or_skip()
-    job = _job(tmp_path)
-    scene = tmp_path / "cn_scene.txt"
-    scene.write_text(scene.read_text().replace("5 0.001 0.001 23", "5 0.001 0.0012 23"))
-    with pytest.raises(InputError, match="contact radius equals their radius") as err:
-        python_api.run(job)
-    assert str(err.value).startswith(f"{job}:10: ")
+    check_other_contact_radius_is_refused(_job(tmp_path), tmp_path / "cn_scene.txt", 10, "0.0012", -1)
 
 
 @needs_cmusen

@@ -18,10 +18,10 @@ from fibrelmp.translate.musen.text import read_time_points
 
 from .conftest import data_path
 from .musen_model_checks import (ANGVEL, COORD, VEL, check_lmp_replay_is_bitwise,
+                                 check_other_contact_radius_is_refused,
                                  check_reference_is_cmusens_output, check_refused_without_styles,
                                  check_resume_is_bitwise, check_run_is_cmusens, model_job,
-                                 needs_cmusen, pair_contact, print_per_contact_cost,
-                                 styles_or_skip)
+                                 needs_cmusen, pair_contact, print_per_contact_cost, styles_or_skip)
 
 DATA = data_path("real-outputs/musen/models/pp_hertz_mindlin_liquid")
 PARAMS = "MIN_THICKNESS 2e-5 CONTACT_ANGLE 20 SURFACE_TENSION 0.7 DYNAMIC_VISCOSITY 0.001"
@@ -160,12 +160,7 @@ def test_bad_parameters_are_input_errors(tmp_path, params, word):
 
 def test_contact_radius_other_than_radius_is_refused(tmp_path):
     styles_or_skip()
-    job = _job(tmp_path)
-    scene = tmp_path / "liq_scene.txt"
-    scene.write_text(scene.read_text().replace("5 0.001 0.001 23", "5 0.001 0.0012 23", 1))
-    with pytest.raises(InputError, match="contact radius equals their radius") as err:
-        python_api.run(job)
-    assert str(err.value).startswith(f"{job}:10: ")
+    check_other_contact_radius_is_refused(_job(tmp_path), tmp_path / "liq_scene.txt", 10, "0.0012")
 
 
 @needs_cmusen

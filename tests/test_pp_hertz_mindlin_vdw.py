@@ -20,8 +20,7 @@ from .conftest import data_path
 from .musen_model_checks import (ANGVEL, COORD, VEL, check_lmp_replay_is_bitwise,
                                  check_reference_is_cmusens_output, check_refused_without_styles,
                                  check_resume_is_bitwise, check_run_is_cmusens, model_job,
-                                 needs_cmusen, pair_contact, print_per_contact_cost,
-                                 styles_or_skip)
+                                 needs_cmusen, pair_contact, print_per_contact_cost, styles_or_skip)
 
 DATA = data_path("real-outputs/musen/models/pp_hertz_mindlin_vdw")
 SCENE_MATERIAL = "11 0.5 12"      # the surface energy in the scene's material line

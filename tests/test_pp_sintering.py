@@ -18,10 +18,10 @@ from fibrelmp.errors import InputError
 from fibrelmp.translate.musen.text import read_time_points
 
 from .conftest import data_path
-from .musen_model_checks import (ANGVEL, COORD, VEL, check_reference_is_cmusens_output,
-                                 check_refused_without_styles, check_resume_is_bitwise,
-                                 check_run_is_cmusens, model_job, needs_cmusen, pair_contact,
-                                 print_per_contact_cost, styles_or_skip)
+from .musen_model_checks import (ANGVEL, COORD, VEL, check_other_contact_radius_is_refused,
+                                 check_reference_is_cmusens_output, check_refused_without_styles,
+                                 check_resume_is_bitwise, check_run_is_cmusens, model_job,
+                                 needs_cmusen, pair_contact, print_per_contact_cost, styles_or_skip)
 
 DATA = data_path("real-outputs/musen/models/pp_sintering")
 PARAMS = "MODEL_PP_PARAMS      DIFFUSION 1e-12 VISCOUS_PARAMETER 0.01"
@@ -134,12 +134,7 @@ def test_bad_parameters_are_refused(tmp_path, new_params, match):
 
 def test_other_contact_radius_is_refused(tmp_path):
     styles_or_skip()
-    job = _job(tmp_path)
-    scene = tmp_path / "sinter_scene.txt"
-    scene.write_text(scene.read_text().replace("5 0.001 0.001 23", "5 0.001 0.0011 23", 1))
-    with pytest.raises(InputError, match="contact radius equals their radius") as err:
-        python_api.run(job)
-    assert str(err.value).startswith(f"{job}:{MODEL_LINE}: ")
+    check_other_contact_radius_is_refused(_job(tmp_path), tmp_path / "sinter_scene.txt", MODEL_LINE, "0.0011")
 
 
 @needs_cmusen

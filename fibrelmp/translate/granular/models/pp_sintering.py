@@ -17,27 +17,10 @@ from fibrelmp.errors import InputError
 from fibrelmp.granmodel import GranularModel
 from fibrelmp.lammps_text import LammpsText
 from fibrelmp.translate.granular.models import PhysicsModel, register
-from fibrelmp.translate.granular.models.pp_hertz_mindlin_vdw import (GAMMA, SURFACE_ENERGY,
-                                                                    check_one_radius,
-                                                                    equivalent_surface_energies)
+from fibrelmp.translate.granular.models.pp_hertz_mindlin_vdw import (GAMMA, check_one_radius,
+                                                                    equivalent_surface_energies,
+                                                                    one_surface_energy)
 from fibrelmp.translate.lammps_format import float_text
-
-
-def one_surface_energy(model: GranularModel, name: str, path: Path | str | None,
-                       line: int | None) -> float:
-    """The sphere materials' one equivalent surface energy sqrt(gamma1 gamma2); refused when
-    material pairs differ (the law takes one value)."""
-    energies = equivalent_surface_energies(model)
-    if len(energies) > 1:
-        raise InputError(path, line, f"{name}: the sphere materials' surface energies (property "
-                         f"{SURFACE_ENERGY}) give different equivalent energies per material "
-                         "pair; fibrelmp's law takes one value, so it translates the model only "
-                         "for sphere materials of equal surface energy")
-    gamma = next(iter(energies), 0.0)
-    if not (gamma >= 0 and math.isfinite(gamma)):
-        raise InputError(path, line, f"{name}: the sphere materials' surface energy must be "
-                         f">= 0 in J/m2 (got {gamma:g})")
-    return gamma
 
 
 @register

@@ -18,8 +18,8 @@ from fibrelmp.granmodel import GranularModel
 from fibrelmp.lammps_text import LammpsText
 from fibrelmp.translate.granular.models import PhysicsModel, register
 from fibrelmp.translate.granular.models.pp_hertz_mindlin_vdw import (GAMMA, check_one_radius,
-                                                                    equivalent_surface_energies)
-from fibrelmp.translate.granular.models.pp_sintering import one_surface_energy
+                                                                    equivalent_surface_energies,
+                                                                    one_surface_energy)
 from fibrelmp.translate.lammps_format import float_text
 
 NAMES = ("GRAINBOUND_DIFFUSION", "VISCOUS_PARAMETER", "ATOMIC_VOLUME", "ACTIVATION_ENERGY",

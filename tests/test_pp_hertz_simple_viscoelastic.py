@@ -28,7 +28,7 @@ from .conftest import data_path
 from .musen_model_checks import (ANGVEL, COORD, VEL, check_reference_is_cmusens_output,
                                  check_refused_without_styles, check_result_is_cmusens, model_job,
                                  needs_cmusen, styles_or_skip)
-from .test_style_musen_pair import HOLD, STEPS, gathered, persistent_lammps, plugin_or_skip
+from .test_style_musen_pair import check_restart_round_trip, persistent_lammps, plugin_or_skip
 
 HERTZ = data_path("real-outputs/musen/models/pp_hertz")
 SVE = data_path("real-outputs/musen/models/pp_simple_viscoelastic")
@@ -198,27 +198,7 @@ def test_hertz_only_as_the_only_law():
                                    "hertz/mindlin"])
 def test_restart_keeps_the_first_law(tmp_path, style):
     """write_restart mid-contact; a new LAMMPS reading it continues bit for bit."""
-    plugin = plugin_or_skip()
-    restart = tmp_path / "mid.restart"
-    lmp = persistent_lammps(plugin, style=style)
-    try:
-        lmp.command(f"run {STEPS // 2} post no")
-        lmp.command(f"write_restart {restart}")
-        lmp.command(f"run {STEPS // 2} post no")
-        straight = gathered(lmp)
-    finally:
-        lmp.close()
-    lmp = new_lammps(["-log", "none", "-screen", "none", "-nocite"])
-    try:
-        for c in [f"plugin load {plugin}", f"read_restart {restart}", "comm_modify vel yes",
-                  "neighbor 0.0005 bin", "neigh_modify every 1 delay 0 check yes",
-                  "fix integrate all nve/sphere", *HOLD[2:], f"run {STEPS // 2} post no"]:
-            lmp.command(c)
-        again = gathered(lmp)
-    finally:
-        lmp.close()
-    for name in ("x", "v", "omega"):
-        assert straight[name] == again[name], name
+    check_restart_round_trip(tmp_path, style)
 
 
 def test_cost_per_contact_vs_hertz_mindlin(tmp_path):

@@ -249,3 +249,34 @@ def check_translated_job_replays_bitwise(tmp_path: Path, job: Path, dumps: tuple
     assert done.returncode == 0, done.stdout + done.stderr
     for dump in dumps:
         assert (tmp_path / "job" / dump).read_bytes() == (tmp_path / "work" / "job2" / dump).read_bytes()
+
+
+def sphere_differences(theirs: Path, ours: Path, tags: tuple[int, ...],
+                       times_rtol: float = 0.0) -> dict[int, float]:
+    """The largest difference of each quantity (MUSEN tag of ``tags``) of the spheres (type 1)
+    of ``ours`` from cmusen's result ``theirs`` over every saved time, as a fraction of its
+    scale (the largest magnitude of cmusen's values; positions (12): of the largest
+    displacement); the saved times agree within ``times_rtol`` (0: exactly)."""
+    real = read_time_points(theirs, tags=tags)
+    mine = read_time_points(ours, tags=tags)
+    np.testing.assert_allclose(mine.times, real.times, rtol=times_rtol, atol=0)
+    spheres = real.types == 1
+    out = {}
+    for tag in tags:
+        r = np.array([f[spheres] for f in real.fields[tag]])
+        o = np.array([f[spheres] for f in mine.fields[tag]])
+        if tag == COORD:
+            r, o = r - r[0], o - o[0]
+        out[tag] = float(np.abs(o - r).max() / np.abs(r).max())
+    return out
+
+
+def bond_ends(path: Path) -> dict[str, float]:
+    """Each solid bond's activity end in a MUSEN text result (object id -> time; MUSEN writes
+    a broken bond's break time there)."""
+    ends = {}
+    for line in path.read_text().splitlines():
+        w = line.split()
+        if len(w) > 3 and w[0] == "0" and w[3] == "9":
+            ends[w[1]] = float(w[w.index("24") + 2])
+    return ends

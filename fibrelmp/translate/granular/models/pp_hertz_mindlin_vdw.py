@@ -68,12 +68,11 @@ def one_surface_energy(model: GranularModel, name: str, path: Path | str | None,
     return gamma
 
 
-@register
-class PPHertzMindlinVdW(PhysicsModel):
-    name = "ModelPPHertzMindlinVdW"
-    kind = "PP"
-    mdem_key = "B18A46C2786D4D44B925A8V04D0D1008"
-    needs_styles = "pair_style musen/vdw"
+class SurfaceEnergyModel(PhysicsModel):
+    """What the PP laws of the sphere materials' surface energy share (ModelPPHertzMindlinVdW,
+    ModelPPSintering, ModelPPSinteringTemperature; not a MUSEN model itself: unregistered):
+    spheres whose contact radius is their radius, one equivalent surface energy, which
+    ``with_scene`` adds to the parameters as GAMMA."""
 
     @classmethod
     def read_parameters(cls, text: str, path: Path | str | None, line: int | None,
@@ -86,6 +85,14 @@ class PPHertzMindlinVdW(PhysicsModel):
     @classmethod
     def with_scene(cls, model: GranularModel, params: dict[str, float]) -> dict[str, float]:
         return {**params, GAMMA: next(iter(equivalent_surface_energies(model)), 0.0)}
+
+
+@register
+class PPHertzMindlinVdW(SurfaceEnergyModel):
+    name = "ModelPPHertzMindlinVdW"
+    kind = "PP"
+    mdem_key = "B18A46C2786D4D44B925A8V04D0D1008"
+    needs_styles = "pair_style musen/vdw"
 
     @classmethod
     def pair_style_lines(cls, params: dict[str, float], own_styles: bool) -> list[str]:

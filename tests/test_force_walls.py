@@ -18,8 +18,8 @@ from fibrelmp.translate.musen.scene import read
 from fibrelmp.translate.musen.text import read_time_points
 
 from .conftest import data_path
-from .musen_model_checks import (check_reference_is_cmusens_output, needs_cmusen, run_cut_and_resumed,
-                                 styles_or_skip)
+from .musen_model_checks import (check_reference_is_cmusens_output, check_resume_is_bitwise,
+                                 model_job, needs_cmusen, styles_or_skip)
 
 DATA = data_path("real-outputs/musen/force_walls")
 COORD, VEL, FORCE, WALL = 12, 15, 20, 44       # MUSEN text tags
@@ -152,23 +152,12 @@ def test_saved_wall_force_is_the_previous_steps(tmp_path):
                                rtol=0, atol=1e-12 * np.max(np.abs(force)))
 
 
-def _result_bytes(folder: Path) -> bytes:
-    return (folder / "press_result_prec17.txt").read_bytes()
-
-
 def test_checkpoint_and_resume_give_the_uninterrupted_run(tmp_path, monkeypatch):
     """The stepped state (interval, velocities, vertices) goes through LAMMPS's restart file:
     a run stopped after a checkpoint taken while the plate presses, then resumed, writes the
     uninterrupted run's result byte for byte."""
-    styles_or_skip()
-    (tmp_path / "whole").mkdir()
-    _run(tmp_path / "whole", "press")
-    cut = tmp_path / "cut"
-    cut.mkdir()
-    shutil.copy(DATA / "press_scene.txt", cut)
-    shutil.copy(DATA / "job_press.txt", cut)
-    run_cut_and_resumed(monkeypatch, cut / "job_press.txt", cut / "work", 2290)
-    assert _result_bytes(cut) == _result_bytes(tmp_path / "whole")
+    check_resume_is_bitwise(tmp_path, monkeypatch, lambda at: model_job(at, DATA, "press", ""),
+                            "press_result_prec17.txt", 2290)
 
 
 def test_free_lid_starts_with_its_walls_velocity(tmp_path):

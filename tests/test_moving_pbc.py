@@ -16,7 +16,7 @@ from fibrelmp.translate.musen.mdem.model import read_scene
 from fibrelmp.translate.musen.text import read_time_points
 
 from .conftest import data_path
-from .musen_model_checks import CMUSEN, needs_cmusen, run_cut_and_resumed, styles_or_skip
+from .musen_model_checks import CMUSEN, check_resume_is_bitwise, needs_cmusen, styles_or_skip
 
 DATA = data_path("real-outputs/musen/moving_pbc")
 COORD, VEL, ANGVEL = 12, 15, 16
@@ -83,11 +83,4 @@ def test_reference_is_cmusens_output(tmp_path):
 
 def test_checkpoint_and_resume_give_the_uninterrupted_run(tmp_path, monkeypatch):
     """The box of the checkpoint's time and the box at t = 0 go through the restart file."""
-    styles_or_skip()
-    (tmp_path / "whole").mkdir()
-    python_api.run(_job(tmp_path / "whole"), work=tmp_path / "whole" / "work")
-    cut = tmp_path / "cut"
-    cut.mkdir()
-    run_cut_and_resumed(monkeypatch, _job(cut), cut / "work", 1700)
-    assert (cut / "pbc_result_prec17.txt").read_bytes() == \
-        (tmp_path / "whole" / "pbc_result_prec17.txt").read_bytes()
+    check_resume_is_bitwise(tmp_path, monkeypatch, _job, "pbc_result_prec17.txt", 1700)

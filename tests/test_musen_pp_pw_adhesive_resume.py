@@ -5,18 +5,10 @@ tests/test_pp_hertz_simple_viscoelastic.py, test_pp_jkr.py, test_pw_jkr.py)."""
 
 from __future__ import annotations
 
-import shutil
-import subprocess
-import sys
-from pathlib import Path
-
 import pytest
 
-from fibrelmp import python_api
-from fibrelmp._lammps import lmp_executable_env
-
 from .conftest import data_path
-from .musen_model_checks import model_job, run_cut_and_resumed, styles_or_skip
+from .musen_model_checks import check_lmp_replay_is_bitwise, check_resume_is_bitwise, model_job
 
 MODELS = data_path("real-outputs/musen/models")
 # (folder, prefix, a checkpoint step inside a contact)
@@ -32,30 +24,11 @@ IDS = [c[1] for c in CASES]
 @pytest.mark.parametrize("folder,prefix,every", CASES, ids=IDS)
 def test_checkpointed_and_resumed_run_is_bitwise_the_same(tmp_path, monkeypatch, folder, prefix,
                                                           every):
-    styles_or_skip()
-    whole, cut = tmp_path / "whole", tmp_path / "cut"
-    whole.mkdir()
-    cut.mkdir()
-    python_api.run(model_job(whole, MODELS / folder, prefix, ""), work=whole / "work")
-    run_cut_and_resumed(monkeypatch, model_job(cut, MODELS / folder, prefix, ""), cut / "work",
-                        every)
-    name = f"{prefix}_result_prec17.txt"
-    assert (cut / name).read_bytes() == (whole / name).read_bytes()
+    check_resume_is_bitwise(tmp_path, monkeypatch, lambda at: model_job(at, MODELS / folder, prefix, ""),
+                            f"{prefix}_result_prec17.txt", every)
 
 
 @pytest.mark.parametrize("folder,prefix,every", CASES, ids=IDS)
 def test_lmp_replays_the_run_bitwise(tmp_path, folder, prefix, every):
     """The rendered job, run by the wheel's ``lmp`` executable, writes the same frames."""
-    styles_or_skip()
-    lmp = Path(sys.executable).parent / "lmp"
-    if not lmp.exists():
-        pytest.skip(f"no lmp executable next to {sys.executable}")
-    python_api.run(model_job(tmp_path, MODELS / folder, prefix, ""), work=tmp_path / "work")
-    ran, replay = tmp_path / "work" / "job2", tmp_path / "replay"
-    shutil.copytree(ran, replay)
-    (replay / "frames.dump").unlink()
-    proc = subprocess.run([str(lmp), "-in", "in.lammps", "-log", "none", "-screen", "none",
-                           "-nocite"], cwd=replay, env=lmp_executable_env(), capture_output=True,
-                          text=True, timeout=300)
-    assert proc.returncode == 0, proc.stdout + proc.stderr
-    assert (replay / "frames.dump").read_bytes() == (ran / "frames.dump").read_bytes()
+    check_lmp_replay_is_bitwise(tmp_path, lambda at: model_job(at, MODELS / folder, prefix, ""))

@@ -20,6 +20,7 @@ import pytest
 from fibrelmp.translate.musen.scene import read, read_time_points
 
 from .conftest import data_path
+from .musen_model_checks import sphere_differences
 
 CASE = data_path("real-outputs", "musen", "several_bond_models")
 JOB = "job_kelvin_elastic.txt"
@@ -34,23 +35,6 @@ def _run_fibrelmp(folder, job_text: str | None = None) -> None:
     done = subprocess.run([sys.executable, "-m", "fibrelmp.cli", "--quiet", "run", JOB],
                           cwd=folder, capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
-
-
-def _differences(real_path, ours_path) -> dict[int, float]:
-    """The largest difference of each quantity over every saved time, as a fraction of its
-    scale (positions: of the largest displacement)."""
-    real = read_time_points(real_path, tags=TAGS)
-    ours = read_time_points(ours_path, tags=TAGS)
-    assert ours.times.tolist() == real.times.tolist()
-    spheres = real.types == 1
-    out = {}
-    for tag in TAGS:
-        r = np.array([f[spheres] for f in real.fields[tag]])
-        o = np.array([f[spheres] for f in ours.fields[tag]])
-        if tag == 12:
-            r, o = r - r[0], o - o[0]
-        out[tag] = float(np.abs(o - r).max() / np.abs(r).max())
-    return out
 
 
 @pytest.fixture(scope="module")
@@ -72,7 +56,7 @@ def test_kelvin_then_elastic_matches_cmusen_at_every_saved_time(tmp_path, real_r
     _run_fibrelmp(tmp_path)
     script = next(tmp_path.glob("*_work/job2/in.lammps")).read_text()
     assert "musen/elastic breakage 1 kelvin 0.3 then elastic 2 " in script
-    diffs = _differences(real_result, tmp_path / RESULT)
+    diffs = sphere_differences(real_result, tmp_path / RESULT, TAGS)
     assert all(d < 1e-6 for d in diffs.values()), diffs
     # the same bond breaks at the same step (its activity end is cmusen's time of that step)
     real_end = read(real_result).bonds.active_end
@@ -88,7 +72,7 @@ def test_one_bond_model_alone_is_far_from_cmusen(tmp_path, real_result):
     text = text.replace("MODEL_SB             ModelSBElastic\n", "")
     text = text.replace("MODEL_PARAMS         ModelSBElastic CONSIDER_BREAKAGE 2\n", "")
     _run_fibrelmp(tmp_path, text)
-    diffs = _differences(real_result, tmp_path / RESULT)
+    diffs = sphere_differences(real_result, tmp_path / RESULT, TAGS)
     assert min(diffs.values()) > 0.1, diffs
 
 

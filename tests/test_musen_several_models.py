@@ -27,8 +27,8 @@ from fibrelmp.translate.musen.scene_record import scene_record
 from fibrelmp.translate.musen.text import read_time_points
 
 from .conftest import data_path
-from .musen_model_checks import (ANGVEL, COORD, VEL, check_refused_without_styles, needs_cmusen,
-                                 run_cut_and_resumed, styles_or_skip)
+from .musen_model_checks import (ANGVEL, COORD, VEL, check_refused_without_styles,
+                                 check_resume_is_bitwise, needs_cmusen, styles_or_skip)
 
 DATA = data_path("real-outputs/musen/several_models")
 # each case's source: a text scene, or a .mdem whose model list names a model twice (MUSEN
@@ -91,14 +91,8 @@ def test_several_models_act_as_in_cmusen(tmp_path, case):
 # near 1250): the law lists and the shared tangential overlap survive the restart
 @pytest.mark.parametrize("case,every", [("hm_le", 1560), ("pw_hm_sve", 1300)])
 def test_checkpointed_and_resumed_run_is_bitwise_the_same(tmp_path, monkeypatch, case, every):
-    styles_or_skip()
-    (tmp_path / "whole").mkdir()
-    python_api.run(_staged(tmp_path / "whole", case), work=tmp_path / "whole" / "work")
-    cut = tmp_path / "cut"
-    cut.mkdir()
-    run_cut_and_resumed(monkeypatch, _staged(cut, case), cut / "work", every)
-    assert (cut / f"{case}_result_prec17.txt").read_bytes() == \
-        (tmp_path / "whole" / f"{case}_result_prec17.txt").read_bytes()
+    check_resume_is_bitwise(tmp_path, monkeypatch, lambda at: _staged(at, case), f"{case}_result_prec17.txt",
+                            every)
 
 
 def test_the_references_tell_the_laws_and_their_order_apart():

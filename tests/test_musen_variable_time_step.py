@@ -28,6 +28,7 @@ from fibrelmp.translate.musen.text import TimePoints, read_time_points
 
 from .conftest import data_path
 from .musen_model_checks import CMUSEN, needs_cmusen, styles_or_skip
+from .test_checkpoint import _RUNS      # the CLI runs, each stopped at its K-th stop check
 
 DATA = data_path("real-outputs/musen/variable_time_step")
 COORD, VEL, ANGVEL, WALL = 12, 15, 16, 44
@@ -204,30 +205,6 @@ def test_stop_criterion_as_cmusen(tmp_path):
     for tag in (COORD, VEL):
         scale = np.max(np.abs(theirs.fields[tag][:, :5]))
         assert np.max(np.abs(ours.fields[tag][:, :5] - theirs.fields[tag][:, :5])) <= 1e-12 * scale
-
-
-# Runs the CLI once per argument list in one process and prints the exit codes; a run given a
-# K stops (as on SIGTERM) when its K-th run command asks whether to stop (test_checkpoint.py)
-_RUNS = """\
-import json, signal, sys
-from fibrelmp import checkpoint
-from fibrelmp.cli import main
-asked = checkpoint.Checkpointing.stop_requested
-codes = []
-for args, k in {runs!r}:
-    calls = [0]
-    def stop_requested(self, size, calls=calls, k=k):
-        calls[0] += 1
-        return signal.SIGTERM if calls[0] == k else asked(self, size)
-    checkpoint.Checkpointing.stop_requested = stop_requested
-    sys.argv = ["fibrelmp"] + args
-    try:
-        main()
-        codes.append(0)
-    except SystemExit as exc:
-        codes.append(exc.code or 0)
-print(json.dumps(codes))
-"""
 
 
 def test_checkpoint_and_resume_give_the_same_files(tmp_path):

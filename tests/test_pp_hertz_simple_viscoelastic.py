@@ -26,9 +26,9 @@ from fibrelmp.translate.musen.text import read_time_points
 
 from .conftest import data_path
 from .musen_model_checks import (ANGVEL, COORD, VEL, check_reference_is_cmusens_output,
-                                 check_refused_without_styles, model_job, needs_cmusen,
-                                 styles_or_skip)
-from .test_style_musen_pair import HOLD, STEPS, gathered, persistent_lammps, plugin_or_skip
+                                 check_refused_without_styles, check_result_is_cmusens, model_job,
+                                 needs_cmusen, styles_or_skip)
+from .test_style_musen_pair import check_restart_round_trip, persistent_lammps, plugin_or_skip
 
 HERTZ = data_path("real-outputs/musen/models/pp_hertz")
 SVE = data_path("real-outputs/musen/models/pp_simple_viscoelastic")
@@ -38,18 +38,13 @@ SVE_PARAMS = "NORMAL_FORCE_COEFF 2000 NORMAL_DAMPING_PARAMETER 0.02"
 def _compare(tmp_path: Path, data: Path, prefix: str, params: str) -> None:
     job = model_job(tmp_path, data, prefix, params)
     python_api.run(job, work=tmp_path / "work")
-    ours = read_time_points(tmp_path / f"{prefix}_result_prec17.txt")
-    theirs = read_time_points(data / f"cmusen_{prefix}_result_prec17.txt")
-    np.testing.assert_allclose(ours.times, theirs.times, rtol=1e-12, atol=0)
-    assert np.array_equal(ours.ids, theirs.ids)
+    # 1e-6 of each quantity's scale is the project's bar; measured: 0 (hertz), <= 3e-16 (sve)
+    _, theirs = check_result_is_cmusens(tmp_path / f"{prefix}_result_prec17.txt",
+                                        data / f"cmusen_{prefix}_result_prec17.txt",
+                                        dict.fromkeys((COORD, VEL, ANGVEL)), rel=1e-12)
     # the impact happened: the spheres' velocities changed clearly
     v0, v1 = theirs.fields[VEL][0], theirs.fields[VEL][-1]
     assert np.linalg.norm(v1 - v0, axis=1).min() > 0.05
-    # 1e-6 of each quantity's scale is the project's bar; measured: 0 (hertz), <= 3e-16 (sve)
-    for field in (COORD, VEL, ANGVEL):
-        scale = np.abs(theirs.fields[field]).max()
-        np.testing.assert_allclose(ours.fields[field], theirs.fields[field], rtol=0,
-                                   atol=1e-12 * scale)
 
 
 def test_hertz_impact_is_cmusens(tmp_path):
@@ -203,27 +198,7 @@ def test_hertz_only_as_the_only_law():
                                    "hertz/mindlin"])
 def test_restart_keeps_the_first_law(tmp_path, style):
     """write_restart mid-contact; a new LAMMPS reading it continues bit for bit."""
-    plugin = plugin_or_skip()
-    restart = tmp_path / "mid.restart"
-    lmp = persistent_lammps(plugin, style=style)
-    try:
-        lmp.command(f"run {STEPS // 2} post no")
-        lmp.command(f"write_restart {restart}")
-        lmp.command(f"run {STEPS // 2} post no")
-        straight = gathered(lmp)
-    finally:
-        lmp.close()
-    lmp = new_lammps(["-log", "none", "-screen", "none", "-nocite"])
-    try:
-        for c in [f"plugin load {plugin}", f"read_restart {restart}", "comm_modify vel yes",
-                  "neighbor 0.0005 bin", "neigh_modify every 1 delay 0 check yes",
-                  "fix integrate all nve/sphere", *HOLD[2:], f"run {STEPS // 2} post no"]:
-            lmp.command(c)
-        again = gathered(lmp)
-    finally:
-        lmp.close()
-    for name in ("x", "v", "omega"):
-        assert straight[name] == again[name], name
+    check_restart_round_trip(tmp_path, style)
 
 
 def test_cost_per_contact_vs_hertz_mindlin(tmp_path):

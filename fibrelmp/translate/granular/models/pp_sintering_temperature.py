@@ -16,10 +16,8 @@ from pathlib import Path
 from fibrelmp.errors import InputError
 from fibrelmp.granmodel import GranularModel
 from fibrelmp.lammps_text import LammpsText
-from fibrelmp.translate.granular.models import PhysicsModel, register
-from fibrelmp.translate.granular.models.pp_hertz_mindlin_vdw import (GAMMA, check_one_radius,
-                                                                    equivalent_surface_energies)
-from fibrelmp.translate.granular.models.pp_sintering import one_surface_energy
+from fibrelmp.translate.granular.models import register
+from fibrelmp.translate.granular.models.pp_hertz_mindlin_vdw import GAMMA, SurfaceEnergyModel
 from fibrelmp.translate.lammps_format import float_text
 
 NAMES = ("GRAINBOUND_DIFFUSION", "VISCOUS_PARAMETER", "ATOMIC_VOLUME", "ACTIVATION_ENERGY",
@@ -27,7 +25,7 @@ NAMES = ("GRAINBOUND_DIFFUSION", "VISCOUS_PARAMETER", "ATOMIC_VOLUME", "ACTIVATI
 
 
 @register
-class PPSinteringTemperature(PhysicsModel):
+class PPSinteringTemperature(SurfaceEnergyModel):
     name = "ModelPPSinteringTemperature"
     kind = "PP"
     mdem_key = "A41AB40D3A074FE9AAE0B0ADB27XBFBA"
@@ -41,9 +39,7 @@ class PPSinteringTemperature(PhysicsModel):
     @classmethod
     def read_parameters(cls, text: str, path: Path | str | None, line: int | None,
                         model: GranularModel) -> dict[str, float]:
-        params = super().read_parameters(text, path, line, model)
-        check_one_radius(model, cls.name, path, line)
-        one_surface_energy(model, cls.name, path, line)
+        params = super().read_parameters(text, path, line, model)      # radius, surface energy
         for key in NAMES:
             if not math.isfinite(params[key]):
                 raise InputError(path, line, f"{cls.name} parameter {key} must be finite")
@@ -54,10 +50,6 @@ class PPSinteringTemperature(PhysicsModel):
         if not params["MAX_OVERLAP_COEFF"] >= 0:
             raise InputError(path, line, f"{cls.name} parameter MAX_OVERLAP_COEFF must be >= 0")
         return params
-
-    @classmethod
-    def with_scene(cls, model: GranularModel, params: dict[str, float]) -> dict[str, float]:
-        return {**params, GAMMA: next(iter(equivalent_surface_energies(model)), 0.0)}
 
     @classmethod
     def pair_style_lines(cls, params: dict[str, float], own_styles: bool) -> list[str]:

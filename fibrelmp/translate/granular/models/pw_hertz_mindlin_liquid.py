@@ -9,34 +9,16 @@ contact point (about the radius, not the gap), kept as MUSEN has it."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
-from fibrelmp.granmodel import GranularModel, GranularPlan
-from fibrelmp.translate.granular.models import PhysicsModel, register
-from fibrelmp.translate.granular.models.pp_hertz_mindlin_liquid import (
-    ETA, HMIN, SIGMA, THETA, check_liquid_parameters, law_words)
-from fibrelmp.translate.granular.models.pp_hertz_mindlin_vdw import check_one_radius
+from fibrelmp.translate.granular.models import register
+from fibrelmp.translate.granular.models.pp_hertz_mindlin_liquid import LiquidBridgeModel, law_words
 
 
 @register
-class PWHertzMindlinLiquid(PhysicsModel):
+class PWHertzMindlinLiquid(LiquidBridgeModel):
     name = "ModelPWHertzMindlinLiquid"
     kind = "PW"
     mdem_key = "906949ACFFAE4B8C8B1B62209930EA6D"
-    parameters = {HMIN: 1e-5, THETA: 70.0, SIGMA: 0.7, ETA: 0.1}
     needs_styles = "fix musen/wall/mesh law hertz/mindlin/liquid"
-
-    @classmethod
-    def read_parameters(cls, text: str, path: Path | str | None, line: int | None,
-                        model: GranularModel) -> dict[str, float]:
-        params = super().read_parameters(text, path, line, model)
-        check_one_radius(model, cls.name, path, line)
-        return params
-
-    @classmethod
-    def apply(cls, plan: GranularPlan, params: dict[str, float], path: Path | str | None,
-              line: int | None) -> None:
-        check_liquid_parameters(cls.name, params, path, line)
 
     @classmethod
     def mesh_law_words(cls, params: dict[str, float]) -> str:

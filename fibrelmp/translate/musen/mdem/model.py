@@ -126,7 +126,7 @@ class MdemReader(Reader):
     """A ``.mdem`` file through the abstract Reader: ``read()`` the scene (``read_scene``),
     iterating its saved time points as ``GranularFrame``s, one block in memory at a time
     (spheres and bonds with an empty entry, MUSEN's mark of inactive objects, are absent /
-    not alive); ``frames_of`` gives the frames of an open file by number."""
+    not alive); ``MdemFrames`` gives the frames of an open file by number."""
 
     format = "mdem"
     what = "MUSEN .mdem file"
@@ -163,7 +163,7 @@ class MdemFrames:
         return self.frame(index, *self.mdem.time_point(index))
 
     def frame(self, step: int, time: float, values: np.ndarray, masks: np.ndarray) -> GranularFrame:
-        from fibrelmp.translate.musen.mdem.timepoints import columns
+        from fibrelmp.translate.musen.mdem.timepoints import bit, columns
 
         spheres, bonds, walls = self.spheres, self.bonds, self.walls
         q = columns("quaternion").start
@@ -175,6 +175,10 @@ class MdemFrames:
                               position=v[:, columns("coord")], velocity=v[:, columns("vel")],
                               omega=v[:, columns("angle_vel")], force=v[:, columns("force")],
                               quaternion=v[:, columns("quaternion")])
+        saved = masks[spheres[live]]
+        if len(live) and np.all(saved & bit("temperature")):
+            # MUSEN saves temperatures when a heat model ran
+            frame.temperature = v[:, columns("temperature").start].copy()
         if len(bonds):
             b = np.zeros((len(bonds), values.shape[1]))
             inside = bonds < n

@@ -47,4 +47,4 @@ class MdemSource(Source):
 
     def _scene_frame(self, i: int, f) -> SceneFrame:
         return musen_frame(self.model, i, f.time, f.sphere_rows, f.position, f.velocity,
-                           f.triangle_vertices)
+                           f.triangle_vertices, f.temperature)

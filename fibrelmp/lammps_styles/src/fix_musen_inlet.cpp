@@ -11,6 +11,7 @@
 #include "comm.h"
 #include "domain.h"
 #include "error.h"
+#include "force.h"
 #include "group.h"
 #include "memory.h"
 #include "modify.h"
@@ -173,20 +174,53 @@ FixMusenInlet::FixMusenInlet(LAMMPS *lmp, int narg, char **arg) :
     for (int k = 0; k < 3; k++) velocity[k] = utils::numeric(FLERR, arg[at + 2 + k], false, lmp);
     at += 5;
   }
-  need(at, 2, "fractions");
-  const int nfrac = utils::inumeric(FLERR, arg[at + 1], false, lmp);
-  at += 2;
-  need(at, 4 * nfrac, nullptr);
-  for (int i = 0; i < nfrac; i++, at += 4) {
-    Fraction f{utils::inumeric(FLERR, arg[at], false, lmp),
-               0.5 * utils::numeric(FLERR, arg[at + 1], false, lmp),
-               utils::numeric(FLERR, arg[at + 2], false, lmp),
-               utils::numeric(FLERR, arg[at + 3], false, lmp), 0};
-    if (f.type < 1 || f.type > atom->ntypes) error->all(FLERR, "Fix musen/inlet: invalid atom type {}", f.type);
-    if (!(f.radius > 0 && f.density > 0)) error->all(FLERR, "Fix musen/inlet: diameter and density must be > 0");
-    fractions.push_back(f);
+  if (at < narg && strcmp(arg[at], "agglomerate") == 0) {
+    // the agglomerate's spheres become one "fraction" each (type, radius, density, group)
+    need(at, 2, "agglomerate");
+    const int npart = utils::inumeric(FLERR, arg[at + 1], false, lmp);
+    if (npart < 1) error->all(FLERR, "Fix musen/inlet: an agglomerate needs at least one sphere");
+    at += 2;
+    need(at, 6 * npart, nullptr);
+    for (int i = 0; i < npart; i++, at += 6) {
+      Part p{utils::inumeric(FLERR, arg[at], false, lmp), utils::numeric(FLERR, arg[at + 1], false, lmp),
+             utils::numeric(FLERR, arg[at + 2], false, lmp),
+             {utils::numeric(FLERR, arg[at + 3], false, lmp), utils::numeric(FLERR, arg[at + 4], false, lmp),
+              utils::numeric(FLERR, arg[at + 5], false, lmp)}};
+      if (p.type < 1 || p.type > atom->ntypes) error->all(FLERR, "Fix musen/inlet: invalid atom type {}", p.type);
+      if (!(p.radius > 0 && p.density > 0)) error->all(FLERR, "Fix musen/inlet: radius and density must be > 0");
+      parts.push_back(p);
+      fractions.push_back(Fraction{p.type, p.radius, p.density, 0.0, 0});
+    }
+    need(at, 2, "bonds");
+    const int nb = utils::inumeric(FLERR, arg[at + 1], false, lmp);
+    at += 2;
+    need(at, 4 * nb, nullptr);
+    for (int i = 0; i < nb; i++, at += 4) {
+      AggloBond b{utils::inumeric(FLERR, arg[at], false, lmp), utils::inumeric(FLERR, arg[at + 1], false, lmp),
+                  utils::inumeric(FLERR, arg[at + 2], false, lmp), utils::numeric(FLERR, arg[at + 3], false, lmp)};
+      if (b.left < 0 || b.left >= npart || b.right < 0 || b.right >= npart || b.left == b.right)
+        error->all(FLERR, "Fix musen/inlet: bond {} joins spheres {} and {} of an agglomerate of {}", i,
+                   b.left, b.right, npart);
+      if (!(b.diameter > 0)) error->all(FLERR, "Fix musen/inlet: bond diameters must be > 0");
+      if (b.type < 1 || b.type > atom->nbondtypes) error->all(FLERR, "Fix musen/inlet: invalid bond type {}", b.type);
+      bonds.push_back(b);
+    }
+  } else {
+    need(at, 2, "fractions");
+    const int nfrac = utils::inumeric(FLERR, arg[at + 1], false, lmp);
+    at += 2;
+    need(at, 4 * nfrac, nullptr);
+    for (int i = 0; i < nfrac; i++, at += 4) {
+      Fraction f{utils::inumeric(FLERR, arg[at], false, lmp),
+                 0.5 * utils::numeric(FLERR, arg[at + 1], false, lmp),
+                 utils::numeric(FLERR, arg[at + 2], false, lmp),
+                 utils::numeric(FLERR, arg[at + 3], false, lmp), 0};
+      if (f.type < 1 || f.type > atom->ntypes) error->all(FLERR, "Fix musen/inlet: invalid atom type {}", f.type);
+      if (!(f.radius > 0 && f.density > 0)) error->all(FLERR, "Fix musen/inlet: diameter and density must be > 0");
+      fractions.push_back(f);
+    }
+    if (fractions.empty()) error->all(FLERR, "Fix musen/inlet needs at least one fraction");
   }
-  if (fractions.empty()) error->all(FLERR, "Fix musen/inlet needs at least one fraction");
   made.assign(fractions.size(), 0);
   need(at, 2, "events");
   const int nev = utils::inumeric(FLERR, arg[at + 1], false, lmp);
@@ -217,6 +251,13 @@ FixMusenInlet::FixMusenInlet(LAMMPS *lmp, int narg, char **arg) :
       volume.resize(9 * static_cast<size_t>(ntri));
       for (size_t i = 0; i < volume.size(); i++) volume[i] = utils::numeric(FLERR, arg[at + 2 + i], false, lmp);
       at += 9 * ntri;
+    } else if (strcmp(arg[at], "geometry") == 0) {    // PARTNER VALUES K
+      need(at, 4, nullptr);
+      partners_name = arg[at + 1];
+      values_name = arg[at + 2];
+      nslots = utils::inumeric(FLERR, arg[at + 3], false, lmp);
+      if (nslots < 1) error->all(FLERR, "Fix musen/inlet: geometry needs K >= 1 slots");
+      at += 2;
     } else if (strcmp(arg[at], "log") == 0) {
       if (comm->me == 0) {
         log = fopen(arg[at + 1], "a");
@@ -230,6 +271,12 @@ FixMusenInlet::FixMusenInlet(LAMMPS *lmp, int narg, char **arg) :
   if (strcmp(atom->atom_style, "sphere") != 0 && strcmp(atom->atom_style, "bpm/sphere") != 0)
     error->all(FLERR, "Fix musen/inlet needs atom style sphere or bpm/sphere, not {}", atom->atom_style);
   if (domain->triclinic) error->all(FLERR, "Fix musen/inlet needs an orthogonal box");
+  if (!bonds.empty()) {
+    if (!atom->molecular || !atom->bond_per_atom)
+      error->all(FLERR, "Fix musen/inlet: agglomerates with bonds need an atom style with bonds "
+                 "(bpm/sphere) and room for them (read_data extra/bond/per/atom)");
+    if (!force->newton_bond) error->all(FLERR, "Fix musen/inlet: agglomerates with bonds need newton_bond on");
+  }
   const int periodic[3] = {domain->xperiodic, domain->yperiodic, domain->zperiodic};
   for (int k = 0; k < 3; k++)    // a sphere created outside the box would be lost unseen
     if (!periodic[k] && (lo[k] < domain->boxlo[k] || hi[k] > domain->boxhi[k]))
@@ -278,7 +325,10 @@ void FixMusenInlet::pre_exchange()
 {
   if (next_reneighbor != update->ntimestep) return;
   for (const Event &e : events)
-    if (e.step == update->ntimestep) insert(e);
+    if (e.step == update->ntimestep) {
+      if (parts.empty()) insert(e);
+      else insert_agglomerates(e);
+    }
   schedule_next();
 }
 
@@ -323,6 +373,28 @@ int FixMusenInlet::next_fraction() const
   return 0;
 }
 
+/* the sphere is totally inside the volume, overlaps none of near and touches no close triangle */
+bool FixMusenInlet::sphere_fits(const Sphere &s, const std::vector<Sphere> &near, const std::vector<double> &tri,
+                                const std::vector<int> &close) const
+{
+  const double r = s.r;
+  bool placed = true;
+  if (volume.empty())
+    for (int k = 0; k < 3; k++) placed = placed && s.x[k] - r >= lo[k] && s.x[k] + r <= hi[k];
+  else
+    placed = musen_sphere_inside(s.x, r, volume);
+  for (size_t j = 0; placed && j < near.size(); j++) {
+    double d[3] = {s.x[0] - near[j].x[0], s.x[1] - near[j].x[1], s.x[2] - near[j].x[2]};
+    const double reach = r + near[j].r;
+    placed = dot(d, d) >= reach * reach;
+  }
+  for (size_t c = 0; placed && c < close.size(); c++) {
+    const double *v = &tri[9 * close[c]];
+    placed = triangle_distance2(s.x, v, v + 3, v + 6) >= r * r;
+  }
+  return placed;
+}
+
 void FixMusenInlet::insert(const Event &event)
 {
   double rmax = 0.0;
@@ -352,20 +424,7 @@ void FixMusenInlet::insert(const Event &event)
     Sphere s{{0, 0, 0}, r};
     for (int attempt = 0; attempt < tries && !placed; attempt++) {
       for (int k = 0; k < 3; k++) s.x[k] = lo[k] + rng.uniform() * (hi[k] - lo[k]);
-      placed = true;
-      if (volume.empty())
-        for (int k = 0; k < 3; k++) placed = placed && s.x[k] - r >= lo[k] && s.x[k] + r <= hi[k];
-      else
-        placed = musen_sphere_inside(s.x, r, volume);
-      for (size_t j = 0; placed && j < near.size(); j++) {
-        double d[3] = {s.x[0] - near[j].x[0], s.x[1] - near[j].x[1], s.x[2] - near[j].x[2]};
-        const double reach = r + near[j].r;
-        placed = dot(d, d) >= reach * reach;
-      }
-      for (size_t c = 0; placed && c < close.size(); c++) {
-        const double *v = &tri[9 * close[c]];
-        placed = triangle_distance2(s.x, v, v + 3, v + 6) >= r * r;
-      }
+      placed = sphere_fits(s, near, tri, close);
     }
     if (!placed) continue;
     double u[3] = {velocity[0], velocity[1], velocity[2]};
@@ -386,9 +445,160 @@ void FixMusenInlet::insert(const Event &event)
   if (!created.empty()) create(created, types, vel);
 }
 
+/* the triangles of fix musen/wall/mesh that can touch a sphere inside the box */
+static std::vector<int> close_triangles(const std::vector<double> &tri, const double *lo, const double *hi)
+{
+  std::vector<int> close;
+  for (size_t t = 0; t < tri.size() / 9; t++) {
+    bool apart = false;
+    for (int k = 0; k < 3 && !apart; k++) {
+      const double *v = &tri[9 * t];
+      const double tlo = std::min({v[k], v[3 + k], v[6 + k]}), thi = std::max({v[k], v[3 + k], v[6 + k]});
+      apart = thi < lo[k] || tlo > hi[k];
+    }
+    if (!apart) close.push_back(static_cast<int>(t));
+  }
+  return close;
+}
+
+/* MUSEN's generator of agglomerates (CObjectsGenerator::Generate, GenerateNewObject) */
+void FixMusenInlet::insert_agglomerates(const Event &event)
+{
+  double rmax = 0.0;
+  for (int i = 0; i < atom->nlocal; i++) rmax = std::max(rmax, atom->radius[i]);
+  MPI_Allreduce(MPI_IN_PLACE, &rmax, 1, MPI_DOUBLE, MPI_MAX, world);
+  std::vector<Sphere> near = spheres_near(rmax);
+  const std::vector<double> tri = wall_triangles();
+  const std::vector<int> close = close_triangles(tri, lo, hi);
+  Stream rng{seed * 0x9E3779B97F4A7C15ULL ^ static_cast<std::uint64_t>(event.step)};
+  const size_t n = parts.size();
+  std::vector<Sphere> created, object(n);
+  std::vector<int> which;
+  std::vector<double> vel;
+  size_t objects = 0;
+  for (int obj = 0; obj < event.count; obj++) {
+    bool placed = false;
+    for (int attempt = 0; attempt < tries && !placed; attempt++) {
+      double c[3], q[4], R[3][3];
+      for (int k = 0; k < 3; k++) c[k] = lo[k] + rng.uniform() * (hi[k] - lo[k]);
+      // CQuaternion::Random (Shoemake), normalised; R its rotation matrix (q0 the scalar)
+      const double u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform();
+      q[0] = std::sqrt(1 - u1) * std::sin(2 * M_PI * u2);
+      q[1] = std::sqrt(1 - u1) * std::cos(2 * M_PI * u2);
+      q[2] = std::sqrt(u1) * std::sin(2 * M_PI * u3);
+      q[3] = std::sqrt(u1) * std::cos(2 * M_PI * u3);
+      const double len = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+      for (double &v : q) v /= len;
+      R[0][0] = 1 - 2 * (q[2] * q[2] + q[3] * q[3]);
+      R[0][1] = 2 * (q[1] * q[2] - q[0] * q[3]);
+      R[0][2] = 2 * (q[1] * q[3] + q[0] * q[2]);
+      R[1][0] = 2 * (q[1] * q[2] + q[0] * q[3]);
+      R[1][1] = 1 - 2 * (q[1] * q[1] + q[3] * q[3]);
+      R[1][2] = 2 * (q[2] * q[3] - q[0] * q[1]);
+      R[2][0] = 2 * (q[1] * q[3] - q[0] * q[2]);
+      R[2][1] = 2 * (q[2] * q[3] + q[0] * q[1]);
+      R[2][2] = 1 - 2 * (q[1] * q[1] + q[2] * q[2]);
+      placed = true;
+      for (size_t p = 0; p < n && placed; p++) {
+        Sphere &s = object[p];
+        s.r = parts[p].radius;
+        for (int k = 0; k < 3; k++) s.x[k] = c[k] + dot(R[k], parts[p].x);
+        placed = sphere_fits(s, near, tri, close);    // not against its own spheres
+      }
+    }
+    if (!placed) continue;
+    double u[3] = {velocity[0], velocity[1], velocity[2]};
+    if (random_velocity) {
+      double len;
+      do {
+        for (int k = 0; k < 3; k++) u[k] = 2.0 * rng.uniform() - 1.0;
+        len = std::sqrt(dot(u, u));
+      } while (len == 0.0 || len > 1.0);
+      for (int k = 0; k < 3; k++) u[k] = u[k] / len * magnitude;
+    }
+    for (size_t p = 0; p < n; p++) {
+      near.push_back(object[p]);
+      created.push_back(object[p]);
+      which.push_back(static_cast<int>(p));
+      vel.insert(vel.end(), {u[0], u[1], u[2]});
+    }
+    objects++;
+  }
+  if (created.empty()) return;
+  const tagint first = create(created, which, vel);
+  if (!bonds.empty()) add_bonds(first, created, objects);
+}
+
+/* the bonds of the objects just made (their spheres have IDs first, first + 1, .. in part
+   order, object after object): on the left sphere's bond list and geometry slot, and 1-2
+   special neighbours of both spheres */
+void FixMusenInlet::add_bonds(tagint first, const std::vector<Sphere> &made_now, size_t objects)
+{
+  const size_t n = parts.size();
+  std::vector<int> islot(nslots, -1), ivalue(nslots, -1);
+  int width = 0;
+  for (int k = 0; k < nslots; k++) {
+    int flag, cols;
+    islot[k] = atom->find_custom(fmt::format("{}{}", partners_name, k + 1).c_str(), flag, cols);
+    if (islot[k] < 0 || flag != 0 || cols != 0)
+      error->all(FLERR, "Fix musen/inlet: no per-atom integer vector i_{}{}", partners_name, k + 1);
+    ivalue[k] = atom->find_custom(fmt::format("{}{}", values_name, k + 1).c_str(), flag, cols);
+    if (ivalue[k] < 0 || flag != 1 || cols < 2)
+      error->all(FLERR, "Fix musen/inlet: no per-atom array d2_{}{}", values_name, k + 1);
+    width = cols;
+  }
+  // a new atom's slots may hold what an atom that left this rank had there: cleared
+  const tagint last = first + static_cast<tagint>(objects * n) - 1;
+  for (int i = 0; i < atom->nlocal; i++)
+    if (atom->tag[i] >= first && atom->tag[i] <= last)
+      for (int k = 0; k < nslots; k++) {
+        atom->ivector[islot[k]][i] = 0;
+        for (int c = 0; c < width; c++) atom->darray[ivalue[k]][i][c] = 0.0;
+      }
+  for (size_t obj = 0; obj < objects; obj++) {
+    const tagint base = first + static_cast<tagint>(obj * n);
+    for (const AggloBond &b : bonds) {
+      const tagint left = base + b.left, right = base + b.right;
+      const Sphere &sl = made_now[obj * n + b.left], &sr = made_now[obj * n + b.right];
+      const double d[3] = {sr.x[0] - sl.x[0], sr.x[1] - sl.x[1], sr.x[2] - sl.x[2]};
+      const double length0 = std::sqrt(dot(d, d));    // AddSolidBond: the current length
+      const int i = atom->map(left);
+      if (i >= 0 && i < atom->nlocal) {
+        if (atom->num_bond[i] == atom->bond_per_atom)
+          error->one(FLERR, "Fix musen/inlet: atom {} would hold more than {} bonds (read_data "
+                     "extra/bond/per/atom)", left, atom->bond_per_atom);
+        const int m = atom->num_bond[i]++;
+        atom->bond_type[i][m] = b.type;
+        atom->bond_atom[i][m] = right;
+        if (nslots) {
+          int k = 0;
+          while (k < nslots && atom->ivector[islot[k]][i] != 0) k++;
+          if (k == nslots)
+            error->one(FLERR, "Fix musen/inlet: atom {} has no free bond geometry slot of {}", left, nslots);
+          atom->ivector[islot[k]][i] = right;
+          double *v = atom->darray[ivalue[k]][i];
+          for (int c = 0; c < width; c++) v[c] = 0.0;
+          v[0] = b.diameter;
+          v[1] = length0;
+        }
+      }
+      for (tagint pair[2] = {left, right}, j = 0; j < 2; j++) {    // 1-2 special neighbours
+        const int a = atom->map(pair[j]);
+        if (a < 0 || a >= atom->nlocal) continue;
+        if (atom->nspecial[a][0] == atom->maxspecial)
+          error->one(FLERR, "Fix musen/inlet: atom {} would have more than {} special neighbours "
+                     "(read_data extra/special/per/atom)", pair[j], atom->maxspecial);
+        atom->special[a][atom->nspecial[a][0]++] = pair[1 - j];
+        atom->nspecial[a][1] = atom->nspecial[a][2] = atom->nspecial[a][0];
+      }
+    }
+  }
+  atom->nbonds += static_cast<bigint>(objects * bonds.size());
+}
+
 /* the new atoms, through Atom::data_atoms (each rank keeps those in its sub-domain) */
-void FixMusenInlet::create(const std::vector<Sphere> &made_now, const std::vector<int> &which,
-                           const std::vector<double> &vel)
+tagint FixMusenInlet::create(const std::vector<Sphere> &made_now, const std::vector<int> &which,
+                             const std::vector<double> &vel)
 {
   tagint maxtag = 0;
   for (int i = 0; i < atom->nlocal; i++) maxtag = std::max(maxtag, atom->tag[i]);
@@ -430,6 +640,7 @@ void FixMusenInlet::create(const std::vector<Sphere> &made_now, const std::vecto
     atom->map_init();
     atom->map_set();
   }
+  return maxtag + 1;
 }
 
 void *FixMusenInlet::extract(const char *name, int &itype)

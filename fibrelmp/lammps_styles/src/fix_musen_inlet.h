@@ -7,9 +7,11 @@
      fix ID group musen/inlet SEED box XLO XHI YLO YHI ZLO ZHI tries N walls WALLFIX|none
          velocity fixed VX VY VZ | velocity random MAGNITUDE
          fractions K  TYPE DIAMETER DENSITY SHARE  (K times)
+           | agglomerate N  TYPE RADIUS DENSITY X Y Z  (N times)  bonds M  I J BTYPE DIAMETER  (M times)
          events M  STEP COUNT  (M times, steps ascending)
          [first_id ID] [log FILE] [groups NAME1 .. NAMEK]   (a further group per fraction)
          [volume N  X1 Y1 Z1 X2 Y2 Z2 X3 Y3 Z3  (N times)]   (a closed triangle volume)
+         [geometry PARTNER VALUES K]   (agglomerates: bond_style musen/elastic's per-atom slots)
 
    At each listed STEP (MUSEN's generation times, computed by fibrelmp from cmusen's summed
    clock: the fix does not recompute it) it tries to make COUNT spheres.  Per sphere: the
@@ -23,7 +25,22 @@
    from the cube, as MUSEN) times MAGNITUDE, one draw per sphere.  Mass 4/3 pi r^3 rho (MUSEN's
    expression), orientation the identity (fibrelmp does not turn quaternions).
 
-   Insertion happens in pre_exchange of STEP: LAMMPS has moved the atoms to their positions of
+   "agglomerate" (MUSEN's generator of agglomerates, obj_type 2): each object is one rigid
+   set of N spheres (TYPE, RADIUS, DENSITY, position X Y Z relative to the object's centre:
+   MUSEN's agglomerate already shifted to its volume-weighted centre and scaled, by fibrelmp)
+   and M solid bonds between its spheres I and J (0-based; I is MUSEN's left sphere, which
+   stores the LAMMPS bond) of bond type BTYPE and diameter DIAMETER.  Per object and attempt:
+   a random centre in the box (CreateRandomPoint) and a random rotation (Shoemake's uniform
+   quaternion, MUSEN's CQuaternion::Random) turning every relative position; the object is
+   placed when every sphere passes the sphere tests above (its own spheres may overlap each
+   other, as in MUSEN's IsOverlapped), else it is redrawn (N tries) and dropped whole.  One
+   velocity per object (fixed, or one random draw) for all its spheres.  The bonds are added
+   to the left sphere's bond list (newton_bond on), with the left sphere's geometry slot
+   (i_PARTNERk = right sphere's ID, d2_VALUESk = DIAMETER and the initial length |x_I - x_J|,
+   MUSEN's AddSolidBond) and each other's 1-2 special neighbours; the log line of a sphere of
+   an agglomerate is "STEP ID" too, in part order.
+
+ of STEP: LAMMPS has moved the atoms to their positions of
    that step and computes the step's forces afterwards, which is where MUSEN's
    PreCalculationStep generates.  Every rank gathers the spheres near the box, draws the same
    random numbers and takes the same decisions; each rank keeps the new atoms it owns.  The
@@ -42,6 +59,7 @@
 
 #include <cstdint>
 #include <cstdio>
+#include <string>
 #include <vector>
 
 namespace LAMMPS_NS {
@@ -83,6 +101,18 @@ class FixMusenInlet : public Fix {
   bool random_velocity;
   double velocity[3], magnitude;
   std::vector<Fraction> fractions;
+  struct Part {
+    int type;
+    double radius, density, x[3];
+  };
+  struct AggloBond {
+    int left, right, type;
+    double diameter;
+  };
+  std::vector<Part> parts;          // "agglomerate": its spheres (empty: a mixture)
+  std::vector<AggloBond> bonds;     // and its bonds
+  std::string partners_name, values_name;    // "geometry": the per-atom slots' names
+  int nslots = 0;
   std::vector<int> made;        // successes per fraction (MUSEN's generated mixture particles)
   std::vector<Event> events;
   bigint inserted;
@@ -95,8 +125,12 @@ class FixMusenInlet : public Fix {
   std::vector<double> wall_triangles();
   int next_fraction() const;
   void insert(const Event &event);
-  void create(const std::vector<Sphere> &made_now, const std::vector<int> &types,
-              const std::vector<double> &vel);
+  tagint create(const std::vector<Sphere> &made_now, const std::vector<int> &types,
+                const std::vector<double> &vel);
+  void insert_agglomerates(const Event &event);
+  void add_bonds(tagint first_tag, const std::vector<Sphere> &made_now, size_t objects);
+  bool sphere_fits(const Sphere &s, const std::vector<Sphere> &near, const std::vector<double> &tri,
+                   const std::vector<int> &close) const;
 };
 
 }    // namespace LAMMPS_NS

@@ -103,13 +103,11 @@ def _copies(c: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     body = np.array([p[3:] for p in PARTS])
     rot, centre = [], []
     for xs in x:
-        ctr = xs.mean(0) - body.mean(0)
         h = (body - body.mean(0)).T @ (xs - xs.mean(0))
         u, _, vt = np.linalg.svd(h)
         r = (u @ vt).T
         rot.append(r)
         centre.append(xs.mean(0) - r @ body.mean(0))
-        del ctr
     return x, np.array(rot), np.array(centre)
 
 
@@ -117,8 +115,15 @@ def test_copies_are_turned_agglomerates_inside_and_apart(inserted):
     c, _, folder = inserted
     n, total = len(PARTS), sum(k for _, k in EVENTS)
     assert len(c["id"]) == n * total and (c["id"] == np.arange(1, n * total + 1)).all()
-    log = np.loadtxt(folder / "inlets.log", dtype=np.int64)
+    lines = [ln.split() for ln in (folder / "inlets.log").read_text().splitlines()]
+    log = np.array([ln for ln in lines if len(ln) == 2], np.int64)
     assert (log[:, 1] == c["id"]).all()
+    bond_lines = [ln for ln in lines if len(ln) == 4]          # STEP LEFT RIGHT L0
+    assert len(bond_lines) == len(BONDS) * total
+    x = np.column_stack([c["x"], c["y"], c["z"]])
+    for step, left, right, length0 in bond_lines:
+        d = x[int(right) - 1] - x[int(left) - 1]
+        assert float(length0) == np.sqrt((d ** 2).sum())
     assert (log[:, 0] == np.repeat([s for s, _ in EVENTS], [n * k for _, k in EVENTS])).all()
     types = np.tile([p[0] for p in PARTS], total)
     r = np.tile([p[1] for p in PARTS], total)

@@ -34,7 +34,7 @@ from fibrelmp.translate.granular.schedule import (STOP_LABEL, RunTime, compress_
                                                   with_stop_criterion)
 from fibrelmp.translate.granular.fields import TEMPERATURE, field_commands, uses_temperature
 from fibrelmp.translate.granular.inlets import LOG_NAME as INLET_LOG
-from fibrelmp.translate.granular.inlets import inlet_commands
+from fibrelmp.translate.granular.inlets import inlet_bond_capacity, inlet_bond_reach, inlet_commands
 from fibrelmp.translate.granular.spheres import SimulatedSpheres, select_spheres
 from fibrelmp.translate.granular.tiles import TILE_MASS_FACTOR, WallTiles, place_tiles, tile_estimate, tile_types
 from fibrelmp.translate.granular.verlet import VerletSchedule, musen_verlet
@@ -172,14 +172,15 @@ def build_granular_job(model: GranularModel, folder: str | Path):
         write_data(model, data_path, spheres.rows, spheres.type_of_mat, spheres.smat, spheres.crad,
                    parts.axes.lo, parts.axes.hi, parts.ntypes, tiles.x, tiles.types, tiles.v, tiles.ids,
                    tiles.radius, TILE_MASS_FACTOR * float(spheres.mass.max() if len(spheres.mass) else 1.0),
-                   bonds.rows, bonds.type, len(bonds.types), parts.geometry)
+                   bonds.rows, bonds.type, len(bonds.types), parts.geometry,
+                   inlet_bond_capacity(model))
         if len(parts.mesh):
             write_mesh(model, parts.wall_plans, spheres, folder / MESH_NAME)
         write_facts(data_path, job_facts(model, spheres, tiles, run.t_start, run.dt, run.clock is not None))
 
     saves = save_steps(model, run)
     script = _render_script(model, parts, saves)
-    has_bonds = len(bonds.rows) > 0
+    has_bonds = len(bonds.rows) > 0 or inlet_bond_capacity(model)[0] > 0
     breakage = model.plan.bonds_may_break()
     has_mesh = len(parts.mesh) > 0
     job = GranularJob(
@@ -268,11 +269,16 @@ def _plan_parts(model: GranularModel) -> _JobParts:
     if model.plan.inlets and not musen_hm:
         raise InputError(model.source, None, "MUSEN's dynamic generators need fibrelmp's LAMMPS "
                          f"styles (fix musen/inlet): {styles.how}")
-    wall_cmds += inlet_commands(model, spheres.type_of_mat, dt, t_start, run.t_end,
-                                MESH_FIX if len(mesh) else None)
+    # generated agglomerates: bonds per sphere (geometry slots, LAMMPS's extra bond room)
+    stored, _ = inlet_bond_capacity(model)
+    if stored:
+        bonds.max_length = max(bonds.max_length, inlet_bond_reach(model))
     # musen/elastic: each bond's d, L0 (and initial tangential overlap) on its first sphere
-    geometry = (bond_geometry(model, bonds, spheres.rows, len(spheres.rows) + len(tiles.x))
-                if bonds.exact and len(bonds.rows) else None)
+    geometry = (bond_geometry(model, bonds, spheres.rows, len(spheres.rows) + len(tiles.x), stored)
+                if bonds.exact and (len(bonds.rows) or stored) else None)
+    wall_cmds += inlet_commands(model, spheres.type_of_mat, dt, t_start, run.t_end,
+                                MESH_FIX if len(mesh) else None, bonds.type_of_material,
+                                geometry.slots if geometry is not None else 0)
     # broken bonds' spheres touch from MUSEN's next contact-list update (fix musen/verlet):
     # only where contacts between bonded spheres are off (else they touch all along)
     verlet = None
@@ -328,7 +334,7 @@ def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> 
         fmt=float_text, dim=run.dim, bnd=parts.axes.bnd, data_name=DATA_NAME, frames_name=FRAMES_NAME,
         bonds_name=BONDS_NAME, tiles_name=TILES_NAME, breaks_name=BREAKS_NAME,
         comm_cut=comm_cut, skin=skin, musen_hm=parts.musen_hm, pair_lines=parts.pair_lines,
-        has_bonds=len(bonds.rows) > 0,
+        has_bonds=len(bonds.rows) > 0 or inlet_bond_capacity(model)[0] > 0,
         overlay=bool(plan.contacts_between_bonded), breakage=plan.bonds_may_break(),
         bond_types=bonds.types,
         musen_bonds=geometry is not None, bond_geometry=geometry, bond_partners=PARTNERS,

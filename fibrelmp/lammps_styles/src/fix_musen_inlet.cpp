@@ -22,6 +22,7 @@
 #include <cmath>
 #include <cstring>
 #include <string>
+#include <unordered_map>
 
 using namespace LAMMPS_NS;
 using namespace FixConst;
@@ -475,8 +476,12 @@ void FixMusenInlet::insert_agglomerates(const Event &event)
   std::vector<Sphere> created, object(n);
   std::vector<int> which;
   std::vector<double> vel;
-  size_t objects = 0;
-  for (int obj = 0; obj < event.count; obj++) {
+  std::vector<tagint> tags;
+  // requested object j of this fix (over its events) has IDs first_id + j n + part, made or not
+  bigint slot = 0;
+  for (const Event &e : events)
+    if (e.step < event.step) slot += e.count;
+  for (int obj = 0; obj < event.count; obj++, slot++) {
     bool placed = false;
     for (int attempt = 0; attempt < tries && !placed; attempt++) {
       double c[3], q[4], R[3][3];
@@ -521,20 +526,20 @@ void FixMusenInlet::insert_agglomerates(const Event &event)
       created.push_back(object[p]);
       which.push_back(static_cast<int>(p));
       vel.insert(vel.end(), {u[0], u[1], u[2]});
+      tags.push_back(first_id + static_cast<tagint>(slot * static_cast<bigint>(n) + static_cast<bigint>(p)));
     }
-    objects++;
   }
   if (created.empty()) return;
-  const tagint first = create(created, which, vel);
-  if (!bonds.empty()) add_bonds(first, created, objects);
+  create(created, which, vel, &tags);
+  if (!bonds.empty()) add_bonds(created, tags);
 }
 
 /* the bonds of the objects just made (their spheres have IDs first, first + 1, .. in part
    order, object after object): on the left sphere's bond list and geometry slot, and 1-2
    special neighbours of both spheres */
-void FixMusenInlet::add_bonds(tagint first, const std::vector<Sphere> &made_now, size_t objects)
+void FixMusenInlet::add_bonds(const std::vector<Sphere> &made_now, const std::vector<tagint> &tags)
 {
-  const size_t n = parts.size();
+  const size_t n = parts.size(), objects = made_now.size() / n;
   std::vector<int> islot(nslots, -1), ivalue(nslots, -1);
   int width = 0;
   for (int k = 0; k < nslots; k++) {
@@ -548,20 +553,21 @@ void FixMusenInlet::add_bonds(tagint first, const std::vector<Sphere> &made_now,
     width = cols;
   }
   // a new atom's slots may hold what an atom that left this rank had there: cleared
-  const tagint last = first + static_cast<tagint>(objects * n) - 1;
+  const tagint lowest = tags.front(), last = tags.back();
   for (int i = 0; i < atom->nlocal; i++)
-    if (atom->tag[i] >= first && atom->tag[i] <= last)
+    if (atom->tag[i] >= lowest && atom->tag[i] <= last)
       for (int k = 0; k < nslots; k++) {
         atom->ivector[islot[k]][i] = 0;
         for (int c = 0; c < width; c++) atom->darray[ivalue[k]][i][c] = 0.0;
       }
   for (size_t obj = 0; obj < objects; obj++) {
-    const tagint base = first + static_cast<tagint>(obj * n);
+    const tagint base = tags[obj * n];
     for (const AggloBond &b : bonds) {
       const tagint left = base + b.left, right = base + b.right;
       const Sphere &sl = made_now[obj * n + b.left], &sr = made_now[obj * n + b.right];
       const double d[3] = {sr.x[0] - sl.x[0], sr.x[1] - sl.x[1], sr.x[2] - sl.x[2]};
       const double length0 = std::sqrt(dot(d, d));    // AddSolidBond: the current length
+      if (log) fmt::print(log, "{} {} {} {:.17g}\n", update->ntimestep, left, right, length0);
       const int i = atom->map(left);
       if (i >= 0 && i < atom->nlocal) {
         if (atom->num_bond[i] == atom->bond_per_atom)
@@ -594,23 +600,33 @@ void FixMusenInlet::add_bonds(tagint first, const std::vector<Sphere> &made_now,
     }
   }
   atom->nbonds += static_cast<bigint>(objects * bonds.size());
+  if (log) fflush(log);
 }
 
 /* the new atoms, through Atom::data_atoms (each rank keeps those in its sub-domain) */
 tagint FixMusenInlet::create(const std::vector<Sphere> &made_now, const std::vector<int> &which,
-                             const std::vector<double> &vel)
+                             const std::vector<double> &vel, const std::vector<tagint> *given)
 {
+  // a mixture's spheres: the next IDs, in order of success; an agglomerate's: the IDs given
   tagint maxtag = 0;
-  for (int i = 0; i < atom->nlocal; i++) maxtag = std::max(maxtag, atom->tag[i]);
-  MPI_Allreduce(MPI_IN_PLACE, &maxtag, 1, MPI_LMP_TAGINT, MPI_MAX, world);
-  maxtag = std::max(maxtag, first_id - 1);
-  for (Fix *other : modify->get_fix_by_style("^musen/inlet$"))
-    maxtag = std::max(maxtag, static_cast<FixMusenInlet *>(other)->last_given());
+  if (!given) {
+    for (int i = 0; i < atom->nlocal; i++) maxtag = std::max(maxtag, atom->tag[i]);
+    MPI_Allreduce(MPI_IN_PLACE, &maxtag, 1, MPI_LMP_TAGINT, MPI_MAX, world);
+    maxtag = std::max(maxtag, first_id - 1);
+    for (Fix *other : modify->get_fix_by_style("^musen/inlet$"))
+      maxtag = std::max(maxtag, static_cast<FixMusenInlet *>(other)->last_given());
+  }
+  std::vector<tagint> tags(made_now.size());
+  std::unordered_map<tagint, size_t> index;
+  for (size_t j = 0; j < made_now.size(); j++) {
+    tags[j] = given ? (*given)[j] : maxtag + 1 + static_cast<tagint>(j);
+    index[tags[j]] = j;
+  }
   std::string lines;
   for (size_t j = 0; j < made_now.size(); j++) {
     const Fraction &f = fractions[which[j]];
     // the Atoms line of atom styles sphere (id type d rho x y z) and bpm/sphere (id mol ...)
-    lines += fmt::format("{}{} {} {:.17g} {:.17g} {:.17g} {:.17g} {:.17g}\n", maxtag + 1 + (tagint) j,
+    lines += fmt::format("{}{} {} {:.17g} {:.17g} {:.17g} {:.17g} {:.17g}\n", tags[j],
                          atom->molecule_flag ? " 0" : "", f.type, 2.0 * f.radius, f.density,
                          made_now[j].x[0], made_now[j].x[1], made_now[j].x[2]);
   }
@@ -620,7 +636,7 @@ tagint FixMusenInlet::create(const std::vector<Sphere> &made_now, const std::vec
   double shift[3] = {0.0, 0.0, 0.0};
   atom->data_atoms(static_cast<int>(made_now.size()), buf.data(), 0, 0, 0, 0, shift, 0, nullptr, 0);
   for (int i = first; i < atom->nlocal; i++) {
-    const size_t j = static_cast<size_t>(atom->tag[i] - maxtag - 1);
+    const size_t j = index.at(atom->tag[i]);
     const Fraction &f = fractions[which[j]];
     atom->mask[i] |= groupbit | f.groupbit;
     atom->rmass[i] = 4.0 / 3.0 * M_PI * std::pow(f.radius, 3) * f.density;    // MUSEN's mass
@@ -628,10 +644,9 @@ tagint FixMusenInlet::create(const std::vector<Sphere> &made_now, const std::vec
     modify->create_attribute(i);
   }
   atom->natoms += static_cast<bigint>(made_now.size());
-  last_id = maxtag + static_cast<tagint>(made_now.size());
+  last_id = std::max(last_id, *std::max_element(tags.begin(), tags.end()));
   if (log) {
-    for (size_t j = 0; j < made_now.size(); j++)
-      fmt::print(log, "{} {}\n", update->ntimestep, maxtag + 1 + static_cast<tagint>(j));
+    for (size_t j = 0; j < made_now.size(); j++) fmt::print(log, "{} {}\n", update->ntimestep, tags[j]);
     fflush(log);
   }
   inserted += static_cast<bigint>(made_now.size());
@@ -640,7 +655,7 @@ tagint FixMusenInlet::create(const std::vector<Sphere> &made_now, const std::vec
     atom->map_init();
     atom->map_set();
   }
-  return maxtag + 1;
+  return tags[0];
 }
 
 void *FixMusenInlet::extract(const char *name, int &itype)

@@ -34,11 +34,13 @@
    quaternion, MUSEN's CQuaternion::Random) turning every relative position; the object is
    placed when every sphere passes the sphere tests above (its own spheres may overlap each
    other, as in MUSEN's IsOverlapped), else it is redrawn (N tries) and dropped whole.  One
-   velocity per object (fixed, or one random draw) for all its spheres.  The bonds are added
+   velocity per object (fixed, or one random draw) for all its spheres.  IDs: the j-th object
+   this fix is asked for (over its events, made or not) has IDs FIRST_ID + j N + part, so that
+   fibrelmp knows every sphere's and bond's row in advance (first_id must leave room).  The bonds are added
    to the left sphere's bond list (newton_bond on), with the left sphere's geometry slot
    (i_PARTNERk = right sphere's ID, d2_VALUESk = DIAMETER and the initial length |x_I - x_J|,
-   MUSEN's AddSolidBond) and each other's 1-2 special neighbours; the log line of a sphere of
-   an agglomerate is "STEP ID" too, in part order.
+   MUSEN's AddSolidBond) and each other's 1-2 special neighbours; the log gets "STEP ID" per
+   sphere, in part order, then "STEP LEFT_ID RIGHT_ID L0" per bond of the agglomerate.
 
  of STEP: LAMMPS has moved the atoms to their positions of
    that step and computes the step's forces afterwards, which is where MUSEN's
@@ -126,9 +128,9 @@ class FixMusenInlet : public Fix {
   int next_fraction() const;
   void insert(const Event &event);
   tagint create(const std::vector<Sphere> &made_now, const std::vector<int> &types,
-                const std::vector<double> &vel);
+                const std::vector<double> &vel, const std::vector<tagint> *tags = nullptr);
   void insert_agglomerates(const Event &event);
-  void add_bonds(tagint first_tag, const std::vector<Sphere> &made_now, size_t objects);
+  void add_bonds(const std::vector<Sphere> &made_now, const std::vector<tagint> &tags);
   bool sphere_fits(const Sphere &s, const std::vector<Sphere> &near, const std::vector<double> &tri,
                    const std::vector<int> &close) const;
 };

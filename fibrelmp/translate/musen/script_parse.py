@@ -70,7 +70,7 @@ _IGNORED = {
     "SELECTIVE_SAVING_LB": "every field is saved", "SELECTIVE_SAVING_TW": "every field is saved",
 }
 # keywords only the generator / analyser / snapshot components read: accepted, no effect
-_OTHER_COMPONENT_KEYS = ("AGGLOMERATES_DB",)
+_OTHER_COMPONENT_KEYS: tuple[str, ...] = ()
 
 
 @dataclass
@@ -91,6 +91,7 @@ class MusenJob:
     line: int
     source_file: str | None = None
     result_file: str | None = None
+    agglomerates_db: str | None = None       # AGGLOMERATES_DB: the .madb the generators read
     component: str = "SIMULATOR"            # cmusen's default component
     simulator_type: str | None = None
     models: list[MusenModelSpec] = field(default_factory=list)
@@ -473,6 +474,7 @@ _HANDLERS = {
     **{key: _generator_key for key in _GENERATOR_KEYS},
     "MIXTURE_PROPERTY": _mixture_property, "SNAPSHOT_TIME": _number("snapshot_time", False),
     "SOURCE_FILE": _set("source_file"), "RESULT_FILE": _set("result_file"),
+    "AGGLOMERATES_DB": _set("agglomerates_db"),
     "RESULTS_FILE": _set("result_file"), "COMPONENT": _component,
     "SIMULATOR_TYPE": _simulator_type,
     "MODEL_PP": _model("PP"), "MODEL_PW": _model("PW"), "MODEL_SB": _model("SB"),

@@ -91,6 +91,8 @@ class GranularJob:
     geometry: Path | None = None     # per-atom bond geometry (musen/elastic), beside the data file
     contacts: Path | None = None     # sphere-sphere contacts per frame (compute pair/local)
     inlet_log: Path | None = None    # fix musen/inlet: "STEP ID" per inserted sphere
+    # bond rows reserved for generated agglomerates (inlets.reserve_agglomerate_rows)
+    inlet_bond_rows: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     type_materials: dict[int, int] | None = None   # LAMMPS sphere type -> material
     variable_clock: Path | None = None   # variable time step: each frame's step, time and dt
 
@@ -199,9 +201,17 @@ def build_granular_job(model: GranularModel, folder: str | Path):
         geometry=folder / GEOMETRY_NAME if parts.geometry is not None else None,
         contacts=folder / CONTACTS_NAME,
         inlet_log=folder / INLET_LOG if model.plan.inlets else None,
+        inlet_bond_rows=_inlet_bond_rows(model),
         type_materials={t: m for m, t in spheres.type_of_mat.items()},
         variable_clock=folder / CLOCK_NAME if model.plan.variable_step is not None else None)
     return job, script, write_data_file
+
+
+def _inlet_bond_rows(model: GranularModel) -> np.ndarray:
+    """The bond rows reserved for generated agglomerates (empty without)."""
+    layout = model.plan.inlet_layout or []
+    return np.concatenate([np.arange(bfirst, bfirst + count * m) for _, _, bfirst, count, _, m in layout]
+                          + [np.zeros(0, np.int64)]).astype(np.int64)
 
 
 @dataclass

@@ -162,6 +162,8 @@ def bond_geometry(model: GranularModel, bonds: SimulatedBonds, atom_rows: np.nda
     ``min_slots`` slots (generated agglomerates' bonds on one sphere)."""
     b = model.bonds
     rows = bonds.rows
+    if b is None or not len(rows):          # only generated bonds (fix musen/inlet sets them)
+        return BondGeometry(np.zeros((natoms, min_slots), np.int64), np.zeros((natoms, min_slots, 2)), 2)
     left = b.pair[rows, 0].astype(np.int64)
     right = b.pair[rows, 1].astype(np.int64)
     where = np.full(int(max(atom_rows.max(initial=-1), left.max(initial=-1))) + 1, -1, np.int64)

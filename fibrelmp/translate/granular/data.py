@@ -64,7 +64,7 @@ def write_data(model, path: Path, rows, type_of_mat, smat, crad, lo, hi, ntypes,
                                     [np.arange(1, len(b) + 1), btype + 1, b[:, 0], b[:, 1]]))
     write_data_file(path, f"LAMMPS data file written by fibrelmp from {comment_text(model.source.name)}",
                     counts, list(zip(lo, hi)), sections)
-    if geometry is not None:
+    if geometry is not None and geometry.slots and len(geometry.partners):
         columns = []
         for k in range(geometry.slots):
             columns.append((f"i_{PARTNERS}{k + 1}", geometry.partners[:, k].astype(np.int64)))

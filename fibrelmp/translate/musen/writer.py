@@ -108,8 +108,10 @@ class MusenResultWriter(Writer):
         self.removed |= gone
         self.liquid.save(t, ~self.removed)
         if self.bond_end is not None and frame.bond_alive is not None:
-            # (a generated agglomerate's bond not made yet is not dead: activity start inf)
-            dead = ~np.asarray(frame.bond_alive, bool) & (self.model.bonds.active_start <= t)
+            dead = ~np.asarray(frame.bond_alive, bool)
+            if self.model.plan.inlet_layout is not None:
+                # a generated agglomerate's bond not made yet is not dead (activity start inf)
+                dead &= np.isfinite(self.model.bonds.active_start)
             when = (np.asarray(frame.bond_end_time, np.float64) if frame.bond_end_time is not None
                     else np.full(len(dead), t))
             when = np.where(np.isfinite(when), when, t)

@@ -28,7 +28,9 @@ fibrelmp reads and checks the settings (``read_inlets``: spheres of a mixture in
 or any other triangle volume: cylinder, sphere, STL), computes the schedule for the job's own step and end time, and inserts the spheres
 with fibrelmp's ``fix musen/inlet`` (one per generator, the schedule's steps and counts
 passed to it).  A volume that is not an axis-aligned box is passed as its triangles and
-tested with MUSEN's 15-point ray-parity test.  Agglomerates, moving volumes and
+tested with MUSEN's 15-point ray-parity test.  A generator of agglomerates gets its
+agglomerate from the job's ``AGGLOMERATES_DB`` (``attach_agglomerates``) and inserts it
+whole, with its solid bonds (docs/musen.md section 6).  Moving volumes and
 ``inside_geometries`` off are refused with the generator's and the field's name.
 """
 
@@ -305,8 +307,9 @@ def _volume(storage: Any, gen: DynamicGenerator,
 
 
 def read_inlets(storage: Any, path: Path) -> list[Inlet]:
-    """Every active generator of spheres of a scene, checked (``check_generator``) and with
-    what fibrelmp's ``fix musen/inlet`` needs."""
+    """Every active generator of a scene, checked (``check_generator``) and with what
+    fibrelmp's ``fix musen/inlet`` needs (a generator of agglomerates: its agglomerate comes
+    with the job, ``attach_agglomerates``)."""
     out = []
     for g in read_generators(storage):
         if not g.active:

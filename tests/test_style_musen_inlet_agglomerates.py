@@ -205,3 +205,32 @@ def test_restart_continues_the_ids_and_bonds(plugin_path, inserted, tmp_path):
     for col in c:
         np.testing.assert_array_equal(c2[col], c[col])
     np.testing.assert_array_equal(b2, b)
+
+
+@pytest.mark.parametrize("weights, pairs", [("lj/coul 0.0 1.0 1.0", 0), ("lj/coul 1.0 1.0 1.0", 1)])
+def test_bonded_spheres_are_special_neighbours(plugin_path, tmp_path, weights, pairs):
+    """A generated two-sphere agglomerate whose spheres overlap (MUSEN allows it): with 1-2
+    weight 0 the bonded pair leaves LAMMPS's neighbour list (the fix made them each other's
+    1-2 special neighbours), with weight 1 it is a contact."""
+    box = "-0.01 0.01 -0.01 0.01 -0.01 0.01"
+    text = "\n".join([
+        f"plugin load {plugin_path}", "units si", "atom_style bpm/sphere", "atom_modify map array",
+        "boundary f f f", "newton on", "region b block -0.05 0.05 -0.05 0.05 -0.05 0.05",
+        "create_box 1 b bond/types 1 extra/bond/per/atom 1 extra/special/per/atom 1",
+        "fix g1 all property/atom i_fl_bp1 d2_fl_bv1 2",
+        # a sphere of the same size far away: gran/hooke sizes its cutoff from those at init
+        "create_atoms 1 single 0.04 0.04 0.04", "set atom 1 diameter 0.002 density 2500.0",
+        "pair_style gran/hooke 2000.0 NULL 0.0 NULL 0.0 0", "pair_coeff * *",
+        "bond_style zero", "bond_coeff *", f"special_bonds {weights}",
+        "comm_modify vel yes", "neighbor 0.0005 bin", "timestep 1e-7", "group spheres empty",
+        f"fix in spheres musen/inlet 3 box {box} tries 30 walls none velocity fixed 0 0 0 "
+        "agglomerate 2 1 0.001 2500.0 -0.00075 0.0 0.0 1 0.001 2500.0 0.00075 0.0 0.0 "
+        "bonds 1 0 1 1 0.0005 events 1 1 1 first_id 10 geometry fl_bp fl_bv 1",
+        "compute pl all pair/local dist", "run 2",
+        "variable n equal count(all)",
+        'print "atoms ${n}" file atoms.txt',
+        "write_dump all local pairs.dump c_pl"])
+    _run_lmp_script(tmp_path, text + "\n")
+    assert (tmp_path / "atoms.txt").read_text().split() == ["atoms", "3"]
+    dump = (tmp_path / "pairs.dump").read_text().split("ITEM: ENTRIES c_pl")[1].split()
+    assert len(dump) == pairs

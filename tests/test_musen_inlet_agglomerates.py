@@ -33,6 +33,9 @@ SCENE, DB = DATA / "agglo_scene.mdem", DATA / "agglomerates.madb"
 DT, END = 1e-6, 0.012                                    # job_agglo.txt
 # cmusen's spread: (spheres, bonds) at the end of the stored run and three reruns (README)
 CMUSEN_COUNTS = ((88, 78), (87, 78), (90, 81), (83, 75))
+# and the spheres' z centre (r^3-weighted) at the end, m
+CMUSEN_Z_CENTRE = (0.006558580371786801, 0.006596479946240262, 0.006760397302187756,
+                   0.006970608091596152)
 
 
 def _storage():
@@ -185,8 +188,22 @@ def test_counts_within_three_cmusen_spreads(fibrelmp_result):
         assert abs(value - mean) <= 3 * half, (value, runs)
 
 
+def test_z_centre_at_the_end_within_three_cmusen_spreads(fibrelmp_run):
+    """The falling agglomerates' z centre (r^3-weighted, all spheres) at the last time point
+    against cmusen's four runs."""
+    with MdemFile(fibrelmp_run / "agglo_result.mdem") as f:
+        info = f.storage.info.particles
+        t, values, masks = list(f.time_points())[-1]
+    ids = [i for i, p in enumerate(info) if p.type == 1]
+    r = np.array([np.frombuffer(info[i].encoded_properties, "<f8")[0] for i in ids])
+    assert t == pytest.approx(0.012001, abs=1e-12) and (masks[ids] != 0).all()
+    z = float((values[ids, 2] * r ** 3).sum() / (r ** 3).sum())
+    mean, half = float(np.mean(CMUSEN_Z_CENTRE)), 0.5 * (max(CMUSEN_Z_CENTRE) - min(CMUSEN_Z_CENTRE))
+    assert abs(z - mean) <= 3 * half, (z, CMUSEN_Z_CENTRE)
+
+
 def test_bonds_hold_the_agglomerates_together(fibrelmp_run, fibrelmp_result):
-    """At the end (on the floor) every bond still joins spheres at about its initial length:
+    """At the end every bond still joins spheres at about its initial length:
     the generated bonds act (MBOND's strengths are 1e12 Pa: none breaks)."""
     with MdemFile(fibrelmp_run / "agglo_result.mdem") as f:
         t, values, masks = list(f.time_points())[-1]
@@ -210,11 +227,11 @@ def test_checkpoint_and_resume_give_the_uninterrupted_run(tmp_path, monkeypatch,
 
 def test_two_ranks_insert_the_same_agglomerates(tmp_path):
     """``mpiexec -n 2``: the same insertions (inlet log byte for byte), the same objects and
-    topology, and every saved time point bit-identical through 0.007 s (all insertions and
-    the first landings).  Not later: the bond force on a sphere whose partner is a ghost
-    (newton_bond on) is summed in another order on two ranks, and the heap of colliding
-    agglomerates amplifies that last bit (measured: 1e-16 of scale at 0.008 s, 6e-5 at the
-    end) -- as for any bonded scene on several ranks."""
+    topology, and every saved time point bit-identical through 0.007 s (all insertions).
+    Not later: the bond force on a sphere whose partner is a ghost (newton_bond on) is summed
+    in another order on two ranks, and the colliding agglomerates amplify that last bit
+    (measured: 1e-16 of scale at 0.008 s, 6e-5 at the end) -- as for any bonded scene on
+    several ranks."""
     from .test_mpi import MPIEXEC, assert_ran, serial_and_mpi
 
     if not MPIEXEC:

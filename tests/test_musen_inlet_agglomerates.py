@@ -299,14 +299,25 @@ def test_unknown_alias_and_multisphere_refused(tmp_path):
 
 
 def test_hostile_database_is_refused_without_allocating(tmp_path):
-    """A .madb declaring a huge length, or a million empty messages in a few bytes, is
-    refused (the wire walk counts messages against half the file size)."""
+    """A .madb declaring a huge length, or many empty messages in few bytes, is refused
+    before the parse (the wire walk counts messages against size / 16 + 4096); MUSEN's own
+    database (1.5 MB, 15 agglomerates) passes."""
+    from fibrelmp.translate.musen.mdem import agglomerates
+
     bad = tmp_path / "bad.madb"
     bad.write_bytes(b"\x0a\xff\xff\xff\xff\x0f" + b"\x00" * 10)
-    with pytest.raises(InputError):
+    with pytest.raises(InputError, match="not a MUSEN .madb"):
         read_database(bad)
-    bad.write_bytes(b"\x0a\x00" * 1000)       # 1000 empty agglomerates: 2 bytes each, allowed
-    assert len(read_database(bad)) == 1       # (one key '')
+    bad.write_bytes(b"\x0a\x00" * 1000)       # 1000 empty agglomerates: within the slack
+    assert len(read_database(bad)) == 1        # (one key '')
+    bad.write_bytes(b"\x0a\x00" * 500_000)    # 1 MB of them: 500000 messages > 69632
+    with pytest.raises(InputError, match="not a MUSEN .madb"):
+        read_database(bad)
+    big = tmp_path / "big.madb"
+    with open(big, "wb") as fh:
+        fh.truncate(agglomerates.MAX_BYTES + 1)
+    with pytest.raises(InputError, match="more than fibrelmp reads"):
+        read_database(big)
 
 
 def test_scene_run_without_a_job_names_the_missing_database(tmp_path):
@@ -335,3 +346,24 @@ def test_lmp_replays_the_run_bitwise(fibrelmp_run, tmp_path):
     assert proc.returncode == 0, proc.stdout + proc.stderr
     for name in ("frames.dump", "bonds.dump", "inlets.log"):
         assert (tmp_path / name).read_bytes() == (ran / name).read_bytes(), name
+
+
+def test_musens_shipped_database_reads(tmp_path):
+    """MUSEN's own Installers/Data/Databases/Agglomerates.madb (from the MUSEN mirror, when
+    this machine has it): 15 agglomerates, e.g. 'Small rod' of 3 spheres and 2 bonds."""
+    import subprocess
+
+    repo = Path("/work/.mirror/msolids+musen/repo")
+    if not repo.exists():
+        pytest.skip("no MUSEN mirror on this machine")
+    out = tmp_path / "Agglomerates.madb"
+    with open(out, "wb") as fh:
+        proc = subprocess.run(["git", "-C", str(repo), "show", "HEAD:Installers/Data/Databases/Agglomerates.madb"],
+                              stdout=fh, stderr=subprocess.PIPE)
+    if proc.returncode != 0:
+        pytest.skip("the mirror does not hold the database")
+    db = read_database(out)
+    assert len(db) == 15
+    rod = next(a for a in db.values() if a.name == "Small rod")
+    assert (len(rod.radius), len(rod.bond_radius)) == (3, 2) and rod.kind == 0
+    assert all((a.contact_radius == a.radius).all() for a in db.values())

@@ -12,8 +12,9 @@ the origin and multiplies coordinates, radii, contact radii and bond radii by th
 generator's ``scaling_factor`` (``prepared_agglomerate`` reproduces that arithmetic).
 
 Reading is bounded: the file is at most ``MAX_BYTES`` and its messages are counted on the
-wire before the parse (``bounds.count_messages``), so a hostile file cannot make the parser
-allocate more than ``MAX_BYTES / 2`` messages.
+wire before the parse (``bounds.count_messages``): at most one per ``BYTES_PER_MESSAGE``
+stored bytes (+ ``MESSAGES_SLACK``), so a hostile file of empty messages cannot make the
+parser allocate more than about 1 M messages (~160 MB).
 """
 
 from __future__ import annotations
@@ -27,7 +28,11 @@ import numpy as np
 from fibrelmp.errors import InputError
 
 AGGLOMERATE, MULTISPHERE = 0, 1        # SAgglomerate::nType
-MAX_BYTES = 64 << 20                   # MUSEN's shipped database is 1.5 MB
+MAX_BYTES = 16 << 20                   # MUSEN's shipped database is 1.5 MB
+# messages per stored byte: MUSEN's shipped database has one per 27 bytes (a sphere is 3
+# messages of ~80 bytes, a bond one of ~25); at most this many, then ~160 bytes each parsed
+BYTES_PER_MESSAGE = 16
+MESSAGES_SLACK = 4096
 _PI = 3.14159265358979323846           # MUSEN's PI (BasicTypes.h)
 
 
@@ -64,7 +69,7 @@ def read_database(path: Path, where: Path | None = None, line: int | None = None
                          f"than fibrelmp reads ({MAX_BYTES})")
     data = path.read_bytes()[:MAX_BYTES]
     try:
-        bounds.count_messages(data, "ProtoAgglomeratesDB", len(data) // 2 + 16)
+        bounds.count_messages(data, "ProtoAgglomeratesDB", len(data) // BYTES_PER_MESSAGE + MESSAGES_SLACK)
         db = new("ProtoAgglomeratesDB", data)
     except Exception as exc:        # TooMany, a broken wire format, protobuf's DecodeError
         raise InputError(src, line, f"agglomerates database {str(path)!r} is not a MUSEN "

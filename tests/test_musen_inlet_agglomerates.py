@@ -367,3 +367,23 @@ def test_musens_shipped_database_reads(tmp_path):
     rod = next(a for a in db.values() if a.name == "Small rod")
     assert (len(rod.radius), len(rod.bond_radius)) == (3, 2) and rod.kind == 0
     assert all((a.contact_radius == a.radius).all() for a in db.values())
+
+
+def test_agglomerates_without_bonds_run(tmp_path):
+    """Agglomerates of spheres alone (no bond in the database entry): spheres only, in the
+    database's order, no LAMMPS bond room asked for."""
+    from fibrelmp.translate.musen.mdem.agglomerates import write_database
+
+    job = _job(tmp_path)
+    write_database(tmp_path / "agglomerates.madb", [
+        dict(key="AGGTRI", name="t", particles=[(0, 0, 0, 4e-4, "Part"), (8e-4, 0, 0, 4e-4, "Part")], bonds=[]),
+        dict(key="AGGROD", name="r", particles=[(0, 0, 0, 3e-4, "Part")], bonds=[])])
+    text = job.read_text().replace("END_TIME             0.012", "END_TIME             0.0025")
+    job.write_text(text)
+    python_api.run(job)
+    res = _objects((tmp_path / "agglo_result_prec17.txt").read_text())
+    assert {o["type"] for o in res.values()} == {1}
+    radii = [res[i]["r"] for i in sorted(res)]
+    # 0.001 s: 3 pairs of glass spheres; 0.002 s: 3 more pairs, then 4 single steel spheres
+    assert radii == pytest.approx([4e-4] * 12 + [3e-4 * 1.25] * 4, rel=1e-5)     # 6 digits
+    assert "extra bond per atom" not in (tmp_path / "job_agglo_work" / "job1" / "data.lammps").read_text()

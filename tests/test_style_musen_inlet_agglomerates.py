@@ -234,3 +234,19 @@ def test_bonded_spheres_are_special_neighbours(plugin_path, tmp_path, weights, p
     assert (tmp_path / "atoms.txt").read_text().split() == ["atoms", "3"]
     dump = (tmp_path / "pairs.dump").read_text().split("ITEM: ENTRIES c_pl")[1].split()
     assert len(dump) == pairs
+
+
+def test_taken_reserved_id_is_an_error(plugin_path, tmp_path):
+    """first_id 1 while atom 1 exists: the fix stops with an error rather than give an ID twice."""
+    text = "\n".join([
+        f"plugin load {plugin_path}", "units si", "atom_style bpm/sphere", "atom_modify map array",
+        "boundary f f f", "newton on", "region b block -0.05 0.05 -0.05 0.05 -0.05 0.05",
+        "create_box 1 b bond/types 1 extra/bond/per/atom 1 extra/special/per/atom 1",
+        "create_atoms 1 single 0.04 0.04 0.04", "set atom 1 diameter 0.002",
+        "pair_style zero 0.01", "pair_coeff * *",
+        "bond_style zero", "bond_coeff *", "timestep 1e-7", "group spheres empty",
+        "fix in spheres musen/inlet 3 box -0.01 0.01 -0.01 0.01 -0.01 0.01 tries 30 walls none "
+        "velocity fixed 0 0 0 agglomerate 1 1 0.001 2500.0 0 0 0 bonds 0 events 1 1 1 first_id 1",
+        "run 2"])
+    with pytest.raises(AssertionError, match="is taken by another atom"):
+        _run_lmp_script(tmp_path, text + "\n")

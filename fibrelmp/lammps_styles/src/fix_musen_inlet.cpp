@@ -530,6 +530,14 @@ void FixMusenInlet::insert_agglomerates(const Event &event)
     }
   }
   if (created.empty()) return;
+  // the IDs reserved for these objects must be free (another fix or a read_data could hold them)
+  int taken = 0;
+  for (tagint t : tags)    // (map() reads past its table above map_tag_max)
+    if (t <= atom->map_tag_max) taken |= (atom->map(t) >= 0 && atom->map(t) < atom->nlocal);
+  MPI_Allreduce(MPI_IN_PLACE, &taken, 1, MPI_INT, MPI_MAX, world);
+  if (taken)
+    error->all(FLERR, "Fix musen/inlet: an ID reserved for its agglomerates ({}..{}) is taken by "
+               "another atom (first_id must leave room for every requested agglomerate)", tags.front(), tags.back());
   create(created, which, vel, &tags);
   if (!bonds.empty()) add_bonds(created, tags);
 }

@@ -69,8 +69,6 @@ _IGNORED = {
     "SELECTIVE_SAVING_P": "every field is saved", "SELECTIVE_SAVING_SB": "every field is saved",
     "SELECTIVE_SAVING_LB": "every field is saved", "SELECTIVE_SAVING_TW": "every field is saved",
 }
-# keywords only the generator / analyser / snapshot components read: accepted, no effect
-_OTHER_COMPONENT_KEYS: tuple[str, ...] = ()
 
 
 @dataclass
@@ -212,7 +210,7 @@ read = read_script
 
 
 def _known_keys() -> list[str]:
-    return sorted(set(_HANDLERS) | set(_IGNORED) | set(_OTHER_COMPONENT_KEYS) | set(_EXPORT_KEYS)
+    return sorted(set(_HANDLERS) | set(_IGNORED) | set(_EXPORT_KEYS)
                   | {"JOB", "NEW_JOB"})
 
 
@@ -233,8 +231,6 @@ def _keyword(job: MusenJob, line: _Line) -> None:
     elif key in _IGNORED:
         job.warnings.append(("musen-ignored-keyword", f"{line.path}:{line.ln}: {key} ignored "
                              f"({_IGNORED[key]})"))
-    elif key in _OTHER_COMPONENT_KEYS:
-        pass                            # read by components fibrelmp refuses; no effect here
     elif not line.tok and not any(ch.isalnum() for ch in key):   # a lone stray mark (Example 6's ´)
         job.warnings.append(("musen-ignored-keyword", f"{line.path}:{line.ln}: {key!r} skipped "
                              "(not a keyword; cmusen skips it as an unknown key)"))

@@ -14,6 +14,7 @@ volume, apart, uniform orientation) is tested on fix musen/inlet alone
 from __future__ import annotations
 
 import gzip
+import math
 import shutil
 from pathlib import Path
 
@@ -387,3 +388,93 @@ def test_agglomerates_without_bonds_run(tmp_path):
     # 0.001 s: 3 pairs of glass spheres; 0.002 s: 3 more pairs, then 4 single steel spheres
     assert radii == pytest.approx([4e-4] * 12 + [3e-4 * 1.25] * 4, rel=1e-5)     # 6 digits
     assert "extra bond per atom" not in (tmp_path / "job_agglo_work" / "job1" / "data.lammps").read_text()
+
+
+# cmusen's srand(time(0)) of the stored run: the Unix second its generators were initialised
+# (found by trying the seconds before the result file's time; README)
+CMUSEN_TIME0 = 1795879240
+_RAND_MAX = 2147483647
+
+
+class _GlibcRand:
+    """glibc's rand() (random_r TYPE_3: the additive feedback generator srand seeds with
+    16807 LCG words and runs 310 times), as cmusen calls it."""
+
+    def __init__(self, seed: int):
+        r = [seed & 0xFFFFFFFF or 1]
+        for i in range(1, 31):
+            prev = r[i - 1] - (1 << 32) if r[i - 1] >= 1 << 31 else r[i - 1]
+            hi, lo = divmod(prev, 127773)
+            word = 16807 * lo - 2836 * hi
+            r.append(word + 2147483647 if word < 0 else word)
+        r += r[:3]
+        self.r = r
+        for _ in range(310):
+            self()
+
+    def __call__(self) -> int:
+        v = (self.r[-31] + self.r[-3]) & 0xFFFFFFFF
+        self.r.append(v)
+        del self.r[:-34]
+        return v >> 1
+
+
+def _musen_seed(t: int) -> int:
+    """CObjectsGenerator::Initialize's seed from time(0) (unsigned arithmetic)."""
+    s, m = t & 0xFFFFFFFF, t % 5
+    return {4: (2 * s), 3: (s * s), 2: (s + s * s), 1: s // 2, 0: s}[m] & 0xFFFFFFFF
+
+
+def test_musens_placement_rule_gives_cmusens_first_agglomerates():
+    """MUSEN's generation as read (GenerateNewObject: a centre (rand() + 1) size / RAND_MAX in
+    the bounding box, then CQuaternion::Random from three rand() / RAND_MAX, the database
+    agglomerate centred by volume turned by its rotation matrix; tried until totally inside
+    and apart; then the velocity's rejection loop), written here with glibc's rand() and the
+    seed of the stored run, gives cmusen's three triangles of 0.001 s (saved as made)
+    to 1e-19 m and their velocities bit for bit: the rule fibrelmp's fix follows with its own
+    random numbers."""
+    with gzip.open(DATA / "agglo_result_prec17.txt.gz", "rt") as fh:
+        text = fh.read()
+    saved = {}
+    for line in text.splitlines():
+        tok = line.split()
+        if len(tok) < 12 or tok[0] != "0" or tok[3] != "1":
+            continue
+        marker = " 2 0.0010000000000000152 16 "
+        if marker in line:
+            rec = line.split(marker)[1].split()
+            x = [float(v) for v in rec[4:7]]        # 16 f f f 12 x y z
+            if any(x):
+                vel = rec[rec.index("15") + 1:rec.index("15") + 4]
+                saved[int(tok[1])] = (np.array(x), np.array([float(v) for v in vel]))
+    assert sorted(saved) == [10, 11, 12, 16, 17, 18, 22, 23, 24]
+    lo, hi = np.array([-0.004, -0.004, 0.006999999999999999]), np.array([0.004, 0.004, 0.011])
+    coords, radius, _ = prepared_agglomerate(read_database(DB)["AGGTRI"], 1.0)
+    rand = _GlibcRand(_musen_seed(CMUSEN_TIME0))
+    made: list[tuple[np.ndarray, float]] = []
+    for obj, first in enumerate((10, 16, 22)):
+        for _ in range(30):
+            c = lo + np.array([rand() + 1 for _ in range(3)], float) * (hi - lo) / _RAND_MAX
+            u1, u2, u3 = (rand() / _RAND_MAX for _ in range(3))
+            q = np.array([math.sqrt(1 - u1) * math.sin(2 * math.pi * u2), math.sqrt(1 - u1) * math.cos(2 * math.pi * u2),
+                          math.sqrt(u1) * math.sin(2 * math.pi * u3), math.sqrt(u1) * math.cos(2 * math.pi * u3)])
+            q0, q1, q2, q3 = q / np.linalg.norm(q)
+            rot = np.array([[1 - 2 * (q2 * q2 + q3 * q3), 2 * (q1 * q2 - q0 * q3), 2 * (q1 * q3 + q0 * q2)],
+                            [2 * (q1 * q2 + q0 * q3), 1 - 2 * (q1 * q1 + q3 * q3), 2 * (q2 * q3 - q0 * q1)],
+                            [2 * (q1 * q3 - q0 * q2), 2 * (q2 * q3 + q0 * q1), 1 - 2 * (q1 * q1 + q2 * q2)]])
+            x = c + coords @ rot.T
+            ok = ((x - radius[:, None] >= lo) & (x + radius[:, None] <= hi)).all()
+            ok = ok and all(np.linalg.norm(x[p] - y) >= radius[p] + ry for p in range(3) for y, ry in made)
+            if ok:
+                break
+        while True:
+            v = np.array([2.0 * rand() / _RAND_MAX - 1 for _ in range(3)])
+            length = float(np.linalg.norm(v))
+            if 0 < length <= 1:
+                break
+        v = v / length * 0.2
+        made += [(x[p], float(radius[p])) for p in range(3)]
+        for p in range(3):
+            want_x, want_v = saved[first + p]
+            assert np.abs(x[p] - want_x).max() <= 1e-19 * 10, (first + p, x[p] - want_x)
+            np.testing.assert_array_equal(v, want_v)

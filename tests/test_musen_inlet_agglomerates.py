@@ -478,3 +478,41 @@ def test_musens_placement_rule_gives_cmusens_first_agglomerates():
             want_x, want_v = saved[first + p]
             assert np.abs(x[p] - want_x).max() <= 1e-19 * 10, (first + p, x[p] - want_x)
             np.testing.assert_array_equal(v, want_v)
+
+
+def test_scene_bonds_and_generated_bonds_together(tmp_path):
+    """A scene holding a bonded pair (ids 10, 11, bond 12) and the two generators: the scene's
+    bond and the generated ones share MBOND's bond type, the generated objects' ids follow
+    the scene's (13 ...), each agglomerate's bonds name its own spheres."""
+    from fibrelmp.translate.musen.mdem.document import MdemWriter
+    from fibrelmp.translate.musen.mdem.text_import import import_text
+
+    lines = (DATA / "agglo_scene.txt").read_text().splitlines()
+    pair = ["0 10 1 1 5 0.0004 0.0004 23 MGLASS 24 0 1e+300 2 0 12 0.0 0.0 0.0004",
+            "0 11 1 1 5 0.0004 0.0004 23 MGLASS 24 0 1e+300 2 0 12 0.0008 0.0 0.0004",
+            "0 12 1 9 5 10 11 0.0004 0.0008 23 MBOND 24 0 1e+300 2 0"]
+    walls = [ln for ln in lines if ln.startswith("0 ")]
+    (tmp_path / "scene.txt").write_text("\n".join(walls + pair + lines[len(walls):]) + "\n")
+    storage, points = import_text(tmp_path / "scene.txt")
+    with MdemFile(SCENE) as f:
+        storage.modules_data.objects_generator.CopyFrom(f.storage.modules_data.objects_generator)
+    with open(tmp_path / "agglo_scene.mdem", "wb") as fh:
+        w = MdemWriter(fh)
+        for t, values, masks in points:
+            w.add(t, values, masks)
+        w.finish(storage)
+    shutil.copy(DB, tmp_path)
+    text = (DATA / "job_agglo.txt").read_text().replace("END_TIME             0.012",
+                                                        "END_TIME             0.0025")
+    (tmp_path / "job_agglo.txt").write_text(text)
+    python_api.run(tmp_path / "job_agglo.txt")
+    res = _objects((tmp_path / "agglo_result_prec17.txt").read_text())
+    assert (res[12]["left"], res[12]["right"]) == (10, 11)
+    generated = {i: o for i, o in res.items() if i >= 13}
+    again = _agglomerates({i - 3: o for i, o in generated.items()})     # as if after the walls
+    assert len(again) == 3 + 3 + 4                 # 0.001 s: 3 triangles; 0.002 s: 3 and 4 rods
+    for _, spheres, bonds in again:
+        for b in bonds:
+            assert {res[b + 3]["left"] - 3, res[b + 3]["right"] - 3} <= set(spheres)
+    script = (tmp_path / "job_agglo_work" / "job1" / "in.lammps").read_text()
+    assert script.count("bond_coeff      ") == 1

@@ -19,7 +19,7 @@ import numpy as np
 from fibrelmp.errors import InputError
 from fibrelmp.granmodel import GranularModel
 from fibrelmp import lammps_styles
-from fibrelmp.lammps_text import lammps_path, template_environment
+from fibrelmp.lammps_text import LammpsText, comment_text, lammps_path, template_environment
 from fibrelmp.textio import atomic_write
 from fibrelmp.translate.granular.bonds import (GEOMETRY_FIX, GEOMETRY_NAME, PARTNERS, VALUES, BondGeometry,
                                               SimulatedBonds, bond_geometry, select_bonds)
@@ -262,6 +262,13 @@ def _plan_parts(model: GranularModel) -> _JobParts:
     place_tiles(model, wall_plans, tiles, spheres, axes, travel, t_start, warnings)
     fit = fit_box(model, axes, spheres, tiles, dim)
     box_cmds = box_commands(fit, axes, spheres, tiles, travel, dt, warnings)
+    if any(i.makes_agglomerates for i in plan.inlets) and not any("atom_modify" in c for c in box_cmds):
+        # a resumed run sorts its atoms at once, the uninterrupted one at multiples of 1000
+        # steps: agglomerates' bonded spheres (3 and more forces each) would then sum their
+        # forces in other orders and differ in the last bit; unsorted, the order is the same
+        box_cmds += [LammpsText("# " + comment_text("atoms kept in creation order: a resumed run "
+                                                    "sums forces as the uninterrupted one")),
+                     "atom_modify     sort 0 0.0"]
     styles = lammps_styles.plugin()
     if not styles.available and model.kind == "musen":     # DEMDF's law is stock-exact
         warnings.append(("approximate MUSEN physics", f"fibrelmp's LAMMPS styles are not used "

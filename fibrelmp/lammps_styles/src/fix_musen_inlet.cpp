@@ -44,6 +44,8 @@ struct Stream {
 
 double dot(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
+const double GLIBC_RAND_MAX = 2147483647.0;
+
 // squared distance from p to the triangle a b c (closest point by Voronoi regions)
 double triangle_distance2(const double *p, const double *a, const double *b, const double *c)
 {
@@ -259,6 +261,18 @@ FixMusenInlet::FixMusenInlet(LAMMPS *lmp, int narg, char **arg) :
       nslots = utils::inumeric(FLERR, arg[at + 3], false, lmp);
       if (nslots < 1) error->all(FLERR, "Fix musen/inlet: geometry needs K >= 1 slots");
       at += 2;
+    } else if (strcmp(arg[at], "musen_rand") == 0) {    // TIME0: cmusen's srand(time(0))
+      if (parts.empty()) error->all(FLERR, "Fix musen/inlet: musen_rand is for agglomerates");
+      std::uint32_t t0 = static_cast<std::uint32_t>(utils::bnumeric(FLERR, arg[at + 1], false, lmp));
+      switch (t0 % 5) {    // CObjectsGenerator::Initialize (unsigned arithmetic)
+        case 4: t0 *= 2; break;
+        case 3: t0 *= t0; break;
+        case 2: t0 += t0 * t0; break;
+        case 1: t0 = t0 / 2; break;
+        default: break;
+      }
+      musen_rand = true;
+      glibc.seed(t0);
     } else if (strcmp(arg[at], "log") == 0) {
       if (comm->me == 0) {
         log = fopen(arg[at + 1], "a");
@@ -472,6 +486,8 @@ void FixMusenInlet::insert_agglomerates(const Event &event)
   const std::vector<double> tri = wall_triangles();
   const std::vector<int> close = close_triangles(tri, lo, hi);
   Stream rng{seed * 0x9E3779B97F4A7C15ULL ^ static_cast<std::uint64_t>(event.step)};
+  // musen_rand: cmusen's one rand() stream, shared by every generator (the first fix owns it)
+  GlibcRand *crand = musen_rand ? &stream_owner()->glibc : nullptr;
   const size_t n = parts.size();
   std::vector<Sphere> created, object(n);
   std::vector<int> which;
@@ -485,14 +501,23 @@ void FixMusenInlet::insert_agglomerates(const Event &event)
     bool placed = false;
     for (int attempt = 0; attempt < tries && !placed; attempt++) {
       double c[3], q[4], R[3][3];
-      for (int k = 0; k < 3; k++) c[k] = lo[k] + rng.uniform() * (hi[k] - lo[k]);
+      double u1, u2, u3;
+      if (crand) {    // CreateRandomPoint, then CQuaternion::Random, as cmusen computes them
+        for (int k = 0; k < 3; k++) c[k] = lo[k] + static_cast<double>(crand->next() + 1) * (hi[k] - lo[k]) / GLIBC_RAND_MAX;
+        u1 = crand->next() / GLIBC_RAND_MAX;
+        u2 = crand->next() / GLIBC_RAND_MAX;
+        u3 = crand->next() / GLIBC_RAND_MAX;
+      } else {
+        for (int k = 0; k < 3; k++) c[k] = lo[k] + rng.uniform() * (hi[k] - lo[k]);
+        u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform();
+      }
       // CQuaternion::Random (Shoemake), normalised; R its rotation matrix (q0 the scalar)
-      const double u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform();
       q[0] = std::sqrt(1 - u1) * std::sin(2 * M_PI * u2);
       q[1] = std::sqrt(1 - u1) * std::cos(2 * M_PI * u2);
       q[2] = std::sqrt(u1) * std::sin(2 * M_PI * u3);
       q[3] = std::sqrt(u1) * std::cos(2 * M_PI * u3);
-      const double len = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+      double len = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+      if (q[0] < 0) len = -len;    // MUSEN's Normalize: q0 >= 0 (the same rotation)
       for (double &v : q) v /= len;
       R[0][0] = 1 - 2 * (q[2] * q[2] + q[3] * q[3]);
       R[0][1] = 2 * (q[1] * q[2] - q[0] * q[3]);
@@ -516,7 +541,7 @@ void FixMusenInlet::insert_agglomerates(const Event &event)
     if (random_velocity) {
       double len;
       do {
-        for (int k = 0; k < 3; k++) u[k] = 2.0 * rng.uniform() - 1.0;
+        for (int k = 0; k < 3; k++) u[k] = crand ? 2 * static_cast<double>(crand->next()) / GLIBC_RAND_MAX - 1 : 2.0 * rng.uniform() - 1.0;
         len = std::sqrt(dot(u, u));
       } while (len == 0.0 || len > 1.0);
       for (int k = 0; k < 3; k++) u[k] = u[k] / len * magnitude;
@@ -675,6 +700,16 @@ void *FixMusenInlet::extract(const char *name, int &itype)
   return &type_radius;
 }
 
+/* the fix holding cmusen's rand() stream: the first musen/inlet fix with musen_rand */
+FixMusenInlet *FixMusenInlet::stream_owner()
+{
+  for (Fix *other : modify->get_fix_by_style("^musen/inlet$")) {
+    auto *f = static_cast<FixMusenInlet *>(other);
+    if (f->musen_rand) return f;
+  }
+  return this;
+}
+
 double FixMusenInlet::compute_scalar()
 {
   return static_cast<double>(inserted);
@@ -687,6 +722,10 @@ void FixMusenInlet::write_restart(FILE *fp)
   std::vector<double> list{static_cast<double>(made.size()), static_cast<double>(inserted),
                            static_cast<double>(last_id)};
   for (int m : made) list.push_back(m);
+  if (musen_rand) {    // the rand() stream: 34 words and the count (exact in doubles)
+    for (std::uint32_t w : glibc.r) list.push_back(static_cast<double>(w));
+    list.push_back(static_cast<double>(glibc.n));
+  }
   const int size = static_cast<int>(list.size() * sizeof(double));
   fwrite(&size, sizeof(int), 1, fp);
   fwrite(list.data(), sizeof(double), list.size(), fp);
@@ -701,6 +740,11 @@ void FixMusenInlet::restart(char *buf)
   inserted = static_cast<bigint>(list[1]);
   last_id = static_cast<tagint>(list[2]);
   for (size_t i = 0; i < made.size(); i++) made[i] = static_cast<int>(list[3 + i]);
+  if (musen_rand) {
+    const double *w = list + 3 + made.size();
+    for (int k = 0; k < 34; k++) glibc.r[k] = static_cast<std::uint32_t>(w[k]);
+    glibc.n = static_cast<std::uint64_t>(w[34]);
+  }
 }
 
 // registration with LAMMPS when the plugin loads (style_registry.h)

@@ -12,6 +12,7 @@
          [first_id ID] [log FILE] [groups NAME1 .. NAMEK]   (a further group per fraction)
          [volume N  X1 Y1 Z1 X2 Y2 Z2 X3 Y3 Z3  (N times)]   (a closed triangle volume)
          [geometry PARTNER VALUES K]   (agglomerates: bond_style musen/elastic's per-atom slots)
+         [musen_rand TIME0]   (agglomerates: cmusen's random numbers, see below)
 
    At each listed STEP (MUSEN's generation times, computed by fibrelmp from cmusen's summed
    clock: the fix does not recompute it) it tries to make COUNT spheres.  Per sphere: the
@@ -36,7 +37,13 @@
    other, as in MUSEN's IsOverlapped), else it is redrawn (N tries) and dropped whole.  One
    velocity per object (fixed, or one random draw) for all its spheres.  IDs: the j-th object
    this fix is asked for (over its events, made or not) has IDs FIRST_ID + j N + part, so that
-   fibrelmp knows every sphere's and bond's row in advance (first_id must leave room).  The bonds are added
+   fibrelmp knows every sphere's and bond's row in advance (first_id must leave room).
+   "musen_rand TIME0": instead of the seeded stream below, cmusen's own: glibc's rand() seeded
+   as CObjectsGenerator::Initialize seeds it from time(0) = TIME0, one stream for every fix
+   with musen_rand (in definition order, as cmusen's generators share rand()), drawn in
+   MUSEN's order and arithmetic (centre (rand() + 1) size / RAND_MAX, quaternion rand() /
+   RAND_MAX, velocity 2 rand() / RAND_MAX - 1), kept in the restart file: with the TIME0 of a
+   cmusen run the same agglomerates as that run, as long as the overlap decisions agree.  The bonds are added
    to the left sphere's bond list (newton_bond on), with the left sphere's geometry slot
    (i_PARTNERk = right sphere's ID, d2_VALUESk = DIAMETER and the initial length |x_I - x_J|,
    MUSEN's AddSolidBond) and each other's 1-2 special neighbours; the log gets "STEP ID" per
@@ -65,6 +72,33 @@
 #include <vector>
 
 namespace LAMMPS_NS {
+
+// glibc's rand() (random_r TYPE_3), as cmusen calls it: srand's 16807 LCG fill, 310 discarded
+struct GlibcRand {
+  std::uint32_t r[34];
+  std::uint64_t n = 0;    // words made (the next goes to r[n % 34])
+  void seed(std::uint32_t s)
+  {
+    std::int32_t word = static_cast<std::int32_t>(s ? s : 1);
+    r[0] = static_cast<std::uint32_t>(word);
+    for (int i = 1; i < 31; i++) {
+      const std::int32_t hi = word / 127773, lo = word % 127773;    // C truncation
+      word = 16807 * lo - 2836 * hi;
+      if (word < 0) word += 2147483647;
+      r[i] = static_cast<std::uint32_t>(word);
+    }
+    for (int i = 31; i < 34; i++) r[i] = r[i - 31];
+    n = 34;
+    for (int i = 0; i < 310; i++) next();
+  }
+  int next()
+  {
+    const std::uint32_t v = r[(n - 31) % 34] + r[(n - 3) % 34];
+    r[n % 34] = v;
+    n++;
+    return static_cast<int>(v >> 1);
+  }
+};
 
 class FixMusenInlet : public Fix {
  public:
@@ -114,6 +148,9 @@ class FixMusenInlet : public Fix {
   std::vector<Part> parts;          // "agglomerate": its spheres (empty: a mixture)
   std::vector<AggloBond> bonds;     // and its bonds
   std::string partners_name, values_name;    // "geometry": the per-atom slots' names
+  bool musen_rand = false;          // "musen_rand TIME0": cmusen's rand() stream (agglomerates)
+  GlibcRand glibc;                  // that stream, used from the first such fix
+  FixMusenInlet *stream_owner();
   int nslots = 0;
   std::vector<int> made;        // successes per fraction (MUSEN's generated mixture particles)
   std::vector<Event> events;

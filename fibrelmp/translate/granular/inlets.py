@@ -280,6 +280,9 @@ def _agglomerate_commands(model: GranularModel, type_of_mat: dict[int, int], typ
         steps = " ".join(f"{e.step} {e.requested}" for e in mine)
         groups = " ".join(f"m{type_of_mat[m]}" for m in mats)
         geometry = f" geometry {PARTNERS} {VALUES} {geometry_slots}" if agg.bonds else ""
+        time0 = model.plan.inlet_musen_time0
+        if time0 is not None:
+            geometry += f" musen_rand {int(time0)}"
         out.append(f"fix             fl_inlet{k + 1} spheres musen/inlet {INLET_SEED + k} box {box} "
                    f"tries {g.max_iterations} walls {wall_fix or 'none'} velocity {vel} "
                    f"agglomerate {agg.spheres} {parts} bonds {agg.bonds} {bonds} "

@@ -559,11 +559,12 @@ def _run_with_cmusens_random_numbers(folder: Path, monkeypatch) -> None:
 def test_cmusens_random_numbers_give_cmusens_run(tmp_path, monkeypatch):
     """With cmusen's own random numbers (fix musen/inlet musen_rand: glibc's rand() from the
     stored run's time(0)) fibrelmp makes cmusen's agglomerates: the same 88 spheres and 78
-    bonds with the same ids, and every sphere at every saved time through 0.003 s (three
-    generations, the first collisions with the floor's neighbours not yet) within 1e-13 of the
-    box (0.01 m) in position and 1e-11 of the speed scale in velocity (measured 4e-15 and
+    bonds with the same ids; every sphere at every saved time through 0.002 s (the first
+    generation and its fall) bit for bit, through 0.003 s (three generations) within 1e-13 of
+    the box (0.01 m) in position and 1e-11 of the speed scale in velocity (measured 7e-16 and
     2e-12); through 0.0065 s positions within 1e-6 of the box (measured 9.6e-7; from 0.0035 s
-    one triangle's collision differs by 1e-5 in velocity and the difference grows)."""
+    one triangle differs by 1e-5 in velocity -- its spheres touch at exactly 2r, where a contact
+    starts or not on the last bit -- and the difference grows)."""
     _run_with_cmusens_random_numbers(tmp_path, monkeypatch)
     with gzip.open(DATA / "agglo_result_prec17.txt.gz", "rt") as fh:
         want = _load_records(fh.read())
@@ -582,6 +583,8 @@ def test_cmusens_random_numbers_give_cmusens_run(tmp_path, monkeypatch):
                 continue                        # not generated yet
             dx = np.abs(np.subtract(got[i][t][12], recs[t][12])).max()
             dv = np.abs(np.subtract(got[i][t][15], recs[t][15])).max()
+            if t <= 0.002 + 1e-9:               # the first generation and its fall
+                assert dx == 0 and dv == 0, (t, i, dx, dv)
             if t <= 0.003 + 1e-9:
                 assert dx <= 1e-13 * 0.01 and dv <= 1e-11 * vmax, (t, i, dx, dv)
             assert dx <= 1e-6 * 0.01, (t, i, dx)

@@ -511,23 +511,24 @@ void FixMusenInlet::insert_agglomerates(const Event &event)
         for (int k = 0; k < 3; k++) c[k] = lo[k] + rng.uniform() * (hi[k] - lo[k]);
         u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform();
       }
-      // CQuaternion::Random (Shoemake), normalised; R its rotation matrix (q0 the scalar)
+      // CQuaternion::Random (Shoemake), then QuatRotateVector's ToRotmat, with MUSEN's
+      // operations in MUSEN's order (three normalisations, its diagonal w1 + w2 - w3 - w4), so
+      // that the same random numbers give cmusen's positions bit for bit
       q[0] = std::sqrt(1 - u1) * std::sin(2 * M_PI * u2);
       q[1] = std::sqrt(1 - u1) * std::cos(2 * M_PI * u2);
       q[2] = std::sqrt(u1) * std::sin(2 * M_PI * u3);
       q[3] = std::sqrt(u1) * std::cos(2 * M_PI * u3);
-      double len = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-      if (q[0] < 0) len = -len;    // MUSEN's Normalize: q0 >= 0 (the same rotation)
-      for (double &v : q) v /= len;
-      R[0][0] = 1 - 2 * (q[2] * q[2] + q[3] * q[3]);
-      R[0][1] = 2 * (q[1] * q[2] - q[0] * q[3]);
-      R[0][2] = 2 * (q[1] * q[3] + q[0] * q[2]);
-      R[1][0] = 2 * (q[1] * q[2] + q[0] * q[3]);
-      R[1][1] = 1 - 2 * (q[1] * q[1] + q[3] * q[3]);
-      R[1][2] = 2 * (q[2] * q[3] - q[0] * q[1]);
-      R[2][0] = 2 * (q[1] * q[3] - q[0] * q[2]);
-      R[2][1] = 2 * (q[2] * q[3] + q[0] * q[1]);
-      R[2][2] = 1 - 2 * (q[1] * q[1] + q[2] * q[2]);
+      for (int times = 0; times < 3; times++) {    // Random, QuatRotateVector, ToRotmat
+        double len = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+        if (q[0] < 0) len = -len;    // MUSEN's Normalize: q0 >= 0 (the same rotation)
+        for (double &v : q) v /= len;
+      }
+      const double w1 = q[0] * q[0], w2 = q[1] * q[1], w3 = q[2] * q[2], w4 = q[3] * q[3];
+      const double ij = 2 * q[1] * q[2], ik = 2 * q[1] * q[3], jk = 2 * q[2] * q[3];
+      const double iw = 2 * q[1] * q[0], jw = 2 * q[2] * q[0], kw = 2 * q[3] * q[0];
+      R[0][0] = w1 + w2 - w3 - w4, R[0][1] = ij - kw, R[0][2] = jw + ik;
+      R[1][0] = ij + kw, R[1][1] = w1 - w2 + w3 - w4, R[1][2] = jk - iw;
+      R[2][0] = ik - jw, R[2][1] = jk + iw, R[2][2] = w1 - w2 - w3 + w4;
       placed = true;
       for (size_t p = 0; p < n && placed; p++) {
         Sphere &s = object[p];

@@ -563,8 +563,8 @@ def test_cmusens_random_numbers_give_cmusens_run(tmp_path, monkeypatch):
     generation and its fall) bit for bit, through 0.003 s (three generations) within 1e-13 of
     the box (0.01 m) in position and 1e-11 of the speed scale in velocity (measured 7e-16 and
     2e-12); through 0.0065 s positions within 1e-6 of the box (measured 9.6e-7; from 0.0035 s
-    one triangle differs by 1e-5 in velocity -- its spheres touch at exactly 2r, where a contact
-    starts or not on the last bit -- and the difference grows)."""
+    one triangle, whose bonded spheres are pressed into contact (overlaps 1e-7 m), differs by
+    1e-5 in velocity, cause not found, and the difference grows)."""
     _run_with_cmusens_random_numbers(tmp_path, monkeypatch)
     with gzip.open(DATA / "agglo_result_prec17.txt.gz", "rt") as fh:
         want = _load_records(fh.read())

@@ -257,6 +257,13 @@ class GranularPlan:
     # MUSEN's active dynamic generators (translate/musen/mdem/generators.py Inlet): fix musen/inlet
     inlets: list = field(default_factory=list)
     inlet_rows: int | None = None   # the first sphere row reserved for them (inlets.reserve_rows)
+    # generators of agglomerates: (generator, first sphere row, first bond row) each
+    # (inlets.reserve_agglomerate_rows), and the first MUSEN id of what they make
+    inlet_layout: list | None = None
+    inlet_next_id: int = 0
+    # generators of agglomerates: draw cmusen's own random numbers, glibc's rand() seeded from
+    # this time(0) of a cmusen run (fix musen/inlet musen_rand; None: fibrelmp's seeded stream)
+    inlet_musen_time0: int | None = None
     # (dt, t_end) -> their GenerationEvents on cmusen's summed clock (generation_schedule)
     inlet_schedule: Callable[[float, float], list] | None = None
 

@@ -299,7 +299,9 @@ def test_unsupported_generator_setting_refuses_the_run(tmp_path, change, message
 
 
 @pytest.mark.parametrize("change, message", [
-    (lambda g, s: setattr(g, "obj_type", 2), "obj_type: generating agglomerates"),
+    (lambda g, s: setattr(g, "obj_type", 3), "obj_type: unknown object type 3"),
+    (lambda g, s: (setattr(g, "obj_type", 2), setattr(g, "scaling_factor", 0.0)),
+     "scaling_factor: must be > 0"),
     (lambda g, s: setattr(g, "volume_key", "NOPE"), "volume_key: no analysis volume 'NOPE'"),
     (lambda g, s: setattr(s.modules_data.materials_database.mixture[1].fraction[0],
                           "fraction", 0.4), "mixture_key: the fractions of mixture 'MIXTWO' sum"),

@@ -86,6 +86,7 @@ class FrameBuilder:
         self.frame_clock, self.break_clock = _clock(job), _clock(job)
         self.variable_clock = None     # variable time step: fix musen/leapfrog's line per frame
         self.inlet_clock = _clock(job)
+        self.next_inlet_id = model.plan.inlet_next_id     # generated agglomerates' next id
         self.deletion_time: dict[int, float] = {}
         deletion_clock = _clock(job)
         for step, rows in sorted(job.deletions, key=lambda d: d[0]):
@@ -104,7 +105,7 @@ class FrameBuilder:
             lo, hi = pair.min(1), pair.max(1)
             self.id_base = int(pair.max()) + 1
             key = lo * self.id_base + hi
-            sim = job.bond_rows
+            sim = np.r_[job.bond_rows, job.inlet_bond_rows].astype(np.int64)
             order = np.argsort(key[sim], kind="stable")
             self.bkeys = key[sim][order]
             self.brows = sim[order]
@@ -220,9 +221,14 @@ class FrameBuilder:
         if not len(new):
             return
         made: dict[int, int] = {}
+        lengths: dict[tuple[int, int], float] = {}
         with open(self.job.inlet_log) as fh:          # "STEP ID"; a resumed run repeats lines
             for line in fh:
-                step, tag = line.split()
+                words = line.split()
+                if len(words) == 4:                   # an agglomerate's bond: STEP LEFT RIGHT L0
+                    lengths[int(words[1]), int(words[2])] = float(words[3])
+                    continue
+                step, tag = words
                 made[int(tag)] = int(step)
         steps = [made.get(int(rows[k]) + 1) for k in new]
         if None in steps:
@@ -236,6 +242,34 @@ class FrameBuilder:
             sp.material[r] = self.job.type_materials[int(c["type"][i])]
             if sp.compound_key is not None:
                 sp.compound_key[r] = self.model.materials[int(sp.material[r])].key
+        if self.model.plan.inlet_layout is not None:
+            self._generated_agglomerates(rows[new], made, lengths)
+
+    def _generated_agglomerates(self, new_rows: np.ndarray, made: dict[int, int],
+                                lengths: dict[tuple[int, int], float]) -> None:
+        """Agglomerates fix musen/inlet made since the last frame: MUSEN's ids (spheres, then
+        bonds, agglomerate after agglomerate in MUSEN's order of generation: by step, then
+        generator, then request) and their bonds alive from the spheres' generation."""
+        sp, b = self.model.spheres, self.model.bonds
+        objects = set()
+        for r in new_rows.tolist():
+            for k, first, bfirst, count, n, m in self.model.plan.inlet_layout:
+                if first <= r < first + count * n:
+                    objects.add((made[r + 1], k, (r - first) // n))
+                    break
+        layout = {entry[0]: entry for entry in self.model.plan.inlet_layout}
+        for step, k, j in sorted(objects):
+            _, first, bfirst, _, n, m = layout[k]
+            srows = first + j * n + np.arange(n)
+            sp.ids[srows] = self.next_inlet_id + np.arange(n)
+            if m:
+                brows = bfirst + j * m + np.arange(m)
+                b.ids[brows] = self.next_inlet_id + n + np.arange(m)
+                b.active_start[brows] = sp.active_start[srows[0]]
+                for row in brows.tolist():
+                    b.length0[row] = lengths[int(b.pair[row, 0]) + 1, int(b.pair[row, 1]) + 1]
+                self.bond_alive[brows] = True
+            self.next_inlet_id += n + m
 
     def _bonds(self, frame: GranularFrame, step: int) -> None:
         """Bond states at ``step``: breaks logged since the last frame, bonds of removed

@@ -19,7 +19,7 @@ import numpy as np
 from fibrelmp.errors import InputError
 from fibrelmp.granmodel import GranularModel
 from fibrelmp import lammps_styles
-from fibrelmp.lammps_text import lammps_path, template_environment
+from fibrelmp.lammps_text import LammpsText, comment_text, lammps_path, template_environment
 from fibrelmp.textio import atomic_write
 from fibrelmp.translate.granular.bonds import (GEOMETRY_FIX, GEOMETRY_NAME, PARTNERS, VALUES, BondGeometry,
                                               SimulatedBonds, bond_geometry, select_bonds)
@@ -34,7 +34,7 @@ from fibrelmp.translate.granular.schedule import (STOP_LABEL, RunTime, compress_
                                                   with_stop_criterion)
 from fibrelmp.translate.granular.fields import TEMPERATURE, field_commands, uses_temperature
 from fibrelmp.translate.granular.inlets import LOG_NAME as INLET_LOG
-from fibrelmp.translate.granular.inlets import inlet_commands
+from fibrelmp.translate.granular.inlets import inlet_bond_capacity, inlet_bond_reach, inlet_commands
 from fibrelmp.translate.granular.spheres import SimulatedSpheres, select_spheres
 from fibrelmp.translate.granular.tiles import TILE_MASS_FACTOR, WallTiles, place_tiles, tile_estimate, tile_types
 from fibrelmp.translate.granular.verlet import VerletSchedule, musen_verlet
@@ -91,6 +91,8 @@ class GranularJob:
     geometry: Path | None = None     # per-atom bond geometry (musen/elastic), beside the data file
     contacts: Path | None = None     # sphere-sphere contacts per frame (compute pair/local)
     inlet_log: Path | None = None    # fix musen/inlet: "STEP ID" per inserted sphere
+    # bond rows reserved for generated agglomerates (inlets.reserve_agglomerate_rows)
+    inlet_bond_rows: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     type_materials: dict[int, int] | None = None   # LAMMPS sphere type -> material
     variable_clock: Path | None = None   # variable time step: each frame's step, time and dt
 
@@ -172,14 +174,15 @@ def build_granular_job(model: GranularModel, folder: str | Path):
         write_data(model, data_path, spheres.rows, spheres.type_of_mat, spheres.smat, spheres.crad,
                    parts.axes.lo, parts.axes.hi, parts.ntypes, tiles.x, tiles.types, tiles.v, tiles.ids,
                    tiles.radius, TILE_MASS_FACTOR * float(spheres.mass.max() if len(spheres.mass) else 1.0),
-                   bonds.rows, bonds.type, len(bonds.types), parts.geometry)
+                   bonds.rows, bonds.type, len(bonds.types), parts.geometry,
+                   inlet_bond_capacity(model))
         if len(parts.mesh):
             write_mesh(model, parts.wall_plans, spheres, folder / MESH_NAME)
         write_facts(data_path, job_facts(model, spheres, tiles, run.t_start, run.dt, run.clock is not None))
 
     saves = save_steps(model, run)
     script = _render_script(model, parts, saves)
-    has_bonds = len(bonds.rows) > 0
+    has_bonds = len(bonds.rows) > 0 or inlet_bond_capacity(model)[0] > 0
     breakage = model.plan.bonds_may_break()
     has_mesh = len(parts.mesh) > 0
     job = GranularJob(
@@ -195,12 +198,21 @@ def build_granular_job(model: GranularModel, folder: str | Path):
         domain_lo=parts.dom_lo, domain_hi=parts.dom_hi, removal_axes=parts.axes.removal_axes,
         frame_columns=parts.frame_columns, warnings=parts.warnings,
         wall_forces=folder / MESH_FORCES_NAME if has_mesh else None, mesh_rows=parts.mesh,
-        geometry=folder / GEOMETRY_NAME if parts.geometry is not None else None,
+        # (not written when the data file has no atom: only generated agglomerates' bonds)
+        geometry=folder / GEOMETRY_NAME if parts.geometry is not None and len(parts.geometry.partners) else None,
         contacts=folder / CONTACTS_NAME,
         inlet_log=folder / INLET_LOG if model.plan.inlets else None,
+        inlet_bond_rows=_inlet_bond_rows(model),
         type_materials={t: m for m, t in spheres.type_of_mat.items()},
         variable_clock=folder / CLOCK_NAME if model.plan.variable_step is not None else None)
     return job, script, write_data_file
+
+
+def _inlet_bond_rows(model: GranularModel) -> np.ndarray:
+    """The bond rows reserved for generated agglomerates (empty without)."""
+    layout = model.plan.inlet_layout or []
+    return np.concatenate([np.arange(bfirst, bfirst + count * m) for _, _, bfirst, count, _, m in layout]
+                          + [np.zeros(0, np.int64)]).astype(np.int64)
 
 
 @dataclass
@@ -250,6 +262,13 @@ def _plan_parts(model: GranularModel) -> _JobParts:
     place_tiles(model, wall_plans, tiles, spheres, axes, travel, t_start, warnings)
     fit = fit_box(model, axes, spheres, tiles, dim)
     box_cmds = box_commands(fit, axes, spheres, tiles, travel, dt, warnings)
+    if any(i.makes_agglomerates for i in plan.inlets) and not any("atom_modify" in c for c in box_cmds):
+        # a resumed run sorts its atoms at once, the uninterrupted one at multiples of 1000
+        # steps: agglomerates' bonded spheres (3 and more forces each) would then sum their
+        # forces in other orders and differ in the last bit; unsorted, the order is the same
+        box_cmds += [LammpsText("# " + comment_text("atoms kept in creation order: a resumed run "
+                                                    "sums forces as the uninterrupted one")),
+                     "atom_modify     sort 0 0.0"]
     styles = lammps_styles.plugin()
     if not styles.available and model.kind == "musen":     # DEMDF's law is stock-exact
         warnings.append(("approximate MUSEN physics", f"fibrelmp's LAMMPS styles are not used "
@@ -268,11 +287,16 @@ def _plan_parts(model: GranularModel) -> _JobParts:
     if model.plan.inlets and not musen_hm:
         raise InputError(model.source, None, "MUSEN's dynamic generators need fibrelmp's LAMMPS "
                          f"styles (fix musen/inlet): {styles.how}")
-    wall_cmds += inlet_commands(model, spheres.type_of_mat, dt, t_start, run.t_end,
-                                MESH_FIX if len(mesh) else None)
+    # generated agglomerates: bonds per sphere (geometry slots, LAMMPS's extra bond room)
+    stored, _ = inlet_bond_capacity(model)
+    if stored:
+        bonds.max_length = max(bonds.max_length, inlet_bond_reach(model))
     # musen/elastic: each bond's d, L0 (and initial tangential overlap) on its first sphere
-    geometry = (bond_geometry(model, bonds, spheres.rows, len(spheres.rows) + len(tiles.x))
-                if bonds.exact and len(bonds.rows) else None)
+    geometry = (bond_geometry(model, bonds, spheres.rows, len(spheres.rows) + len(tiles.x), stored)
+                if bonds.exact and (len(bonds.rows) or stored) else None)
+    wall_cmds += inlet_commands(model, spheres.type_of_mat, dt, t_start, run.t_end,
+                                MESH_FIX if len(mesh) else None, bonds.type_of_material,
+                                geometry.slots if geometry is not None else 0)
     # broken bonds' spheres touch from MUSEN's next contact-list update (fix musen/verlet):
     # only where contacts between bonded spheres are off (else they touch all along)
     verlet = None
@@ -328,7 +352,7 @@ def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> 
         fmt=float_text, dim=run.dim, bnd=parts.axes.bnd, data_name=DATA_NAME, frames_name=FRAMES_NAME,
         bonds_name=BONDS_NAME, tiles_name=TILES_NAME, breaks_name=BREAKS_NAME,
         comm_cut=comm_cut, skin=skin, musen_hm=parts.musen_hm, pair_lines=parts.pair_lines,
-        has_bonds=len(bonds.rows) > 0,
+        has_bonds=len(bonds.rows) > 0 or inlet_bond_capacity(model)[0] > 0,
         overlay=bool(plan.contacts_between_bonded), breakage=plan.bonds_may_break(),
         bond_types=bonds.types,
         musen_bonds=geometry is not None, bond_geometry=geometry, bond_partners=PARTNERS,

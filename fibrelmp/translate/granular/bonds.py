@@ -52,20 +52,33 @@ class SimulatedBonds:
     type: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))    # type of each (0-based)
     max_length: float = 0.0          # longest bond (communication cutoff)
     exact: bool = False              # musen/elastic (types: per material) or bpm/rotational
+    # musen/elastic: LAMMPS bond type (1-based) of each bond material, the generated
+    # agglomerates' included
+    type_of_material: dict[int, int] = field(default_factory=dict)
 
 
 def select_bonds(model: GranularModel, run: RunTime, spheres, periodic: np.ndarray,
                  warnings: list[tuple[str, str]], exact: bool = False) -> SimulatedBonds:
     """Bonds alive at the start whose spheres are both simulated (``spheres``), typed:
     ``exact`` for ``musen/elastic`` (fibrelmp's styles), else for stock ``bpm/rotational``."""
+    from fibrelmp.translate.granular.inlets import inlet_bond_materials
+
     bonds = model.bonds
     out = SimulatedBonds(exact=exact)
+    generated = inlet_bond_materials(model)       # the bonds of generated agglomerates
+    if generated and not exact:
+        raise InputError(model.source, None, "generated agglomerates' solid bonds need fibrelmp's "
+                         "LAMMPS styles (bond_style musen/elastic, fix musen/inlet)")
+    if generated:          # bond types of the generated bonds' materials (none alive yet)
+        out.type_of_material = {m: t + 1 for t, m in enumerate(generated)}
+        out.types = [_musen_coeffs(model, m, 0) for m in generated]
     if bonds is None or not bonds.count:
         return out
     eps, t_start, keep, x = 0.5 * run.dt, run.t_start, spheres.keep, spheres.x
     pair = bonds.pair.astype(np.int64)
+    keep_all = np.r_[keep, np.zeros(max(0, int(pair.max(initial=-1)) + 1 - len(keep)), bool)]
     alive = ((bonds.active_start <= t_start + eps) & (bonds.active_end > t_start + eps)
-             & keep[pair[:, 0]] & keep[pair[:, 1]])
+             & keep_all[pair[:, 0]] & keep_all[pair[:, 1]])
     out.rows = bond_rows = np.flatnonzero(alive)
     if np.isfinite(bonds.active_end[bond_rows]).any():
         warnings.append(("bond activity end", "finite bond activity ends in the future are "
@@ -80,9 +93,11 @@ def select_bonds(model: GranularModel, run: RunTime, spheres, periodic: np.ndarr
         _refuse_coincident(model, bond_rows, dist)
         out.max_length = float(max(L0.max(), dist.max() if not periodic.any() else L0.max()))
         if exact:
-            mats, btype = np.unique(bm, return_inverse=True)
+            mats = np.union1d(np.unique(bm), np.array(generated, np.int64))
+            btype = np.searchsorted(mats, bm)
             out.type = btype.reshape(-1)
             out.types = [_musen_coeffs(model, int(m), int((bm == m).sum())) for m in mats]
+            out.type_of_material = {int(m): t + 1 for t, m in enumerate(mats)}
             return out
         if model.plan.bond_law.form != "elastic" or model.plan.then_bond_laws:
             form = "kelvin" if model.plan.bond_laws_use("kelvin") else "several-model"
@@ -141,11 +156,14 @@ def _refuse_coincident(model: GranularModel, bond_rows: np.ndarray, dist: np.nda
 
 
 def bond_geometry(model: GranularModel, bonds: SimulatedBonds, atom_rows: np.ndarray,
-                  natoms: int) -> BondGeometry:
+                  natoms: int, min_slots: int = 1) -> BondGeometry:
     """The per-atom bond geometry of the data file's ``natoms`` atoms; the first
-    ``len(atom_rows)`` are the spheres ``atom_rows`` (LAMMPS id = sphere row + 1)."""
+    ``len(atom_rows)`` are the spheres ``atom_rows`` (LAMMPS id = sphere row + 1).  At least
+    ``min_slots`` slots (generated agglomerates' bonds on one sphere)."""
     b = model.bonds
     rows = bonds.rows
+    if b is None or not len(rows):          # only generated bonds (fix musen/inlet sets them)
+        return BondGeometry(np.zeros((natoms, min_slots), np.int64), np.zeros((natoms, min_slots, 2)), 2)
     left = b.pair[rows, 0].astype(np.int64)
     right = b.pair[rows, 1].astype(np.int64)
     where = np.full(int(max(atom_rows.max(initial=-1), left.max(initial=-1))) + 1, -1, np.int64)
@@ -156,7 +174,7 @@ def bond_geometry(model: GranularModel, bonds: SimulatedBonds, atom_rows: np.nda
     first = np.searchsorted(atom_sorted, atom_sorted)    # slot = rank within the atom's bonds
     slot = np.empty(len(rows), np.int64)
     slot[order] = np.arange(len(rows)) - first
-    K = int(slot.max()) + 1 if len(rows) else 1
+    K = max(int(slot.max()) + 1 if len(rows) else 1, min_slots)
     overlap = b.tangential_overlap
     width = 5 if overlap is not None and np.any(overlap[rows]) else 2
     partners = np.zeros((natoms, K), np.int64)

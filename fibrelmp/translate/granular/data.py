@@ -19,7 +19,7 @@ from fibrelmp.translate.lammps_format import atomfile_blocks
 
 def write_data(model, path: Path, rows, type_of_mat, smat, crad, lo, hi, ntypes,
                tx, ttype, tv, tids, tile_radius, tile_mass, bond_rows, btype, nbtypes,
-               geometry=None) -> None:
+               geometry=None, generated: tuple[int, int] = (0, 0)) -> None:
     """``geometry`` (bonds.BondGeometry, or None): the per-atom bond geometry, written to
     ``GEOMETRY_NAME`` beside the data file as atomfile blocks: per slot k the partner ids
     (i_fl_bpk), then each column c of d2_fl_bvk[c], in the order the script sets them."""
@@ -28,6 +28,10 @@ def write_data(model, path: Path, rows, type_of_mat, smat, crad, lo, hi, ntypes,
     counts = [(n, "atoms"), (ntypes, "atom types")]
     if len(bond_rows):
         counts += [(len(bond_rows), "bonds"), (nbtypes, "bond types")]
+    elif generated[0]:
+        counts += [(nbtypes, "bond types")]
+    if generated[0]:        # room for the bonds of generated agglomerates (fix musen/inlet)
+        counts += [(generated[0], "extra bond per atom"), (generated[1], "extra special per atom")]
     r = crad[rows]
     # LAMMPS sets rmass = 4/3 pi r^3 density (also in 2D): density chosen to give the mass
     dens = sp.mass[rows] / (4.0 * math.pi / 3.0 * r * r * r)
@@ -60,7 +64,7 @@ def write_data(model, path: Path, rows, type_of_mat, smat, crad, lo, hi, ntypes,
                                     [np.arange(1, len(b) + 1), btype + 1, b[:, 0], b[:, 1]]))
     write_data_file(path, f"LAMMPS data file written by fibrelmp from {comment_text(model.source.name)}",
                     counts, list(zip(lo, hi)), sections)
-    if len(bond_rows) and geometry is not None:
+    if geometry is not None and geometry.slots and len(geometry.partners):
         columns = []
         for k in range(geometry.slots):
             columns.append((f"i_{PARTNERS}{k + 1}", geometry.partners[:, k].astype(np.int64)))

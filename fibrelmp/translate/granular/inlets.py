@@ -65,6 +65,12 @@ def inlet_spheres(model: GranularModel) -> list[tuple[int, float, float]]:
     """(material, radius, mass) of every kind of sphere the generators can make."""
     out = []
     for inlet in model.plan.inlets:
+        if inlet.makes_agglomerates:
+            agg = _agglomerate(model, inlet)
+            for key, r in zip(agg.part_keys, agg.radius):
+                m = _material(model, key, inlet.generator.name)
+                out.append((m, float(r), _mass(float(r), model.materials[m].density)))
+            continue
         for key, diameter, _ in inlet.fractions:
             m = _material(model, key, inlet.generator.name)
             r = 0.5 * diameter
@@ -72,8 +78,135 @@ def inlet_spheres(model: GranularModel) -> list[tuple[int, float, float]]:
     return out
 
 
+def _mass(r: float, density: float) -> float:
+    return 4.0 / 3.0 * math.pi * r ** 3 * density       # MUSEN's expression (Generate)
+
+
+def _agglomerate(model: GranularModel, inlet: Inlet):
+    """The generator's agglomerate; refused when no job gave it its database."""
+    if inlet.agglomerate is None:
+        raise InputError(model.source, None, f"dynamic generator '{inlet.generator.name}' makes "
+                         f"agglomerates ('{inlet.generator.agglomerate_key}'), which come from the "
+                         "agglomerates database: run the scene through a cmusen job script whose "
+                         "job names it (AGGLOMERATES_DB)")
+    return inlet.agglomerate
+
+
+def inlet_bond_materials(model: GranularModel) -> list[int]:
+    """Material indices of the bonds the generators of agglomerates make (sorted)."""
+    mats = set()
+    for inlet in model.plan.inlets:
+        if inlet.makes_agglomerates:
+            mats |= {_material(model, k, inlet.generator.name) for k in _agglomerate(model, inlet).bond_keys}
+    return sorted(mats)
+
+
+def inlet_bond_capacity(model: GranularModel) -> tuple[int, int]:
+    """(bonds on one sphere, 1-2 neighbours of one sphere) the generated agglomerates need:
+    LAMMPS's extra bond and special room per atom (0, 0 without agglomerates with bonds)."""
+    stored = special = 0
+    for inlet in model.plan.inlets:
+        if inlet.makes_agglomerates and _agglomerate(model, inlet).bonds:
+            agg = inlet.agglomerate
+            stored = max(stored, int(np.bincount(agg.pairs[:, 0]).max()))
+            special = max(special, int(np.bincount(agg.pairs.ravel()).max()))
+    return stored, special
+
+
+def inlet_bond_reach(model: GranularModel) -> float:
+    """The longest bond of a generated agglomerate (its spheres' distance at generation)."""
+    out = 0.0
+    for inlet in model.plan.inlets:
+        if inlet.makes_agglomerates and _agglomerate(model, inlet).bonds:
+            x = inlet.agglomerate.coords
+            out = max(out, float(np.linalg.norm(x[inlet.agglomerate.pairs[:, 0]]
+                                                - x[inlet.agglomerate.pairs[:, 1]], axis=1).max()))
+    return out
+
+
+def reserve_agglomerate_rows(model: GranularModel, events: list) -> list[tuple[int, ...]]:
+    """Rows for the spheres and bonds the generators of agglomerates may make, appended once:
+    generator k's j-th requested agglomerate (over its events) has sphere rows
+    first_k + j n_k + p (LAMMPS ID = row + 1, given by the fix whether or not it is made) and
+    bond rows bond_first_k + j m_k + b.  Inactive (activity start inf) until a frame shows
+    them; MUSEN's ids are given then, in MUSEN's order of success (frames.py).  Returns
+    (generator index, first sphere row, first bond row, agglomerates requested, spheres and
+    bonds of one) per generator of agglomerates."""
+    from fibrelmp.granmodel import SolidBonds
+
+    plan = model.plan
+    if plan.inlet_layout is not None:
+        return plan.inlet_layout
+    if any(not i.makes_agglomerates for i in plan.inlets):
+        raise InputError(model.source, None, "a scene with dynamic generators of spheres and of "
+                         "agglomerates is not supported by fibrelmp (their new objects' ids would "
+                         "interleave); keep one kind")
+    sp = model.spheres
+    requested = {k: sum(e.requested for e in events if e.generator == k) for k in range(len(plan.inlets))}
+    kinds, layout = [], []
+    bond_rows = 0 if model.bonds is None else model.bonds.count
+    row = sp.count
+    pair, bmat, bdiam = [], [], []
+    for k, inlet in enumerate(plan.inlets):
+        agg = _agglomerate(model, inlet)
+        layout.append((k, row, bond_rows, requested[k], agg.spheres, agg.bonds))
+        parts = [(_material(model, key, inlet.generator.name), float(r)) for key, r in zip(agg.part_keys, agg.radius)]
+        bm = [_material(model, key, inlet.generator.name) for key in agg.bond_keys]
+        for j in range(requested[k]):
+            kinds += parts
+            base = row + j * agg.spheres
+            pair += [(base + int(a), base + int(b)) for a, b in agg.pairs]
+            bmat += bm
+            bdiam += list(agg.bond_diameter)
+        row += requested[k] * agg.spheres
+        bond_rows += requested[k] * agg.bonds
+    n, nb = len(kinds), len(pair)
+    # the other objects' largest id: placeholder ids after it (frames.py gives MUSEN's)
+    others = [sp.ids] + [np.asarray(o.ids) for o in (model.bonds, model.triangles) if o is not None]
+    others.append(np.array([lb.id for lb in model.liquid_bonds or []], np.int64))
+    next_id = 1 + max((int(np.max(i)) for i in others if len(i)), default=-1)
+    plan.inlet_next_id = next_id
+    sp.ids = np.r_[sp.ids, next_id + np.arange(n)].astype(np.int64)
+    sp.material = np.r_[sp.material, np.array([m for m, _ in kinds], np.int64)].astype(sp.material.dtype)
+    r = np.array([r for _, r in kinds], float)
+    sp.radius = np.r_[sp.radius, r]
+    sp.contact_radius = np.r_[sp.contact_radius, r]
+    sp.mass = np.r_[sp.mass, np.array([_mass(r, model.materials[m].density) for m, r in kinds])]
+    for name in ("position", "velocity", "omega"):
+        setattr(sp, name, np.r_[np.asarray(getattr(sp, name), float).reshape(-1, 3), np.zeros((n, 3))])
+    sp.quaternion = np.r_[np.asarray(sp.quaternion, float).reshape(-1, 4), np.tile([1.0, 0, 0, 0], (n, 1))]
+    sp.active_start = np.r_[sp.active_start, np.full(n, np.inf)]
+    sp.active_end = np.r_[sp.active_end, np.full(n, np.inf)]
+    if sp.compound_key is not None:
+        sp.compound_key = list(sp.compound_key) + [model.materials[m].key for m, _ in kinds]
+    if sp.temperature is not None:
+        sp.temperature = np.r_[sp.temperature, np.zeros(n)]
+    if nb:
+        b = model.bonds
+        new = dict(ids=next_id + n + np.arange(nb), pair=np.array(pair, np.int64).reshape(-1, 2),
+                   material=np.array(bmat, np.int64), diameter=np.array(bdiam, float),
+                   length0=np.zeros(nb), active_start=np.full(nb, np.inf), active_end=np.full(nb, np.inf))
+        if b is None:
+            model.bonds = SolidBonds(**new)
+        else:
+            for name, value in new.items():
+                setattr(b, name, np.r_[np.asarray(getattr(b, name)), value].astype(
+                    np.asarray(getattr(b, name)).dtype if len(getattr(b, name)) else value.dtype))
+            if b.compound_key is not None:
+                b.compound_key = list(b.compound_key) + [model.materials[m].key for m in bmat]
+            for name in ("force", "tangential_overlap"):
+                if getattr(b, name) is not None:
+                    setattr(b, name, np.r_[getattr(b, name), np.zeros((nb, 3))])
+            if b.source_line is not None:
+                b.source_line = np.r_[b.source_line, np.zeros(nb, b.source_line.dtype)]
+    plan.inlet_rows = sp.count - n
+    plan.inlet_layout = layout
+    return layout
+
+
 def inlet_commands(model: GranularModel, type_of_mat: dict[int, int], dt: float, t_start: float,
-                   t_end: float, wall_fix: str | None) -> list[str]:
+                   t_end: float, wall_fix: str | None, type_of_bond_mat: dict[int, int] | None = None,
+                   geometry_slots: int = 0) -> list[str]:
     """One ``fix musen/inlet`` per active generator (in MUSEN's order: the new ids follow it);
     reserves the model's rows for what they may make (``reserve_rows``)."""
     from fibrelmp.translate.lammps_format import float_text
@@ -88,6 +221,9 @@ def inlet_commands(model: GranularModel, type_of_mat: dict[int, int], dt: float,
         raise InputError(model.source, None, f"dynamic generator '{inlets[0].generator.name}': "
                          "generating in a periodic box is not supported by fibrelmp")
     events = model.plan.inlet_schedule(dt, t_end)     # cmusen's clock (mdem/generators.py)
+    if any(i.makes_agglomerates for i in inlets):
+        return _agglomerate_commands(model, type_of_mat, type_of_bond_mat or {}, events, wall_fix,
+                                     geometry_slots)
     first = reserve_rows(model, sum(e.requested for e in events))
     out = []
     for k, inlet in enumerate(inlets):
@@ -118,3 +254,38 @@ def _volume_words(inlet: Inlet) -> str:
         return ""
     coords = " ".join(float_text(float(v)) for v in np.asarray(inlet.triangles).ravel())
     return f" volume {len(inlet.triangles)} {coords}"
+
+
+def _agglomerate_commands(model: GranularModel, type_of_mat: dict[int, int], type_of_bond_mat: dict[int, int],
+                          events: list, wall_fix: str | None, geometry_slots: int) -> list[str]:
+    """``fix musen/inlet ... agglomerate`` per generator of agglomerates."""
+    from fibrelmp.translate.granular.bonds import PARTNERS, VALUES
+    from fibrelmp.translate.lammps_format import float_text
+
+    layout = reserve_agglomerate_rows(model, events)
+    out = []
+    for (k, first, *_), inlet in zip(layout, model.plan.inlets):
+        g, agg = inlet.generator, inlet.agglomerate
+        mine = [e for e in events if e.generator == k]
+        box = " ".join(f"{float_text(a)} {float_text(b)}" for a, b in zip(inlet.lo, inlet.hi))
+        vel = (f"random {float_text(g.velocity_magnitude)}" if g.random_velocity
+               else "fixed " + " ".join(float_text(v) for v in g.init_velocity))
+        mats = [_material(model, key, g.name) for key in agg.part_keys]
+        parts = " ".join(
+            f"{type_of_mat[m]} {float_text(float(r))} {float_text(model.materials[m].density)} "
+            + " ".join(float_text(float(c)) for c in x) for m, r, x in zip(mats, agg.radius, agg.coords))
+        bonds = " ".join(
+            f"{int(a)} {int(b)} {type_of_bond_mat[_material(model, key, g.name)]} {float_text(float(d))}"
+            for (a, b), key, d in zip(agg.pairs, agg.bond_keys, agg.bond_diameter))
+        steps = " ".join(f"{e.step} {e.requested}" for e in mine)
+        groups = " ".join(f"m{type_of_mat[m]}" for m in mats)
+        geometry = f" geometry {PARTNERS} {VALUES} {geometry_slots}" if agg.bonds else ""
+        time0 = model.plan.inlet_musen_time0
+        if time0 is not None:
+            geometry += f" musen_rand {int(time0)}"
+        out.append(f"fix             fl_inlet{k + 1} spheres musen/inlet {INLET_SEED + k} box {box} "
+                   f"tries {g.max_iterations} walls {wall_fix or 'none'} velocity {vel} "
+                   f"agglomerate {agg.spheres} {parts} bonds {agg.bonds} {bonds} "
+                   f"events {len(mine)} {steps} first_id {first + 1} log {LOG_NAME} groups {groups}"
+                   f"{geometry}{_volume_words(inlet)}")
+    return out

@@ -370,6 +370,8 @@ class _Planner:
         if source not in self.handles:
             self.inputs.append(source)
         model = _script_model(job, self.handles, self.path_of)
+        if any(i.makes_agglomerates for i in model.plan.inlets):
+            self._agglomerates(job, model)
         apply_simulator_settings(model, job)
         check_musen_runnable(model)
         if not patched_reading():        # (check re-reading with placeholder values)
@@ -379,6 +381,18 @@ class _Planner:
         self.result(step)
         self.handles[handle] = ("result", model)
         return step
+
+    def _agglomerates(self, job, model: GranularModel) -> None:
+        """The generators of agglomerates get theirs from the job's AGGLOMERATES_DB."""
+        from fibrelmp.translate.musen.mdem.generators import attach_agglomerates
+
+        db = None
+        if job.agglomerates_db:
+            db = self.path_of(job.agglomerates_db, job, "AGGLOMERATES_DB")
+            self.inputs.append(db)
+        materials = {m.key: m.density for m in model.materials}
+        model.plan.inlets = attach_agglomerates(model.plan.inlets, db, materials, job.path,
+                                                job.where("AGGLOMERATES_DB"))
 
     def export(self, job) -> ScriptStep:
         source = self.path_of(job.source_file, job, "SOURCE_FILE")

@@ -69,8 +69,6 @@ _IGNORED = {
     "SELECTIVE_SAVING_P": "every field is saved", "SELECTIVE_SAVING_SB": "every field is saved",
     "SELECTIVE_SAVING_LB": "every field is saved", "SELECTIVE_SAVING_TW": "every field is saved",
 }
-# keywords only the generator / analyser / snapshot components read: accepted, no effect
-_OTHER_COMPONENT_KEYS = ("AGGLOMERATES_DB",)
 
 
 @dataclass
@@ -91,6 +89,7 @@ class MusenJob:
     line: int
     source_file: str | None = None
     result_file: str | None = None
+    agglomerates_db: str | None = None       # AGGLOMERATES_DB: the .madb the generators read
     component: str = "SIMULATOR"            # cmusen's default component
     simulator_type: str | None = None
     models: list[MusenModelSpec] = field(default_factory=list)
@@ -211,7 +210,7 @@ read = read_script
 
 
 def _known_keys() -> list[str]:
-    return sorted(set(_HANDLERS) | set(_IGNORED) | set(_OTHER_COMPONENT_KEYS) | set(_EXPORT_KEYS)
+    return sorted(set(_HANDLERS) | set(_IGNORED) | set(_EXPORT_KEYS)
                   | {"JOB", "NEW_JOB"})
 
 
@@ -232,8 +231,6 @@ def _keyword(job: MusenJob, line: _Line) -> None:
     elif key in _IGNORED:
         job.warnings.append(("musen-ignored-keyword", f"{line.path}:{line.ln}: {key} ignored "
                              f"({_IGNORED[key]})"))
-    elif key in _OTHER_COMPONENT_KEYS:
-        pass                            # read by components fibrelmp refuses; no effect here
     elif not line.tok and not any(ch.isalnum() for ch in key):   # a lone stray mark (Example 6's ´)
         job.warnings.append(("musen-ignored-keyword", f"{line.path}:{line.ln}: {key!r} skipped "
                              "(not a keyword; cmusen skips it as an unknown key)"))
@@ -473,6 +470,7 @@ _HANDLERS = {
     **{key: _generator_key for key in _GENERATOR_KEYS},
     "MIXTURE_PROPERTY": _mixture_property, "SNAPSHOT_TIME": _number("snapshot_time", False),
     "SOURCE_FILE": _set("source_file"), "RESULT_FILE": _set("result_file"),
+    "AGGLOMERATES_DB": _set("agglomerates_db"),
     "RESULTS_FILE": _set("result_file"), "COMPONENT": _component,
     "SIMULATOR_TYPE": _simulator_type,
     "MODEL_PP": _model("PP"), "MODEL_PW": _model("PW"), "MODEL_SB": _model("SB"),

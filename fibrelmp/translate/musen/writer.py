@@ -109,6 +109,9 @@ class MusenResultWriter(Writer):
         self.liquid.save(t, ~self.removed)
         if self.bond_end is not None and frame.bond_alive is not None:
             dead = ~np.asarray(frame.bond_alive, bool)
+            if self.model.plan.inlet_layout is not None:
+                # a generated agglomerate's bond not made yet is not dead (activity start inf)
+                dead &= np.isfinite(self.model.bonds.active_start)
             when = (np.asarray(frame.bond_end_time, np.float64) if frame.bond_end_time is not None
                     else np.full(len(dead), t))
             when = np.where(np.isfinite(when), when, t)
@@ -205,6 +208,9 @@ class MusenResultWriter(Writer):
         # rows reserved for generated spheres that were never made (translate/granular/inlets.py)
         keep &= ~((types == 1) & ~np.isfinite(np.r_[m.spheres.active_start, np.zeros(len(rows))][
             np.where(types == 1, rows, len(m.spheres.active_start))]))
+        if m.bonds is not None and m.plan.inlet_layout is not None:     # and their bonds
+            starts = np.r_[m.bonds.active_start, 0.0]
+            keep &= ~((types == 9) & ~np.isfinite(starts[np.where(types == 9, rows, len(starts) - 1)]))
         order = np.argsort(ids[keep], kind="stable")
         return ids[keep][order], types[keep][order], rows[keep][order]
 

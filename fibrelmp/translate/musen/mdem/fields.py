@@ -34,10 +34,15 @@ _STOP = ("BROKEN_BONDS (type 1, max_broken_bonds) stops the run as cmusen does, 
 _VARIABLE_STEP = ("MUSEN's variable time step: fix musen/leapfrog variable (its rule, saves and "
                   "end; compared with cmusen in tests/test_musen_variable_time_step.py); a job "
                   "script's VARIABLE_TIME_STEP replaces it")
-_INLETS = ("an active dynamic generator (inlet) of spheres into a box volume inserts "
-           "them during the run (mdem/generators.py `read_inlets`, fix musen/inlet); "
-           "agglomerates, other volume shapes and inside_geometries off are refused by name "
-           "and field; an inactive one is inert, as in MUSEN")
+_INLETS = ("an active dynamic generator (inlet) of spheres or of agglomerates (with their "
+           "solid bonds, from the job's AGGLOMERATES_DB) into an analysis volume inserts them "
+           "during the run (mdem/generators.py `read_inlets`, fix musen/inlet); moving volumes "
+           "and inside_geometries off are refused by name and field; an inactive one is inert, "
+           "as in MUSEN")
+_AGGLOMERATES_DB = ("the agglomerates database (`.madb`, a job's AGGLOMERATES_DB; not part of "
+                    "a `.mdem`): a generator's agglomerate is read from it "
+                    "(mdem/agglomerates.py, docs section 6); multispheres and contact radius "
+                    "!= radius are refused by generator and key")
 
 # "Message.field" -> (class, why); "Message.*" classifies every field of a message
 FIELDS: dict[str, tuple[str, str]] = {
@@ -182,6 +187,12 @@ FIELDS: dict[str, tuple[str, str]] = {
                                                  "MUSEN: <= 0 is no limit; item 4)"),
     "ProtoModuleObjectsGenerator.*": (HONOURED, _INLETS),
     "ProtoObjectsGenerator.*": (HONOURED, _INLETS),
+    "ProtoAgglQuatern.*": (HONOURED, _AGGLOMERATES_DB),
+    "ProtoAgglVect.*": (HONOURED, _AGGLOMERATES_DB),
+    "ProtoAgglParticle.*": (HONOURED, _AGGLOMERATES_DB),
+    "ProtoAgglBond.*": (HONOURED, _AGGLOMERATES_DB),
+    "ProtoAgglomerate.*": (HONOURED, _AGGLOMERATES_DB),
+    "ProtoAgglomeratesDB.*": (HONOURED, _AGGLOMERATES_DB),
     "ProtoModuleBondsGenerator.*": (NOT_SIMULATION, "pre-processing (COMPONENT BONDS_GENERATOR)"),
     "ProtoBondsGenerator.*": (NOT_SIMULATION, "pre-processing (COMPONENT BONDS_GENERATOR)"),
     "ProtoModulePackageGenerator.*": (NOT_SIMULATION, "pre-processing (COMPONENT "

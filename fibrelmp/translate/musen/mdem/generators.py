@@ -28,7 +28,9 @@ fibrelmp reads and checks the settings (``read_inlets``: spheres of a mixture in
 or any other triangle volume: cylinder, sphere, STL), computes the schedule for the job's own step and end time, and inserts the spheres
 with fibrelmp's ``fix musen/inlet`` (one per generator, the schedule's steps and counts
 passed to it).  A volume that is not an axis-aligned box is passed as its triangles and
-tested with MUSEN's 15-point ray-parity test.  Agglomerates, moving volumes and
+tested with MUSEN's 15-point ray-parity test.  A generator of agglomerates gets its
+agglomerate from the job's ``AGGLOMERATES_DB`` (``attach_agglomerates``) and inserts it
+whole, with its solid bonds (docs/musen.md section 6).  Moving volumes and
 ``inside_geometries`` off are refused with the generator's and the field's name.
 """
 
@@ -69,6 +71,10 @@ class DynamicGenerator:
     max_iterations: int
     inside_geometries: bool
     active: bool
+    # agglomerates: the database key's compound aliases -> compound keys; scaling factor
+    part_materials: tuple[tuple[str, str], ...] = ()
+    bond_materials: tuple[tuple[str, str], ...] = ()
+    scaling_factor: float = 1.0
 
     @property
     def rate(self) -> float:
@@ -111,7 +117,11 @@ def read_generators(storage: Any) -> list[DynamicGenerator]:
             rate_type=RATE_PER_SECOND if old else int(g.rate_type),
             rate_value=g.generation_rate if old else g.rate_value,
             max_iterations=30 if old else int(g.max_iterations),
-            inside_geometries=bool(g.inside_geometries), active=bool(g.activity)))
+            inside_geometries=bool(g.inside_geometries), active=bool(g.activity),
+            # CGenerationManager::LoadConfiguration: a std::map, the last alias line wins
+            part_materials=tuple(dict(zip(g.aggl_part_materials_alias, g.aggl_part_materials_key)).items()),
+            bond_materials=tuple(dict(zip(g.aggl_bond_materials_alias, g.aggl_bond_materials_key)).items()),
+            scaling_factor=g.scaling_factor))
     return out
 
 
@@ -127,12 +137,16 @@ def check_generator(gen: DynamicGenerator, storage: Any, path: Path) -> None:
     if gen.volume_key not in volumes:
         raise _field(path, gen, "volume_key", f"no analysis volume '{gen.volume_key}' in the "
                      "scene (MUSEN: 'No generation volume was specified')")
-    if gen.objects == AGGLOMERATES:
-        raise _field(path, gen, "obj_type", "generating agglomerates (from the agglomerates "
-                     "database) is not supported by fibrelmp; generate spheres of a mixture")
-    if gen.objects != SPHERES:
+    if gen.objects not in (SPHERES, AGGLOMERATES):
         raise _field(path, gen, "obj_type", f"unknown object type {gen.objects} (1: spheres, "
                      "2: agglomerates)")
+    if gen.objects == AGGLOMERATES:
+        # the agglomerate itself is checked once the job's AGGLOMERATES_DB is known
+        # (attach_agglomerates)
+        if not (math.isfinite(gen.scaling_factor) and gen.scaling_factor > 0):
+            raise _field(path, gen, "scaling_factor", f"must be > 0, got {gen.scaling_factor!r}")
+        _check_rate(gen, path)
+        return
     mixtures = {m.uniqueKey: m for m in storage.modules_data.materials_database.mixture}
     mixture = mixtures.get(gen.mixture_key)
     if mixture is None or not len(mixture.fraction):
@@ -142,6 +156,10 @@ def check_generator(gen: DynamicGenerator, storage: Any, path: Path) -> None:
     if abs(total - 1.0) > 1e-14:             # CMaterialsDatabase::IsMixtureCorrect
         raise _field(path, gen, "mixture_key", f"the fractions of mixture '{gen.mixture_key}' "
                      f"sum to {total:.17g}, not 1 (MUSEN refuses the mixture)")
+    _check_rate(gen, path)
+
+
+def _check_rate(gen: DynamicGenerator, path: Path) -> None:
     if gen.rate_type not in (RATE_PER_SECOND, RATE_PER_UPDATE, RATE_TOTAL):
         raise _field(path, gen, "rate_type", f"unknown rate type {gen.rate_type} (0: objects "
                      "per second, 1: per update step, 2: in total)")
@@ -228,6 +246,37 @@ class Inlet:
     fractions: tuple[tuple[str, float, float], ...]
     # (n, 3, 3); not compared (an array has no single truth value; lo/hi tell volumes apart)
     triangles: np.ndarray | None = field(default=None, compare=False)
+    # a generator of agglomerates: what it inserts, once the job's database is read
+    # (attach_agglomerates; None until then)
+    agglomerate: InletAgglomerate | None = field(default=None, compare=False)
+
+    @property
+    def makes_agglomerates(self) -> bool:
+        return self.generator.objects == AGGLOMERATES
+
+
+@dataclass(frozen=True)
+class InletAgglomerate:
+    """An agglomerate as a generator inserts it (``CObjectsGenerator::Initialize``): sphere
+    positions relative to its volume-weighted centre, scaled; radii; compound keys of the
+    spheres and bonds (the generator's alias maps); bond sphere pairs (left, right) and
+    diameters (2 x the scaled bond radius)."""
+
+    key: str
+    coords: np.ndarray = field(compare=False)
+    radius: np.ndarray = field(compare=False)
+    part_keys: tuple[str, ...] = ()
+    pairs: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64), compare=False)
+    bond_diameter: np.ndarray = field(default_factory=lambda: np.zeros(0), compare=False)
+    bond_keys: tuple[str, ...] = ()
+
+    @property
+    def spheres(self) -> int:
+        return len(self.radius)
+
+    @property
+    def bonds(self) -> int:
+        return len(self.bond_diameter)
 
 
 def _volume(storage: Any, gen: DynamicGenerator,
@@ -258,8 +307,9 @@ def _volume(storage: Any, gen: DynamicGenerator,
 
 
 def read_inlets(storage: Any, path: Path) -> list[Inlet]:
-    """Every active generator of spheres of a scene, checked (``check_generator``) and with
-    what fibrelmp's ``fix musen/inlet`` needs."""
+    """Every active generator of a scene, checked (``check_generator``) and with what
+    fibrelmp's ``fix musen/inlet`` needs (a generator of agglomerates: its agglomerate comes
+    with the job, ``attach_agglomerates``)."""
     out = []
     for g in read_generators(storage):
         if not g.active:
@@ -276,6 +326,9 @@ def read_inlets(storage: Any, path: Path) -> list[Inlet]:
             raise InputError(path, None, f"dynamic generator '{g.name}': generating in a periodic "
                              "box is not supported by fibrelmp")
         lo, hi, triangles = _volume(storage, g, path)
+        if g.objects == AGGLOMERATES:
+            out.append(Inlet(g, lo, hi, (), triangles))
+            continue
         mixture = next(m for m in storage.modules_data.materials_database.mixture
                        if m.uniqueKey == g.mixture_key)
         fractions = []
@@ -289,4 +342,70 @@ def read_inlets(storage: Any, path: Path) -> list[Inlet]:
                              f"{f.diameter!r}")
             fractions.append((f.compoundKey, float(f.diameter), float(f.fraction)))
         out.append(Inlet(g, lo, hi, tuple(fractions), triangles))
+    return out
+
+
+def attach_agglomerates(inlets: list[Inlet], db_path: Path | None, materials: dict[str, float],
+                        where: Path, line: int | None) -> list[Inlet]:
+    """The inlets with each generator of agglomerates given its agglomerate from the
+    database ``db_path`` (the job's ``AGGLOMERATES_DB``; ``where``/``line`` name that line),
+    checked as MUSEN's ``IsDataCorrect`` checks it (the agglomerate exists; every alias of its
+    spheres and bonds maps to a compound of the scene: ``materials`` maps compound key ->
+    density) and as fibrelmp needs it (an agglomerate, not a multisphere; contact radius =
+    radius; bond spheres in range)."""
+    from dataclasses import replace
+
+    from fibrelmp.translate.musen.mdem.agglomerates import MULTISPHERE, prepared_agglomerate, read_database
+
+    if not any(i.makes_agglomerates for i in inlets):
+        return inlets
+    if db_path is None:
+        gen = next(i.generator for i in inlets if i.makes_agglomerates)
+        raise InputError(where, line, f"dynamic generator '{gen.name}' makes agglomerates of "
+                         f"'{gen.agglomerate_key}', but the job names no AGGLOMERATES_DB (MUSEN: "
+                         "'No correct agglomerate has been specified')")
+    db = read_database(db_path, where, line)
+    out = []
+    for inlet in inlets:
+        g = inlet.generator
+        if not inlet.makes_agglomerates:
+            out.append(inlet)
+            continue
+
+        def bad(message: str, g=g) -> InputError:
+            return InputError(where, line, f"dynamic generator '{g.name}': agglomerate "
+                              f"'{g.agglomerate_key}' of {db_path.name}: {message}")
+        agg = db.get(g.agglomerate_key)
+        if agg is None:
+            raise bad("no such key in the database (MUSEN: 'No correct agglomerate has been "
+                      "specified')")
+        if agg.kind == MULTISPHERE:
+            raise bad("a multisphere (rigid clump) is not supported by fibrelmp; only "
+                      "agglomerates of spheres and solid bonds")
+        if not len(agg.radius):
+            raise bad("has no spheres")
+        if not (agg.radius > 0).all() or not np.isfinite(agg.coords).all():
+            raise bad("needs finite coordinates and radii > 0")
+        if (agg.contact_radius != agg.radius).any():
+            raise bad("a sphere's contact radius differs from its radius, which fibrelmp's "
+                      "generator does not support")
+        parts, bonds = dict(g.part_materials), dict(g.bond_materials)
+        part_keys = tuple(parts.get(a, "") for a in agg.part_alias)
+        bond_keys = tuple(bonds.get(a, "") for a in agg.bond_alias)
+        for kind, aliases, keys in (("sphere", agg.part_alias, part_keys),
+                                    ("bond", agg.bond_alias, bond_keys)):
+            for alias, key in zip(aliases, keys):
+                if key not in materials:
+                    raise bad(f"{kind} compound alias '{alias}' maps to '{key}', which is not a "
+                              f"compound of the scene (MUSEN: 'No correct {'particle' if kind == 'sphere' else 'bond'} "
+                              "materials have been specified')")
+        n = len(agg.radius)
+        pairs = agg.bond_pairs
+        if len(pairs) and ((pairs < 0) | (pairs >= n)).any() or (pairs[:, 0] == pairs[:, 1]).any():
+            raise bad(f"a bond joins sphere indices outside 0..{n - 1} or a sphere to itself")
+        if not (agg.bond_radius > 0).all():
+            raise bad("bond radii must be > 0")
+        coords, radius, diameter = prepared_agglomerate(agg, g.scaling_factor)
+        out.append(replace(inlet, agglomerate=InletAgglomerate(
+            agg.key, coords, radius, part_keys, pairs.copy(), diameter, bond_keys)))
     return out

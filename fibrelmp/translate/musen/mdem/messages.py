@@ -34,6 +34,17 @@ _SPEC = {
     "ProtoInteraction": "compoundKey1 1 string, compoundKey2 2 string, property 3 ProtoTPProperty*",
     "ProtoMaterialsDatabase": "compound 1 ProtoCompound*, interaction 2 ProtoInteraction*, "
                               "mixture 3 ProtoMixture*",
+    # AgglomeratesDatabase.proto (the .madb file: a bare ProtoAgglomeratesDB); MUSEN's names
+    # ProtoQuatern, ProtoVect, ProtoParticle, ProtoBond, ProtoAgglomerate renamed (same wire format)
+    "ProtoAgglQuatern": "q0 1 double, q1 2 double, q2 3 double, q3 4 double",
+    "ProtoAgglVect": "x 1 double, y 2 double, z 3 double",
+    "ProtoAgglParticle": "coord 1 ProtoAgglVect, radius 2 double, compound 3 string, "
+                         "orient 4 ProtoAgglVect, quaternion 5 ProtoAgglQuatern, "
+                         "contact_radius 6 double",
+    "ProtoAgglBond": "leftID 1 int32, rightID 2 int32, radius 3 double, compound 4 string",
+    "ProtoAgglomerate": "name 1 string, key 2 string, volume 3 double, "
+                        "particles 4 ProtoAgglParticle*, bonds 5 ProtoAgglBond*, type 6 int32",
+    "ProtoAgglomeratesDB": "Agglomerate 1 ProtoAgglomerate*",
     # SimulationDescription: scene
     "ProtoSelectiveSaving": "p_coord 1 bool, p_vel 2 bool, p_angvel 3 bool, p_quatern 4 bool, "
                             "p_force 5 bool, p_tensor 6 bool, sb_force 7 bool, sb_tangoverlap 8 bool, "

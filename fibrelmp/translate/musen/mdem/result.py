@@ -76,6 +76,8 @@ class MdemResultWriter(MusenResultWriter):
         rows = np.asarray(frame.sphere_rows, np.int64)
         ids = self.sphere_ids[rows]
         self.n = max(self.n, 1 + int(ids.max()) if len(ids) else 0)
+        if self.bond_ids is not None and frame.bond_alive is not None and np.any(frame.bond_alive):
+            self.n = max(self.n, 1 + int(self.bond_ids[np.asarray(frame.bond_alive, bool)].max()))
         values = np.zeros((self.n, tp.NCOLS))
         masks = np.zeros(self.n, np.uint32)
         values[ids, 0:3] = frame.position
@@ -183,6 +185,23 @@ class MdemResultWriter(MusenResultWriter):
             entry.compound = self.model.materials[int(sp.material[r])].key
             entry.encoded_properties = np.array([sp.radius[r], sp.contact_radius[r]], "<f8").tobytes()
             entry.activity_start = float(sp.active_start[r])
+            entry.activity_end = 1e300
+        b = self.model.bonds
+        if self.model.plan.inlet_layout is None or b is None:
+            return
+        from fibrelmp.translate.musen.mdem.objects import SOLID_BOND, encode_bond
+
+        first_bond = min(entry[2] for entry in self.model.plan.inlet_layout)
+        for r in np.flatnonzero(np.isfinite(b.active_start[first_bond:])) + first_bond:
+            i = int(b.ids[r])           # a generated agglomerate's bond (frames.py gave its id)
+            while len(particles) <= i:
+                particles.add()
+            entry = particles[i]
+            entry.id, entry.type = i, SOLID_BOND
+            entry.compound = self.model.materials[int(b.material[r])].key
+            left, right = (int(sp.ids[k]) for k in b.pair[r])
+            entry.encoded_properties = encode_bond(left, right, float(b.diameter[r]), float(b.length0[r]))
+            entry.activity_start = float(b.active_start[r])
             entry.activity_end = 1e300
 
     def _set_scene(self, storage: Any) -> None:

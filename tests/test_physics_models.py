@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import pkgutil
 import re
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -14,6 +16,9 @@ from fibrelmp.translate.granular import models as physics
 from fibrelmp.translate.musen.script_parse import MUSEN_MODELS
 
 CMUSEN_MODELS = Path("/work/shared/oracles/cmusen_models.txt")   # cmusen's printed model list
+MUSEN_GIT = Path("/work/.mirror/msolids+musen/repo")               # MUSEN's source (e0ff360)
+ROOT = Path(__file__).resolve().parents[1]
+MUSEN_DOC = ROOT / "docs" / "musen.md"
 
 
 def _registered():
@@ -31,14 +36,45 @@ def test_names_and_kinds_are_musens():
         assert m.name in MUSEN_MODELS[m.kind], m.name
         assert m.name.startswith(f"Model{m.kind}")
         assert physics.find(m.name) is m
-        # MUSEN's keys are 32 upper-case hex digits, but for ModelSBPlasticConcrete's
-        # ("...914SS7D..."), ModelPPChealNess's ("...8A4SSSS6D...", 31 characters),
-        # ModelPPHertzMindlinVdW's ("...25A8V04..."), ModelPPSinteringTemperature's
-        # ("...ADB27XBFBA") and ModelEFLiquidDiffusion's (a 40-digit sha1)
-        key = m.mdem_key.replace("SS", "00").replace("A8V0", "A800").replace("27XB", "270B")
-        if m.name == "ModelPPChealNess":
-            key += "0"
-        assert re.fullmatch(r"[0-9A-F]{32}|[0-9a-f]{40}", key), m.name
+        # MUSEN's keys are mostly 32 upper-case hex digits, but not all (ModelSBPlasticConcrete's
+        # "...914SS7D...", ModelEFLiquidDiffusion's 40-digit sha1): test_keys_are_musens
+        # compares each with MUSEN's source
+        assert re.fullmatch(r"[0-9A-Z]{31,32}|[0-9a-f]{40}", m.mdem_key), m.name
+
+
+@pytest.mark.skipif(not MUSEN_GIT.exists(), reason="MUSEN's source is not on this machine")
+def test_keys_are_musens():
+    """Each model's .mdem key is the m_uniqueKey of MUSEN's model of that name (e0ff360)."""
+    files = subprocess.run(["git", "-C", str(MUSEN_GIT), "ls-tree", "-r", "--name-only", "HEAD",
+                            "Models"], capture_output=True, text=True, check=True).stdout.split()
+    for m in _registered():
+        [source] = [f for f in files if f.endswith(f"/{m.name}.cpp")]
+        text = subprocess.run(["git", "-C", str(MUSEN_GIT), "show", f"HEAD:{source}"],
+                              capture_output=True, text=True, check=True).stdout
+        keys = re.findall(r'm_uniqueKey\s*=\s*"([^"]*)"', text)
+        assert keys == [m.mdem_key], (m.name, keys)
+
+
+def test_model_table_is_the_registrys():
+    """docs/musen.md's model table is what tools/model_table.py renders from the registry now:
+    a model without its row, or a row whose model changed, fails here (rerun the tool)."""
+    text = MUSEN_DOC.read_text()
+    assert physics.TABLE_START in text and physics.TABLE_END in text
+    table = text[text.index(physics.TABLE_START):text.index(physics.TABLE_END) + len(physics.TABLE_END)]
+    assert table == physics.model_table(ROOT), "docs/musen.md: rerun python tools/model_table.py"
+    rows = [ln for ln in table.splitlines() if ln.startswith("| `Model")]
+    assert sorted(r.split("`")[1] for r in rows) == sorted(m.name for m in _registered())
+
+
+def test_every_model_documents_itself():
+    """The row's text is the model module's docstring, which starts with MUSEN's name; a page of
+    its own (docs/models/<module>.md) belongs to a registered model."""
+    for m in _registered():
+        doc = sys.modules[m.__module__].__doc__ or ""
+        assert doc.startswith(m.name) and len(physics.model_doc(m)) > 40, m.name
+    modules = {m.__module__.rsplit(".", 1)[1] for m in _registered()}
+    for page in (ROOT / physics.MODEL_PAGES).glob("*.md"):
+        assert page.stem in modules, page
 
 
 def test_one_stock_default_per_translated_kind():

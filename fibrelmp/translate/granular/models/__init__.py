@@ -48,6 +48,13 @@ class PhysicsModel:
     plan_bond_model: ClassVar[str | None] = None
     # SB models: the law's name in the script's comment (None: bond_law's)
     law_title: ClassVar[str | None] = None
+    # what the run needs for the model (fields.py, script_settings): a contact heat law
+    # (temperatures and fix musen/heat), a PP law that reads the temperatures without heat
+    # (d_musen_temperature, ghosts too), a law that keeps its own contact history and so cannot
+    # act together with another model of its kind
+    contact_heat: ClassVar[bool] = False
+    reads_temperature: ClassVar[bool] = False
+    acts_alone: ClassVar[bool] = False
 
     @classmethod
     def read_parameters(cls, text: str, path: Path | str | None, line: int | None,

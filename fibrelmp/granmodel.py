@@ -209,8 +209,8 @@ class ExternalField:
     model: str                      # MUSEN's name, e.g. "ModelEFViscousField"
     parameters: dict[str, float]    # its parameters (MUSEN's names)
     fix_args: str                   # what follows ``musen/field``: the law and its numbers
-    # the law changes the spheres' temperature (then the job adds `cp` and each type's heat
-    # capacity to fix_args and keeps the temperature in d_musen_temperature)
+    # the law changes the spheres' temperature (then the job defines fix musen/heat, owner of
+    # the heat flux and the temperature update, and keeps the temperature in d_musen_temperature)
     heat: bool = False
     style: str = "musen/field"      # its LAMMPS fix style
 
@@ -412,6 +412,9 @@ class GranularModel(ParticleModel):
         if nbonds:
             out["bonds"] = {"start": nbonds, "end": tally.get("bonds"),
                             "broken": line_count(job.breaks) if job.breaks is not None else 0}
+        if tally.get("temperature"):
+            # a heat model: the spheres' temperatures at every frame this session saved
+            out["temperature"] = {"unit": "K", "frames": tally["temperature"]}
         return out
 
 

@@ -371,6 +371,11 @@ def summary_lines(s: dict) -> list[str]:
         b = s["bonds"]
         name = "springs " if p["kind"] == "beads" else "bonds   "
         lines.append(f"  {name}   {b['start']} -> {b['end']} ({b['broken']} broken)")
+    temp = s.get("temperature")
+    if temp and temp["frames"]:
+        first, last = temp["frames"][0], temp["frames"][-1]
+        lines.append(f"  temperature {g(first['min'])} .. {g(first['max'])} -> {g(last['min'])} .. "
+                     f"{g(last['max'])} {temp['unit']} (min .. max of the spheres, first -> last frame)")
     st = s.get("max_spring_strain")
     if st:
         lines.append(f"  strain     largest spring strain {st['value']:+.3g} (beads "

@@ -34,7 +34,9 @@ PW = ("pw_heat_transfer", "pwh", "ModelPWHeatTransfer WALL_TEMPERATURE 1000 "
 # ModelPWHeatTransfer as the only PW model: walls without force that still heat (as cmusen)
 PW_ALONE = ("pw_heat_transfer", "pwa", PW[2])
 SB = ("sb_heat_conduction", "sbh", "ModelSBHeatConduction CONDUCTION_SCALING_FACTOR 1.5")
-CASES = {"pp": PP, "pw": PW, "pw_alone": PW_ALONE, "sb": SB}
+# ModelEFHeatTransfer together with ModelPPHeatConduction: one flux, EF first, one update
+EF_PP = ("ef_pp_heat", "efph", "ModelEFHeatTransfer AIR_TEMPERATURE_INIT 500")
+CASES = {"pp": PP, "pw": PW, "pw_alone": PW_ALONE, "sb": SB, "ef_pp": EF_PP}
 
 
 def _run(tmp_path: Path, case: str, params: str | None = None) -> Path:
@@ -136,6 +138,8 @@ def test_without_the_heat_model_temperatures_stay(tmp_path):
 
 
 @pytest.mark.parametrize("folder, prefix, every", [(PP[0], PP[1], 170), (SB[0], SB[1], 1050),
+                                                   (EF_PP[0], EF_PP[1], 170),
+                                                   ("sb_thermal_break", "sbtb", 300),
                                                    ("sb_thermal", "sbt", 1050)])
 def test_checkpoint_and_resume_give_the_uninterrupted_run(tmp_path, monkeypatch, folder, prefix,
                                                           every):
@@ -172,16 +176,37 @@ def test_lmp_replays_the_run_bitwise(tmp_path):
     assert (replay / "frames.dump").read_bytes() == (ran / "frames.dump").read_bytes()
 
 
-def test_with_the_air_heat_model_is_refused(tmp_path):
-    """fix musen/field heat and fix musen/heat would both update the temperature: refused."""
+def test_air_and_contact_heat_add_into_one_flux(tmp_path):
+    """ModelEFHeatTransfer with ModelPPHeatConduction (models/ef_pp_heat): fix musen/heat owns
+    the flux, fix musen/field heat (defined after it) adds the air's first, the contact law
+    then; the far sphere (no contact) follows the air alone, the touching ones both.  Against
+    cmusen in test_temperatures_and_motion_are_cmusens; here: the far sphere's temperatures
+    are MUSEN's air law in numpy (half a step at t = 0, then a full step per step), and the
+    touching spheres moved further from that law than the contact alone explains."""
     styles_or_skip()
-    folder, prefix, params = PP
-    job = model_job(tmp_path, MODELS / folder, prefix, params)
-    job.write_text(job.read_text().replace("SIMULATION_STEP", "MODEL_EF             "
-                                           "ModelEFHeatTransfer\nSIMULATION_STEP"))
-    with pytest.raises(InputError, match="ModelPPHeatConduction together with "
-                                         "ModelEFHeatTransfer is not supported"):
-        python_api.run(job, work=tmp_path / "work")
+    ours = read_time_points(_run(tmp_path, "ef_pp"))
+    script = (tmp_path / "work" / "job2" / "in.lammps").read_text()
+    assert script.count("musen/heat cp") == 1
+    assert script.index("musen/heat cp") < script.index("musen/field heat")
+    mc = _scene_heat_capacity("ef_pp")
+    radius, dt = 5e-4, 1e-6
+
+    def air_flux(temp: float, t: float) -> float:
+        air = 800.0 if t > 2e-4 else 500.0 + t * (800.0 - 500.0) / 2e-4
+        surface = math.pi * radius ** 2
+        return 1.2 * (2e4 * surface * (air - temp) + 1e-7 * surface * (air ** 4 - temp ** 4))
+    temp = 700.0 + air_flux(700.0, 0.0) / mc[2] * dt / 2
+    expected = [700.0]
+    for k in range(400):
+        temp = temp + air_flux(temp, k * dt) / mc[2] * dt
+        if (k + 1) % 20 == 0:
+            expected.append(temp)
+    got = ours.fields[TEMPERATURE][:, 2, 0]
+    np.testing.assert_allclose(got, expected, rtol=1e-12)
+    assert got[-1] - got[0] > 10
+    alone = read_time_points(MODELS / PP[0] / "cmusen_phc_result_prec17.txt").fields[TEMPERATURE]
+    # the air moves the touching spheres by tens of K more than the contact alone
+    assert np.abs(ours.fields[TEMPERATURE][-1, :2, 0] - alone[-1, :2, 0]).min() > 50
 
 
 def test_thermal_bond_is_cmusens(tmp_path):
@@ -202,6 +227,46 @@ def test_thermal_bond_is_cmusens(tmp_path):
     assert gap[-1] > 1.03 * gap[0]
     script = (tmp_path / "work" / "job2" / "in.lammps").read_text()
     assert "musen/elastic breakage 1 thermal 100.0 0.5 2.0" in script
+
+
+def test_thermal_bond_breaks_as_in_cmusen(tmp_path):
+    """ModelSBThermal with ModelSBHeatConduction (models/sb_thermal_break): the bond's rest
+    length grows at THERM_DIFF alpha = 200 /s (MUSEN's 'thermal' rule: the strength does not
+    depend on temperature), the spheres at rest lag behind, overshoot into tension and the bond
+    breaks in its first tension, at cmusen's time to the step (4.47e-5 s); heat flows from
+    the hot sphere to the cold one until then and stops.  Positions, velocities, temperatures
+    at every saved time within 1e-6 of scale (measured: positions and temperatures bit for
+    bit, velocities 3e-15)."""
+    from fibrelmp.translate.musen.scene import read
+    styles_or_skip()
+    folder, prefix = "sb_thermal_break", "sbtb"
+    python_api.run(model_job(tmp_path, MODELS / folder, prefix, ""), work=tmp_path / "work")
+    script = (tmp_path / "work" / "job2" / "in.lammps").read_text()
+    assert "thermal 100.0 0.1 2.0" in script and "heat 0 1.5 10.0" in script
+    ours_path = tmp_path / f"{prefix}_result_prec17.txt"
+    theirs_path = MODELS / folder / f"cmusen_{prefix}_result_prec17.txt"
+    ours, theirs = read_time_points(ours_path), read_time_points(theirs_path)
+    np.testing.assert_allclose(ours.times, theirs.times, rtol=1e-12, atol=0)
+    x0 = theirs.fields[COORD][0, :2]
+    for tag in (COORD, VEL, TEMPERATURE):
+        a, b = ours.fields[tag][:, :2], theirs.fields[tag][:, :2]
+        if tag == COORD:     # of the displacement
+            a, b = a - x0, b - x0
+        np.testing.assert_allclose(a, b, rtol=0, atol=1e-6 * np.abs(b).max())
+    end = read(theirs_path).bonds.active_end
+    assert np.array_equal(end, [4.47e-5])       # the case is what its README says
+    assert np.array_equal(read(ours_path).bonds.active_end, end)
+    temp = theirs.fields[TEMPERATURE][:, :2, 0]
+    broken = theirs.times > end[0]
+    assert np.all(temp[broken] == temp[broken][0]) and temp[0, 0] - temp[broken][0, 0] > 20
+    # the bond was in tension when it broke: the spheres fly apart at a constant speed
+    gap = np.diff(theirs.fields[COORD][:, :2, 0], axis=1)[:, 0]
+    assert gap[-1] > 0.8e-3 * 1.02 and np.allclose(np.diff(gap[broken]), np.diff(gap[broken])[0])
+
+
+@needs_cmusen
+def test_thermal_break_reference_is_cmusens_output(tmp_path):
+    check_reference_is_cmusens_output(tmp_path, MODELS / "sb_thermal_break", "sbtb")
 
 
 @needs_cmusen
@@ -328,3 +393,29 @@ def test_cost_per_contact_against_hertz_mindlin(plugin_path):
 def test_reference_is_cmusens_output(tmp_path, case):
     folder, prefix, _ = CASES[case]
     check_reference_is_cmusens_output(tmp_path, MODELS / folder, prefix)
+
+
+@pytest.mark.parametrize("fixes, message", [
+    (["fix air all musen/field heat 500 800 1 1e4 0 1"], "needs one fix musen/heat"),
+    (["fix air all musen/field heat 500 800 1 1e4 0 1", "fix heat all musen/heat cp 10"],
+     "must be defined after fix musen/heat"),
+    (["fix heat all musen/heat cp 10", "pair_style musen/hm then heat/conduction 1.5 0.3 0.01 0.03",
+      "pair_coeff * * 2.6e7 1e7 0.7 0.3 0.05"], "needs the conductivities"),
+])
+def test_the_flux_owner_is_required_before_its_contributors(plugin_path, fixes, message):
+    """fix musen/heat clears the flux in its pre_force: an EF heat fix defined before it would
+    have its flux cleared (LAMMPS calls pre_force in definition order), so that is an error, as
+    is a heat field without the owner and a contact heat law without the conductivities."""
+    lmp = new_lammps(["-log", "none", "-screen", "none", "-nocite"])
+    try:
+        for c in [f"plugin load {plugin_path}", "units si", "atom_style sphere", "boundary f f f",
+                  "comm_modify vel yes", "fix fl_t all property/atom d_musen_temperature ghost yes",
+                  "region box block -0.01 0.01 -0.01 0.01 -0.01 0.01", "create_box 1 box",
+                  "create_atoms 1 single 0 0 0", "set atom 1 diameter 1e-3 density 2500",
+                  "pair_style musen/hm", "pair_coeff * * 2.6e7 1e7 0.7 0.3 0.05", *fixes,
+                  "timestep 1e-6"]:
+            lmp.command(c)
+        with pytest.raises(Exception, match=message):
+            lmp.command("run 1 post no")
+    finally:
+        lmp.close()

@@ -45,7 +45,7 @@ LD_PARAMS = ("TEMPERATURE 310 DYN_VISCOSITY_OF_LIQUID 0.001 STOKES_FACTOR 1.2 HY
 DIFFUSION = ("ef_liquid_diffusion", "ld", LD_PARAMS, ["musen/diffusion 310.0 0.001 1.2 1e-07 12345 1"],
              (0.0, 0.0, 0.0))
 HEAT = ("ef_heat_transfer", "ht", HT_PARAMS,
-        ["musen/field heat 400.0 1000.0 0.01 30000.0 5e-06 1.5 cp 840.0 1500.0"], (0.0, 0.0, -9.81))
+        ["musen/field heat 400.0 1000.0 0.01 30000.0 5e-06 1.5"], (0.0, 0.0, -9.81))
 DENSITY = {"MGLASS": 2500.0, "MLIGHT": {"vf": 1200.0, "cc": 800.0, "vc": 800.0, "ht": 800.0, "ld": 1000.0}}
 HEAT_CAPACITY = {"MGLASS": 840.0, "MLIGHT": 1500.0}          # the heat case's materials
 
@@ -338,6 +338,9 @@ def test_heated_spheres_are_cmusens(tmp_path):
     script = (tmp_path / "work" / "job2" / "in.lammps").read_text()
     assert [ln.split(None, 3)[3] for ln in script.splitlines() if ln.startswith("fix")
             and "musen/field" in ln] == fixes
+    # the flux and the temperature update are fix musen/heat's, defined before the field
+    assert "fix             fl_heat spheres musen/heat cp 840.0 1500.0\n" in script
+    assert script.index("musen/heat cp") < script.index("musen/field heat")
     assert "set             atom 1*2 d_musen_temperature 300.0" in script
     reference = MODELS / folder / f"cmusen_{prefix}_result_prec17.txt"
     _assert_matches(tmp_path / f"{prefix}_result_prec17.txt", reference,

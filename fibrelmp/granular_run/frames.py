@@ -111,6 +111,8 @@ class FrameBuilder:
             self.first_id = pair[:, 0]
         tri = model.triangles
         self.v0 = np.asarray(tri.vertices, float) if tri is not None and tri.count else None
+        # a heat model's spheres: {time, step, min, mean, max} of their temperature per frame
+        self.temperatures: list[dict] = []
 
     def tally(self) -> dict:
         """Spheres and bonds as of the last frame read, for the run summary (fibrelmp.record):
@@ -120,9 +122,12 @@ class FrameBuilder:
                      if self.deletion_time.get(r) == self.sphere_end[r])
         first = self.model.plan.inlet_rows
         made = 0 if first is None else int(np.isfinite(self.model.spheres.active_start[first:]).sum())
-        return {"spheres": int(self.present.sum()), "activity_end": at_end, "generated": made,
-                "left_domain": len(removed) - at_end,
-                "bonds": int(self.bond_alive.sum()) if self.nb else 0}
+        out = {"spheres": int(self.present.sum()), "activity_end": at_end, "generated": made,
+               "left_domain": len(removed) - at_end,
+               "bonds": int(self.bond_alive.sum()) if self.nb else 0}
+        if self.temperatures:
+            out["temperature"] = self.temperatures
+        return out
 
     def _bond_lookup(self, id1: np.ndarray, id2: np.ndarray) -> np.ndarray:
         """Bond rows (or -1) for atom-id pairs."""
@@ -183,8 +188,9 @@ class FrameBuilder:
 
         frame = GranularFrame(time=t, step=step, sphere_rows=rows, position=pos, velocity=vel,
                               omega=omega, force=force, quaternion=quat)
-        if "d_musen_temperature" in c:    # fix musen/field heat: MUSEN's particle temperature
+        if "d_musen_temperature" in c:    # a heat model (fix musen/heat): MUSEN's temperature
             frame.temperature = np.asarray(c["d_musen_temperature"], np.float64)
+            self.temperatures.append(_temperature_figures(t, step, frame.temperature))
         if "sfx" in c:      # fix musen/leapfrog: the force cmusen saves (the previous evaluation's)
             frame.saved_force = np.column_stack([c["sfx"], c["sfy"], c["sfz"]])
         if self.nb:
@@ -351,6 +357,14 @@ class FrameBuilder:
         for dump in (self.frames, self.bonds, self.tiles, self.mesh):
             if dump is not None:
                 dump.close()
+
+
+def _temperature_figures(t: float, step: int, temperature: np.ndarray) -> dict:
+    """The summary's temperature entry of one frame (None for a frame without spheres)."""
+    if not len(temperature):
+        return {"time": t, "step": step, "min": None, "mean": None, "max": None}
+    return {"time": t, "step": step, "min": float(temperature.min()),
+            "mean": float(temperature.mean()), "max": float(temperature.max())}
 
 
 def _stepped_walls(job, fm: dict, k: np.ndarray, verts: np.ndarray, tvel: np.ndarray) -> None:

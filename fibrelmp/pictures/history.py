@@ -41,9 +41,12 @@ class History:
 
 
 def panel_of(name: str) -> str:
-    """"energy", "counts", or the column's own panel (other quantities have other units)."""
+    """"energy", "counts", "temperature" (a MUSEN heat model's sphere temperatures, not
+    LAMMPS's kinetic ``Temp``), or the column's own panel (other quantities have other units)."""
     low = name.lower()
     bare = low[2:] if low[:2] in ("c_", "v_", "f_") else low
+    if bare.startswith("temperature"):
+        return "temperature"
     if bare in _ENERGY_KEYWORDS or bare.endswith("eng") or bare.startswith("e_") or "energy" in bare:
         return "energy"
     if any(w in bare for w in _COUNT_WORDS):
@@ -74,6 +77,8 @@ def from_log(log: Path, notes: list[str] | None = None) -> History:
     if "energy" in hist.panels:
         title = "energy per atom" if thermo.per_atom else "energy"
         hist.panels[f"{title} [{energy}]" if energy else title] = hist.panels.pop("energy")
+    if "temperature" in hist.panels and units == "si":
+        hist.panels["temperature [K]"] = hist.panels.pop("temperature")
     hist.panels = dict(sorted(hist.panels.items(), key=lambda kv: _panel_rank(kv[0])))
     return hist
 
@@ -105,6 +110,7 @@ def from_result(located: Located, notes: list[str] | None = None) -> History:
     velocities are known), the number of particles, and bonds ended by each frame's time."""
     source = open_source(located)
     times, steps, kinetic, particles, broken = [], [], [], [], []
+    temperature: list[tuple[float, float, float]] = []      # min, mean, max of each frame
     for frame in source.frames():
         times.append(np.nan if frame.time is None else frame.time)
         steps.append(np.nan if frame.step is None else frame.step)
@@ -114,6 +120,10 @@ def from_result(located: Located, notes: list[str] | None = None) -> History:
                                                                       frame.velocity))))
         if frame.broken_bonds is not None:
             broken.append(frame.broken_bonds)
+        if frame.temperature is not None:
+            t = frame.temperature
+            temperature.append((float(t.min()), float(t.mean()), float(t.max())) if len(t)
+                               else (np.nan, np.nan, np.nan))
     if not times:
         raise InputError(located.path, None, f"the {source.what} has no frames")
     t = np.asarray(times)
@@ -134,6 +144,14 @@ def from_result(located: Located, notes: list[str] | None = None) -> History:
     if len(broken) == len(times):
         hist.series["bonds broken (activity ended)"] = np.asarray(broken, float)
         hist.panels["counts"].append("bonds broken (activity ended)")
+    # a heat model's temperatures (a MUSEN result without one writes 0 for every sphere)
+    values = np.asarray(temperature, float).reshape(-1, 3)
+    if len(temperature) == len(times) and np.nan_to_num(values).any():
+        title = "temperature [K]" if source.energy_unit == "J" else "temperature"
+        hist.panels[title] = []
+        for k, name in enumerate(("temperature min", "temperature mean", "temperature max")):
+            hist.series[name] = values[:, k]
+            hist.panels[title].append(name)
     return hist
 
 

@@ -41,6 +41,7 @@ class SceneFrame:
     # MUSEN liquid bonds active at ``time`` (rows; drawn apart from solid bonds)
     liquid_bonds: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))
     triangles: np.ndarray | None = None # (k,3,3) wall triangles
+    temperature: np.ndarray | None = None   # (n,) K: a MUSEN heat model's sphere temperatures
     planes: list[tuple[np.ndarray, np.ndarray]] = field(default_factory=list)   # (normal, point)
     box: tuple[np.ndarray, np.ndarray] | None = None      # (lo, hi)
     dimension: int = 3
@@ -183,8 +184,10 @@ class DumpSource(Source):
             found = (ids[order][at] == d.bonds).all(axis=1)        # both atoms in this frame
             bonds = order[at[found]]
         velocity = f.vector("vx", "vy", "vz") if f.has("vx", "vy", "vz") else None
+        temperature = f.vector("d_musen_temperature")[:, 0] if f.has("d_musen_temperature") else None
         return SceneFrame(i, f.time, f.step, f.wrapped(), radius, kinds, kind_names,
-                          velocity=velocity, mass=mass, bonds=bonds, box=(f.lo, f.hi))
+                          velocity=velocity, mass=mass, bonds=bonds, box=(f.lo, f.hi),
+                          temperature=temperature)
 
 
 class WorkFolderSource(DumpSource):

@@ -8,8 +8,7 @@
 
 #include "atom.h"
 #include "error.h"
-#include "memory.h"
-#include "musen_startup.h"
+#include "modify.h"
 #include "update.h"
 #include "utils.h"
 
@@ -42,9 +41,8 @@ double non_negative(const char *value, const char *what, LAMMPS *lmp)
 FixMusenField::FixMusenField(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), law(VISCOUS), nu(0), medium_density(0), omega(0), liquid_density(0),
     liquid_viscosity(0), air_t0(0), air_t1(0), heating_time(0), heat_alpha(0), emissivity(0),
-    heat_scale(0), heat_capacity(nullptr), flux(nullptr), startup_setups(0)
+    heat_scale(0), heat_fix(nullptr)
 {
-  const int ntypes = atom->ntypes;
   if (narg == 6 && strcmp(arg[3], "viscous") == 0) {
     law = VISCOUS;
     nu = positive(arg[4], "viscous NU (kinematic viscosity)", lmp);
@@ -55,7 +53,7 @@ FixMusenField::FixMusenField(LAMMPS *lmp, int narg, char **arg) :
     if (!std::isfinite(omega)) error->all(FLERR, "Fix musen/field: centrifugal OMEGA must be finite");
     liquid_density = non_negative(arg[5], "centrifugal RHO (liquid density)", lmp);
     liquid_viscosity = non_negative(arg[6], "centrifugal MU (liquid viscosity)", lmp);
-  } else if (narg == 11 + ntypes && strcmp(arg[3], "heat") == 0 && strcmp(arg[10], "cp") == 0) {
+  } else if (narg == 10 && strcmp(arg[3], "heat") == 0) {
     law = HEAT;
     air_t0 = non_negative(arg[4], "heat T0 (initial air temperature)", lmp);
     air_t1 = non_negative(arg[5], "heat T1 (final air temperature)", lmp);
@@ -63,108 +61,46 @@ FixMusenField::FixMusenField(LAMMPS *lmp, int narg, char **arg) :
     heat_alpha = non_negative(arg[7], "heat ALPHA (heat transfer coefficient)", lmp);
     emissivity = non_negative(arg[8], "heat EPS (surface emissivity)", lmp);
     heat_scale = non_negative(arg[9], "heat SCALE (scaling factor)", lmp);
-    memory->create(heat_capacity, ntypes + 1, "musen/field:heat_capacity");
-    heat_capacity[0] = 0.0;
-    for (int k = 1; k <= ntypes; k++)
-      heat_capacity[k] = non_negative(arg[10 + k], "heat cp (heat capacity)", lmp);
-    FixMusenField::grow_arrays(atom->nmax);
-    atom->add_callback(Atom::GROW);
-    for (int i = 0; i < atom->nlocal; i++) flux[i] = 0.0;
   } else {
     error->all(FLERR, "Illegal fix musen/field command: fix ID group musen/field viscous NU RHO | "
-               "centrifugal OMEGA RHO MU | heat T0 T1 TIME ALPHA EPS SCALE cp C_1 ... C_ntypes");
+               "centrifugal OMEGA RHO MU | heat T0 T1 TIME ALPHA EPS SCALE");
   }
 }
 
-FixMusenField::~FixMusenField()
-{
-  if (copymode) return;
-  if (law == HEAT) atom->delete_callback(id, Atom::GROW);
-  memory->destroy(heat_capacity);
-  memory->destroy(flux);
-}
-
-void FixMusenField::grow_arrays(int nmax)
-{
-  memory->grow(flux, nmax, "musen/field:flux");
-}
-
-void FixMusenField::set_arrays(int i)
-{
-  flux[i] = 0.0;
-}
-
-void FixMusenField::copy_arrays(int i, int j, int /*delflag*/)
-{
-  flux[j] = flux[i];
-}
-
-int FixMusenField::pack_exchange(int i, double *buf)
-{
-  buf[0] = flux[i];
-  return 1;
-}
-
-int FixMusenField::unpack_exchange(int nlocal, double *buf)
-{
-  flux[nlocal] = buf[0];
-  return 1;
-}
-
-double FixMusenField::memory_usage()
-{
-  return law == HEAT ? atom->nmax * sizeof(double) : 0.0;
-}
-
-double *FixMusenField::temperature()
-{
-  int flag, cols;
-  const int index = atom->find_custom("musen_temperature", flag, cols);
-  if (index < 0 || flag != 1 || cols != 0)
-    error->all(FLERR, "Fix musen/field heat needs the per-atom property d_musen_temperature "
-               "(fix ID all property/atom d_musen_temperature)");
-  return atom->dvector[index];
-}
-
-/* CCPUSimulator::UpdateTemperatures with the last evaluation's flux */
-void FixMusenField::update_temperature(double dt)
-{
-  double *t = temperature();
-  const double *rmass = atom->rmass;
-  const int *mask = atom->mask, *type = atom->type;
-  for (int i = 0; i < atom->nlocal; i++) {
-    if (!(mask[i] & groupbit)) continue;
-    t[i] += flux[i] / (heat_capacity[type[i]] * rmass[i]) * dt;
-    t[i] = t[i] < 0.0 ? 0.0 : t[i];
-  }
-}
-
-void FixMusenField::initial_integrate(int /*vflag*/)
-{
-  if (law == HEAT) update_temperature(update->dt);
-}
+FixMusenField::~FixMusenField() = default;
 
 int FixMusenField::setmask()
 {
-  int mask = PRE_FORCE;
-  if (law == HEAT) mask |= INITIAL_INTEGRATE;
-  return mask;
+  return PRE_FORCE;
 }
 
 void FixMusenField::init()
 {
   if (!atom->radius_flag || !atom->rmass_flag)
     error->all(FLERR, "Fix musen/field needs atom style sphere (radius, rmass)");
+  if (law != HEAT) return;
+  // the heat flux and the temperature update are fix musen/heat's; it must clear the flux
+  // (its pre_force) before this fix adds to it (MUSEN: the EF models first)
+  const auto &fixes = modify->get_fix_list();
+  const auto heats = modify->get_fix_by_style("^musen/heat$");
+  if (heats.size() != 1)
+    error->all(FLERR, "Fix musen/field heat needs one fix musen/heat (found {})", heats.size());
+  heat_fix = heats[0];
+  for (const Fix *f : fixes) {
+    if (f == this)
+      error->all(FLERR, "Fix musen/field heat must be defined after fix musen/heat {}", heat_fix->id);
+    if (f == heat_fix) break;
+  }
+  int flag, cols;
+  const int index = atom->find_custom("musen_temperature", flag, cols);
+  if (index < 0 || flag != 1 || cols != 0)
+    error->all(FLERR, "Fix musen/field heat needs the per-atom property d_musen_temperature "
+               "(fix ID all property/atom d_musen_temperature)");
 }
 
 // the set-up evaluations (MUSEN's two at t = 0, musen_startup.h) carry the field as well
 void FixMusenField::setup_pre_force(int vflag)
 {
-  // heat: the second set-up at t = 0 follows MUSEN's prediction iteration, whose temperature
-  // update is half a step (its velocities' half kick is musen/predict's)
-  if (law == HEAT && musen_startup::advances(update) && update->setupflag) {
-    if (++startup_setups == 2) update_temperature(0.5 * update->dt);
-  }
   pre_force(vflag);
 }
 
@@ -225,10 +161,12 @@ void FixMusenField::centrifugal()
   }
 }
 
-/* CModelEFHeatTransfer::CalculateEF at the evaluation's time */
+/* CModelEFHeatTransfer::CalculateEF at the evaluation's time: adds to fix musen/heat's flux */
 void FixMusenField::heat()
 {
-  const double *t = temperature();
+  int flag, cols, dim;
+  const double *t = atom->dvector[atom->find_custom("musen_temperature", flag, cols)];
+  double *flux = static_cast<double *>(heat_fix->extract("flux", dim));
   const double *radius = atom->radius;
   const int *mask = atom->mask;
   const double time = update->atime + static_cast<double>(update->ntimestep - update->atimestep) * update->dt;
@@ -242,7 +180,7 @@ void FixMusenField::heat()
     const double surface = MUSEN_PI * std::pow(radius[i], 2);
     const double convection = heat_alpha * surface * (environment - t[i]);
     const double radiation = emissivity * surface * (std::pow(environment, 4) - std::pow(t[i], 4));
-    flux[i] = heat_scale * (convection + radiation);    // MUSEN clears HeatFlux each step
+    flux[i] += heat_scale * (convection + radiation);
   }
 }
 

@@ -13,19 +13,17 @@
          turning at OMEGA rad/s about y: buoyant centrifugal force (m - 4/3 pi r^3 RHO)
          OMEGA^2 (x, 0, z) plus Stokes drag 6 pi MU r (u - v) towards the liquid's velocity
          u = OMEGA (z, 0, -x)
-     fix ID group musen/field heat T0 T1 TIME ALPHA EPS SCALE cp C_1 ... C_ntypes
+     fix ID group musen/field heat T0 T1 TIME ALPHA EPS SCALE
          ModelEFHeatTransfer: heat flux from the surrounding air into each sphere,
          SCALE (ALPHA pi r^2 (Tenv - T) + EPS pi r^2 (Tenv^4 - T^4)) (MUSEN's formula: no
          Stefan-Boltzmann constant, EPS carries it), Tenv = T0 + t (T1 - T0)/TIME up to
          t = TIME, T1 after; the temperature T is the custom per-atom property
-         d_musen_temperature (fix property/atom), C_k the heat capacity (J/(kg K)) of type k.
-         MUSEN (CCPUSimulator::UpdateTemperatures): after each evaluation T += flux/(C m) dt
-         (dt/2 in its prediction iteration), then T = max(T, 0).  Here the update of an
-         evaluation's flux is done in the next initial_integrate (where fix musen/leapfrog
-         kicks with that evaluation's forces), and the half update of the prediction at the
-         set-up after `musen/predict ID` (the second of the two set-ups at t = 0,
-         musen_startup.h), so T between steps is the temperature MUSEN saves at that time.
-         The flux is a function of T, t and r only: a set-up (restart) recomputes it exactly.
+         d_musen_temperature (fix property/atom).  The flux is added to the per-atom heat
+         flux of fix musen/heat (defined before this fix), which clears it before every
+         evaluation, lets the contact heat laws add to it and updates T (MUSEN's HeatFlux and
+         CCPUSimulator::UpdateTemperatures, in fix_musen_heat.h): one flux per sphere, EF
+         first, as MUSEN sums it.  The flux is a function of T, t and r only: a set-up
+         (restart) recomputes it exactly.
 
    Where MUSEN adds it: CCPUSimulator::CalculateForcesStep runs the EF models first, on the
    cleared forces, before the particle-particle, particle-wall and bond forces, and
@@ -34,8 +32,7 @@
    force in pre_force (and setup_pre_force), which LAMMPS calls right after clearing the
    forces and before the pair, bond and fix post_force (gravity, walls) forces, with x and v
    of that evaluation.  Several such fixes act in the order they are defined (MUSEN: its EF
-   models in the model manager's order).  No law adds torque; only heat keeps a per-atom
-   value between evaluations (the last flux), which any set-up recomputes.
+   models in the model manager's order).  No law adds torque; none keeps a per-atom value.
 ------------------------------------------------------------------------- */
 
 #ifndef FIBRELMP_FIX_MUSEN_FIELD_H
@@ -53,14 +50,6 @@ class FixMusenField : public Fix {
   void init() override;
   void setup_pre_force(int) override;
   void pre_force(int) override;
-  void initial_integrate(int) override;
-
-  void grow_arrays(int) override;
-  void copy_arrays(int, int, int) override;
-  void set_arrays(int) override;
-  int pack_exchange(int, double *) override;
-  int unpack_exchange(int, double *) override;
-  double memory_usage() override;
 
  private:
   enum Law { VISCOUS, CENTRIFUGAL, HEAT };
@@ -68,14 +57,10 @@ class FixMusenField : public Fix {
   double nu, medium_density;                            // viscous
   double omega, liquid_density, liquid_viscosity;       // centrifugal
   double air_t0, air_t1, heating_time, heat_alpha, emissivity, heat_scale;   // heat
-  double *heat_capacity;     // heat: per atom type (1..ntypes)
-  double *flux;              // heat: per atom, the last evaluation's heat flux (W)
-  int startup_setups;        // heat: set-ups at t = 0 seen (MUSEN's two evaluations there)
+  class Fix *heat_fix;       // heat: fix musen/heat, owner of the flux (init)
   void viscous();
   void centrifugal();
   void heat();
-  double *temperature();     // d_musen_temperature
-  void update_temperature(double dt);
 };
 
 }    // namespace LAMMPS_NS

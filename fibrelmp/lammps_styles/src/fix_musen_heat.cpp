@@ -25,18 +25,25 @@ FixMusenHeat::FixMusenHeat(LAMMPS *lmp, int narg, char **arg) :
     startup_setups(0)
 {
   const int ntypes = atom->ntypes;
-  if (narg != 5 + 2 * ntypes || strcmp(arg[3], "cp") != 0 || strcmp(arg[4 + ntypes], "k") != 0)
+  // the conductivities are for the contact laws (pair musen/hm's heat/conduction); an
+  // external heat field alone (fix musen/field heat) needs only the heat capacities
+  const bool with_k = narg == 5 + 2 * ntypes;
+  if ((narg != 4 + ntypes && !with_k) || strcmp(arg[3], "cp") != 0 ||
+      (with_k && strcmp(arg[4 + ntypes], "k") != 0))
     error->all(FLERR, "Illegal fix musen/heat command: fix ID group musen/heat cp C_1 ... "
-               "C_ntypes k K_1 ... K_ntypes");
+               "C_ntypes [k K_1 ... K_ntypes]");
   memory->create(heat_capacity, ntypes + 1, "musen/heat:heat_capacity");
-  memory->create(conductivity, ntypes + 1, "musen/heat:conductivity");
-  heat_capacity[0] = conductivity[0] = 0.0;
+  if (with_k) memory->create(conductivity, ntypes + 1, "musen/heat:conductivity");
+  heat_capacity[0] = 0.0;
+  if (with_k) conductivity[0] = 0.0;
   for (int k = 1; k <= ntypes; k++) {
     heat_capacity[k] = utils::numeric(FLERR, arg[3 + k], false, lmp);
+    if (!(heat_capacity[k] >= 0) || !std::isfinite(heat_capacity[k]))
+      error->all(FLERR, "Fix musen/heat: heat capacities must be >= 0 and finite");
+    if (!with_k) continue;
     conductivity[k] = utils::numeric(FLERR, arg[4 + ntypes + k], false, lmp);
-    if (!(heat_capacity[k] >= 0) || !std::isfinite(heat_capacity[k]) || !(conductivity[k] >= 0) ||
-        !std::isfinite(conductivity[k]))
-      error->all(FLERR, "Fix musen/heat: heat capacities and conductivities must be >= 0 and finite");
+    if (!(conductivity[k] >= 0) || !std::isfinite(conductivity[k]))
+      error->all(FLERR, "Fix musen/heat: conductivities must be >= 0 and finite");
   }
   comm_forward = 1;
   comm_reverse = 1;
@@ -143,7 +150,7 @@ void *FixMusenHeat::extract(const char *name, int &dim)
     dim = 1;
     return flux;
   }
-  if (strcmp(name, "conductivity") == 0) {
+  if (strcmp(name, "conductivity") == 0) {    // nullptr when the fix was given no k
     dim = 1;
     return conductivity;
   }

@@ -1,24 +1,29 @@
 /* -*- c++ -*- ----------------------------------------------------------
    fibrelmp's LAMMPS styles; GPL-2.0-or-later like LAMMPS (see ../LICENSE).
 
-   FixMusenHeat (fix style musen/heat): MUSEN's per-particle heat flux and temperature update
-   for the contact heat models (ModelPPHeatConduction through pair musen/hm's law
-   heat/conduction; later PW and SB heat laws add to the same flux):
+   FixMusenHeat (fix style musen/heat): MUSEN's per-particle heat flux and temperature update,
+   the one owner of both for every heat model: ModelEFHeatTransfer (fix musen/field heat),
+   ModelPPHeatConduction (pair musen/hm's law heat/conduction), ModelPWHeatTransfer (fix
+   musen/wall/mesh's law heat/transfer) and ModelSBHeatConduction (bond musen/elastic's heat)
+   all add to its flux:
 
-     fix ID group musen/heat cp C_1 ... C_ntypes k K_1 ... K_ntypes
+     fix ID group musen/heat cp C_1 ... C_ntypes [k K_1 ... K_ntypes]
 
    C_k: heat capacity (J/(kg K)) of type k; K_k: its material's thermal conductivity
    (W/(m K)), from which a contact takes MUSEN's dEquivThermalConductivity
-   1 / (1/K_i + 1/K_j) (SimplifiedScene.cpp).  The temperature is the per-atom property
-   d_musen_temperature (fix property/atom ... ghost yes: the contact laws read it on ghosts).
+   1 / (1/K_i + 1/K_j) (SimplifiedScene.cpp); k only for pair musen/hm's heat law.  The
+   temperature is the per-atom property d_musen_temperature (fix property/atom ... ghost yes:
+   the contact laws read it on ghosts).
 
    MUSEN (CSimplifiedScene::ClearState, CCPUSimulator::CalculateForcesStep, UpdateTemperatures):
    HeatFlux = 0 before every evaluation; its models add to it (EF, PP, PW, SB in that order);
    after the move T += HeatFlux/(C m) dt (dt/2 in its prediction iteration), then
    T = max(T, 0).  Here: pre_force (LAMMPS: before the pair, bond and post_force styles)
    sends the temperatures to the ghosts and clears the flux; the styles add to it (extract
-   "flux"; a bond's on a ghost sphere goes back to its owner in post_force); the next initial_integrate updates T with it (as fix musen/field heat, whose
-   ModelEFHeatTransfer cannot run together with this fix yet); the half update of the
+   "flux"; a bond's on a ghost sphere goes back to its owner in post_force, reverse
+   communication); fix musen/field heat, defined after this fix, adds in its own pre_force,
+   after the clearing and before the contact laws (MUSEN: EF first); the next
+   initial_integrate updates T with the sum; the half update of the
    prediction at the second set-up at t = 0 (musen_startup.h).  The flux depends only on the
    state at the evaluation, so a set-up (restart) recomputes it exactly.
 ------------------------------------------------------------------------- */

@@ -459,6 +459,10 @@ void PairMusenHM::init_style()
         error->all(FLERR, "pair {}: its heat law needs one fix musen/heat (found {})",
                    force->pair_style, heats.size());
       heat_fix = heats[0];
+      int dim;
+      if (!heat_fix->extract("conductivity", dim))
+        error->all(FLERR, "pair {}: its heat law needs the conductivities: fix musen/heat cp ... k ...",
+                   force->pair_style);
     }
 
   // a law that reads temperatures without a heat flux: d_musen_temperature alone

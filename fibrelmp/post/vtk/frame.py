@@ -20,7 +20,8 @@ VECTORS = {"Velocity": ("vx", "vy", "vz"), "Force": ("fx", "fy", "fz"),
            "Angular Velocity": ("omegax", "omegay", "omegaz"),
            "Angular Momentum": ("angmomx", "angmomy", "angmomz"), "Torque": ("tqx", "tqy", "tqz"),
            "Orientation": ("quati", "quatj", "quatk", "quatw")}
-SCALARS = {"Radius": "radius", "Mass": "mass"}
+SCALARS = {"Radius": "radius", "Mass": "mass",
+           "temperature": "d_musen_temperature"}     # fibrelmp's MUSEN heat models (K)
 # columns that are not per-atom data for a viewer (positions, images, the integer fields)
 SKIP = {"x", "y", "z", "xs", "ys", "zs", "xu", "yu", "zu", "xsu", "ysu", "zsu", "ix", "iy", "iz",
         "id", "type"}

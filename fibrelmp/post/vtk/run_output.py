@@ -85,6 +85,8 @@ def granular_frame(model: "GranularModel", frame: "GranularFrame") -> ViewerFram
             "Radius": np.asarray(s.radius, float)[rows], "Mass": np.asarray(s.mass, float)[rows],
             "Velocity": frame.velocity, "Force": frame.force, "Angular Velocity": frame.omega,
             "Orientation": frame.quaternion[:, [1, 2, 3, 0]]}          # w x y z -> X Y Z W
+    if frame.temperature is not None:       # a heat model's (K)
+        data["temperature"] = frame.temperature
     bonds, bond_data = None, {}
     if model.bonds is not None and frame.bond_alive is not None:
         alive = np.flatnonzero(frame.bond_alive)

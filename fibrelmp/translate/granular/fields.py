@@ -65,26 +65,21 @@ def field_commands(model: GranularModel, rows: np.ndarray, type_of_mat: dict[int
     lines = _set_temperatures(model, rows) if heat else []
     fixes = []
     for fld in model.plan.external_fields:
-        args = fld.fix_args
-        if fld.heat:
-            args += " cp " + " ".join(float_text(c) for c in _heat_capacities(model, type_of_mat, ntypes))
         if fld.style == "musen/diffusion":
             _check_diffusion(model, rows)
-        fixes.append((fld.model, fld.style, args))
+        fixes.append((fld.model, fld.style, fld.fix_args))
+    # one owner of the heat flux and the temperature update for every heat model (EF and
+    # contact): fix musen/heat, defined before the EF fixes, which add to its flux
     heat_args = ""
     contact = contact_heat_models(model)
-    if contact:
-        ef = [f.model for f in model.plan.external_fields if f.heat]
-        if ef:
-            # both would update the temperature (fix musen/field heat and fix musen/heat)
-            raise InputError(model.source, None, f"{contact[0]} together with {ef[0]} is not "
-                             "supported yet")
+    if contact or any(f.heat for f in model.plan.external_fields):
         cp = _heat_capacities(model, type_of_mat, ntypes)
-        k = _conductivities(model, type_of_mat, ntypes)
-        heat_args = ("cp " + " ".join(float_text(c) for c in cp) + " k "
-                     + " ".join(float_text(c) for c in k))
+        heat_args = "cp " + " ".join(float_text(c) for c in cp)
+        if contact:
+            k = _conductivities(model, type_of_mat, ntypes)
+            heat_args += " k " + " ".join(float_text(c) for c in k)
     return FieldCommands(heat, lines, fixes, heat_args,
-                         ghost_temperature=bool(heat_args) or _pp_reads_temperature(model))
+                         ghost_temperature=bool(contact) or _pp_reads_temperature(model))
 
 
 def _conductivities(model: GranularModel, type_of_mat: dict[int, int], ntypes: int) -> list[float]:

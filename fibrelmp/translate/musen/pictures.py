@@ -13,7 +13,8 @@ from fibrelmp.pictures.sources import SceneFrame, Source, kind_indices
 
 
 def musen_frame(model, index: int, time: float, rows: np.ndarray, position: np.ndarray,
-                 velocity: np.ndarray | None, triangles: np.ndarray | None) -> SceneFrame:
+                 velocity: np.ndarray | None, triangles: np.ndarray | None,
+                 temperature: np.ndarray | None = None) -> SceneFrame:
     """A frame of the spheres at ``rows`` of the model (bonds between them, if intact, and
     liquid bonds, while active)."""
     s = model.spheres
@@ -39,7 +40,7 @@ def musen_frame(model, index: int, time: float, rows: np.ndarray, position: np.n
     domain = model.plan.domain
     return SceneFrame(index, time, None, position, s.radius[rows], kinds, names,
                       velocity=velocity, mass=s.mass[rows], bonds=bonds, broken_bonds=broken,
-                      triangles=triangles, box=domain, liquid_bonds=liquid)
+                      triangles=triangles, box=domain, liquid_bonds=liquid, temperature=temperature)
 
 
 class MusenTextSource(Source):
@@ -52,7 +53,7 @@ class MusenTextSource(Source):
 
         super().__init__(path)
         self.model = scene.read(path)
-        self.tp = read_time_points(path, types=(SPHERE, WALL), tags=(12, 15, 44))
+        self.tp = read_time_points(path, types=(SPHERE, WALL), tags=(12, 15, 37, 44))
         ids = self.tp.ids
         self.sphere_cols = np.searchsorted(ids, self.model.spheres.ids)
         t = self.model.triangles
@@ -71,4 +72,6 @@ class MusenTextSource(Source):
             if self.wall_cols is not None and 44 in f:
                 tri = f[44][k, self.wall_cols].reshape(-1, 3, 3)
                 tri = tri[np.isfinite(tri).all(axis=(1, 2))]
-            yield musen_frame(self.model, k, float(time), rows, pos[rows], vel, tri)
+            # 37: MUSEN writes 0 for every sphere without a heat model
+            temp = f[37][k, self.sphere_cols][rows, 0] if 37 in f else None
+            yield musen_frame(self.model, k, float(time), rows, pos[rows], vel, tri, temp)

@@ -131,7 +131,7 @@ class MdemReader(Reader):
     def __iter__(self) -> Iterator[GranularFrame]:
         from fibrelmp.translate.musen.mdem.document import MdemFile
         from fibrelmp.translate.musen.mdem.objects import SOLID_BOND, SPHERE, WALL, read_objects
-        from fibrelmp.translate.musen.mdem.timepoints import columns
+        from fibrelmp.translate.musen.mdem.timepoints import bit, columns
 
         with MdemFile(self.path) as mdem:
             obj = read_objects(mdem.info, mdem.version, self.path)
@@ -148,6 +148,10 @@ class MdemReader(Reader):
                                       position=v[:, columns("coord")], velocity=v[:, columns("vel")],
                                       omega=v[:, columns("angle_vel")], force=v[:, columns("force")],
                                       quaternion=v[:, columns("quaternion")])
+                saved = masks[spheres[live]]
+                if len(live) and np.all(saved & bit("temperature")):
+                    # MUSEN saves temperatures when a heat model ran
+                    frame.temperature = v[:, columns("temperature").start].copy()
                 if len(bonds):
                     b = np.zeros((len(bonds), values.shape[1]))
                     inside = bonds < n

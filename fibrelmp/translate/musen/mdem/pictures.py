@@ -30,4 +30,4 @@ class MdemSource(Source):
     def frames(self) -> Iterator[SceneFrame]:
         for i, f in enumerate(self.reader):
             yield musen_frame(self.model, i, f.time, f.sphere_rows, f.position, f.velocity,
-                               f.triangle_vertices)
+                               f.triangle_vertices, f.temperature)

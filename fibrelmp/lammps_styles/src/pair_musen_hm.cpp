@@ -181,7 +181,8 @@ template <bool LAW_VALUES, class Laws> void PairMusenHM::contacts(Laws apply)
   } else if (temperature_index >= 0) {
     temp = atom->dvector[temperature_index];
   }
-  // the laws' own per-contact values (law_block: copied in from the entry, back after the laws)
+  // the laws' own per-contact values: the entry's own when the step advances (get() made it,
+  // zero for a new contact), else a copy (law_block) the laws may change without effect
   const int law_values = LAW_VALUES ? history_values - HISTORY_VALUES : 0;
   double *block = law_block.data();
   // MUSEN's time of this evaluation (its `_time == 0` rule)
@@ -231,14 +232,22 @@ template <bool LAW_VALUES, class Laws> void PairMusenHM::contacts(Laws apply)
         xi[1] = stored[1];
         xi[2] = stored[2];
       }
-      for (int v = 0; v < law_values; v++) block[v] = stored ? stored[HISTORY_VALUES + v] : 0.0;
+      double *own_values = nullptr;
+      if (LAW_VALUES) {
+        if (advance) {
+          own_values = xi_i + HISTORY_VALUES;
+        } else {
+          for (int v = 0; v < law_values; v++) block[v] = stored ? stored[HISTORY_VALUES + v] : 0.0;
+          own_values = block;
+        }
+      }
 
       // ---- CalculatePP of each law in turn (MUSEN's order), each continuing xi
       double n[3], cvlen, vn, vt[3];
       kinematics(i, j, cv, n, cvlen, vn, vt);
       musen_pp::Contact c{overlap, equiv_radius, equiv_mass, r1, r2, n, vn, vt,
                           omega[i], omega[j], dt};
-      if (LAW_VALUES) c.law_history = block;
+      c.law_history = own_values;
       c.at_time_zero = at_time_zero;
       if (temp) {
         c.t1 = temp[i];
@@ -280,7 +289,6 @@ template <bool LAW_VALUES, class Laws> void PairMusenHM::contacts(Laws apply)
           xi_i[3 + k] = r.fn[k];
           xi_i[6 + k] = r.ft[k];
         }
-        for (int v = 0; v < law_values; v++) xi_i[HISTORY_VALUES + v] = block[v];
         if (j < nlocal) {
           double *xi_j = history->get(j, tag[i]);
           for (int k = 0; k < 3; k++) {
@@ -288,7 +296,9 @@ template <bool LAW_VALUES, class Laws> void PairMusenHM::contacts(Laws apply)
             xi_j[3 + k] = -r.fn[k];
             xi_j[6 + k] = -r.ft[k];
           }
-          for (int v = 0; v < law_values; v++) xi_j[HISTORY_VALUES + v] = block[v];
+          // the partner's entry: the same law values (symmetric, musen_pp_law.h); xi_i stays
+          // valid (another atom's entries)
+          for (int v = 0; v < law_values; v++) xi_j[HISTORY_VALUES + v] = xi_i[HISTORY_VALUES + v];
         }
       }
 

@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import pkgutil
 import re
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -14,6 +16,8 @@ from fibrelmp.translate.granular import models as physics
 from fibrelmp.translate.musen.script_parse import MUSEN_MODELS
 
 CMUSEN_MODELS = Path("/work/shared/oracles/cmusen_models.txt")   # cmusen's printed model list
+MUSEN_GIT = Path("/work/.mirror/msolids+musen/repo")               # MUSEN's source (e0ff360)
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def _registered():
@@ -31,22 +35,44 @@ def test_names_and_kinds_are_musens():
         assert m.name in MUSEN_MODELS[m.kind], m.name
         assert m.name.startswith(f"Model{m.kind}")
         assert physics.find(m.name) is m
-        # MUSEN's keys are 32 upper-case hex digits, but for ModelSBPlasticConcrete's
-        # ("...914SS7D..."), ModelPPChealNess's ("...8A4SSSS6D...", 31 characters),
-        # ModelPPHertzMindlinVdW's ("...25A8V04..."), ModelPPSinteringTemperature's
-        # ("...ADB27XBFBA") and ModelEFLiquidDiffusion's (a 40-digit sha1)
-        key = m.mdem_key.replace("SS", "00").replace("A8V0", "A800").replace("27XB", "270B")
-        if m.name == "ModelPPChealNess":
-            key += "0"
-        assert re.fullmatch(r"[0-9A-F]{32}|[0-9a-f]{40}", key), m.name
+        # MUSEN's keys are mostly 32 upper-case hex digits, but not all (ModelSBPlasticConcrete's
+        # "...914SS7D...", ModelEFLiquidDiffusion's 40-digit sha1): test_keys_are_musens
+        # compares each with MUSEN's source
+        assert re.fullmatch(r"[0-9A-Z]{31,32}|[0-9a-f]{40}", m.mdem_key), m.name
 
 
-def test_one_stock_default_per_translated_kind():
-    for kind in ("PP", "PW", "SB"):
-        stock = physics.default_model(kind)
-        assert stock is not None and stock.needs_styles is None
-        assert physics.of_kind(kind)[0] is stock
-    assert physics.default_model("LB") is None and physics.find("ModelLBCapilarViscous").kind == "LB"
+@pytest.mark.skipif(not MUSEN_GIT.exists(), reason="MUSEN's source is not on this machine")
+def test_keys_are_musens():
+    """Each model's .mdem key is the m_uniqueKey of MUSEN's model of that name (e0ff360)."""
+    files = subprocess.run(["git", "-C", str(MUSEN_GIT), "ls-tree", "-r", "--name-only", "HEAD",
+                            "Models"], capture_output=True, text=True, check=True).stdout.split()
+    for m in _registered():
+        [source] = [f for f in files if f.endswith(f"/{m.name}.cpp")]
+        text = subprocess.run(["git", "-C", str(MUSEN_GIT), "show", f"HEAD:{source}"],
+                              capture_output=True, text=True, check=True).stdout
+        keys = re.findall(r'm_uniqueKey\s*=\s*"([^"]*)"', text)
+        assert keys == [m.mdem_key], (m.name, keys)
+
+
+def test_every_model_has_its_current_page():
+    """Each registered model has its page docs/models/<module>.md whose generated part is what
+    tools/model_pages.py renders from the module now, and every page belongs to a model: a model
+    added without its page, or changed without rerunning the tool, fails here."""
+    pages = ROOT / physics.MODEL_PAGES
+    for m in _registered():
+        page = pages / f"{physics.module_name(m)}.md"
+        assert page.exists(), f"{m.name}: no {page.relative_to(ROOT)} (python tools/model_pages.py)"
+        generated = page.read_text().split(physics.PAGE_END, 1)[0] + physics.PAGE_END + "\n"
+        assert generated == physics.model_page(m), f"{page.name} is stale: python tools/model_pages.py"
+    modules = {physics.module_name(m) for m in _registered()}
+    assert {p.stem for p in pages.glob("*.md")} == modules
+
+
+def test_every_model_documents_itself():
+    """A page's text is the model module's docstring, which starts with MUSEN's name."""
+    for m in _registered():
+        doc = sys.modules[m.__module__].__doc__ or ""
+        assert doc.startswith(m.name) and len(" ".join(physics.model_doc(m))) > 40, m.name
 
 
 @pytest.mark.skipif(not CMUSEN_MODELS.exists(), reason="the cmusen oracle is not on this machine")

@@ -124,11 +124,19 @@ def musen_sintering_temperature(x2, v1, v2, t1, t2, initial, at_zero, p=LAW):
     return n * (-(overlap - max_overlap) * kn * 2 / 3 + damp_n)
 
 
-def _lammps_forces(x2, v1, v2, t1, t2, time_now, x1=(0.0, 0.0, 0.0), boundary="f f f"):
+def _law_words(p=LAW) -> str:
+    return "sintering/temperature " + " ".join(
+        repr(p[k]) for k in ("db", "eta", "omega", "q", "tmin", "cmax", "gamma"))
+
+
+def _lammps_forces(x2, v1, v2, t1, t2, time_now, x1=(0.0, 0.0, 0.0), boundary="f f f",
+                   laws=None, steps=0, state=None):
+    """Forces and torques on both spheres at the given state (``run 0``); with ``steps``, after
+    that many steps first (then ``state``, a dict, gets the final positions and velocities)."""
     x1 = np.asarray(x1, float).tolist()
     x2 = (np.asarray(x2, float) + x1).tolist()
     v1, v2 = (np.asarray(a, float).tolist() for a in (v1, v2))
-    words = " ".join(repr(LAW[k]) for k in ("db", "eta", "omega", "q", "tmin", "cmax", "gamma"))
+    words = laws or _law_words()
     lmp = new_lammps(["-log", "none", "-screen", "none", "-nocite"])
     try:
         for c in [f"plugin load {lammps_styles.plugin().path}", "units si", "atom_style sphere",
@@ -143,13 +151,16 @@ def _lammps_forces(x2, v1, v2, t1, t2, time_now, x1=(0.0, 0.0, 0.0), boundary="f
                   f"set atom 2 vx {v2[0]!r} vy {v2[1]!r} vz {v2[2]!r}",
                   "set atom 1 omega 0 0 30.0", "set atom 2 omega 7.0 0 0",
                   f"set atom 1 d_musen_temperature {t1!r}", f"set atom 2 d_musen_temperature {t2!r}",
-                  f"pair_style musen/pp sintering/temperature {words}",
+                  f"pair_style musen/pp {words}",
                   f"pair_coeff 1 1 {E_STAR} {G_STAR} {REST} {MU} {MU_R}",
                   f"reset_timestep 0 time {time_now!r}",
                   "neighbor 0.0005 bin", f"timestep {DT!r}", "fix integrate all nve/sphere",
-                  "run 0 post no"]:
+                  *([f"run {steps} post no"] if steps else []), "run 0 post no"]:
             lmp.command(c)
         order = np.argsort(lmp.numpy.extract_atom("id")[:2])     # by atom id (atoms sort)
+        if state is not None:
+            state["x"] = lmp.numpy.extract_atom("x")[:2][order].copy()
+            state["v"] = lmp.numpy.extract_atom("v")[:2][order].copy()
         f = lmp.numpy.extract_atom("f")[:2][order].copy()
         t = lmp.numpy.extract_atom("torque")[:2][order].copy()
     finally:
@@ -184,6 +195,55 @@ def test_single_contact_is_musens_law(overlap, vn, vt, t1, t2, time_now):
     assert scale > 0
     np.testing.assert_allclose(f[0], force, rtol=0, atol=1e-12 * scale)
     np.testing.assert_allclose(f[1], -force, rtol=0, atol=1e-12 * scale)
+
+
+def test_two_laws_keep_their_own_initial_overlap():
+    """Each law's per-contact values are its own block of the contact's history (pair musen/hm
+    sizes the entry as 9 + the laws' blocks): at 1500 K a law with Tmin 1000 sinters and sets
+    its initial overlap to the overlap; after it, one with Tmin 2000 is cold and springs towards
+    ITS initial overlap, zero for a contact that starts after time 0.  Shared values would give
+    the second the first's overlap (no elastic force)."""
+    styles_or_skip()
+    direction = np.array([0.8, 0.6, 0.0])
+    x2 = direction * (R1 + R2 - 1e-5)
+    v1, v2 = direction * 0.01, np.array([-0.6, 0.8, 0.0]) * 0.003
+    cold = {**LAW, "tmin": 2000.0}
+    f, t = _lammps_forces(x2, v1, v2, 1500.0, 1500.0, 1e-3,
+                          laws=f"{_law_words()} then {_law_words(cold)}")
+    hot_part = musen_sintering_temperature(x2, v1, v2, 1500.0, 1500.0, 0.0, False)
+    cold_part = musen_sintering_temperature(x2, v1, v2, 1500.0, 1500.0, 0.0, False, p=cold)
+    shared = musen_sintering_temperature(x2, v1, v2, 1500.0, 1500.0, 1e-5, False, p=cold)
+    expected = hot_part + cold_part
+    scale = np.abs(expected).max()
+    assert np.abs(cold_part - shared).max() > 1e-3 * scale      # the test tells them apart
+    np.testing.assert_allclose(f[0], expected, rtol=0, atol=1e-12 * scale)
+    np.testing.assert_allclose(f[1], -expected, rtol=0, atol=1e-12 * scale)
+
+
+def test_two_laws_keep_their_own_initial_overlap_through_steps():
+    """The same two laws after 5 steps (pair musen/hm writes each law's values into its block
+    of the contact's stored entry), then evaluated at the final state (``run 0`` reads the
+    entry): the cold law's initial overlap is still its own zero, not the hot law's overlap."""
+    styles_or_skip()
+    direction = np.array([0.8, 0.6, 0.0])
+    x2 = direction * (R1 + R2 - 1e-5)
+    v1, v2 = direction * 0.01, np.array([-0.6, 0.8, 0.0]) * 0.003
+    cold = {**LAW, "tmin": 2000.0}
+    state = {}
+    f, _ = _lammps_forces(x2, v1, v2, 1500.0, 1500.0, 1e-3,
+                          laws=f"{_law_words()} then {_law_words(cold)}", steps=5, state=state)
+    rel = state["x"][1] - state["x"][0]
+    v1, v2 = state["v"]
+    assert not np.allclose(rel, x2, rtol=0, atol=1e-12)           # the spheres moved
+    expected = (musen_sintering_temperature(rel, v1, v2, 1500.0, 1500.0, 0.0, False)
+                + musen_sintering_temperature(rel, v1, v2, 1500.0, 1500.0, 0.0, False, p=cold))
+    overlap = R1 + R2 - np.linalg.norm(rel)
+    shared = (musen_sintering_temperature(rel, v1, v2, 1500.0, 1500.0, 0.0, False)
+              + musen_sintering_temperature(rel, v1, v2, 1500.0, 1500.0, overlap, False, p=cold))
+    scale = np.abs(expected).max()
+    assert np.abs(expected - shared).max() > 1e-3 * scale
+    np.testing.assert_allclose(f[0], expected, rtol=0, atol=1e-12 * scale)
+    np.testing.assert_allclose(f[1], -expected, rtol=0, atol=1e-12 * scale)
 
 
 def test_across_a_periodic_boundary_the_ghosts_temperature_counts():
@@ -264,7 +324,7 @@ def test_refused_without_fibrelmps_styles(tmp_path):
 
 
 def test_checkpointed_and_resumed_run_is_bitwise_the_same(tmp_path, monkeypatch):
-    """The initial overlap (the 10th history value) goes through the checkpoint."""
+    """The initial overlap (the law's block of the contact history) goes through the checkpoint."""
     check_resume_is_bitwise(tmp_path, monkeypatch, _job, "sintert_result_prec17.txt", 2010)
 
 

@@ -11,10 +11,16 @@
    step left and writes its own; the forces and moments of all laws add.
    A law is one .cpp file that registers itself with one line:
      const bool registered = musen_pp::add("NAME", &create_function);
+   A law that keeps its own per-contact values (history_size() > 0) gets a block of each
+   contact's history: pair musen/hm stores its own values first (HISTORY_VALUES: xi and the last
+   forces), then each law's block in the order the laws act, at the offset it tells the law
+   (set_history_offset); the law reads and writes it through own_history(c).
 ------------------------------------------------------------------------- */
 
 #ifndef FIBRELMP_MUSEN_PP_LAW_H
 #define FIBRELMP_MUSEN_PP_LAW_H
+
+#include "musen_law_registry.h"
 
 #include <cmath>
 #include <memory>
@@ -36,10 +42,10 @@ struct Contact {
   double dt;
   // heat laws only (fix musen/heat; zero otherwise): temperatures and thermal conductivities
   double t1 = 0, t2 = 0, k1 = 0, k2 = 0;
-  // laws that keep an initial overlap (keeps_initial_overlap): the contact's stored one (in/out;
-  // nullptr: a contact with no entry), and whether this is MUSEN's time 0
-  double *initial_overlap = nullptr;
-  bool at_time_zero = false;
+  // the laws' own per-contact values (Law::history_size; in/out, zero for a new contact): each
+  // law's block at its offset (Law::own_history); nullptr when no law keeps any
+  double *law_history = nullptr;
+  bool at_time_zero = false;    // this evaluation is at MUSEN's time 0 (its `_time == 0` rule)
 };
 
 // pair_coeff of the type pair
@@ -66,17 +72,30 @@ class Law {
   virtual bool heats() const { return false; }
   // whether the law reads the temperatures (without a heat flux: d_musen_temperature alone)
   virtual bool reads_temperature() const { return heats(); }
-  // whether the law keeps a per-contact initial overlap (pair musen/hm's 10th history value)
-  virtual bool keeps_initial_overlap() const { return false; }
+  // how many per-contact values the law keeps (its block of each contact's history; symmetric
+  // quantities: the pair style gives both spheres' entries the same block)
+  virtual int history_size() const { return 0; }
+  // where the law's block starts among the laws' values (the pair style sets it)
+  void set_history_offset(int offset) { history_offset = offset; }
+
+ protected:
+  // the law's history_size() values of contact c (in/out; zero for a new contact)
+  double *own_history(const Contact &c) const { return c.law_history + history_offset; }
+
+ private:
+  int history_offset = 0;
 };
 
-// a law from its parameters; sets why and returns nullptr when they are wrong
-using Factory = std::unique_ptr<Law> (*)(const std::vector<double> &params, std::string &why);
-
-bool add(const char *name, Factory factory);
-std::unique_ptr<Law> create(const std::string &name, const std::vector<double> &params,
-                            std::string &why);
-std::string names();    // the registered laws, for messages
+// the registry of particle-particle laws (musen_law_registry.h)
+using Registry = LawRegistry<Law>;
+using Factory = Registry::Factory;
+inline bool add(const char *name, Factory factory) { return Registry::add(name, factory); }
+inline std::unique_ptr<Law> create(const std::string &name, const std::vector<double> &params,
+                                   std::string &why)
+{
+  return Registry::create("particle-particle", name, params, why);
+}
+inline std::string names() { return Registry::names(); }    // the registered laws, for messages
 
 // MUSEN's Hertz-Mindlin-shaped CalculatePP (ModelPPHertzMindlin.cpp, ModelPPLinearElastic.cpp:
 // the same operations around their stiffnesses): Derived gives

@@ -11,8 +11,9 @@
        MUSEN's damping, tangential spring and damping, no friction limit, no moments
      else (T > TMIN, overlap >= max): normal spring towards max with damping; xi = 0, initial
        overlap = overlap
-   The initial overlap is the contact's stored one (pair musen/hm's 10th history value): zero for
-   a new contact, the overlap at MUSEN's time 0 (its `_time == 0` rule) for one present then.
+   The initial overlap is the contact's stored one (the law's one-value block of the contact's
+   history, musen_pp_law.h history_size): zero for a new contact, the overlap at MUSEN's time 0
+   (its `_time == 0` rule) for one present then.
    Velocities are the centres' (MUSEN's Particles().Vel, no spin term).
 ------------------------------------------------------------------------- */
 
@@ -38,7 +39,7 @@ class SinteringTemperature final : public musen_pp::Law {
   {
   }
   bool reads_temperature() const override { return true; }
-  bool keeps_initial_overlap() const override { return true; }
+  int history_size() const override { return 1; }    // the contact's initial overlap
 
   void force(const musen_pp::Contact &c, const musen_pp::Materials &m, double *xi,
              musen_pp::Result &r) const override
@@ -60,8 +61,7 @@ class SinteringTemperature final : public musen_pp::Law {
 
     const double temperature = (c.t1 + c.t2) / 2;
     const double max_overlap = max_overlap_coeff * 2 * c.equiv_radius;
-    double local_initial = 0.0;
-    double &initial = c.initial_overlap ? *c.initial_overlap : local_initial;
+    double &initial = own_history(c)[0];
     // MUSEN: "set initial overlap as equilibrium value" at _time == 0
     if (c.at_time_zero) {
       for (int k = 0; k < 3; k++) xi[k] = 0.0;

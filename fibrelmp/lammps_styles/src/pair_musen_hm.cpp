@@ -47,6 +47,7 @@
 #include "update.h"
 #include "utils.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -130,10 +131,13 @@ void PairMusenHM::compute(int eflag, int vflag)
   if (only_hertz) {
     // MUSEN's default, alone: its law called directly (inlined), not through the list
     const musen_pp::HertzMindlin &law = *only_hertz;
-    contacts([&law](const musen_pp::Contact &c, const musen_pp::Materials &m, double *xi,
+    contacts<false>([&law](const musen_pp::Contact &c, const musen_pp::Materials &m, double *xi,
                     musen_pp::Result &r) { law.calculate_pp(c, m, xi, r); });
+  } else if (law_block.empty()) {
+    contacts<false>([this](const musen_pp::Contact &c, const musen_pp::Materials &m, double *xi,
+                           musen_pp::Result &r) { apply_laws(c, m, xi, r); });
   } else {
-    contacts([this](const musen_pp::Contact &c, const musen_pp::Materials &m, double *xi,
+    contacts<true>([this](const musen_pp::Contact &c, const musen_pp::Materials &m, double *xi,
                     musen_pp::Result &r) { apply_laws(c, m, xi, r); });
   }
 }
@@ -150,7 +154,7 @@ void PairMusenHM::apply_laws(const musen_pp::Contact &c, const musen_pp::Materia
   }
 }
 
-template <class Laws> void PairMusenHM::contacts(Laws apply)
+template <bool LAW_VALUES, class Laws> void PairMusenHM::contacts(Laws apply)
 {
   // LAMMPS recomputes forces at the start of every run (setup) and for `run 0`: those
   // evaluations must not advance the tangential overlap (MUSEN advances it once per step)
@@ -177,7 +181,10 @@ template <class Laws> void PairMusenHM::contacts(Laws apply)
   } else if (temperature_index >= 0) {
     temp = atom->dvector[temperature_index];
   }
-  const bool keeps_initial = history_values > HISTORY_VALUES;
+  // the laws' own per-contact values: the entry's own when the step advances (get() made it,
+  // zero for a new contact), else a copy (law_block) the laws may change without effect
+  const int law_values = LAW_VALUES ? history_values - HISTORY_VALUES : 0;
+  double *block = law_block.data();
   // MUSEN's time of this evaluation (its `_time == 0` rule)
   const bool at_time_zero =
       update->atime + static_cast<double>(update->ntimestep - update->atimestep) * dt == 0.0;
@@ -210,21 +217,29 @@ template <class Laws> void PairMusenHM::contacts(Laws apply)
       const double equiv_radius = r1 * r2 / (r1 + r2);
       const double equiv_mass = rmass[i] * rmass[j] / (rmass[i] + rmass[j]);
 
-      // stored tangential overlap (zero for a new contact)
+      // stored tangential overlap and law values (zero for a new contact)
       double *xi_i = nullptr;
       double xi[3] = {0.0, 0.0, 0.0};
-      double initial_overlap = 0.0;
+      const double *stored = nullptr;
       if (advance) {
         xi_i = history->get(i, tag[j]);
-        xi[0] = xi_i[0];
-        xi[1] = xi_i[1];
-        xi[2] = xi_i[2];
-        if (keeps_initial) initial_overlap = xi_i[HISTORY_VALUES];
-      } else if (const double *found = history->find(i, tag[j])) {
-        xi[0] = found[0];
-        xi[1] = found[1];
-        xi[2] = found[2];
-        if (keeps_initial) initial_overlap = found[HISTORY_VALUES];
+        stored = xi_i;
+      } else {
+        stored = history->find(i, tag[j]);
+      }
+      if (stored) {
+        xi[0] = stored[0];
+        xi[1] = stored[1];
+        xi[2] = stored[2];
+      }
+      double *own_values = nullptr;
+      if (LAW_VALUES) {
+        if (advance) {
+          own_values = xi_i + HISTORY_VALUES;
+        } else {
+          for (int v = 0; v < law_values; v++) block[v] = stored ? stored[HISTORY_VALUES + v] : 0.0;
+          own_values = block;
+        }
       }
 
       // ---- CalculatePP of each law in turn (MUSEN's order), each continuing xi
@@ -232,10 +247,8 @@ template <class Laws> void PairMusenHM::contacts(Laws apply)
       kinematics(i, j, cv, n, cvlen, vn, vt);
       musen_pp::Contact c{overlap, equiv_radius, equiv_mass, r1, r2, n, vn, vt,
                           omega[i], omega[j], dt};
-      if (keeps_initial) {
-        c.initial_overlap = &initial_overlap;
-        c.at_time_zero = at_time_zero;
-      }
+      c.law_history = own_values;
+      c.at_time_zero = at_time_zero;
       if (temp) {
         c.t1 = temp[i];
         c.t2 = temp[j];
@@ -276,7 +289,6 @@ template <class Laws> void PairMusenHM::contacts(Laws apply)
           xi_i[3 + k] = r.fn[k];
           xi_i[6 + k] = r.ft[k];
         }
-        if (keeps_initial) xi_i[HISTORY_VALUES] = initial_overlap;
         if (j < nlocal) {
           double *xi_j = history->get(j, tag[i]);
           for (int k = 0; k < 3; k++) {
@@ -284,7 +296,9 @@ template <class Laws> void PairMusenHM::contacts(Laws apply)
             xi_j[3 + k] = -r.fn[k];
             xi_j[6 + k] = -r.ft[k];
           }
-          if (keeps_initial) xi_j[HISTORY_VALUES] = initial_overlap;
+          // the partner's entry: the same law values (symmetric, musen_pp_law.h); xi_i stays
+          // valid (another atom's entries)
+          for (int v = 0; v < law_values; v++) xi_j[HISTORY_VALUES + v] = xi_i[HISTORY_VALUES + v];
         }
       }
 
@@ -341,9 +355,14 @@ void PairMusenHM::set_laws(const std::string &first, int narg, char **arg)
     if (!law) error->all(FLERR, "pair {}: {}", force->pair_style, why);
     laws.push_back(std::move(law));
   }
-  history_values = HISTORY_VALUES;
-  for (const auto &law : laws)
-    if (law->keeps_initial_overlap()) history_values = HISTORY_VALUES + 1;
+  // each law's block of the contact's history after the style's own values, in the laws' order
+  int law_values = 0;
+  for (const auto &law : laws) {
+    law->set_history_offset(law_values);
+    law_values += law->history_size();
+  }
+  history_values = HISTORY_VALUES + law_values;
+  law_block.assign(law_values, 0.0);
   only_hertz = laws.size() == 1 ? dynamic_cast<const musen_pp::HertzMindlin *>(laws[0].get())
                                 : nullptr;
 }
@@ -589,7 +608,9 @@ double PairMusenHM::single(int i, int j, int itype, int jtype, double rsq, doubl
   }
   const musen_pp::Materials mats{estar[itype][jtype], gstar[itype][jtype], alpha[itype][jtype],
                                  mu[itype][jtype], mu_roll[itype][jtype]};
-  double xi[3] = {0.0, 0.0, 0.0};    // a new contact's
+  double xi[3] = {0.0, 0.0, 0.0};    // a new contact's, and its law values
+  std::fill(law_block.begin(), law_block.end(), 0.0);
+  if (!law_block.empty()) c.law_history = law_block.data();
   musen_pp::Result r;
   apply_laws(c, mats, xi, r);
   const double fn_len = r.fn_len;

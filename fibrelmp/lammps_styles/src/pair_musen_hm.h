@@ -68,7 +68,8 @@ class PairMusenHM : public Pair {
   // per contact: tangential overlap xi (3), the last step's normal and tangential force on
   // the atom (3 + 3, for single())
   static constexpr int HISTORY_VALUES = 9;
-  // a law that keeps an initial overlap adds it as a 10th value (set_laws)
+  // and after them each law's own values (musen_pp::Law::history_size, in the laws' order;
+  // set_laws): the contact's whole entry
   int history_values = HISTORY_VALUES;
 
  protected:
@@ -95,10 +96,13 @@ class PairMusenHM : public Pair {
   class Fix *heat_fix = nullptr;
   // d_musen_temperature's index for a law that reads temperatures without heat (or -1)
   int temperature_index = -1;
+  // one contact's law values while the laws act (history_values - HISTORY_VALUES of them)
+  std::vector<double> law_block;
   // every law in turn on one contact; the loop over the contacts with one of those
+  // (LAW_VALUES false: no law keeps values of its own, the loop without their copies)
   void apply_laws(const musen_pp::Contact &c, const musen_pp::Materials &m, double *xi,
                   musen_pp::Result &r) const;
-  template <class Laws> void contacts(Laws apply);
+  template <bool LAW_VALUES, class Laws> void contacts(Laws apply);
 
   // the contact's geometry for the laws, spheres i (src) and j (dst), cv = x_j - x_i: the unit
   // normal n (zero with cv), |cv|, and the normal and tangential relative velocity there

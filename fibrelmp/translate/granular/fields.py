@@ -23,15 +23,15 @@ def contact_heat_models(model: GranularModel) -> list[str]:
     """The contact and bond models (PP, PW, SB) that carry heat to the spheres (fix musen/heat)."""
     from fibrelmp.translate.granular import models as physics
     names = [m.name for kind in ("PP", "PW") for m, _ in physics.chosen_all(model, kind)
-             if getattr(m, "contact_heat", False)]
+             if m.contact_heat]
     plan = model.plan
     return names + [law.model for law in (plan.bond_law, *plan.then_bond_laws) if law.form == "heat"]
 
 
 def _pp_reads_temperature(model: GranularModel) -> bool:
-    """A PP law that reads the temperatures without carrying heat (ModelPPSinteringTemperature)."""
+    """A PP law that reads the temperatures without carrying heat (its ``reads_temperature``)."""
     from fibrelmp.translate.granular import models as physics
-    return any(getattr(m, "reads_temperature", False) for m, _ in physics.chosen_all(model, "PP"))
+    return any(m.reads_temperature for m, _ in physics.chosen_all(model, "PP"))
 
 
 def uses_temperature(model: GranularModel) -> bool:

@@ -108,7 +108,7 @@ def _apply_later_contact_models(model: GranularModel, plan) -> None:
                                  f"available here ({styles.how})")
             # a law that keeps its own contact history (ModelPPHertz: the tangential force)
             alone = [m for m in (model.models[kind].name, choice.name)
-                     if getattr(physics.find(m), "acts_alone", False)]
+                     if physics.find(m).acts_alone]
             if alone:
                 raise InputError(choice.source, choice.line, f"{choice.name} after "
                                  f"{model.models[kind].name}: fibrelmp runs {alone[0]} only as "

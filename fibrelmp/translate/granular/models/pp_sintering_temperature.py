@@ -6,7 +6,7 @@ below it a Hertz-like spring towards the contact's initial overlap (its overlap 
 for a later contact); hot and past the maximum overlap a normal spring towards it.  Only with
 fibrelmp's ``pair_style musen/pp sintering/temperature`` (src/musen_pp_sintering_temperature.cpp),
 which reads the spheres' temperatures (d_musen_temperature, scene tag 37) and keeps the initial
-overlap as a 10th history value of each contact.  Range: as ModelPPSintering (one radius)."""
+overlap as its own one-value block of each contact's history.  Range: as ModelPPSintering (one radius)."""
 
 from __future__ import annotations
 

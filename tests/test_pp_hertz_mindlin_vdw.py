@@ -192,3 +192,20 @@ def test_checkpointed_and_resumed_run_is_bitwise_the_same(tmp_path, monkeypatch)
 def test_lmp_replays_the_run_bitwise(tmp_path):
     """The rendered job, run by the wheel's ``lmp`` executable, writes the same frames."""
     check_lmp_replay_is_bitwise(tmp_path, _job)
+
+
+@pytest.mark.parametrize("pbc, warned", [("1 0 0", True), ("0 0 0", False)])
+def test_periodic_box_warns_of_musens_raw_distance(tmp_path, pbc, warned):
+    """MUSEN's CalculatePP takes the surface distance from the stored coordinates, so a pair
+    touching across a periodic boundary is no contact to cmusen (measured by
+    benchmarks/musen_models_cost.py: 1.4 overlaps apart at the end); LAMMPS uses the image."""
+    styles_or_skip()
+    job = _job(tmp_path)
+    text = job.read_text()
+    model_line = "MODEL_PP             ModelPPHertzMindlinVdW\n"
+    assert model_line in text
+    job.write_text(text.replace(model_line, model_line + f"PBC_FLAGS {pbc}\n"
+                                "PBC_DOMAIN -0.02 -0.02 -0.02 0.02 0.02 0.02\n"))
+    kinds: list[str] = []
+    python_api.translate_job(job, tmp_path / "work", lambda items: kinds.extend(k for k, _ in items))
+    assert ("musen-periodic-raw-distance" in kinds) == warned

@@ -250,6 +250,7 @@ def _plan_parts(model: GranularModel) -> _JobParts:
     dim, dt, total, t_start = run.dim, run.dt, run.total, run.t_start
     warnings: list[tuple[str, str]] = []
     periodic = periodic_axes(plan, dim)
+    warnings.extend(physics.periodic_contact_warnings(model, periodic))
     dom_lo, dom_hi = domain_bounds(plan)
     spheres = select_spheres(model, run, periodic, dom_lo, dom_hi, warnings)
     wall_plans = plan_walls(model, dt, run.t_end)

@@ -15,7 +15,7 @@ import math
 import pkgutil
 import sys
 from pathlib import Path
-from typing import ClassVar
+from typing import Any, ClassVar
 
 from fibrelmp.errors import InputError
 from fibrelmp.granmodel import GranularModel, GranularPlan, SolidBondLaw
@@ -55,6 +55,9 @@ class PhysicsModel:
     contact_heat: ClassVar[bool] = False
     reads_temperature: ClassVar[bool] = False
     acts_alone: ClassVar[bool] = False
+    # a PP law whose MUSEN code takes the surface distance from the spheres' stored coordinates
+    # (not the contact vector): across a periodic boundary MUSEN sees no touching pair
+    raw_coordinate_distance: ClassVar[bool] = False
 
     @classmethod
     def read_parameters(cls, text: str, path: Path | str | None, line: int | None,
@@ -179,6 +182,20 @@ def chosen_all(model: GranularModel, kind: str) -> list[tuple[type[PhysicsModel]
     runs every selected PP / PW model on each contact in turn, forces adding)."""
     return [chosen(model, kind)] + [(find(c.name), c.parameters) for c in model.later_models
                                     if c.kind == kind]
+
+
+def periodic_contact_warnings(model: GranularModel, periodic: Any) -> list[tuple[str, str]]:
+    """A warning for each PP law that MUSEN evaluates with the raw coordinates' distance
+    (``raw_coordinate_distance``) in a periodic box: a pair touching across the boundary is
+    one contact to LAMMPS (its periodic image) but far apart to MUSEN."""
+    if not (model.plan.particle_contacts and any(bool(p) for p in periodic)):
+        return []
+    return [("musen-periodic-raw-distance",
+             f"{m.name}: MUSEN takes the surface distance from the spheres' coordinates, not "
+             "the periodic contact vector, so in cmusen spheres touching across a periodic "
+             "boundary feel no contact force; fibrelmp (LAMMPS) applies the law to the "
+             "periodic image: such contacts differ from cmusen")
+            for m, _ in chosen_all(model, "PP") if m.raw_coordinate_distance]
 
 
 def pair_style_lines(model: GranularModel, own_styles: bool) -> list[str]:

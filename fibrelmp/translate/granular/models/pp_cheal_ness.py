@@ -31,6 +31,7 @@ class PPChealNess(PhysicsModel):
     mdem_key = "B18A4SSSS6D4D44B925A8A04D0D1008"
     parameters = {HMIN: 1e-5, HMAX: 5e-3, ETA: 0.1}
     needs_styles = "pair_style musen/hm"
+    raw_coordinate_distance = True
 
     @classmethod
     def read_parameters(cls, text: str, path: Path | str | None, line: int | None,

@@ -93,6 +93,7 @@ class PPHertzMindlinVdW(SurfaceEnergyModel):
     kind = "PP"
     mdem_key = "B18A46C2786D4D44B925A8V04D0D1008"
     needs_styles = "pair_style musen/vdw"
+    raw_coordinate_distance = True
 
     @classmethod
     def pair_style_lines(cls, params: dict[str, float], own_styles: bool) -> list[str]:

@@ -128,6 +128,25 @@ MODELS: dict[str, tuple[str, str, str]] = {
     "ModelEFLiquidDiffusion": ("EF", "MODEL_EF ModelEFLiquidDiffusion\nMODEL_EF_PARAMS FIXED_SEED 12345\n",
                                "free spheres"),
 }
+# where each model is compared with cmusen's stored outputs (the difference at every saved time)
+TESTS = {
+    "ModelPPHertzMindlin": "test_musen_several_models.py", "ModelPPHertz": "test_pp_hertz_simple_viscoelastic.py",
+    "ModelPPHertzMindlinLiquid": "test_pp_hertz_mindlin_liquid.py", "ModelPPChealNess": "test_pp_cheal_ness.py",
+    "ModelPPJKR": "test_pp_jkr.py", "ModelPPLinearElastic": "test_pp_linear_elastic.py",
+    "ModelPPPopovJKR": "test_pp_jkr.py", "ModelPPSimpleViscoElastic": "test_pp_hertz_simple_viscoelastic.py",
+    "ModelPPSintering": "test_pp_sintering.py", "ModelPPSinteringTemperature": "test_pp_sintering_temperature.py",
+    "ModelPPHertzMindlinVdW": "test_pp_hertz_mindlin_vdw.py", "ModelPPHeatConduction": "test_contact_heat.py",
+    "ModelPWHertzMindlin": "test_musen_several_models.py", "ModelPWHertzMindlinLiquid": "test_pw_hertz_mindlin_liquid.py",
+    "ModelPWJKR": "test_pw_jkr.py", "ModelPWPopovJKR": "test_pw_jkr.py",
+    "ModelPWSimpleViscoElastic": "test_pw_simple_viscoelastic.py", "ModelPWHeatTransfer": "test_contact_heat.py",
+    "ModelSBElastic": "test_style_musen_bond.py", "ModelSBAerogel": "test_sb_plastic_models.py",
+    "ModelSBElasticPerfectlyPlastic": "test_sb_plastic_models.py", "ModelSBCreep": "test_sb_plastic_models.py",
+    "ModelSBHeatConduction": "test_contact_heat.py", "ModelSBKelvin": "test_musen_several_bond_models.py",
+    "ModelSBLinearPlastic": "test_sb_plastic_models.py", "ModelSBThermal": "test_contact_heat.py",
+    "ModelSBWeakening": "test_sb_plastic_models.py", "ModelSBPlasticConcrete": "test_sb_plastic_models.py",
+    "ModelLBCapilarViscous": "test_lb_capilar_viscous.py", "ModelEFCentrifugalCasting": "test_ef_models.py",
+    "ModelEFViscousField": "test_ef_models.py", "ModelEFHeatTransfer": "test_ef_models.py",
+    "ModelEFLiquidDiffusion": "test_ef_models.py"}
 REFERENCE = {"PP": "ModelPPHertzMindlin", "PW": "ModelPWHertzMindlin", "SB": "ModelSBElastic",
              "LB": "ModelSBElastic", "EF": "ModelPPHertzMindlin"}
 # models whose baseline runs the model itself (it has per-sphere work: temperatures, fields)
@@ -260,6 +279,7 @@ class Case:
     walls: dict = field(default_factory=lambda: {"fibrelmp": [], "cmusen": []})   # loop wall s
     loads: list = field(default_factory=list)
     moved: float = float("nan")   # cmusen's largest displacement / overlap
+    diff: float = float("nan")    # largest |x_cmusen - x_fibrelmp| at the end / overlap
 
 
 def family_models(family: str, models: str) -> str:
@@ -392,22 +412,41 @@ def run_cmusen(case: Case, exe: str) -> tuple[float, float]:
     return cpu, wall
 
 
-def displacement(case: Case) -> float:
-    """cmusen's largest sphere displacement over the run / the overlap (from its text export:
-    the first and last `12 x y z` of each sphere line)."""
-    path = case.folder / "cmusen" / "result.txt"
-    worst = 0.0
-    for line in path.read_text().splitlines():
+def cmusen_positions(case: Case) -> dict[int, tuple[np.ndarray, np.ndarray]]:
+    """MUSEN id -> (first, last) sphere position in cmusen's text export (its `12 x y z`)."""
+    out = {}
+    for line in (case.folder / "cmusen" / "result.txt").read_text().splitlines():
         tok = line.split()
         if tok[:1] != ["0"] or tok[3:4] != ["1"]:
             continue
         at = [i for i, t in enumerate(tok) if i > 5 and t == "12" and i + 3 < len(tok)]
-        if len(at) < 2:
-            continue
-        p0 = np.array(tok[at[0] + 1:at[0] + 4], float)
-        p1 = np.array(tok[at[-1] + 1:at[-1] + 4], float)
-        worst = max(worst, float(np.linalg.norm(p1 - p0)))
-    return worst / OVERLAP
+        if at:
+            out[int(tok[1])] = (np.array(tok[at[0] + 1:at[0] + 4], float), np.array(tok[at[-1] + 1:at[-1] + 4], float))
+    return out
+
+
+def fibrelmp_positions(case: Case) -> dict[int, np.ndarray]:
+    """LAMMPS atom id -> position in the last frame of fibrelmp's frames.dump."""
+    frame = (case.folder / "fibrelmp" / "frames.dump").read_text().split("ITEM: TIMESTEP")[-1].splitlines()
+    head = next(k for k, line in enumerate(frame) if line.startswith("ITEM: ATOMS"))
+    cols = frame[head].split()[2:]
+    ix, iy, iz, iid = (cols.index(c) for c in ("x", "y", "z", "id"))
+    out = {}
+    for line in frame[head + 1:]:
+        tok = line.split()
+        if tok:
+            out[int(tok[iid])] = np.array([float(tok[ix]), float(tok[iy]), float(tok[iz])])
+    return out
+
+
+def compare(case: Case) -> None:
+    """case.moved: cmusen's largest displacement over the run / the overlap (did the contacts
+    stay?); case.diff: the largest |x_cmusen - x_fibrelmp| at the end / the overlap (the
+    spheres are MUSEN objects 0..n-1, LAMMPS atoms 1..n)."""
+    cm, fl = cmusen_positions(case), fibrelmp_positions(case)
+    case.moved = max(float(np.linalg.norm(p1 - p0)) for p0, p1 in cm.values()) / OVERLAP
+    if set(fl) == {i + 1 for i in cm}:
+        case.diff = max(float(np.linalg.norm(cm[i][1] - fl[i + 1])) for i in cm) / OVERLAP
 
 
 # ---------------------------------------------------------------- main
@@ -485,8 +524,8 @@ def main() -> int:
                         continue
                     case.times[side].append(cpu)
                     case.walls[side].append(wall)
-                if r == 0 and case.contacts and case.family != "EF" and case.times["cmusen"]:
-                    case.moved = displacement(case)
+                if r == 0 and case.contacts and case.times["cmusen"] and case.times["fibrelmp"]:
+                    compare(case)
             print(f"round {r + 1}/{args.repeat} done at {time.perf_counter() - t_all:.0f} s, "
                   f"load {os.getloadavg()[0]:.2f}", flush=True)
     load1 = os.getloadavg()
@@ -521,7 +560,8 @@ def table(cases: dict[str, Case], models: list[str], steps: int) -> list[dict]:
                      "per": "sphere" if case.family == "EF" else ("bond" if case.family in ("SB", "LB") else "contact"),
                      "fibrelmp_ns": fl, "cmusen_ns": cm, "vs_musen_hm": fl / ref if ref > 0 else math.nan,
                      "vs_cmusen": fl / cm if cm > 0 else math.nan, "load": statistics.median(case.loads),
-                     "moved_over_overlap": case.moved})
+                     "moved_over_overlap": case.moved, "diff_over_overlap": case.diff,
+                     "cmusen_tests": TESTS.get(model, "")})
     return rows
 
 
@@ -531,13 +571,13 @@ def print_table(rows: list[dict], args, load0, load1, wall: float) -> None:
           f"cmusen -t=1, fibrelmp 1 rank; load average {load0[0]:.2f} before / {load1[0]:.2f} after; "
           f"{wall:.0f} s{' (QUICK sizes)' if args.quick else ''}")
     head = (f"| {'model':<31}| {'case':<30}| {'contacts':>8} | {'fibrelmp ns':>11} | {'cmusen ns':>9} "
-            f"| {'vs musen/hm':>11} | {'vs cmusen':>9} | {'load':>5} | {'moved/δ':>7} |")
+            f"| {'vs musen/hm':>11} | {'vs cmusen':>9} | {'load':>5} | {'moved/δ':>7} | {'Δx/δ':>7} |")
     print(head)
     print("|" + "|".join("-" * len(c) for c in head.split("|")[1:-1]) + "|")
     for row in rows:
         print(f"| {row['model']:<31}| {row['case']:<30}| {row['contacts']:>8} | {row['fibrelmp_ns']:11.1f} "
               f"| {row['cmusen_ns']:9.1f} | {row['vs_musen_hm']:11.2f} | {row['vs_cmusen']:9.2f} "
-              f"| {row['load']:5.2f} | {row['moved_over_overlap']:7.3f} |")
+              f"| {row['load']:5.2f} | {row['moved_over_overlap']:7.3f} | {row['diff_over_overlap']:7.1e} |")
     ratios = [r["vs_cmusen"] for r in rows if not math.isnan(r["vs_cmusen"])]
     if ratios:
         print(f"worst fibrelmp / cmusen per-contact ratio: {max(ratios):.2f}")

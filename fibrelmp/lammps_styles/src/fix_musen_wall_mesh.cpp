@@ -80,31 +80,63 @@ inline bool is_zero(const double *a)
   return a[0] == 0 && a[1] == 0 && a[2] == 0;
 }
 
-/* The contact of a sphere (centre p, radius r) with a triangle v (3 vertices, 9 values) of
-   unit normal n and bounding box lo/hi: MUSEN's IsSphereIntersectTriangle
-   (GeometricFunctions.h).  Returns the kind, the contact point in cp. */
-int sphere_triangle(const double *v, const double *n, const double *lo, const double *hi,
-                    const double *p, double r, double *cp)
+/* What sphere_triangle needs of a triangle v that depends on v alone and costs divisions or
+   products, computed once per placement of the triangle (the same operations as MUSEN's
+   IsSphereIntersectTriangle does per call, so the results are the same bits): the centre,
+   the dot products d00 d01 d11 of the edges e21 e31, 1 / (d00 d11 - d01^2) and the squared
+   lengths of e21 e32 e13.  The edges themselves are recomputed (subtractions: cheaper than
+   reading them from memory for large meshes). */
+constexpr int NPRE = 10;
+enum { P_CENTRE = 0, P_D00 = 3, P_D01 = 4, P_D11 = 5, P_INV_DENOM = 6, P_L21 = 7, P_L32 = 8,
+       P_L13 = 9 };
+inline void triangle_edges(const double *v, double *e21, double *e31, double *e32, double *e13)
 {
-  if (p[0] <= lo[0] - r || p[1] <= lo[1] - r || p[2] <= lo[2] - r || p[0] >= hi[0] + r ||
-      p[1] >= hi[1] + r || p[2] >= hi[2] + r)
-    return FixMusenWallMesh::NO_CONTACT;
   const double *v1 = v, *v2 = v + 3, *v3 = v + 6;
-  double centre[3], d[3];
-  for (int k = 0; k < 3; k++) centre[k] = (v1[k] + v2[k] + v3[k]) / 3.0;
-  for (int k = 0; k < 3; k++) d[k] = p[k] - centre[k];
-  const double ppd = dot(d, n);
-  if (std::fabs(ppd) >= r) return FixMusenWallMesh::NO_CONTACT;
-  double A[3], e21[3], e31[3], W[3];
-  for (int k = 0; k < 3; k++) A[k] = p[k] - n[k] * ppd;
   for (int k = 0; k < 3; k++) {
     e21[k] = v2[k] - v1[k];
     e31[k] = v3[k] - v1[k];
-    W[k] = A[k] - v1[k];
+    e32[k] = v3[k] - v2[k];
+    e13[k] = v1[k] - v3[k];
   }
-  const double d00 = dot(e21, e21), d01 = dot(e21, e31), d11 = dot(e31, e31);
+}
+void triangle_constants(const double *v, double *pre)
+{
+  const double *v1 = v, *v2 = v + 3, *v3 = v + 6;
+  for (int k = 0; k < 3; k++) pre[P_CENTRE + k] = (v1[k] + v2[k] + v3[k]) / 3.0;
+  double e21[3], e31[3], e32[3], e13[3];
+  triangle_edges(v, e21, e31, e32, e13);
+  pre[P_D00] = dot(e21, e21);
+  pre[P_D01] = dot(e21, e31);
+  pre[P_D11] = dot(e31, e31);
+  pre[P_INV_DENOM] = 1.0 / (pre[P_D00] * pre[P_D11] - pre[P_D01] * pre[P_D01]);
+  pre[P_L21] = sqlen(e21);
+  pre[P_L32] = sqlen(e32);
+  pre[P_L13] = sqlen(e13);
+}
+
+inline bool outside_bounds(const double *lo, const double *hi, const double *p, double r)
+{
+  return p[0] <= lo[0] - r || p[1] <= lo[1] - r || p[2] <= lo[2] - r || p[0] >= hi[0] + r ||
+      p[1] >= hi[1] + r || p[2] >= hi[2] + r;
+}
+
+int sphere_triangle(const double *v, const double *n, const double *lo, const double *hi,
+                    const double *pre, const double *p, double r, double *cp)
+{
+  if (outside_bounds(lo, hi, p, r)) return FixMusenWallMesh::NO_CONTACT;
+  const double *v1 = v, *v2 = v + 3, *v3 = v + 6;
+  const double *centre = pre + P_CENTRE;
+  double d[3];
+  for (int k = 0; k < 3; k++) d[k] = p[k] - centre[k];
+  const double ppd = dot(d, n);
+  if (std::fabs(ppd) >= r) return FixMusenWallMesh::NO_CONTACT;
+  double A[3], W[3], e21[3], e31[3], e32[3], e13[3];
+  for (int k = 0; k < 3; k++) A[k] = p[k] - n[k] * ppd;
+  triangle_edges(v, e21, e31, e32, e13);
+  for (int k = 0; k < 3; k++) W[k] = A[k] - v1[k];
+  const double d00 = pre[P_D00], d01 = pre[P_D01], d11 = pre[P_D11];
   const double d20 = dot(W, e21), d21 = dot(W, e31);
-  const double inv_denom = 1.0 / (d00 * d11 - d01 * d01);
+  const double inv_denom = pre[P_INV_DENOM];
   const double gamma = (d11 * d20 - d01 * d21) * inv_denom;
   const double betta = (d00 * d21 - d01 * d20) * inv_denom;
   const double alpha = 1.0 - gamma - betta;
@@ -113,17 +145,13 @@ int sphere_triangle(const double *v, const double *n, const double *lo, const do
     return FixMusenWallMesh::FACE_CONTACT;
   }
   // projection outside the triangle: nearest of the closest points on the three edges
-  double e32[3], e13[3], t[3];
-  for (int k = 0; k < 3; k++) {
-    e32[k] = v3[k] - v2[k];
-    e13[k] = v1[k] - v3[k];
-  }
+  double t[3];
   for (int k = 0; k < 3; k++) t[k] = A[k] - v1[k];
-  const double lc1 = std::min(std::max(dot(t, e21) / sqlen(e21), 0.), 1.);
+  const double lc1 = std::min(std::max(dot(t, e21) / pre[P_L21], 0.), 1.);
   for (int k = 0; k < 3; k++) t[k] = A[k] - v2[k];
-  const double lc2 = std::min(std::max(dot(t, e32) / sqlen(e32), 0.), 1.);
+  const double lc2 = std::min(std::max(dot(t, e32) / pre[P_L32], 0.), 1.);
   for (int k = 0; k < 3; k++) t[k] = A[k] - v3[k];
-  const double lc3 = std::min(std::max(dot(t, e13) / sqlen(e13), 0.), 1.);
+  const double lc3 = std::min(std::max(dot(t, e13) / pre[P_L13], 0.), 1.);
   double C1[3], C2[3], C3[3], q[3];
   for (int k = 0; k < 3; k++) {
     C1[k] = v1[k] + lc1 * e21[k];
@@ -486,6 +514,9 @@ void FixMusenWallMesh::parse(const std::string &text)
     for (int k = 0; k < 3; k++) nrm[3 * (size_t) t + k] = c[k] / len;
     face_bounds(v, &tlo[3 * (size_t) t], &thi[3 * (size_t) t]);
   }
+  tpre.assign(NPRE * (size_t) ntri, 0.0);
+  tpre_stamp.assign(ntri, -1);
+  tpre_epoch = 0;
   ftri.assign(3 * (size_t) ntri, 0.0);
   ftri_all.assign(3 * (size_t) ntri, 0.0);
   fgeom_all.assign(3 * (size_t) ngeom, 0.0);
@@ -831,6 +862,15 @@ void FixMusenWallMesh::build_grid(double rmax)
 
 /* ---------------------------------------------------------------------- */
 
+const double *FixMusenWallMesh::constants_of(int tr)
+{
+  if (tpre_stamp[tr] != tpre_epoch) {
+    triangle_constants(&vert[9 * (size_t) tr], &tpre[NPRE * (size_t) tr]);
+    tpre_stamp[tr] = tpre_epoch;
+  }
+  return &tpre[NPRE * (size_t) tr];
+}
+
 void FixMusenWallMesh::post_force(int /*vflag*/)
 {
   // a time step first moves the stepped geometries by the previous step's wall forces
@@ -843,8 +883,13 @@ void FixMusenWallMesh::post_force(int /*vflag*/)
   }
   at_start = false;
   const double t = current_time();
-  if (any_moving || !placed) place(t);
+  const bool placing = any_moving || !placed;
+  if (placing) place(t);
   motion_state(t);
+  // triangles just placed, or moved step by step (or restored), need their constants anew
+  // (computed when first tested: a large moving mesh pays only for triangles near spheres);
+  // a static mesh keeps the ones of its first placement
+  if (placing || any_stepped) tpre_epoch++;
 
   double **x = atom->x, **f = atom->f, **torque = atom->torque;
   double *radius = atom->radius;
@@ -896,7 +941,10 @@ void FixMusenWallMesh::post_force(int /*vflag*/)
       if (cd.shift) shift_vector(cd.shift, s);
       for (int k = 0; k < 3; k++) cd.xs[k] = x[i][k] - s[k];
       const size_t tr = cd.tri;
-      cd.kind = sphere_triangle(&vert[9 * tr], &nrm[3 * tr], &tlo[3 * tr], &thi[3 * tr], cd.xs, r, cd.cp);
+      // the bounding box first: most candidates end there, before their constants are read
+      if (outside_bounds(&tlo[3 * tr], &thi[3 * tr], cd.xs, r)) continue;
+      cd.kind = sphere_triangle(&vert[9 * tr], &nrm[3 * tr], &tlo[3 * tr], &thi[3 * tr],
+                                constants_of(cd.tri), cd.xs, r, cd.cp);
       if (cd.kind != NO_CONTACT) cand.push_back(cd);
     }
     const int nc = static_cast<int>(cand.size());
@@ -1205,7 +1253,8 @@ void FixMusenWallMesh::restart(char *buf)
 
 double FixMusenWallMesh::memory_usage()
 {
-  double bytes = sizeof(double) * (x0.size() + vert.size() + nrm.size() + tlo.size() + thi.size() +
+  double bytes = sizeof(double) * (x0.size() + vert.size() + nrm.size() + tlo.size() + thi.size() + tpre.size() +
+                                   tpre_stamp.size() +
                                    ftri.size() + ftri_all.size() + grid_vert.size());
   bytes += sizeof(int) * (cell_start.size() + cell_entries.size() + all_entries.size() + adj.size());
   return bytes;

@@ -180,6 +180,10 @@ class FixMusenWallMesh : public Fix {
   std::vector<double> vert;     // 9 per triangle, now
   std::vector<double> nrm;      // 3 per triangle (unit normal (v2-v1)x(v3-v1))
   std::vector<double> tlo, thi; // bounding boxes now
+  std::vector<double> tpre;     // per triangle, what sphere_triangle needs of it alone,
+  std::vector<long> tpre_stamp; // valid when its stamp is tpre_epoch (bumped when walls move)
+  long tpre_epoch = 0;
+  const double *constants_of(int tr);
   std::vector<int> tgeom, tmat;
   std::vector<Geometry> geoms;
   std::vector<int> adj_start, adj;    // triangles sharing a vertex, same geometry (CSR)

@@ -61,34 +61,15 @@ double *FixMusenHistory::values(int i, int s)
   return data[i] + s * stride() + 2;
 }
 
-double *FixMusenHistory::find(int i, tagint k)
+double *FixMusenHistory::insert(int i, double kd)
 {
   const int st = stride();
-  double *d = data[i];
-  const double kd = static_cast<double>(k);
-  for (int s = 0; s < num[i]; s++)
-    if (d[s * st] == kd) return d + s * st + 2;
-  return nullptr;
-}
-
-double *FixMusenHistory::get(int i, tagint k, bool *fresh)
-{
-  const int st = stride();
-  const double kd = static_cast<double>(k);
-  double *d = data[i];
-  for (int s = 0; s < num[i]; s++)
-    if (d[s * st] == kd) {
-      d[s * st + 1] = 1.0;
-      if (fresh) *fresh = false;
-      return d + s * st + 2;
-    }
   reserve(i, num[i] + 1);
   double *e = data[i] + num[i] * st;
   e[0] = kd;
   e[1] = 1.0;
   std::fill(e + 2, e + st, 0.0);
   num[i]++;
-  if (fresh) *fresh = true;
   return e + 2;
 }
 

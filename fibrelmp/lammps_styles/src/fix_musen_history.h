@@ -37,9 +37,31 @@ class FixMusenHistory : public Fix {
   int count(int i) const { return num[i]; }                    // entries of atom i
   tagint key(int i, int s) const;                              // key of entry s (0 <= s < count)
   double *values(int i, int s);                                // its nvalues doubles
-  double *find(int i, tagint key);                             // values, or nullptr
+  // (find and get are inline: the pair and wall styles call them for every contact and step)
+  double *find(int i, tagint key)                              // values, or nullptr
+  {
+    const int st = stride();
+    double *d = data[i];
+    const double kd = static_cast<double>(key);
+    for (int s = 0; s < num[i]; s++)
+      if (d[s * st] == kd) return d + s * st + 2;
+    return nullptr;
+  }
   // values of key (inserted with zeros if absent; *fresh tells); marks the entry touched
-  double *get(int i, tagint key, bool *fresh = nullptr);
+  double *get(int i, tagint key, bool *fresh = nullptr)
+  {
+    const int st = stride();
+    double *d = data[i];
+    const double kd = static_cast<double>(key);
+    for (int s = 0; s < num[i]; s++)
+      if (d[s * st] == kd) {
+        d[s * st + 1] = 1.0;
+        if (fresh) *fresh = false;
+        return d + s * st + 2;
+      }
+    if (fresh) *fresh = true;
+    return insert(i, kd);
+  }
   void erase(int i, tagint key);                               // no-op if absent
   // drop every entry not touched (by get) since the last sweep, clear the marks (atoms < n)
   void sweep(int n);
@@ -66,6 +88,7 @@ class FixMusenHistory : public Fix {
   double **data;        // per atom: cap entries of (key, mark, values...), grown per atom
   int stride() const { return nval + 2; }
   void reserve(int i, int n);
+  double *insert(int i, double key);    // a new touched entry of zeros (get's miss)
 };
 
 }    // namespace LAMMPS_NS

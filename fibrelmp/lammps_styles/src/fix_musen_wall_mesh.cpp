@@ -907,6 +907,11 @@ void FixMusenWallMesh::post_force(int /*vflag*/)
   // time steps and MUSEN's two evaluations at t = 0 (musen_startup.h) advance the contacts;
   // other set-ups (run, run 0) leave them as they were
   const bool commit = musen_startup::advances(update);
+  if (heat_fix) {
+    int dim, flag, cols;
+    heat_flux = static_cast<double *>(heat_fix->extract("flux", dim));
+    heat_temperature = atom->dvector[atom->find_custom("musen_temperature", flag, cols)];
+  }
 
   for (int i = 0; i < nlocal; i++) {
     if (!(mask[i] & groupbit)) continue;
@@ -1137,11 +1142,9 @@ void FixMusenWallMesh::wall_force(int i, const Candidate &cd, double *hist, doub
   }
   // heat laws (ConsolidatePart: HeatFlux += the contact's), in the laws' order
   if (heat_fix) {
-    int dim, flag, cols;
-    double *flux = static_cast<double *>(heat_fix->extract("flux", dim));
-    c.temperature = atom->dvector[atom->find_custom("musen_temperature", flag, cols)][i];
+    c.temperature = heat_temperature[i];
     for (const auto &law : pw_laws)
-      if (law->heats()) flux[i] += law->heat(c);
+      if (law->heats()) heat_flux[i] += law->heat(c);
   }
 }
 

@@ -163,6 +163,9 @@ class FixMusenWallMesh : public Fix {
   // the particle-wall laws, in the order they act (musen_pw_law.h)
   std::vector<std::unique_ptr<musen_pw::Law>> pw_laws;
   class Fix *heat_fix = nullptr;    // fix musen/heat when a law heats (init)
+  // with heat_fix, this post_force's heat flux and temperatures (looked up once per call, not
+  // per contact: both lookups search by name)
+  double *heat_flux = nullptr, *heat_temperature = nullptr;
   struct Law {
     bool set;
     double estar, gstar, alpha, mu, mur;

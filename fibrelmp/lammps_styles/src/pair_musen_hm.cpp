@@ -133,6 +133,11 @@ void PairMusenHM::compute(int eflag, int vflag)
     const musen_pp::HertzMindlin &law = *only_hertz;
     contacts<false>([&law](const musen_pp::Contact &c, const musen_pp::Materials &m, double *xi,
                     musen_pp::Result &r) { law.calculate_pp(c, m, xi, r); });
+  } else if (law_block.empty() && laws.size() == 1) {
+    // one law: its force directly (no loop over the laws, no second result to add)
+    const musen_pp::Law &law = *laws[0];
+    contacts<false>([&law](const musen_pp::Contact &c, const musen_pp::Materials &m, double *xi,
+                           musen_pp::Result &r) { law.force(c, m, xi, r); });
   } else if (law_block.empty()) {
     contacts<false>([this](const musen_pp::Contact &c, const musen_pp::Materials &m, double *xi,
                            musen_pp::Result &r) { apply_laws(c, m, xi, r); });
@@ -152,6 +157,36 @@ void PairMusenHM::apply_laws(const musen_pp::Contact &c, const musen_pp::Materia
     laws[l]->force(c, m, xi, more);
     add_result(r, more);
   }
+}
+
+// inline in contacts(): called for every contact of every step
+[[gnu::always_inline]] inline void PairMusenHM::kinematics(int i, int j, const double cv[3], double n[3], double &cvlen,
+                             double &vn, double vt[3]) const
+{
+  double **v = atom->v;
+  double **omega = atom->omega;
+  const double r1 = atom->radius[i], r2 = atom->radius[j];
+  const double *w1 = omega[i], *w2 = omega[j];
+  const double s1 = r1 / (r1 + r2);
+  const double s2 = -r2 / (r1 + r2);
+  const double rc1[3] = {cv[0] * s1, cv[1] * s1, cv[2] * s1};
+  const double rc2[3] = {cv[0] * s2, cv[1] * s2, cv[2] * s2};
+  n[0] = n[1] = n[2] = 0.0;
+  cvlen = length(cv);
+  if (cvlen != 0) {
+    n[0] = cv[0] / cvlen;
+    n[1] = cv[1] / cvlen;
+    n[2] = cv[2] / cvlen;
+  }
+
+  // normal and tangential relative velocity (dst minus src at the contact point)
+  double w2rc2[3], w1rc1[3];
+  cross(w2, rc2, w2rc2);
+  cross(w1, rc1, w1rc1);
+  double rel[3];
+  for (int k = 0; k < 3; k++) rel[k] = (v[j][k] + w2rc2[k]) - (v[i][k] + w1rc1[k]);
+  vn = n[0] * rel[0] + n[1] * rel[1] + n[2] * rel[2];
+  for (int k = 0; k < 3; k++) vt[k] = rel[k] - vn * n[k];
 }
 
 template <bool LAW_VALUES, class Laws> void PairMusenHM::contacts(Laws apply)
@@ -531,35 +566,6 @@ double PairMusenHM::init_one(int i, int j)
   mu[j][i] = mu[i][j];
   mu_roll[j][i] = mu_roll[i][j];
   return maxrad[i] + maxrad[j];
-}
-
-void PairMusenHM::kinematics(int i, int j, const double cv[3], double n[3], double &cvlen,
-                             double &vn, double vt[3]) const
-{
-  double **v = atom->v;
-  double **omega = atom->omega;
-  const double r1 = atom->radius[i], r2 = atom->radius[j];
-  const double *w1 = omega[i], *w2 = omega[j];
-  const double s1 = r1 / (r1 + r2);
-  const double s2 = -r2 / (r1 + r2);
-  const double rc1[3] = {cv[0] * s1, cv[1] * s1, cv[2] * s1};
-  const double rc2[3] = {cv[0] * s2, cv[1] * s2, cv[2] * s2};
-  n[0] = n[1] = n[2] = 0.0;
-  cvlen = length(cv);
-  if (cvlen != 0) {
-    n[0] = cv[0] / cvlen;
-    n[1] = cv[1] / cvlen;
-    n[2] = cv[2] / cvlen;
-  }
-
-  // normal and tangential relative velocity (dst minus src at the contact point)
-  double w2rc2[3], w1rc1[3];
-  cross(w2, rc2, w2rc2);
-  cross(w1, rc1, w1rc1);
-  double rel[3];
-  for (int k = 0; k < 3; k++) rel[k] = (v[j][k] + w2rc2[k]) - (v[i][k] + w1rc1[k]);
-  vn = n[0] * rel[0] + n[1] * rel[1] + n[2] * rel[2];
-  for (int k = 0; k < 3; k++) vt[k] = rel[k] - vn * n[k];
 }
 
 /* ----------------------------------------------------------------------

@@ -106,7 +106,7 @@ class PairMusenHM : public Pair {
 
   // the contact's geometry for the laws, spheres i (src) and j (dst), cv = x_j - x_i: the unit
   // normal n (zero with cv), |cv|, and the normal and tangential relative velocity there
-  void kinematics(int i, int j, const double cv[3], double n[3], double &cvlen, double &vn,
+  inline void kinematics(int i, int j, const double cv[3], double n[3], double &cvlen, double &vn,
                   double vt[3]) const;
   void allocate();
 };

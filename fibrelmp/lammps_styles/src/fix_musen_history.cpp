@@ -51,16 +51,6 @@ int FixMusenHistory::setmask()
 
 /* ---------------------------------------------------------------------- */
 
-tagint FixMusenHistory::key(int i, int s) const
-{
-  return static_cast<tagint>(data[i][s * stride()]);
-}
-
-double *FixMusenHistory::values(int i, int s)
-{
-  return data[i] + s * stride() + 2;
-}
-
 double *FixMusenHistory::insert(int i, double kd)
 {
   const int st = stride();

@@ -35,8 +35,8 @@ class FixMusenHistory : public Fix {
   // ---- what the owning style uses (i: a local atom index < atom->nlocal)
   int nvalues() const { return nval; }
   int count(int i) const { return num[i]; }                    // entries of atom i
-  tagint key(int i, int s) const;                              // key of entry s (0 <= s < count)
-  double *values(int i, int s);                                // its nvalues doubles
+  tagint key(int i, int s) const { return static_cast<tagint>(data[i][s * stride()]); }    // entry s's (0 <= s < count)
+  double *values(int i, int s) { return data[i] + s * stride() + 2; }    // its nvalues doubles
   // (find and get are inline: the pair and wall styles call them for every contact and step)
   double *find(int i, tagint key)                              // values, or nullptr
   {

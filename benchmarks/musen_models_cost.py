@@ -388,8 +388,15 @@ def run_fibrelmp(case: Case) -> tuple[float, float]:
     log = (folder / "log.lammps").read_text()
     loops = [float(t) for t in re.findall(r"Loop time of ([0-9.eE+-]+)", log)]
     if case.family == "PP" and case.contacts:
-        counts = {int(line.split()[-1]) for line in log.splitlines()
-                  if re.match(r"\s+\d+\s+[0-9.e+-]+\s+\d+\s", line)}
+        # the thermo column named Contacts (a heat model adds temperature columns after it)
+        counts: set[int] = set()
+        column = None
+        for line in log.splitlines():
+            words = line.split()
+            if words[:1] == ["Step"] and "Contacts" in words:
+                column = words.index("Contacts")
+            elif column is not None and re.match(r"\s+\d+\s+[0-9.e+-]+\s+\d+\s", line):
+                counts.add(int(float(words[column])))
         if counts != {case.contacts}:
             raise RuntimeError(f"{case.name}: LAMMPS's contact count went {sorted(counts)}, not {case.contacts}")
     return cpu, sum(loops)

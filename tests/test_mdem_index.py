@@ -83,6 +83,15 @@ def _descriptor(**fields) -> bytes:
     return d.SerializeToString()
 
 
+def _varint(n: int) -> bytes:
+    out = bytearray()
+    while n >= 0x80:
+        out.append(n & 0x7F | 0x80)
+        n >>= 7
+    out.append(n)
+    return bytes(out)
+
+
 def _field(number: int, payload: bytes) -> bytes:
     head, n = bytearray([number << 3 | 2]), len(payload)
     while n >= 0x80:
@@ -120,7 +129,8 @@ def test_descriptor_scan_edge_cases_match_protobuf():
     for odd in (_field(3, d1 + b"\x30\x01"),                 # field 6 in a descriptor
                 _field(3, b"\x09\x01"),                      # start_time cut short
                 b"\x19" + bytes(8),                          # field 3 as a double
-                head[:-1]):                                  # the message cut short
+                head[:-1],                                   # the message cut short
+                _varint(((1 << 32) + 3) << 3 | 2) + _field(3, d1)[1:]):   # field 2^32+3: no protobuf field
         assert fast.mdem_blocks(odd, 10) is None
 
 

@@ -323,6 +323,9 @@ def test_hostile_database_is_refused_without_allocating(tmp_path):
         fh.truncate(agglomerates.MAX_BYTES + 1)
     with pytest.raises(InputError, match="more than fibrelmp reads"):
         read_database(big)
+    # a device reports size 0 and never ends: refused before reading
+    with pytest.raises(InputError, match="not a regular file"):
+        read_database(Path("/dev/zero"))
 
 
 def test_scene_run_without_a_job_names_the_missing_database(tmp_path):
@@ -606,3 +609,18 @@ def test_cmusens_random_numbers_continue_through_a_checkpoint(tmp_path, monkeypa
         shutil.copy(DATA / name, cut)
     run_cut_and_resumed(monkeypatch, cut / "job_agglo.txt", cut / "work", 2400)
     assert (cut / "agglo_result_prec17.txt").read_bytes() == (whole / "agglo_result_prec17.txt").read_bytes()
+
+
+def test_scaling_that_overflows_is_refused(tmp_path):
+    """Finite database values scaled by the generator's factor (the rods' 1.25) past the
+    largest double are refused by name, not handed to the fix as inf."""
+    from fibrelmp.translate.musen.mdem.agglomerates import write_database
+    from fibrelmp.translate.musen.script_input import plan_musen_script
+
+    job = _job(tmp_path)
+    write_database(tmp_path / "agglomerates.madb", [
+        dict(key="AGGTRI", name="t", particles=[(0, 0, 0, 1e-4, "Part")], bonds=[]),
+        dict(key="AGGROD", name="r", particles=[(-1.7e308, 0, 0, 1e-4, "Part"), (1.7e308, 0, 0, 1e-4, "Part")],
+             bonds=[])])
+    with pytest.raises(InputError, match="not finite"):
+        plan_musen_script(job)

@@ -711,6 +711,7 @@ int fp_mdem_decode(const unsigned char *buf, int64_t len, double *time, double *
     while (p < end) {
         uint64_t tag, m;
         if (pb_varint(&p, end, &tag)) return -1;
+        if (tag > 0xFFFFFFFFu || (tag >> 3) > 0x1FFFFFFFu) return -1;   /* not a protobuf field */
         int f = (int)(tag >> 3), wt = (int)(tag & 7);
         if (f == 1 && wt == 1) {
             if (end - p < 8) return -1;
@@ -899,6 +900,7 @@ int64_t fp_mdem_blocks(const unsigned char *buf, int64_t len, double *start, int
         const unsigned char *rec = p;
         uint64_t tag, size;
         if (pb_varint(&p, end, &tag)) return -1;
+        if (tag > 0xFFFFFFFFu || (tag >> 3) > 0x1FFFFFFFu) return -1;   /* not a protobuf field */
         int f = (int)(tag >> 3), wt = (int)(tag & 7);
         if (f == 0) return -1;
         if (f != 3) {

@@ -503,7 +503,7 @@ void FixMusenInlet::insert_agglomerates(const Event &event)
       double c[3], q[4], R[3][3];
       double u1, u2, u3;
       if (crand) {    // CreateRandomPoint, then CQuaternion::Random, as cmusen computes them
-        for (int k = 0; k < 3; k++) c[k] = lo[k] + static_cast<double>(crand->next() + 1) * (hi[k] - lo[k]) / GLIBC_RAND_MAX;
+        for (int k = 0; k < 3; k++) c[k] = lo[k] + (static_cast<double>(crand->next()) + 1.0) * (hi[k] - lo[k]) / GLIBC_RAND_MAX;
         u1 = crand->next() / GLIBC_RAND_MAX;
         u2 = crand->next() / GLIBC_RAND_MAX;
         u3 = crand->next() / GLIBC_RAND_MAX;
@@ -720,8 +720,10 @@ double FixMusenInlet::compute_scalar()
 void FixMusenInlet::write_restart(FILE *fp)
 {
   if (comm->me != 0) return;
+  // the 4th word says how many rand() stream words follow, so that a restart never reads
+  // words that were not written
   std::vector<double> list{static_cast<double>(made.size()), static_cast<double>(inserted),
-                           static_cast<double>(last_id)};
+                           static_cast<double>(last_id), musen_rand ? 35.0 : 0.0};
   for (int m : made) list.push_back(m);
   if (musen_rand) {    // the rand() stream: 34 words and the count (exact in doubles)
     for (std::uint32_t w : glibc.r) list.push_back(static_cast<double>(w));
@@ -738,11 +740,14 @@ void FixMusenInlet::restart(char *buf)
   if (static_cast<size_t>(list[0]) != made.size())
     error->all(FLERR, "Fix musen/inlet: the restart file has {} fractions, the command {}",
                static_cast<int>(list[0]), made.size());
+  if ((list[3] == 35.0) != static_cast<bool>(musen_rand))
+    error->all(FLERR, "Fix musen/inlet: the restart file was written {} musen_rand, the command "
+               "is {} it", list[3] == 35.0 ? "with" : "without", musen_rand ? "with" : "without");
   inserted = static_cast<bigint>(list[1]);
   last_id = static_cast<tagint>(list[2]);
-  for (size_t i = 0; i < made.size(); i++) made[i] = static_cast<int>(list[3 + i]);
+  for (size_t i = 0; i < made.size(); i++) made[i] = static_cast<int>(list[4 + i]);
   if (musen_rand) {
-    const double *w = list + 3 + made.size();
+    const double *w = list + 4 + made.size();
     for (int k = 0; k < 34; k++) glibc.r[k] = static_cast<std::uint32_t>(w[k]);
     glibc.n = static_cast<std::uint64_t>(w[34]);
   }

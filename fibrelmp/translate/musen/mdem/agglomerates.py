@@ -20,6 +20,7 @@ parser allocate more than about 1 M messages (~160 MB).
 from __future__ import annotations
 
 import math
+import stat
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -61,13 +62,17 @@ def read_database(path: Path, where: Path | None = None, line: int | None = None
 
     src = where or path
     try:
-        size = path.stat().st_size
+        info = path.stat()
+        # a device or FIFO reports size 0 and may never end: only regular files, read bounded
+        if not stat.S_ISREG(info.st_mode):
+            raise InputError(src, line, f"agglomerates database {str(path)!r} is not a regular file")
+        with path.open("rb") as f:
+            data = f.read(MAX_BYTES + 1)
     except OSError as exc:
         raise InputError(src, line, f"agglomerates database {str(path)!r}: {exc.strerror}") from None
-    if size > MAX_BYTES:
-        raise InputError(src, line, f"agglomerates database {str(path)!r} has {size} bytes, more "
-                         f"than fibrelmp reads ({MAX_BYTES})")
-    data = path.read_bytes()[:MAX_BYTES]
+    if len(data) > MAX_BYTES:
+        raise InputError(src, line, f"agglomerates database {str(path)!r} has more than "
+                         f"{MAX_BYTES} bytes, more than fibrelmp reads")
     try:
         bounds.count_messages(data, "ProtoAgglomeratesDB", len(data) // BYTES_PER_MESSAGE + MESSAGES_SLACK)
         db = new("ProtoAgglomeratesDB", data)

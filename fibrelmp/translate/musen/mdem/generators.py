@@ -406,6 +406,10 @@ def attach_agglomerates(inlets: list[Inlet], db_path: Path | None, materials: di
         if not (agg.bond_radius > 0).all():
             raise bad("bond radii must be > 0")
         coords, radius, diameter = prepared_agglomerate(agg, g.scaling_factor)
+        # a large scaling factor can overflow finite database values
+        if not (np.isfinite(coords).all() and np.isfinite(radius).all() and np.isfinite(diameter).all()):
+            raise bad(f"scaling by {g.scaling_factor!r} gives coordinates or radii that are not "
+                      "finite numbers")
         out.append(replace(inlet, agglomerate=InletAgglomerate(
             agg.key, coords, radius, part_keys, pairs.copy(), diameter, bond_keys)))
     return out

@@ -410,14 +410,9 @@ bool FixMusenInlet::sphere_fits(const Sphere &s, const std::vector<Sphere> &near
   return placed;
 }
 
-void FixMusenInlet::insert(const Event &event)
+/* the triangles of fix musen/wall/mesh that can touch a sphere inside the box */
+static std::vector<int> close_triangles(const std::vector<double> &tri, const double *lo, const double *hi)
 {
-  double rmax = 0.0;
-  for (int i = 0; i < atom->nlocal; i++) rmax = std::max(rmax, atom->radius[i]);
-  MPI_Allreduce(MPI_IN_PLACE, &rmax, 1, MPI_DOUBLE, MPI_MAX, world);
-  std::vector<Sphere> near = spheres_near(rmax);
-  const std::vector<double> tri = wall_triangles();
-  // the triangles that can touch a sphere inside the box
   std::vector<int> close;
   for (size_t t = 0; t < tri.size() / 9; t++) {
     bool apart = false;
@@ -428,6 +423,17 @@ void FixMusenInlet::insert(const Event &event)
     }
     if (!apart) close.push_back(static_cast<int>(t));
   }
+  return close;
+}
+
+void FixMusenInlet::insert(const Event &event)
+{
+  double rmax = 0.0;
+  for (int i = 0; i < atom->nlocal; i++) rmax = std::max(rmax, atom->radius[i]);
+  MPI_Allreduce(MPI_IN_PLACE, &rmax, 1, MPI_DOUBLE, MPI_MAX, world);
+  std::vector<Sphere> near = spheres_near(rmax);
+  const std::vector<double> tri = wall_triangles();
+  const std::vector<int> close = close_triangles(tri, lo, hi);
   Stream rng{seed * 0x9E3779B97F4A7C15ULL ^ static_cast<std::uint64_t>(event.step)};
   std::vector<Sphere> created;
   std::vector<int> types;
@@ -458,22 +464,6 @@ void FixMusenInlet::insert(const Event &event)
     vel.insert(vel.end(), {u[0], u[1], u[2]});
   }
   if (!created.empty()) create(created, types, vel);
-}
-
-/* the triangles of fix musen/wall/mesh that can touch a sphere inside the box */
-static std::vector<int> close_triangles(const std::vector<double> &tri, const double *lo, const double *hi)
-{
-  std::vector<int> close;
-  for (size_t t = 0; t < tri.size() / 9; t++) {
-    bool apart = false;
-    for (int k = 0; k < 3 && !apart; k++) {
-      const double *v = &tri[9 * t];
-      const double tlo = std::min({v[k], v[3 + k], v[6 + k]}), thi = std::max({v[k], v[3 + k], v[6 + k]});
-      apart = thi < lo[k] || tlo > hi[k];
-    }
-    if (!apart) close.push_back(static_cast<int>(t));
-  }
-  return close;
 }
 
 /* MUSEN's generator of agglomerates (CObjectsGenerator::Generate, GenerateNewObject) */

@@ -24,6 +24,10 @@ import numpy as np
 from fibrelmp.particles import ModelCounts, ParticleModel, ParticleView, TimeScale
 from fibrelmp.sanity import hertz_contact_time, pair_speed, speed_bounds
 
+# objects all dynamic generators of one run may ask for: fibrelmp reserves a LAMMPS atom (and
+# its rows) for each before the run, so a hostile rate cannot make it allocate gigabytes
+MAX_GENERATED = 10_000_000
+
 
 @dataclass
 class Material:
@@ -420,8 +424,10 @@ class GranularModel(ParticleModel):
             out["bonds"] = {"start": nbonds, "end": tally.get("bonds"),
                             "broken": line_count(job.breaks) if job.breaks is not None else 0}
         if tally.get("temperature"):
-            # a heat model: the spheres' temperatures at every frame this session saved
-            out["temperature"] = {"unit": "K", "frames": tally["temperature"]}
+            # a heat model: the spheres' temperatures at the frames this session saved (every
+            # `every`-th one and the last: a long run's summary stays small)
+            out["temperature"] = {"unit": "K", "every": tally.get("temperature_every", 1),
+                                  "frames": tally["temperature"]}
         return out
 
 

@@ -117,7 +117,7 @@ def locked(outputs: Outputs, force: bool, rank: int = 0) -> Iterator[Outputs]:
         return
     fds: list[int] = []
     created: list[Path] = []          # removed again when a later location fails
-    ready = False
+    succeeded = False
     try:
         for folder in outputs.folders():
             try:
@@ -143,15 +143,17 @@ def locked(outputs: Outputs, force: bool, rank: int = 0) -> Iterator[Outputs]:
             except OSError as exc:
                 raise InputError(folder, None, f"cannot write here: {exc.strerror or exc}") from None
         _remove_stale_temps(outputs)
-        ready = True
         # every result this run renames into place replaces its earlier file only for good
         # when the whole run succeeds: a failure puts the earlier set back (formatbase)
         with replacing(outputs.folders()):
             yield outputs
+        succeeded = True
     finally:
         for fd in fds:
             os.close(fd)          # closing releases the lock
-        if not ready:
+        # a failure removes the folders this run created while they are still empty (a run
+        # refused while translating leaves nothing; one that failed in LAMMPS keeps its log)
+        if not succeeded:
             for folder in sorted(set(created), key=lambda p: len(p.parts), reverse=True):
                 try:
                     folder.rmdir()

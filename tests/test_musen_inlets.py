@@ -315,6 +315,41 @@ def test_bad_settings_name_generator_and_field(change, message):
         gen.read_inlets(storage, SCENE)
 
 
+def _huge_rate(storage) -> None:
+    g = storage.modules_data.objects_generator.generators[0]
+    if g.version == 0:
+        g.generation_rate = 1e15
+    else:
+        g.rate_type, g.rate_value = gen.RATE_PER_SECOND, 1e15
+
+
+def test_a_hostile_rate_is_refused_before_anything_is_reserved(tmp_path):
+    """A rate asking for more objects than fibrelmp reserves room for (one atom each, before
+    the run) is refused by name, quickly, and nothing is written."""
+    import resource
+    import time
+
+    scene = tmp_path / "inlet_scene.mdem"
+    with MdemFile(SCENE) as f:
+        storage = f.storage
+        points = list(f.time_points())
+    _huge_rate(storage)
+    with open(scene, "wb") as fh:
+        writer = MdemWriter(fh)
+        for t, values, masks in points:
+            writer.add(t, values, masks)
+        writer.finish(storage)
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    start = time.monotonic()
+    with pytest.raises(InputError) as err:
+        python_api.run(scene)
+    assert str(err.value).startswith(f"{scene}: the dynamic generators ask for "), str(err.value)
+    assert f"limit of {gen.MAX_GENERATED:,}" in str(err.value)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["inlet_scene.mdem"]
+    assert time.monotonic() - start < 60          # no hang: the schedule stops at the limit
+    assert resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before < 500_000    # kB
+
+
 def test_inactive_generators_are_no_obstacle():
     storage = _storage()
     for g in storage.modules_data.objects_generator.generators:

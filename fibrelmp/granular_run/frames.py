@@ -112,8 +112,8 @@ class FrameBuilder:
             self.first_id = pair[:, 0]
         tri = model.triangles
         self.v0 = np.asarray(tri.vertices, float) if tri is not None and tri.count else None
-        # a heat model's spheres: {time, step, min, mean, max} of their temperature per frame
-        self.temperatures: list[dict] = []
+        # a heat model's spheres: {time, step, min, mean, max} of their temperature, thinned
+        self.temperatures = ThinnedSeries()
 
     def tally(self) -> dict:
         """Spheres and bonds as of the last frame read, for the run summary (fibrelmp.record):
@@ -126,8 +126,9 @@ class FrameBuilder:
         out = {"spheres": int(self.present.sum()), "activity_end": at_end, "generated": made,
                "left_domain": len(removed) - at_end,
                "bonds": int(self.bond_alive.sum()) if self.nb else 0}
-        if self.temperatures:
-            out["temperature"] = self.temperatures
+        if self.temperatures.count:
+            out["temperature"] = self.temperatures.entries()
+            out["temperature_every"] = self.temperatures.every
         return out
 
     def _bond_lookup(self, id1: np.ndarray, id2: np.ndarray) -> np.ndarray:
@@ -391,6 +392,34 @@ class FrameBuilder:
         for dump in (self.frames, self.bonds, self.tiles, self.mesh):
             if dump is not None:
                 dump.close()
+
+
+class ThinnedSeries:
+    """At most ``limit`` + 1 entries of a per-frame series, however many frames a run saves:
+    every frame while they fit, then every 2nd, 4th, ... frame (the stride doubles each time the
+    store fills, keeping frames 0, every, 2·every, ...), and always the last frame."""
+
+    def __init__(self, limit: int = 1024):
+        self.limit = limit
+        self.kept: list[dict] = []
+        self.last: dict | None = None
+        self.count = 0          # frames offered
+        self.every = 1          # the stride of the kept frames
+
+    def append(self, entry: dict) -> None:
+        if self.count % self.every == 0:
+            self.kept.append(entry)
+            if len(self.kept) > self.limit:
+                self.kept = self.kept[::2]
+                self.every *= 2
+        self.count += 1
+        self.last = entry
+
+    def entries(self) -> list[dict]:
+        """The kept entries, the last frame's included."""
+        if self.last is not None and (not self.kept or self.kept[-1] is not self.last):
+            return [*self.kept, self.last]
+        return list(self.kept)
 
 
 def _temperature_figures(t: float, step: int, temperature: np.ndarray) -> dict:

@@ -234,6 +234,7 @@ FixMusenInlet::FixMusenInlet(LAMMPS *lmp, int narg, char **arg) :
     if (e.step < 1 || (!events.empty() && e.step <= events.back().step))
       error->all(FLERR, "Fix musen/inlet: event steps must be >= 1 and ascending");
     events.push_back(e);
+    requested_before.push_back(i ? requested_before.back() + events[i - 1].count : 0);
   }
   while (at < narg) {
     need(at, 2, nullptr);
@@ -328,22 +329,21 @@ void FixMusenInlet::setup_pre_exchange()
 
 void FixMusenInlet::schedule_next()
 {
-  next_reneighbor = -1;
-  for (const Event &e : events)
-    if (e.step > update->ntimestep) {
-      next_reneighbor = e.step;
-      break;
-    }
+  // events ascend by step: a binary search (a long generation keeps ~1e5 events)
+  const auto later = std::upper_bound(events.begin(), events.end(), update->ntimestep,
+                                      [](bigint step, const Event &e) { return step < e.step; });
+  next_reneighbor = later == events.end() ? -1 : later->step;
 }
 
 void FixMusenInlet::pre_exchange()
 {
   if (next_reneighbor != update->ntimestep) return;
-  for (const Event &e : events)
-    if (e.step == update->ntimestep) {
-      if (parts.empty()) insert(e);
-      else insert_agglomerates(e);
-    }
+  const auto now = std::lower_bound(events.begin(), events.end(), update->ntimestep,
+                                    [](const Event &e, bigint step) { return e.step < step; });
+  if (now != events.end() && now->step == update->ntimestep) {
+    if (parts.empty()) insert(*now);
+    else insert_agglomerates(*now, requested_before[now - events.begin()]);
+  }
   schedule_next();
 }
 
@@ -467,7 +467,7 @@ void FixMusenInlet::insert(const Event &event)
 }
 
 /* MUSEN's generator of agglomerates (CObjectsGenerator::Generate, GenerateNewObject) */
-void FixMusenInlet::insert_agglomerates(const Event &event)
+void FixMusenInlet::insert_agglomerates(const Event &event, bigint slot)
 {
   double rmax = 0.0;
   for (int i = 0; i < atom->nlocal; i++) rmax = std::max(rmax, atom->radius[i]);
@@ -483,10 +483,8 @@ void FixMusenInlet::insert_agglomerates(const Event &event)
   std::vector<int> which;
   std::vector<double> vel;
   std::vector<tagint> tags;
-  // requested object j of this fix (over its events) has IDs first_id + j n + part, made or not
-  bigint slot = 0;
-  for (const Event &e : events)
-    if (e.step < event.step) slot += e.count;
+  // requested object j of this fix (over its events) has IDs first_id + j n + part, made or
+  // not; slot = the objects requested by this fix's earlier events
   for (int obj = 0; obj < event.count; obj++, slot++) {
     bool placed = false;
     for (int attempt = 0; attempt < tries && !placed; attempt++) {

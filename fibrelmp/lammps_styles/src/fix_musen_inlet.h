@@ -154,6 +154,7 @@ class FixMusenInlet : public Fix {
   int nslots = 0;
   std::vector<int> made;        // successes per fraction (MUSEN's generated mixture particles)
   std::vector<Event> events;
+  std::vector<bigint> requested_before;    // objects asked for by the events before each
   bigint inserted;
   tagint first_id, last_id;     // the ID floor; the last ID this fix gave (0: none)
   FILE *log;
@@ -166,7 +167,7 @@ class FixMusenInlet : public Fix {
   void insert(const Event &event);
   tagint create(const std::vector<Sphere> &made_now, const std::vector<int> &types,
                 const std::vector<double> &vel, const std::vector<tagint> *tags = nullptr);
-  void insert_agglomerates(const Event &event);
+  void insert_agglomerates(const Event &event, bigint slot);
   void add_bonds(const std::vector<Sphere> &made_now, const std::vector<tagint> &tags);
   bool sphere_fits(const Sphere &s, const std::vector<Sphere> &near, const std::vector<double> &tri,
                    const std::vector<int> &close) const;

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from fibrelmp.errors import InputError
-from fibrelmp.granmodel import GranularModel
+from fibrelmp.granmodel import MAX_GENERATED, GranularModel
 
 if TYPE_CHECKING:       # the type only: translate/ must not import the format homes
     from fibrelmp.translate.musen.mdem.generators import Inlet
@@ -36,10 +36,10 @@ def reserve_rows(model: GranularModel, requested: int) -> int:
     # until made, each row holds one of the kinds the generators make (the time-step checks
     # see every kind); the frames give each sphere its own (frames.py _generated)
     kinds = inlet_spheres(model)
-    pick = [kinds[k % len(kinds)] for k in range(n)]
-    sp.material = np.r_[sp.material, np.array([m for m, _, _ in pick], np.int64)].astype(sp.material.dtype)
+    pick = np.arange(n) % len(kinds)
+    sp.material = np.r_[sp.material, np.array([m for m, _, _ in kinds], np.int64)[pick]].astype(sp.material.dtype)
     for name, col in (("radius", 1), ("contact_radius", 1), ("mass", 2)):
-        setattr(sp, name, np.r_[getattr(sp, name), np.array([k[col] for k in pick], float)])
+        setattr(sp, name, np.r_[getattr(sp, name), np.array([k[col] for k in kinds], float)[pick]])
     for name in ("position", "velocity", "omega"):
         setattr(sp, name, np.r_[np.asarray(getattr(sp, name), float).reshape(-1, 3), np.zeros((n, 3))])
     sp.quaternion = np.r_[np.asarray(sp.quaternion, float).reshape(-1, 4), np.tile([1.0, 0, 0, 0], (n, 1))]
@@ -143,48 +143,56 @@ def reserve_agglomerate_rows(model: GranularModel, events: list) -> list[tuple[i
                          "interleave); keep one kind")
     sp = model.spheres
     requested = {k: sum(e.requested for e in events if e.generator == k) for k in range(len(plan.inlets))}
-    kinds, layout = [], []
+    n = sum(requested[k] * _agglomerate(model, g).spheres for k, g in enumerate(plan.inlets))
+    if n > MAX_GENERATED:
+        raise InputError(model.source, None, f"the generated agglomerates would hold {n:,} spheres, "
+                         f"more than fibrelmp's limit of {MAX_GENERATED:,} (it reserves room for each "
+                         "before the run): lower the generators' rates or shorten the run")
+    layout, part_mat, part_r, pair, bmat, bdiam = [], [], [], [], [], []
     bond_rows = 0 if model.bonds is None else model.bonds.count
     row = sp.count
-    pair, bmat, bdiam = [], [], []
     for k, inlet in enumerate(plan.inlets):
         agg = _agglomerate(model, inlet)
-        layout.append((k, row, bond_rows, requested[k], agg.spheres, agg.bonds))
-        parts = [(_material(model, key, inlet.generator.name), float(r)) for key, r in zip(agg.part_keys, agg.radius)]
-        bm = [_material(model, key, inlet.generator.name) for key in agg.bond_keys]
-        for j in range(requested[k]):
-            kinds += parts
-            base = row + j * agg.spheres
-            pair += [(base + int(a), base + int(b)) for a, b in agg.pairs]
-            bmat += bm
-            bdiam += list(agg.bond_diameter)
-        row += requested[k] * agg.spheres
-        bond_rows += requested[k] * agg.bonds
-    n, nb = len(kinds), len(pair)
+        count = requested[k]
+        layout.append((k, row, bond_rows, count, agg.spheres, agg.bonds))
+        # agglomerate j's parts are rows row + j n_k + p, its bonds the database's pairs shifted so
+        part_mat.append(np.tile([_material(model, key, inlet.generator.name) for key in agg.part_keys], count))
+        part_r.append(np.tile(np.asarray(agg.radius, float), count))
+        base = row + agg.spheres * np.arange(count, dtype=np.int64)
+        pair.append((base[:, None, None] + np.asarray(agg.pairs, np.int64)[None]).reshape(-1, 2))
+        bmat.append(np.tile([_material(model, key, inlet.generator.name) for key in agg.bond_keys], count))
+        bdiam.append(np.tile(np.asarray(agg.bond_diameter, float), count))
+        row += count * agg.spheres
+        bond_rows += count * agg.bonds
+    mats = np.concatenate(part_mat).astype(np.int64) if part_mat else np.zeros(0, np.int64)
+    r = np.concatenate(part_r) if part_r else np.zeros(0)
+    pair = np.concatenate(pair) if pair else np.zeros((0, 2), np.int64)
+    bmat = np.concatenate(bmat).astype(np.int64) if bmat else np.zeros(0, np.int64)
+    bdiam = np.concatenate(bdiam) if bdiam else np.zeros(0)
+    nb = len(pair)
     # the other objects' largest id: placeholder ids after it (frames.py gives MUSEN's)
     others = [sp.ids] + [np.asarray(o.ids) for o in (model.bonds, model.triangles) if o is not None]
     others.append(np.array([lb.id for lb in model.liquid_bonds or []], np.int64))
     next_id = 1 + max((int(np.max(i)) for i in others if len(i)), default=-1)
     plan.inlet_next_id = next_id
     sp.ids = np.r_[sp.ids, next_id + np.arange(n)].astype(np.int64)
-    sp.material = np.r_[sp.material, np.array([m for m, _ in kinds], np.int64)].astype(sp.material.dtype)
-    r = np.array([r for _, r in kinds], float)
+    sp.material = np.r_[sp.material, mats].astype(sp.material.dtype)
     sp.radius = np.r_[sp.radius, r]
     sp.contact_radius = np.r_[sp.contact_radius, r]
-    sp.mass = np.r_[sp.mass, np.array([_mass(r, model.materials[m].density) for m, r in kinds])]
+    density = {m: model.materials[m].density for m in set(mats.tolist())}
+    sp.mass = np.r_[sp.mass, [_mass(float(ri), density[int(m)]) for m, ri in zip(mats, r)]]
     for name in ("position", "velocity", "omega"):
         setattr(sp, name, np.r_[np.asarray(getattr(sp, name), float).reshape(-1, 3), np.zeros((n, 3))])
     sp.quaternion = np.r_[np.asarray(sp.quaternion, float).reshape(-1, 4), np.tile([1.0, 0, 0, 0], (n, 1))]
     sp.active_start = np.r_[sp.active_start, np.full(n, np.inf)]
     sp.active_end = np.r_[sp.active_end, np.full(n, np.inf)]
     if sp.compound_key is not None:
-        sp.compound_key = list(sp.compound_key) + [model.materials[m].key for m, _ in kinds]
+        sp.compound_key = list(sp.compound_key) + [model.materials[int(m)].key for m in mats]
     if sp.temperature is not None:
         sp.temperature = np.r_[sp.temperature, np.zeros(n)]
     if nb:
         b = model.bonds
-        new = dict(ids=next_id + n + np.arange(nb), pair=np.array(pair, np.int64).reshape(-1, 2),
-                   material=np.array(bmat, np.int64), diameter=np.array(bdiam, float),
+        new = dict(ids=next_id + n + np.arange(nb), pair=pair, material=bmat, diameter=bdiam,
                    length0=np.zeros(nb), active_start=np.full(nb, np.inf), active_end=np.full(nb, np.inf))
         if b is None:
             model.bonds = SolidBonds(**new)
@@ -193,7 +201,7 @@ def reserve_agglomerate_rows(model: GranularModel, events: list) -> list[tuple[i
                 setattr(b, name, np.r_[np.asarray(getattr(b, name)), value].astype(
                     np.asarray(getattr(b, name)).dtype if len(getattr(b, name)) else value.dtype))
             if b.compound_key is not None:
-                b.compound_key = list(b.compound_key) + [model.materials[m].key for m in bmat]
+                b.compound_key = list(b.compound_key) + [model.materials[int(m)].key for m in bmat]
             for name in ("force", "tangential_overlap"):
                 if getattr(b, name) is not None:
                     setattr(b, name, np.r_[getattr(b, name), np.zeros((nb, 3))])

@@ -44,6 +44,7 @@ from typing import Any
 import numpy as np
 
 from fibrelmp.errors import InputError
+from fibrelmp.granmodel import MAX_GENERATED
 
 SPHERES, AGGLOMERATES = 1, 2            # ProtoObjectsGenerator.obj_type
 RATE_PER_SECOND, RATE_PER_UPDATE, RATE_TOTAL = 0, 1, 2
@@ -170,7 +171,7 @@ def _check_rate(gen: DynamicGenerator, path: Path) -> None:
 
 
 def generation_schedule(generators: list[DynamicGenerator], dt: float, t_end: float,
-                        first_only: bool = False) -> list[GenerationEvent]:
+                        first_only: bool = False, source: str | None = None) -> list[GenerationEvent]:
     """Every generation cmusen attempts in a run of step ``dt`` to ``t_end``, in the order
     cmusen attempts them (by step, then generator order, which is also the order of the new
     ids).  The run's steps are those with t < ``t_end`` before the step (cmusen stops once the
@@ -181,12 +182,18 @@ def generation_schedule(generators: list[DynamicGenerator], dt: float, t_end: fl
     if not active:
         return events
     last = {i: 0.0 for i, _ in active}
-    first, t0 = 0, 0.0
+    first, t0, asked = 0, 0.0, 0
     horizon = max(g.end + 0.1 * g.update_step for _, g in active)
     while t0 < t_end and t0 <= horizon:
         # steps first .. first+_CHUNK-1; the last one starts the next chunk
         times = np.cumsum(np.r_[t0, np.full(_CHUNK - 1, dt)])
-        events.extend(_chunk_events(active, last, times, first, t_end))
+        new = _chunk_events(active, last, times, first, t_end)
+        events.extend(new)
+        asked += sum(e.requested for e in new)
+        if asked > MAX_GENERATED:
+            raise InputError(source, None, f"the dynamic generators ask for {asked:,}+ objects in "
+                             f"this run, more than fibrelmp's limit of {MAX_GENERATED:,} (it reserves "
+                             "room for each before the run): lower their rates or shorten the run")
         if first_only and events:
             break
         first += _CHUNK - 1

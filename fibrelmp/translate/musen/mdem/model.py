@@ -50,7 +50,7 @@ def read_scene(path: str | os.PathLike, mdem: MdemFile | None = None) -> Granula
         # inlets: checked here, scheduled for the job's step and end time by the translation
         inlets = model.plan.inlets = read_inlets(mdem.scene, path)
         model.plan.inlet_schedule = (lambda dt, t_end: generation_schedule(
-            [i.generator for i in inlets], dt, t_end))
+            [i.generator for i in inlets], dt, t_end, source=str(path)))
     model.warnings.extend(ignored)
     model.source = path
     scene_record(model, keep=True).mdem_source = path

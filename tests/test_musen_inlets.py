@@ -276,13 +276,9 @@ def _periodic_x(storage) -> None:
     info.periodic_conditions_min.z, info.periodic_conditions_max.z = 0.0, 0.012
 
 
-@pytest.mark.parametrize("change, message", [
-    (lambda s: setattr(s.modules_data.objects_generator.generators[0], "inside_geometries", False),
-     "dynamic generator 'InletA': inside_geometries: off"),
-    (_periodic_x, "dynamic generator 'InletA': generating in a periodic box is not supported"),
-])
-def test_unsupported_generator_setting_refuses_the_run(tmp_path, change, message):
-    scene = tmp_path / "inlet_scene.mdem"
+def _changed_scene(folder: Path, change) -> Path:
+    """The stored inlet scene with ``change(storage)`` applied, written into ``folder``."""
+    scene = folder / "inlet_scene.mdem"
     with MdemFile(SCENE) as f:
         storage = f.storage
         points = list(f.time_points())
@@ -292,6 +288,16 @@ def test_unsupported_generator_setting_refuses_the_run(tmp_path, change, message
         for t, values, masks in points:
             writer.add(t, values, masks)
         writer.finish(storage)
+    return scene
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda s: setattr(s.modules_data.objects_generator.generators[0], "inside_geometries", False),
+     "dynamic generator 'InletA': inside_geometries: off"),
+    (_periodic_x, "dynamic generator 'InletA': generating in a periodic box is not supported"),
+])
+def test_unsupported_generator_setting_refuses_the_run(tmp_path, change, message):
+    scene = _changed_scene(tmp_path, change)
     with pytest.raises(InputError) as err:
         python_api.run(scene)
     assert str(err.value).startswith(f"{scene}: {message}"), str(err.value)
@@ -329,16 +335,7 @@ def test_a_hostile_rate_is_refused_before_anything_is_reserved(tmp_path):
     import resource
     import time
 
-    scene = tmp_path / "inlet_scene.mdem"
-    with MdemFile(SCENE) as f:
-        storage = f.storage
-        points = list(f.time_points())
-    _huge_rate(storage)
-    with open(scene, "wb") as fh:
-        writer = MdemWriter(fh)
-        for t, values, masks in points:
-            writer.add(t, values, masks)
-        writer.finish(storage)
+    scene = _changed_scene(tmp_path, _huge_rate)
     before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
     start = time.monotonic()
     with pytest.raises(InputError) as err:

@@ -426,14 +426,26 @@ static std::vector<int> close_triangles(const std::vector<double> &tri, const do
   return close;
 }
 
-void FixMusenInlet::insert(const Event &event)
+/* what a new object must not overlap: every sphere near the box (any rank's) and the wall
+   triangles near it */
+FixMusenInlet::Surroundings FixMusenInlet::surroundings()
 {
   double rmax = 0.0;
   for (int i = 0; i < atom->nlocal; i++) rmax = std::max(rmax, atom->radius[i]);
   MPI_Allreduce(MPI_IN_PLACE, &rmax, 1, MPI_DOUBLE, MPI_MAX, world);
-  std::vector<Sphere> near = spheres_near(rmax);
-  const std::vector<double> tri = wall_triangles();
-  const std::vector<int> close = close_triangles(tri, lo, hi);
+  Surroundings out;
+  out.near = spheres_near(rmax);
+  out.tri = wall_triangles();
+  out.close = close_triangles(out.tri, lo, hi);
+  return out;
+}
+
+void FixMusenInlet::insert(const Event &event)
+{
+  Surroundings around = surroundings();
+  std::vector<Sphere> &near = around.near;
+  const std::vector<double> &tri = around.tri;
+  const std::vector<int> &close = around.close;
   Stream rng{seed * 0x9E3779B97F4A7C15ULL ^ static_cast<std::uint64_t>(event.step)};
   std::vector<Sphere> created;
   std::vector<int> types;
@@ -469,12 +481,10 @@ void FixMusenInlet::insert(const Event &event)
 /* MUSEN's generator of agglomerates (CObjectsGenerator::Generate, GenerateNewObject) */
 void FixMusenInlet::insert_agglomerates(const Event &event, bigint slot)
 {
-  double rmax = 0.0;
-  for (int i = 0; i < atom->nlocal; i++) rmax = std::max(rmax, atom->radius[i]);
-  MPI_Allreduce(MPI_IN_PLACE, &rmax, 1, MPI_DOUBLE, MPI_MAX, world);
-  std::vector<Sphere> near = spheres_near(rmax);
-  const std::vector<double> tri = wall_triangles();
-  const std::vector<int> close = close_triangles(tri, lo, hi);
+  Surroundings around = surroundings();
+  std::vector<Sphere> &near = around.near;
+  const std::vector<double> &tri = around.tri;
+  const std::vector<int> &close = around.close;
   Stream rng{seed * 0x9E3779B97F4A7C15ULL ^ static_cast<std::uint64_t>(event.step)};
   // musen_rand: cmusen's one rand() stream, shared by every generator (the first fix owns it)
   GlibcRand *crand = musen_rand ? &stream_owner()->glibc : nullptr;

@@ -168,6 +168,12 @@ class FixMusenInlet : public Fix {
   tagint create(const std::vector<Sphere> &made_now, const std::vector<int> &types,
                 const std::vector<double> &vel, const std::vector<tagint> *tags = nullptr);
   void insert_agglomerates(const Event &event, bigint slot);
+  struct Surroundings {
+    std::vector<Sphere> near;
+    std::vector<double> tri;
+    std::vector<int> close;
+  };
+  Surroundings surroundings();
   void add_bonds(const std::vector<Sphere> &made_now, const std::vector<tagint> &tags);
   bool sphere_fits(const Sphere &s, const std::vector<Sphere> &near, const std::vector<double> &tri,
                    const std::vector<int> &close) const;

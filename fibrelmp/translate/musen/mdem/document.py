@@ -18,7 +18,7 @@ import os
 import zlib
 from array import array
 from pathlib import Path
-from typing import Any, BinaryIO, Iterator
+from typing import Any, BinaryIO, Callable, Iterator
 
 import numpy as np
 
@@ -248,14 +248,19 @@ class MdemFile:
             raise InputError(self.path, None, f"corrupt .mdem file: time-point block {index} "
                              "cannot be decoded") from None
 
-    def time_points(self, decode: bool = True) -> Iterator[tuple[float, np.ndarray, np.ndarray] | tuple[float]]:
+    def time_points(self, decode: bool = True, wanted: Callable[[float], bool] | None = None
+                    ) -> Iterator[tuple[float, np.ndarray, np.ndarray] | tuple[float]]:
         """Every stored time point in order: (time, values (n, 34), masks (n,)) -- see
         ``timepoints`` -- one time point in memory at a time (blocks are decompressed as
-        they are read); ``decode=False`` gives (time,)."""
+        they are read); ``decode=False`` gives (time,); ``wanted(time)`` false: the point is
+        skipped undecoded."""
         for index in range(len(self.blocks)):
             with self._block_errors(index):
                 for payload in self._point_payloads(index):
-                    yield self._decode(payload) if decode else (timepoints.time_of(payload),)
+                    if not decode:
+                        yield (timepoints.time_of(payload),)
+                    elif wanted is None or wanted(timepoints.time_of(payload)):
+                        yield self._decode(payload)
 
     def count(self) -> int:
         """The number of time points ``time_points()`` gives (see ``_locate``)."""

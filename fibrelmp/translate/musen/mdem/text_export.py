@@ -198,10 +198,13 @@ def export(mdem: MdemFile, out: IO[str], precision: int = 6,
         done = np.zeros(len(wanted), bool)
         times = array("d")
         try:
-            for time, values, _ in mdem.time_points():
+            def chosen_time(time: float) -> bool:
                 at = int(np.searchsorted(wanted, time))
-                if at == len(wanted) or wanted[at] != time or done[at]:
-                    continue
+                return at < len(wanted) and wanted[at] == time and not done[at]
+
+            # points outside TIME_INTERVAL are skipped undecoded
+            for time, values, _ in mdem.time_points(wanted=chosen_time):
+                at = int(np.searchsorted(wanted, time))
                 for t, block in td_blocks(obj, values, index).items():
                     spools[t].write(np.ascontiguousarray(block).tobytes())
                 times.append(time)

@@ -6,19 +6,17 @@ from __future__ import annotations
 
 import subprocess
 import sys
-import zlib
 from pathlib import Path
 
 import pytest
 
 from fibrelmp.errors import InputError
 from fibrelmp.translate.musen.mdem import fields as mdem_fields
-from fibrelmp.translate.musen.mdem.container import ContainerWriter
-from fibrelmp.translate.musen.mdem.document import MdemFile
 from fibrelmp.translate.musen.mdem.messages import _SPEC, fields
 from fibrelmp.translate.musen.mdem.model import read_scene
 
 from .conftest import REPO
+from .mdem_edit import with_edited_scene
 
 SCENE = REPO / "tests" / "data" / "real-inputs" / "musen" / "SingelParticle.mdem"
 DOC = REPO / "docs" / "musen.md"
@@ -47,19 +45,7 @@ def test_docs_table_lists_every_refused_setting():
 
 def _edited(tmp_path: Path, edit, name: str = "edited.mdem") -> Path:
     """MUSEN's example scene with its scene message edited (time points kept as stored)."""
-    with MdemFile(SCENE) as mdem:
-        storage = mdem.storage
-        blocks = [mdem.block_raw(i) for i in range(len(storage.data_blocks))]
-    edit(storage)
-    path = tmp_path / name
-    with open(path, "w+b") as fh:
-        w = ContainerWriter(fh)
-        w._block(0, 0)
-        for d, raw in zip(storage.data_blocks, blocks):
-            w.write(1, d.offset_in_file, raw)
-        w.write(0, 0, zlib.compress(storage.SerializeToString(), 1))
-        w.finish()
-    return path
+    return with_edited_scene(SCENE, tmp_path / name, edit)
 
 
 def _ht(s, key):

@@ -24,6 +24,7 @@ from fibrelmp.translate.musen.mdem.document import BlockIndex, MdemFile, MdemWri
 from fibrelmp.translate.musen.mdem.messages import new
 
 from .conftest import REPO
+from .mdem_edit import with_edited_scene
 
 MDEM_FILES = sorted((REPO / "tests" / "data").rglob("*.mdem"))
 BOUNCE = REPO / "tests" / "data" / "real-outputs" / "musen" / "bounce" / "bounce_result.mdem"
@@ -236,18 +237,10 @@ def _small(path: Path, saved: list[float] | None) -> Path:
             storage.info.particles.add(type=1, encoded_properties=b"\0" * 16)
         out.finish(storage)
     if saved is not None:                           # written again with other saved times
-        with MdemFile(path) as mdem:
-            storage = mdem.storage
-            blocks = [mdem.block_raw(i) for i in range(len(mdem.blocks))]
-        del storage.info.savedTimePoints[:]
-        storage.info.savedTimePoints.extend(saved)
-        with open(path, "w+b") as fh:
-            w = ContainerWriter(fh)
-            w._block(0, 0)
-            for d, raw in zip(storage.data_blocks, blocks):
-                w.write(1, d.offset_in_file, raw)
-            w.write(0, 0, zlib.compress(storage.SerializeToString(), 1))
-            w.finish()
+        def resave(storage) -> None:
+            del storage.info.savedTimePoints[:]
+            storage.info.savedTimePoints.extend(saved)
+        with_edited_scene(path, path, resave)
     return path
 
 

@@ -181,6 +181,27 @@ template <class Derived> class MindlinShaped : public Law {
   static double length(const double *v) { return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
 };
 
+/* MUSEN's relative velocity of the centres, relVel = v_src - v_dst, from the contact-point
+   velocity of dst minus src the pair style gives: the spin terms w x rc are perpendicular to n,
+   so only the tangential part changes: vt_centres = vt - (w2 x rc2 - w1 x rc1),
+   rc1 = n d r1/(r1+r2), rc2 = -n d r2/(r1+r2).  vn_m = normRelVelLen, vt_m = tangRelVel
+   (the sintering laws). */
+inline void centre_relative_velocity(const Contact &c, double &vn_m, double vt_m[3])
+{
+  const double *n = c.n;
+  const double dist = c.r1 + c.r2 - c.overlap;
+  const double s1 = dist * c.r1 / (c.r1 + c.r2), s2 = -dist * c.r2 / (c.r1 + c.r2);
+  double spin[3];
+  for (int k = 0; k < 3; k++) {
+    const int a = (k + 1) % 3, b = (k + 2) % 3;
+    const double w2rc2 = (c.w2[a] * n[b] - c.w2[b] * n[a]) * s2;
+    const double w1rc1 = (c.w1[a] * n[b] - c.w1[b] * n[a]) * s1;
+    spin[k] = w2rc2 - w1rc1;
+  }
+  vn_m = -c.vn;
+  for (int k = 0; k < 3; k++) vt_m[k] = -(c.vt[k] - spin[k]);
+}
+
 }    // namespace musen_pp
 }    // namespace LAMMPS_NS
 

@@ -30,22 +30,8 @@ class Sintering final : public musen_pp::Law {
              musen_pp::Result &r) const override
   {
     const double *n = c.n;
-    // the pair style gives the contact-point velocity of dst minus src; MUSEN's law takes the
-    // centres': the spin terms w x rc are perpendicular to n, so only the tangential part
-    // changes: vt_centres = vt - (w2 x rc2 - w1 x rc1), rc1 = n d r1/(r1+r2), rc2 = -n d r2/(r1+r2)
-    const double dist = c.r1 + c.r2 - c.overlap;
-    const double s1 = dist * c.r1 / (c.r1 + c.r2), s2 = -dist * c.r2 / (c.r1 + c.r2);
-    double spin[3];
-    for (int k = 0; k < 3; k++) {
-      const int a = (k + 1) % 3, b = (k + 2) % 3;
-      const double w2rc2 = (c.w2[a] * n[b] - c.w2[b] * n[a]) * s2;
-      const double w1rc1 = (c.w1[a] * n[b] - c.w1[b] * n[a]) * s1;
-      spin[k] = w2rc2 - w1rc1;
-    }
-    // MUSEN's relVel = v_src - v_dst = -(centre velocity of dst minus src)
-    const double vn_m = -c.vn;
-    double vt_m[3];
-    for (int k = 0; k < 3; k++) vt_m[k] = -(c.vt[k] - spin[k]);
+    double vn_m, vt_m[3];
+    musen_pp::centre_relative_velocity(c, vn_m, vt_m);
 
     const double squared_contact_radius = 4 * c.equiv_radius * c.overlap;
     const double sintering = 1.125 * MUSEN_PI * 2 * c.equiv_radius * surface_energy;

@@ -45,19 +45,8 @@ class SinteringTemperature final : public musen_pp::Law {
              musen_pp::Result &r) const override
   {
     const double *n = c.n;
-    // centre velocities, MUSEN's relVel = v_src - v_dst (see musen_pp_sintering.cpp)
-    const double dist = c.r1 + c.r2 - c.overlap;
-    const double s1 = dist * c.r1 / (c.r1 + c.r2), s2 = -dist * c.r2 / (c.r1 + c.r2);
-    double spin[3];
-    for (int k = 0; k < 3; k++) {
-      const int a = (k + 1) % 3, b = (k + 2) % 3;
-      const double w2rc2 = (c.w2[a] * n[b] - c.w2[b] * n[a]) * s2;
-      const double w1rc1 = (c.w1[a] * n[b] - c.w1[b] * n[a]) * s1;
-      spin[k] = w2rc2 - w1rc1;
-    }
-    const double vn_m = -c.vn;    // normRelVelLen
-    double vt_m[3];               // tangRelVel
-    for (int k = 0; k < 3; k++) vt_m[k] = -(c.vt[k] - spin[k]);
+    double vn_m, vt_m[3];    // normRelVelLen, tangRelVel
+    musen_pp::centre_relative_velocity(c, vn_m, vt_m);
 
     const double temperature = (c.t1 + c.t2) / 2;
     const double max_overlap = max_overlap_coeff * 2 * c.equiv_radius;

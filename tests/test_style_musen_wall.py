@@ -982,3 +982,33 @@ def test_time_driven_walls_with_different_start_velocities_are_warned(plugin_pat
                    for kind, msg in job.warnings)
     finally:
         lammps_styles.request_stock(previous)
+
+
+def test_sphere_lists_of_a_static_mesh_follow_a_rolling_sphere(plugin_path, tmp_path):
+    """A static mesh keeps each sphere's nearby triangles between steps (MUSEN's Verlet list),
+    refreshed when the sphere moved half a neighbour skin.  With LAMMPS never re-neighbouring
+    during the run (``neigh_modify once yes``) only that refresh brings the next triangles in:
+    the sphere rolling across ~40 skins of the irregular floor moves exactly as on the same
+    floor given a (zero) motion, which tests every triangle of its cell at every step."""
+    law = make_law(1e6, 4e5, 0.5, 0.4, 0.02)
+    R = 0.001
+    s = one_sphere(R, x=(0.0, 0.0003, R - 1.5e-6), v=(0.25, 0.02, 0.0), w=(0.0, 150.0, 30.0))
+    dt, steps = 1e-5, 8000
+    verts = slope_mesh(0.0)
+    out = {}
+    for name, geometry in (("listed", {"name": "floor"}),
+                           ("tested", {"name": "floor", "segments": translation_segments([0.0, 0.0, 0.0])})):
+        mesh = mesh_text(verts, [0] * len(verts), [0] * len(verts), {(1, 0): law}, [geometry])
+        lmp = Lammps(plugin_path, tmp_path / name, mesh, [s], dt, integrate=True,
+                     gravity=(0.0, 0.0, -1.0), box=(-0.05, 0.12, -0.05, 0.05, -0.05, 0.05))
+        try:
+            lmp.L.command("neigh_modify once yes")
+            lmp.set_state(s["x"][None], s["v"][None], s["w"][None])
+            f, tq = lmp.run(steps)
+            out[name] = (*lmp.state(), f, tq)
+        finally:
+            lmp.close()
+    x = out["listed"][0][0]
+    assert x[0] > 0.015 and abs(x[2] - R) < 1e-5       # rolled ~40 half skins, still on the floor
+    for mine, reference in zip(out["listed"], out["tested"]):
+        np.testing.assert_array_equal(mine, reference)

@@ -858,6 +858,82 @@ void FixMusenWallMesh::build_grid(double rmax)
     for (int tr = 0; tr < ntri; tr++) all_entries.push_back(tr * NSHIFT + code);
   grid_vert = vert;
   grid_valid = true;
+  grid_stamp++;
+}
+
+/* The grid entries a sphere at x tests: its cell's, or every entry off the grid. */
+const int *FixMusenWallMesh::entries_of(const double *x, int &nent) const
+{
+  int c[3];
+  for (int k = 0; k < 3; k++) {
+    const double u = (x[k] - grid_lo[k]) / grid_cell;
+    if (!(u >= 0) || u >= grid_n[k]) {
+      nent = static_cast<int>(all_entries.size());
+      return all_entries.data();
+    }
+    c[k] = std::min(grid_n[k] - 1, static_cast<int>(u));
+  }
+  const size_t cell = ((size_t) c[2] * grid_n[1] + c[1]) * grid_n[0] + c[0];
+  nent = cell_start[cell + 1] - cell_start[cell];
+  return cell_entries.data() + cell_start[cell];
+}
+
+bool FixMusenWallMesh::near_lists_stale(int nlocal)
+{
+  if (near_stamp != grid_stamp || near_nlocal != nlocal || neighbor->lastcall == update->ntimestep ||
+      near_step < 0)
+    return true;
+  const double half_skin = 0.5 * neighbor->skin;
+  const double limit = half_skin * half_skin;
+  double **x = atom->x;
+  const int *mask = atom->mask;
+  const tagint *tag = atom->tag;
+  for (int i = 0; i < nlocal; i++) {
+    if (!(mask[i] & groupbit)) continue;
+    const double *x0 = &near_x[3 * (size_t) i];
+    const double d[3] = {x[i][0] - x0[0], x[i][1] - x0[1], x[i][2] - x0[2]};
+    if (!(sqlen(d) <= limit) || tag[i] != near_tag[i]) return true;    // NaN: stale too
+  }
+  return false;
+}
+
+/* Each sphere's entries that come within its radius + the skin: a sphere that moves less than
+   half a skin cannot touch any other (sphere_triangle with the larger radius is the distance
+   test: contact iff the triangle's nearest point is closer). */
+void FixMusenWallMesh::build_near_lists(int nlocal)
+{
+  double **x = atom->x;
+  const double *radius = atom->radius;
+  const int *mask = atom->mask;
+  const double skin = neighbor->skin;
+  near_start.assign(nlocal + 1, 0);
+  near_entries.clear();
+  near_x.resize(3 * (size_t) nlocal);
+  near_tag.assign(atom->tag, atom->tag + nlocal);
+  double cp[3];
+  for (int i = 0; i < nlocal; i++) {
+    near_start[i] = static_cast<int>(near_entries.size());
+    for (int k = 0; k < 3; k++) near_x[3 * (size_t) i + k] = x[i][k];
+    if (!(mask[i] & groupbit)) continue;
+    const double reach = radius[i] + skin;
+    int nent;
+    const int *ent = entries_of(x[i], nent);
+    for (int e = 0; e < nent; e++) {
+      const int tr = ent[e] / NSHIFT, code = ent[e] % NSHIFT;
+      double s[3] = {0, 0, 0};
+      if (code) shift_vector(code, s);
+      const double xs[3] = {x[i][0] - s[0], x[i][1] - s[1], x[i][2] - s[2]};
+      if (outside_bounds(&tlo[3 * (size_t) tr], &thi[3 * (size_t) tr], xs, reach)) continue;
+      if (sphere_triangle(&vert[9 * (size_t) tr], &nrm[3 * (size_t) tr], &tlo[3 * (size_t) tr],
+                          &thi[3 * (size_t) tr], constants_of(tr), xs, reach, cp) == NO_CONTACT)
+        continue;
+      near_entries.push_back(ent[e]);
+    }
+  }
+  near_start[nlocal] = static_cast<int>(near_entries.size());
+  near_stamp = grid_stamp;
+  near_nlocal = nlocal;
+  near_step = update->ntimestep;
 }
 
 /* ---------------------------------------------------------------------- */
@@ -913,29 +989,23 @@ void FixMusenWallMesh::post_force(int /*vflag*/)
     heat_temperature = atom->dvector[atom->find_custom("musen_temperature", flag, cols)];
   }
 
+  // a static mesh: the spheres' lists of nearby entries (made again when stale)
+  const bool listed = !any_moving && !any_stepped;
+  if (listed && near_lists_stale(nlocal)) build_near_lists(nlocal);
+
   for (int i = 0; i < nlocal; i++) {
     if (!(mask[i] & groupbit)) continue;
     const double r = radius[i];
-    // --- candidates: this rank's cell of the sphere, or every entry off the grid
+    // --- candidates: the sphere's list, or this rank's cell of the sphere (every entry off
+    // the grid)
     const int *ent;
     int nent;
-    int c[3];
-    bool on_grid = true;
-    for (int k = 0; k < 3; k++) {
-      const double u = (x[i][k] - grid_lo[k]) / grid_cell;
-      if (!(u >= 0) || u >= grid_n[k]) {
-        on_grid = false;
-        break;
-      }
-      c[k] = std::min(grid_n[k] - 1, static_cast<int>(u));
-    }
-    if (on_grid) {
-      const size_t cell = ((size_t) c[2] * grid_n[1] + c[1]) * grid_n[0] + c[0];
-      ent = cell_entries.data() + cell_start[cell];
-      nent = cell_start[cell + 1] - cell_start[cell];
+    if (listed) {
+      ent = near_entries.data() + near_start[i];
+      nent = near_start[i + 1] - near_start[i];
+      if (!nent && !history->count(i)) continue;
     } else {
-      ent = all_entries.data();
-      nent = static_cast<int>(all_entries.size());
+      ent = entries_of(x[i], nent);
     }
     cand.clear();
     for (int e = 0; e < nent; e++) {

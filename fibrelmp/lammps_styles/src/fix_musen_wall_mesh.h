@@ -219,6 +219,19 @@ class FixMusenWallMesh : public Fix {
   std::vector<double> grid_vert;       // vertices when the grid was built
   std::vector<int> cell_start, cell_entries;
   std::vector<int> all_entries;        // every (triangle, shift) entry, for spheres off the grid
+  long grid_stamp = 0;                 // bumped by every build_grid
+  // a static mesh: each sphere's entries within its radius + the neighbour skin, kept until a
+  // sphere moved half a skin, LAMMPS re-neighboured (atoms re-indexed) or the grid changed
+  // (MUSEN's Verlet list of walls); a subsequence of its cell's entries, so in their order
+  std::vector<int> near_start, near_entries;
+  std::vector<double> near_x;          // the spheres' centres when the lists were made
+  std::vector<tagint> near_tag;
+  long near_stamp = -1;
+  int near_nlocal = -1;
+  bigint near_step = -1;
+  bool near_lists_stale(int nlocal);
+  void build_near_lists(int nlocal);
+  const int *entries_of(const double *x, int &nent) const;
   struct Work {
     int cand;
     double xi[3];        // tangential overlap in, updated out

@@ -1,29 +1,37 @@
-"""fibrelmp post (LAMMPS dump -> FibreNet xyz) vs MDAnalysis merely reading the same dump.
+"""fibrelmp post (LAMMPS dump -> FibreNet xyz) against OVITO and MDAnalysis reading the same dump,
+and against the I/O limit (issue 28, goal 1).
 
 Generates a 256,000-atom x 10-frame text dump (id type x y z vx vy vz fx fy fz in LAMMPS's
-default %g format, ~220 MB) in a temporary folder, then times, in the same process:
+default %g format, ~220 MB) in a temporary folder, then runs, each as a whole command in its
+own subprocess (start-up and imports included; wall time and peak resident memory):
 
-* fibrelmp: ``post_command(dump, "xyz", ...)`` -- reading, parsing, sorting and writing
-  ``_coord/_vel/_force.xyz`` (everything ``fibrelmp post --to xyz`` does but start-up);
-* MDAnalysis: ``Universe(dump, format="LAMMPSDUMP")`` (reads frame 0 for the topology and
-  indexes the frames) plus iterating over every frame (its DumpReader parses each frame;
-  nothing is written).
+* fibrelmp: ``fibrelmp -q post DUMP --to xyz -o OUT`` -- reading, parsing, sorting and writing
+  ``_coord/_vel/_force.xyz``;
+* OVITO (its Python module, C++ readers): ``import_file(DUMP)`` + every frame's positions
+  (``pipeline.compute(frame).particles.positions``), nothing written; needs ``--ovito-python``
+  (a Python with ``pip install ovito``; env FIBRELMP_OVITO_PYTHON), else "not given";
+* MDAnalysis: ``Universe(DUMP, format="LAMMPSDUMP")`` + iterating every frame, nothing written;
+* the I/O limit: reading the dump (16 MB blocks, as ``cat dump > /dev/null``) + writing as many
+  bytes as fibrelmp writes, with nothing computed.
 
-Passes are interleaved after one untimed warm-up conversion (page cache, imports); the best of
-each side counts.  Also printed: fibrelmp's reader alone (``iter_frames``: read + parse, one
-``np.loadtxt`` per frame), the floor of any conversion built on it.
+``--repeat`` interleaved rounds after one untimed warm-up of each (page cache); medians count.
+Printed: seconds, MB/s of dump read, peak RSS, ratios OVITO / fibrelmp and MDAnalysis / fibrelmp
+(goals >= 1 and >= 20) and fibrelmp / I/O limit, and the load average before and after.
 
-Run from the repository root:  python benchmarks/post.py   (~1 min)
+Run from the repository root:  python benchmarks/post.py [--ovito-python /venv/bin/python]  (~2 min)
 """
 
 from __future__ import annotations
 
 import argparse
+import datetime
+import os
 import shutil
+import statistics
+import subprocess
 import sys
 import tempfile
 import time
-import warnings
 from pathlib import Path
 
 import numpy as np
@@ -51,71 +59,113 @@ def generate(path: Path, atoms: int, frames: int, seed: int = 1) -> None:
             x = np.mod(x + 0.05 * v, 100.0)
 
 
-def run_fibrelmp(dump: Path, out: Path) -> float:
-    from fibrelmp.post.convert import post_command
+def timed(cmd: list[str], env: dict | None = None) -> tuple[float, float]:
+    """(wall seconds, peak resident MB) of one command."""
+    t = time.perf_counter()
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=env)
+    _, status, usage = os.wait4(proc.pid, 0)
+    elapsed = time.perf_counter() - t
+    err = proc.stderr.read().decode(errors="replace")
+    proc.stderr.close()
+    if os.waitstatus_to_exitcode(status) != 0:
+        raise SystemExit(f"{cmd[:4]} failed: {err[-2000:]}")
+    return elapsed, usage.ru_maxrss / 1024
 
+
+def fibrelmp_cmd(dump: Path, out: Path) -> list[str]:
     if out.exists():
         shutil.rmtree(out)
     out.mkdir()
-    t = time.perf_counter()
-    post_command(dump, "xyz", out / "net", False, None, None, None, None, None, False, None, lambda s: None)
-    return time.perf_counter() - t
+    return [sys.executable, "-m", "fibrelmp.cli", "-q", "post", str(dump), "--to", "xyz", "-o", str(out / "net")]
 
 
-def run_reader(dump: Path) -> float:
-    """fibrelmp's reader alone (read + parse every frame), to show where the time goes."""
-    from fibrelmp.post.lammps_dump.reader import iter_frames
+OVITO = """
+import sys
+from ovito.io import import_file
+pipeline = import_file(sys.argv[1])
+n = pipeline.source.num_frames
+total = 0.0
+for frame in range(n):
+    total += float(pipeline.compute(frame).particles.positions[0, 0])
+assert n == int(sys.argv[2]), n
+"""
 
-    t = time.perf_counter()
-    for _ in iter_frames(dump):
+MDA = """
+import sys, warnings
+import MDAnalysis as mda
+with warnings.catch_warnings():
+    warnings.simplefilter("ignore")
+    u = mda.Universe(sys.argv[1], format="LAMMPSDUMP")
+    n = sum(1 for _ in u.trajectory)
+assert n == int(sys.argv[2]), n
+"""
+
+IO_LIMIT = """
+import sys
+with open(sys.argv[1], "rb", buffering=0) as src:
+    while src.read(1 << 24):
         pass
-    return time.perf_counter() - t
-
-
-def run_mdanalysis(dump: Path, frames: int) -> float:
-    import MDAnalysis as mda
-
-    t = time.perf_counter()
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        u = mda.Universe(str(dump), format="LAMMPSDUMP")
-        n = sum(1 for _ in u.trajectory)
-    elapsed = time.perf_counter() - t
-    assert n == frames
-    return elapsed
+left, block = int(sys.argv[3]), bytes(1 << 24)
+with open(sys.argv[2], "wb", buffering=0) as dst:
+    while left > 0:
+        left -= dst.write(block[:min(left, len(block))])
+"""
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--atoms", type=int, default=256_000)
     ap.add_argument("--frames", type=int, default=10)
-    ap.add_argument("--repeat", type=int, default=2, help="interleaved passes; the best of each side counts")
-    ap.add_argument("--profile", action="store_true", help="cProfile one fibrelmp conversion")
+    ap.add_argument("--repeat", type=int, default=3, help="interleaved rounds; medians count")
+    ap.add_argument("--ovito-python", default=os.environ.get("FIBRELMP_OVITO_PYTHON"),
+                    help="a Python with the ovito module (env FIBRELMP_OVITO_PYTHON)")
+    ap.add_argument("--quick", action="store_true", help="20,000 atoms x 3 frames, 1 round: checks the script")
     args = ap.parse_args()
+    if args.quick:
+        args.atoms, args.frames, args.repeat = 20_000, 3, 1
+    print(f"post: {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC, "
+          f"load average {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
     tmp = Path(tempfile.mkdtemp(prefix="fibrelmp_bench_post_"))
     try:
         dump = tmp / "dump.lammpstrj"
         t = time.perf_counter()
-        generate(dump, args.atoms, args.frames)
-        print(f"dump: {args.atoms} atoms x {args.frames} frames, {dump.stat().st_size / 1e6:.0f} MB "
+        # in a child: this process stays small, so its children's peak RSS is their own (a
+        # forked child's high-water mark starts at its parent's)
+        subprocess.run([sys.executable, "-c", "import sys; sys.path.insert(0, sys.argv[1]); import post; "
+                        "post.generate(post.Path(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4]))",
+                        str(Path(__file__).parent), str(dump), str(args.atoms), str(args.frames)], check=True)
+        size = dump.stat().st_size / 1e6
+        print(f"dump: {args.atoms} atoms x {args.frames} frames, {size:.0f} MB "
               f"(generated in {time.perf_counter() - t:.1f} s)")
-        run_fibrelmp(dump, tmp / "warm")                     # page cache, imports
-        mine, theirs, reader = [], [], []
+        timed(fibrelmp_cmd(dump, tmp / "out"))               # page cache, first imports
+        written = sum(p.stat().st_size for p in (tmp / "out").iterdir())
+        sides = {"fibrelmp post --to xyz": lambda: fibrelmp_cmd(dump, tmp / "out"),
+                 "MDAnalysis read": lambda: [sys.executable, "-c", MDA, str(dump), str(args.frames)],
+                 "I/O limit (read + write)": lambda: [sys.executable, "-c", IO_LIMIT, str(dump),
+                                                      str(tmp / "io.out"), str(written)]}
+        if args.ovito_python:
+            sides["OVITO read"] = lambda: [args.ovito_python, "-c", OVITO, str(dump), str(args.frames)]
+            timed(sides["OVITO read"]())                      # its first start compiles .pyc files
+        results: dict[str, list[tuple[float, float]]] = {k: [] for k in sides}
+        names = list(sides)
         for k in range(args.repeat):
-            mine.append(run_fibrelmp(dump, tmp / "out"))
-            theirs.append(run_mdanalysis(dump, args.frames))
-            reader.append(run_reader(dump))
-            print(f"pass {k + 1}: fibrelmp post --to xyz {mine[-1]:.2f} s (its reader alone {reader[-1]:.2f} s), "
-                  f"MDAnalysis DumpReader {theirs[-1]:.2f} s")
-        out_mb = sum(p.stat().st_size for p in (tmp / "out").iterdir()) / 1e6
-        print(f"fibrelmp wrote {out_mb:.0f} MB of xyz")
-        if args.profile:
-            import cProfile
-            import pstats
-
-            cProfile.runctx("run_fibrelmp(dump, tmp / 'prof')", globals(), locals(), str(tmp / "p"))
-            pstats.Stats(str(tmp / "p")).sort_stats("tottime").print_stats(15)
-        print(f"MDAnalysis-read / fibrelmp-convert ratio: {min(theirs) / min(mine):.1f}x (goal >= 10x)")
+            for name in names[k % len(names):] + names[:k % len(names)]:
+                results[name].append(timed(sides[name]()))
+            print(f"round {k + 1}: " + ", ".join(f"{n} {results[n][-1][0]:.2f} s" for n in names))
+        med = {n: (statistics.median(t for t, _ in r), max(m for _, m in r)) for n, r in results.items()}
+        print(f"\n| side | s (median of {args.repeat}) | dump MB/s | peak RSS MB |")
+        print("|---|---|---|---|")
+        for n in names:
+            print(f"| {n} | {med[n][0]:.2f} | {size / med[n][0]:.0f} | {med[n][1]:.0f} |")
+        if not args.ovito_python:
+            print("| OVITO read | not given (--ovito-python) | | |")
+        mine = med["fibrelmp post --to xyz"][0]
+        print(f"\nfibrelmp wrote {written / 1e6:.0f} MB of xyz")
+        if args.ovito_python:
+            print(f"OVITO / fibrelmp: {med['OVITO read'][0] / mine:.2f}x (goal >= 1)")
+        print(f"MDAnalysis / fibrelmp: {med['MDAnalysis read'][0] / mine:.1f}x (goal >= 20)")
+        print(f"fibrelmp / I/O limit: {mine / med['I/O limit (read + write)'][0]:.2f}x")
+        print(f"load average after: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
 

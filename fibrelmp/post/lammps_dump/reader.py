@@ -81,8 +81,25 @@ class Frame:
                              f"columns: {' '.join(self.columns) or '(none)'}") from None
 
     def vector(self, *names: str) -> np.ndarray:
-        """(n, k) float array of the named columns."""
+        """(n, k) float array of the named columns (a copy)."""
         return np.column_stack([np.asarray(self.column(c), np.float64) for c in names])
+
+    def block(self, *names: str) -> np.ndarray:
+        """(n, k) float array of the named columns: a read-only view of the parsed table when
+        they are adjacent in it (no copy: the x y z of a 256k-atom frame cost 4 ms to
+        gather), else a copy."""
+        cols = [self.column(c) for c in names]
+        base = cols[0].base
+        if (isinstance(base, np.ndarray) and base.ndim == 2 and base.dtype == np.float64
+                and base.flags.c_contiguous and all(c.base is base and c.dtype == np.float64
+                                                    and c.strides == (base.strides[0],) for c in cols)):
+            first = (cols[0].ctypes.data - base.ctypes.data) // base.itemsize
+            if all(c.ctypes.data == cols[0].ctypes.data + k * base.itemsize for k, c in enumerate(cols)) \
+                    and first + len(cols) <= base.shape[1]:
+                view = base[:, first:first + len(cols)]
+                view.flags.writeable = False
+                return view
+        return np.column_stack([np.asarray(c, np.float64) for c in cols])
 
     # -- coordinates -------------------------------------------------------------------
     @property

@@ -52,24 +52,22 @@ def outside_message(step: int, count: int, lengths: np.ndarray) -> str:
 
 def _pick(frame: Frame, preferred: Sequence[str], fallback: Sequence[str]) -> np.ndarray:
     names = preferred if preferred[0] in frame.columns else fallback
-    return np.column_stack([frame.column(c) for c in names])
+    return frame.block(*names)
 
 
 def wrapped_and_unwrapped(frame: Frame) -> tuple[np.ndarray, np.ndarray]:
     """Positions wrapped into [lo, hi) on periodic axes, and unwrapped positions."""
     lengths = frame.hi - frame.lo
+    # views of the parsed table where possible (read-only): copies only where values change
     if "x" in frame.columns:
-        x = np.column_stack([frame.column(c) for c in "xyz"])
-        if "ix" in frame.columns:
-            img = np.column_stack([frame.column(c) for c in ("ix", "iy", "iz")])
-            unwrapped = x + img * lengths
-        else:
-            unwrapped = x.copy()
+        x = frame.block("x", "y", "z")
+        unwrapped = x + frame.block("ix", "iy", "iz") * lengths if "ix" in frame.columns else x
     else:
-        unwrapped = np.column_stack([frame.column(c) for c in ("xu", "yu", "zu")])
-        x = unwrapped
-    wrapped = x.copy()
+        unwrapped = x = frame.block("xu", "yu", "zu")
     per = frame.periodic
+    if not per.any():
+        return x, unwrapped
+    wrapped = x.copy()
     wrapped[:, per] = frame.lo[per] + np.mod(unwrapped[:, per] - frame.lo[per], lengths[per])
     return wrapped, unwrapped
 

@@ -66,6 +66,8 @@ BENCHES = [
     Bench("mdem_io", "reading 100k spheres x 50 saves: MUSEN .mdem / MUSEN text (fibrelmp's readers)",
           r"mdem/text read time ratio: ([0-9.]+)", "<= 1.0",
           ["--spheres", "20000", "--saves", "10", "--few", "5", "--points", "20000"]),
+    Bench("growth", "cost per particle, largest / smallest input (FibreNet 50k-2.6M beads, MUSEN 5k-500k spheres)",
+          r"worst growth ratio \(FibreNet\): ([0-9.]+)", "<= 1.25", ["--quick"]),
     Bench("musen_models_cost", "per-contact cost of the 33 cmusen models: fibrelmp / cmusen -t=1 (worst model)",
           r"worst fibrelmp / cmusen per-contact ratio: ([0-9.]+)", "<= 1.0", ["--quick"],
           needs="FIBRELMP_CMUSEN"),

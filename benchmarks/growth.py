@@ -76,11 +76,16 @@ def musen_input(folder: Path, spheres: int, steps: int) -> tuple[str, int]:
     return "job.txt", spheres
 
 
-def measure(root: Path, family: str, size: int, steps: int) -> dict:
+def measure(root: Path, family: str, size: int, steps: int, keep: Path | None = None) -> dict:
     folder = root / f"{family}-{size}"
     folder.mkdir(parents=True)
-    make = fibrenet_input if family == "fibrenet" else musen_input
-    name, n = make(folder, size, steps)
+    # made in a child: this process stays small, so the children's peak RSS is their own (a
+    # forked child's high-water mark starts at its parent's)
+    made = subprocess.run([sys.executable, "-c", "import sys; sys.path.insert(0, sys.argv[1]); import growth; "
+                           f"print(*growth.{family}_input(growth.Path(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4])))",
+                           str(HERE), str(folder), str(size), str(steps)],
+                          check=True, capture_output=True, text=True).stdout.split()
+    name, n = made[-2], int(made[-1])
     t_tr, m_tr = timed(CLI + ["-q", "translate", name, "-o", "job"], folder)
     t_run, m_run = timed(CLI + ["-q", "run", name, "-o", "out", "--work", "work"], folder)
     logs = sorted((folder / "work").rglob("log.lammps"))
@@ -90,6 +95,8 @@ def measure(root: Path, family: str, size: int, steps: int) -> dict:
     frames = sum(1 for line in open(dump, "rb") if line.startswith(b"ITEM: TIMESTEP"))
     target = "xyz" if family == "fibrenet" else "musen"
     t_post, m_post = timed(CLI + ["-q", "post", str(dump), "--to", target, "-o", "post/out"], folder)
+    if keep is not None:            # LAMMPS's timing breakdown of the run
+        shutil.copy(logs[-1], keep / f"{family}-{n}.log.lammps")
     shutil.rmtree(folder)           # the 2.6M-bead case writes GBs
     return {"family": family, "n": n, "steps": steps, "frames": frames,
             "translate_s": t_tr / n, "translate_B": m_tr / n,
@@ -122,6 +129,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true", help="small sizes: checks the script")
     ap.add_argument("--only", choices=["fibrenet", "musen"], action="append")
+    ap.add_argument("--keep-logs", type=Path, help="copy each run's log.lammps here")
     args = ap.parse_args()
     if args.quick:
         plan = {"fibrenet": [(5000, 50), (20000, 50)], "musen": [(500, 50), (2000, 50)]}
@@ -137,7 +145,7 @@ def main() -> None:
                 continue
             rows = []
             for size, steps in sizes:
-                rows.append(measure(root, family, size, steps))
+                rows.append(measure(root, family, size, steps, args.keep_logs))
                 r = rows[-1]
                 print(f"{family} {r['n']:,}: run {r['run_wall']:.1f} s, load {os.getloadavg()[0]:.2f}", flush=True)
             table(rows, "FibreNet beads" if family == "fibrenet" else "MUSEN spheres")

@@ -185,9 +185,10 @@ def written_on_ranks(folder: Path) -> int:
 
 
 # measured in tests/test_mpi_ranks.py (docs/cluster.md): resumed at 1, 2 or 4 ranks, a
-# checkpoint written on one rank gives the uninterrupted run's files byte for byte; one
-# written on several ranks did not (a MUSEN inlet case: 7e-6 of a position's scale 500 steps
-# after the resume, also when resumed on the same rank count)
+# checkpoint written on one rank gives the uninterrupted run's files byte for byte; a granular
+# one written on several ranks did not (a MUSEN inlet case with many contacts: 7e-6 of a
+# position's scale 500 steps after the resume, also when resumed on the same rank count;
+# FibreNet's, and MUSEN/DEMDF cases with one contact at a time, did: tests/test_trust_runs.py)
 SEVERAL_RANKS = ("this checkpoint was written on {ranks} MPI ranks: a run resumed from it "
                  "(on any rank count) may differ from an uninterrupted run by more than "
                  "round-off (measured: 7e-6 of the positions' scale in a MUSEN inlet case); "

@@ -106,7 +106,7 @@ class Checkpointing:
         state = {"commands": commands, "line": line, "steps": steps, "frames": frames,
                  "restart": restart, "forces": forces if step_state is not None else None,
                  "script_sha256": _sha(script_text), "inputs_sha256": inputs_digest(self.inputs),
-                 "ranks": int(lmp.extract_setting("world_size")),
+                 "ranks": int(lmp.extract_setting("world_size")),     # a record: any count resumes it
                  "sizes": {name: (self.folder / name).stat().st_size
                            for name in self.appended if (self.folder / name).exists()}}
         part = self.folder / (STATE + ".tmp")
@@ -173,27 +173,6 @@ def load(folder: Path, script_text: str, inputs: list[Path] = ()) -> dict:
                          "translated job differs; run again without --resume")
     state["commands"], state["line"], state["steps"] = commands, line, steps
     return state
-
-
-def written_on_ranks(folder: Path) -> int:
-    """The MPI ranks that wrote the checkpoint in ``folder`` (1 when there is none or it
-    predates the record)."""
-    try:
-        return int(json.loads((Path(folder) / STATE).read_text()).get("ranks", 1))
-    except (OSError, ValueError, TypeError, AttributeError):
-        return 1
-
-
-# measured in tests/test_mpi_ranks.py (docs/cluster.md): resumed at 1, 2 or 4 ranks, a
-# checkpoint written on one rank gives the uninterrupted run's files byte for byte; a granular
-# one written on several ranks did not (a MUSEN inlet case with many contacts: 7e-6 of a
-# position's scale 500 steps after the resume, also when resumed on the same rank count;
-# FibreNet's, and MUSEN/DEMDF cases with one contact at a time, did: tests/test_trust_runs.py)
-SEVERAL_RANKS = ("this checkpoint was written on {ranks} MPI ranks: a run resumed from it "
-                 "(on any rank count) may differ from an uninterrupted run by more than "
-                 "round-off (measured: 7e-6 of the positions' scale in a MUSEN inlet case); "
-                 "checkpoints written by a serial run resume exactly on any rank count "
-                 "(docs/cluster.md)")
 
 
 def truncate_outputs(folder: Path, state: dict) -> None:

@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any, Callable, Iterable, Iterator
 
 from fibrelmp.errors import InputError, RunError
-from fibrelmp.checkpoint import SEVERAL_RANKS, has_checkpoint, written_on_ranks
+from fibrelmp.checkpoint import has_checkpoint
 from fibrelmp.lammps_flow import is_stop_print
 from fibrelmp.runplan import (Action, Consumer, Outcome, Rendered, RunOptions, RunPlan,
                               RunRequest)
@@ -70,12 +70,6 @@ def run(plan: RunPlan, warn: Warn | None = None) -> Outcome:
                 time_step_check(step.model)     # check's warning, said before the run starts
                 long_run_check(step.model)      # over a day even at optimistic speeds
                 rank_check(step.model, size)    # too many MPI ranks for this system
-                # granular jobs only: FibreNet's multi-rank checkpoints resume exactly
-                # (tests/test_trust_runs.py), a MUSEN one with many contacts did not
-                if options.resume and getattr(step.model, "kind", "") != "fibrenet" and \
-                        has_checkpoint(Path(step.work)) and \
-                        (written := written_on_ranks(Path(step.work))) > 1:
-                    step.model.warn("checkpoint-ranks", SEVERAL_RANKS.format(ranks=written))
                 if warn is not None and step.model.warnings[said:]:
                     warn(step.model.warnings[said:])
                 said = len(step.model.warnings)

@@ -106,6 +106,7 @@ class Checkpointing:
         state = {"commands": commands, "line": line, "steps": steps, "frames": frames,
                  "restart": restart, "forces": forces if step_state is not None else None,
                  "script_sha256": _sha(script_text), "inputs_sha256": inputs_digest(self.inputs),
+                 "ranks": int(lmp.extract_setting("world_size")),     # a record: any count resumes it
                  "sizes": {name: (self.folder / name).stat().st_size
                            for name in self.appended if (self.folder / name).exists()}}
         part = self.folder / (STATE + ".tmp")

@@ -191,9 +191,14 @@ int FixMusenHistory::size_restart(int i)
 
 int FixMusenHistory::maxsize_restart()
 {
+  // the largest over every rank (as LAMMPS's FixNeighHistory): the restart file holds one
+  // per-atom width for all atoms, and read_restart sizes atom->extra by it; rank 0's own
+  // largest cut off the entries of atoms with more contacts on other ranks
   int most = 0;
   for (int i = 0; i < atom->nlocal; i++) most = std::max(most, num[i]);
-  return most * stride() + 2;
+  int most_all = most;
+  MPI_Allreduce(&most, &most_all, 1, MPI_INT, MPI_MAX, world);
+  return most_all * stride() + 2;
 }
 
 // registration with LAMMPS when the plugin loads (style_registry.h); the MUSEN styles create

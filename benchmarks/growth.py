@@ -135,7 +135,7 @@ def main() -> None:
         plan = {"fibrenet": [(5000, 50), (20000, 50)], "musen": [(500, 50), (2000, 50)]}
     else:
         plan = {"fibrenet": [(50_000, 200), (260_000, 100), (2_600_000, 20)],
-                "musen": [(5_000, 200), (50_000, 100), (500_000, 20)]}
+                "musen": [(5_000, 200), (50_000, 200), (500_000, 200)]}
     print(f"growth: {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC, {os.cpu_count()} cores, "
           f"load average {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
     root = Path(tempfile.mkdtemp(prefix="fibrelmp_growth_"))

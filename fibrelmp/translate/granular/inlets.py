@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from fibrelmp.errors import InputError
-from fibrelmp.granmodel import MAX_GENERATED, GranularModel
+from fibrelmp.granmodel import MAX_GENERATED, GranularModel, SolidBonds
 
 if TYPE_CHECKING:       # the type only: translate/ must not import the format homes
     from fibrelmp.translate.musen.mdem.generators import Inlet
@@ -132,8 +132,6 @@ def reserve_agglomerate_rows(model: GranularModel, events: list) -> list[tuple[i
     them; MUSEN's ids are given then, in MUSEN's order of success (frames.py).  Returns
     (generator index, first sphere row, first bond row, agglomerates requested, spheres and
     bonds of one) per generator of agglomerates."""
-    from fibrelmp.granmodel import SolidBonds
-
     plan = model.plan
     if plan.inlet_layout is not None:
         return plan.inlet_layout
@@ -191,25 +189,33 @@ def reserve_agglomerate_rows(model: GranularModel, events: list) -> list[tuple[i
     if sp.temperature is not None:
         sp.temperature = np.r_[sp.temperature, np.zeros(n)]
     if nb:
-        b = model.bonds
-        new = dict(ids=next_id + n + np.arange(nb), pair=pair, material=bmat, diameter=bdiam,
-                   length0=np.zeros(nb), active_start=np.full(nb, np.inf), active_end=np.full(nb, np.inf))
-        if b is None:
-            model.bonds = SolidBonds(**new)
-        else:
-            for name, value in new.items():
-                setattr(b, name, np.r_[np.asarray(getattr(b, name)), value].astype(
-                    np.asarray(getattr(b, name)).dtype if len(getattr(b, name)) else value.dtype))
-            if b.compound_key is not None:
-                b.compound_key = list(b.compound_key) + [model.materials[int(m)].key for m in bmat]
-            for name in ("force", "tangential_overlap"):
-                if getattr(b, name) is not None:
-                    setattr(b, name, np.r_[getattr(b, name), np.zeros((nb, 3))])
-            if b.source_line is not None:
-                b.source_line = np.r_[b.source_line, np.zeros(nb, b.source_line.dtype)]
+        _append_bonds(model, next_id + n, pair, bmat, bdiam)
     plan.inlet_rows = sp.count - n
     plan.inlet_layout = layout
     return layout
+
+
+def _append_bonds(model: GranularModel, first_id: int, pair: np.ndarray, bmat: np.ndarray,
+                  bdiam: np.ndarray) -> None:
+    """The generated agglomerates' bonds appended to ``model.bonds`` (inactive until made),
+    with placeholder ids from ``first_id`` on."""
+    b = model.bonds
+    nb = len(pair)
+    new = dict(ids=first_id + np.arange(nb), pair=pair, material=bmat, diameter=bdiam,
+               length0=np.zeros(nb), active_start=np.full(nb, np.inf), active_end=np.full(nb, np.inf))
+    if b is None:
+        model.bonds = SolidBonds(**new)
+    else:
+        for name, value in new.items():
+            setattr(b, name, np.r_[np.asarray(getattr(b, name)), value].astype(
+                np.asarray(getattr(b, name)).dtype if len(getattr(b, name)) else value.dtype))
+        if b.compound_key is not None:
+            b.compound_key = list(b.compound_key) + [model.materials[int(m)].key for m in bmat]
+        for name in ("force", "tangential_overlap"):
+            if getattr(b, name) is not None:
+                setattr(b, name, np.r_[getattr(b, name), np.zeros((nb, 3))])
+        if b.source_line is not None:
+            b.source_line = np.r_[b.source_line, np.zeros(nb, b.source_line.dtype)]
 
 
 def inlet_commands(model: GranularModel, type_of_mat: dict[int, int], dt: float, t_start: float,

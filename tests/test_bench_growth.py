@@ -49,3 +49,9 @@ def test_growth_table(output: str, family: str, tag: str) -> None:
     worst = float(re.search(rf"worst growth ratio \({tag}\): ([0-9.]+)", output).group(1))
     assert worst == pytest.approx(max(printed.values()), abs=0.006)
     assert "load average" in output
+
+
+def test_worst_of_both_families(output: str) -> None:
+    per_family = [float(x) for x in re.findall(r"worst growth ratio \((?:FibreNet|MUSEN)\): ([0-9.]+)", output)]
+    overall = float(re.search(r"worst growth ratio \(all families run\): ([0-9.]+)", output).group(1))
+    assert len(per_family) == 2 and overall == pytest.approx(max(per_family), abs=0.006)

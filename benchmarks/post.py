@@ -129,8 +129,9 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=3, help="interleaved rounds; medians count")
     ap.add_argument("--ovito-python", default=os.environ.get("FIBRELMP_OVITO_PYTHON"),
                     help="a Python with the ovito module (env FIBRELMP_OVITO_PYTHON)")
-    ap.add_argument("--targets", default="xyz,mdem,musen,demdf,res,mercury,vtk",
-                    help="fibrelmp post targets to time, one line each (xyz is the one compared)")
+    ap.add_argument("--targets", default="xyz,res,vtk",
+                    help="fibrelmp post targets to time, one line each (xyz is the one compared; mdem, musen, "
+                         "demdf and mercury need radius/mass columns this dump lacks)")
     ap.add_argument("--quick", action="store_true", help="20,000 atoms x 3 frames, 1 round: checks the script")
     args = ap.parse_args()
     if args.quick:

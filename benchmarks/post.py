@@ -6,7 +6,7 @@ default %g format, ~220 MB) in a temporary folder, then runs, each as a whole co
 own subprocess (start-up and imports included; wall time and peak resident memory):
 
 * fibrelmp: ``fibrelmp -q post DUMP --to xyz -o OUT`` -- reading, parsing, sorting and writing
-  ``_coord/_vel/_force.xyz``;
+  ``_coord/_vel/_force.xyz``; and, one line each, the other targets (``--targets``);
 * OVITO (its Python module, C++ readers): ``import_file(DUMP)`` + every frame's positions
   (``pipeline.compute(frame).particles.positions``), nothing written; needs ``--ovito-python``
   (a Python with ``pip install ovito``; env FIBRELMP_OVITO_PYTHON), else "not given";
@@ -72,11 +72,21 @@ def timed(cmd: list[str], env: dict | None = None) -> tuple[float, float]:
     return elapsed, usage.ru_maxrss / 1024
 
 
-def fibrelmp_cmd(dump: Path, out: Path) -> list[str]:
+def fibrelmp_cmd(dump: Path, out: Path, target: str = "xyz") -> list[str]:
     if out.exists():
         shutil.rmtree(out)
     out.mkdir()
-    return [sys.executable, "-m", "fibrelmp.cli", "-q", "post", str(dump), "--to", "xyz", "-o", str(out / "net")]
+    return [sys.executable, "-m", "fibrelmp.cli", "-q", "post", str(dump), "--to", target, "-o", str(out / "net")]
+
+
+def ovito_missing(python: str | None) -> str | None:
+    """Why OVITO cannot be timed (None if it can)."""
+    if not python:
+        return "not given (--ovito-python)"
+    done = subprocess.run([python, "-c", "import ovito"], capture_output=True, text=True)
+    if done.returncode:
+        return f"not installed in {python}: {done.stderr.strip().splitlines()[-1:]}"
+    return None
 
 
 OVITO = """
@@ -119,10 +129,15 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=3, help="interleaved rounds; medians count")
     ap.add_argument("--ovito-python", default=os.environ.get("FIBRELMP_OVITO_PYTHON"),
                     help="a Python with the ovito module (env FIBRELMP_OVITO_PYTHON)")
+    ap.add_argument("--targets", default="xyz,res,vtk",
+                    help="fibrelmp post targets to time, one line each (xyz is the one compared; mdem, musen, "
+                         "demdf and mercury need radius/mass columns this dump lacks)")
     ap.add_argument("--quick", action="store_true", help="20,000 atoms x 3 frames, 1 round: checks the script")
     args = ap.parse_args()
     if args.quick:
         args.atoms, args.frames, args.repeat = 20_000, 3, 1
+    if args.quick:
+        args.targets = "xyz"
     print(f"post: {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC, "
           f"load average {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
     tmp = Path(tempfile.mkdtemp(prefix="fibrelmp_bench_post_"))
@@ -139,11 +154,15 @@ def main() -> None:
               f"(generated in {time.perf_counter() - t:.1f} s)")
         timed(fibrelmp_cmd(dump, tmp / "out"))               # page cache, first imports
         written = sum(p.stat().st_size for p in (tmp / "out").iterdir())
-        sides = {"fibrelmp post --to xyz": lambda: fibrelmp_cmd(dump, tmp / "out"),
-                 "MDAnalysis read": lambda: [sys.executable, "-c", MDA, str(dump), str(args.frames)],
+        sides = {"fibrelmp post --to xyz": lambda: fibrelmp_cmd(dump, tmp / "out")}
+        for target in [t for t in args.targets.split(",") if t and t != "xyz"]:
+            sides[f"fibrelmp post --to {target}"] = (lambda t=target: fibrelmp_cmd(dump, tmp / f"out_{t}", t))
+            timed(sides[f"fibrelmp post --to {target}"]())   # untimed warm-up, as for xyz
+        sides |= {"MDAnalysis read": lambda: [sys.executable, "-c", MDA, str(dump), str(args.frames)],
                  "I/O limit (read + write)": lambda: [sys.executable, "-c", IO_LIMIT, str(dump),
                                                       str(tmp / "io.out"), str(written)]}
-        if args.ovito_python:
+        missing = ovito_missing(args.ovito_python)
+        if not missing:
             sides["OVITO read"] = lambda: [args.ovito_python, "-c", OVITO, str(dump), str(args.frames)]
             timed(sides["OVITO read"]())                      # its first start compiles .pyc files
         results: dict[str, list[tuple[float, float]]] = {k: [] for k in sides}
@@ -157,11 +176,11 @@ def main() -> None:
         print("|---|---|---|---|")
         for n in names:
             print(f"| {n} | {med[n][0]:.2f} | {size / med[n][0]:.0f} | {med[n][1]:.0f} |")
-        if not args.ovito_python:
-            print("| OVITO read | not given (--ovito-python) | | |")
+        if missing:
+            print(f"| OVITO read | {missing} | | |")
         mine = med["fibrelmp post --to xyz"][0]
         print(f"\nfibrelmp wrote {written / 1e6:.0f} MB of xyz")
-        if args.ovito_python:
+        if not missing:
             print(f"OVITO / fibrelmp: {med['OVITO read'][0] / mine:.2f}x (goal >= 1)")
         print(f"MDAnalysis / fibrelmp: {med['MDAnalysis read'][0] / mine:.1f}x (goal >= 20)")
         print(f"fibrelmp / I/O limit: {mine / med['I/O limit (read + write)'][0]:.2f}x")

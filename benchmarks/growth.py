@@ -30,30 +30,20 @@ import shutil
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
+from _common import timed as run_timed  # noqa: E402
 from vs_real_codes import MUSEN_JOB, load_generator, packing_domain, packing_scene  # noqa: E402
 
 CLI = [sys.executable, "-m", "fibrelmp.cli"]
 
 
 def timed(cmd: list[str], cwd: Path) -> tuple[float, float]:
-    """(wall seconds, peak resident bytes) of one command (this process stays small, so the
-    child's high-water mark is its own)."""
-    t = time.perf_counter()
-    proc = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                            env=dict(os.environ, OMP_NUM_THREADS="1"))
-    _, status, usage = os.wait4(proc.pid, 0)
-    seconds = time.perf_counter() - t
-    err = proc.stderr.read().decode(errors="replace")
-    proc.stderr.close()
-    if os.waitstatus_to_exitcode(status) != 0:
-        raise SystemExit(f"{' '.join(cmd[2:5])} failed in {cwd}:\n{err[-3000:]}")
-    return seconds, usage.ru_maxrss * 1024.0
+    """(wall seconds, peak resident bytes) of one fibrelmp command, single-threaded."""
+    return run_timed(cmd, cwd=cwd, env=dict(os.environ, OMP_NUM_THREADS="1"))
 
 
 def loop_seconds(log: Path) -> float:

@@ -37,6 +37,9 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from _common import timed as run_timed  # noqa: E402
 
 
 def generate(path: Path, atoms: int, frames: int, seed: int = 1) -> None:
@@ -61,15 +64,8 @@ def generate(path: Path, atoms: int, frames: int, seed: int = 1) -> None:
 
 def timed(cmd: list[str], env: dict | None = None) -> tuple[float, float]:
     """(wall seconds, peak resident MB) of one command."""
-    t = time.perf_counter()
-    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=env)
-    _, status, usage = os.wait4(proc.pid, 0)
-    elapsed = time.perf_counter() - t
-    err = proc.stderr.read().decode(errors="replace")
-    proc.stderr.close()
-    if os.waitstatus_to_exitcode(status) != 0:
-        raise SystemExit(f"{cmd[:4]} failed: {err[-2000:]}")
-    return elapsed, usage.ru_maxrss / 1024
+    seconds, peak = run_timed(cmd, env=env)
+    return seconds, peak / 2**20
 
 
 def fibrelmp_cmd(dump: Path, out: Path, target: str = "xyz") -> list[str]:

@@ -880,8 +880,8 @@ const int *FixMusenWallMesh::entries_of(const double *x, int &nent) const
 
 bool FixMusenWallMesh::near_lists_stale(int nlocal)
 {
-  if (near_stamp != grid_stamp || near_nlocal != nlocal || neighbor->lastcall == update->ntimestep ||
-      near_step < 0)
+  // never made (near_stamp -1), or the grid, the atoms or their indices changed
+  if (near_stamp != grid_stamp || near_nlocal != nlocal || neighbor->lastcall == update->ntimestep)
     return true;
   const double half_skin = 0.5 * neighbor->skin;
   const double limit = half_skin * half_skin;
@@ -933,7 +933,6 @@ void FixMusenWallMesh::build_near_lists(int nlocal)
   near_start[nlocal] = static_cast<int>(near_entries.size());
   near_stamp = grid_stamp;
   near_nlocal = nlocal;
-  near_step = update->ntimestep;
 }
 
 /* ---------------------------------------------------------------------- */

@@ -228,7 +228,6 @@ class FixMusenWallMesh : public Fix {
   std::vector<tagint> near_tag;
   long near_stamp = -1;
   int near_nlocal = -1;
-  bigint near_step = -1;
   bool near_lists_stale(int nlocal);
   void build_near_lists(int nlocal);
   const int *entries_of(const double *x, int &nent) const;

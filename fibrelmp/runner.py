@@ -25,6 +25,7 @@ from fibrelmp._lammps import new_lammps
 from fibrelmp.errors import RunError
 from fibrelmp.lammps_flow import condition_holds, execute, jump_target
 from fibrelmp.lammps_text import input_lines, read_script
+from fibrelmp.runplan import FRAME_COMMANDS
 
 if TYPE_CHECKING:
     from fibrelmp.checkpoint import Checkpointing  # noqa: F401
@@ -332,7 +333,7 @@ class _ScriptRun:
         if self.due is not None and words[0] == "run" and not self.jumped:
             self._checkpoint(cmd)
         counts, before = self._execute(cmd, text, replaying)
-        if words[0] == "write_dump":
+        if words[0] in FRAME_COMMANDS:
             self.frames += 1
         if counts:
             n = max(_timestep(self.lmp) - before, 0)
@@ -352,7 +353,7 @@ class _ScriptRun:
 
         # fix_modify ID write FILE: a frame of fix musen/wall/mesh's triangle forces
         if words[0] in ACTIONS or (words[0] == "fix_modify" and words[2:3] == ["write"]):
-            if words[0] == "write_dump":
+            if words[0] in FRAME_COMMANDS:
                 self.frames += 1
                 if self.on_command is not None:
                     self.on_command(words)

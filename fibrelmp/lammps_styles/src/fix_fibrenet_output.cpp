@@ -30,6 +30,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -43,8 +44,15 @@ using namespace LAMMPS_NS;
 
 namespace {
 
-// per gathered atom: tag type x y z ix iy iz v0 v1 v2 f0 f1 f2
+// per gathered atom: tag type x y z ix iy iz v0 v1 v2 f0 f1 f2 [radius mass] (the work dump's)
 constexpr int NV = 14;
+constexpr int NV_DUMP = 16;
+// a frame is formatted in chunks of this many rows, chunk c by rank c % nprocs, and written by
+// rank 0 in order (all ranks format; no rank holds more than a chunk of text)
+constexpr bigint CHUNK_ROWS = 32768;    // the default of keyword chunk
+// the largest piece of text in one MPI message
+constexpr size_t TEXT_PIECE = size_t(1) << 30;
+
 const char *const XYZ_SUFFIX[3] = {"_coord.xyz", "_vel.xyz", "_force.xyz"};
 const char *const RESTART_SUFFIX = "_restart.res";
 const char *const FILE_KEYS[3] = {"coord", "vel", "force"};
@@ -133,8 +141,28 @@ void put_g(std::string &out, double x)
     return;
   }
   char buf[32];
+#if defined(__cpp_lib_to_chars) && __cpp_lib_to_chars >= 201611L
+  // specified to give printf's %.6g (= %g), ~4x faster than glibc's printf
+  const auto r = std::to_chars(buf, buf + sizeof(buf), x, std::chars_format::general, 6);
+  out.append(buf, r.ptr - buf);
+#else
   std::snprintf(buf, sizeof(buf), "%g", x);
   out += buf;
+#endif
+}
+
+// "%.17g", byte for byte (dump custom's "format float %.17g"): std::to_chars with precision
+// 17 in general format is specified to give printf's output, ~4x faster than glibc's printf
+void put_g17(std::string &out, double x)
+{
+  char buf[32];
+#if defined(__cpp_lib_to_chars) && __cpp_lib_to_chars >= 201611L
+  const auto r = std::to_chars(buf, buf + sizeof(buf), x, std::chars_format::general, 17);
+  out.append(buf, r.ptr - buf);
+#else
+  const int n = std::snprintf(buf, sizeof(buf), "%.17g", x);
+  out.append(buf, static_cast<size_t>(n));
+#endif
 }
 
 void put_int(std::string &out, bigint v)
@@ -174,13 +202,13 @@ int write_all(int fd, const std::string &data)
 /* ---------------------------------------------------------------------- */
 
 FixFibreNetOutput::FixFibreNetOutput(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), dt(0.0), restart_steps(-1), frames_written(0), restart_stage(0.25f),
-    outside_step(-1), outside_count(0)
+    Fix(lmp, narg, arg), dt(0.0), restart_steps(-1), nv(NV), chunk_rows(CHUNK_ROWS), frames_written(0), restart_stage(0.25f),
+    outside_step(-1), outside_count(0), nonfinite_xyz(0), nonfinite_res(0)
 {
   const std::string usage =
       "fix ID group fibrenet/output PREFIX dt DT box LX LY LZ names N1 .. Nntypes "
       "[files coord vel force] [only T ...|none] velocity v_x v_y v_z force v_x v_y v_z "
-      "restart N|no";
+      "restart N|no [dump FILE radius v_r mass v_m] [chunk ROWS]";
   if (narg < 4) error->all(FLERR, "Illegal fix fibrenet/output command: {}", usage);
   if (!atom->tag_enable) error->all(FLERR, "Fix fibrenet/output needs atom IDs");
   if (domain->triclinic) error->all(FLERR, "Fix fibrenet/output needs an orthogonal box");
@@ -275,6 +303,22 @@ FixFibreNetOutput::FixFibreNetOutput(LAMMPS *lmp, int narg, char **arg) :
       }
       have_restart = true;
       iarg += 2;
+    } else if (key == "chunk") {
+      need(iarg, 1, "chunk");
+      chunk_rows = utils::bnumeric(FLERR, arg[iarg + 1], false, lmp);
+      if (chunk_rows < 1) error->all(FLERR, "Fix fibrenet/output: chunk needs a number of rows >= 1");
+      iarg += 2;
+    } else if (key == "dump") {
+      need(iarg, 5, "dump");
+      dump_path = arg[iarg + 1];
+      if (dump_path.empty() || strcmp(arg[iarg + 2], "radius") != 0 || strcmp(arg[iarg + 4], "mass") != 0 ||
+          !utils::strmatch(arg[iarg + 3], "^v_.") || !utils::strmatch(arg[iarg + 5], "^v_."))
+        error->all(FLERR, "Fix fibrenet/output: dump needs FILE radius v_name mass v_name; usage: {}",
+                   usage);
+      radius_var = std::string(arg[iarg + 3]).substr(2);
+      mass_var = std::string(arg[iarg + 5]).substr(2);
+      nv = NV_DUMP;
+      iarg += 6;
     } else {
       error->all(FLERR, "Fix fibrenet/output: unknown keyword {}; usage: {}", key, usage);
     }
@@ -285,7 +329,7 @@ FixFibreNetOutput::FixFibreNetOutput(LAMMPS *lmp, int narg, char **arg) :
 
   restart_global = 1;
   vector_flag = 1;
-  size_vector = 2;
+  size_vector = 3;
   global_freq = 1;
   extvector = 0;
 }
@@ -297,6 +341,7 @@ int FixFibreNetOutput::setmask()
 
 double FixFibreNetOutput::compute_vector(int i)
 {
+  if (i == 2) return static_cast<double>(nonfinite_xyz + nonfinite_res);
   return i == 0 ? static_cast<double>(outside_step) : static_cast<double>(outside_count);
 }
 
@@ -305,21 +350,24 @@ double FixFibreNetOutput::compute_vector(int i)
 void FixFibreNetOutput::write_restart(FILE *fp)
 {
   if (comm->me != 0) return;
-  double list[4] = {static_cast<double>(frames_written), static_cast<double>(restart_stage),
-                    static_cast<double>(outside_step), static_cast<double>(outside_count)};
+  double list[6] = {static_cast<double>(frames_written), static_cast<double>(restart_stage),
+                    static_cast<double>(outside_step), static_cast<double>(outside_count),
+                    static_cast<double>(nonfinite_xyz), static_cast<double>(nonfinite_res)};
   int size = sizeof(list);
   fwrite(&size, sizeof(int), 1, fp);
-  fwrite(list, sizeof(double), 4, fp);
+  fwrite(list, sizeof(double), 6, fp);
 }
 
 void FixFibreNetOutput::restart(char *buf)
 {
-  double list[4];
+  double list[6];
   memcpy(list, buf, sizeof(list));
   frames_written = static_cast<bigint>(list[0]);
   restart_stage = static_cast<float>(list[1]);
   outside_step = static_cast<bigint>(list[2]);
   outside_count = static_cast<bigint>(list[3]);
+  nonfinite_xyz = static_cast<bigint>(list[4]);
+  nonfinite_res = static_cast<bigint>(list[5]);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -352,16 +400,21 @@ bool FixFibreNetOutput::restart_due(bigint step)
 void FixFibreNetOutput::write_frame()
 {
   const int nlocal = atom->nlocal;
-  values.resize(6 * static_cast<size_t>(std::max(nlocal, 1)));
+  const int nvar = nv - 8;    // per-atom variables: velocity, force [, radius, mass]
+  values.resize(nvar * static_cast<size_t>(std::max(nlocal, 1)));
   for (int k = 0; k < 3; k++) {
     evaluate(vel_var[k], &values[k * static_cast<size_t>(nlocal)]);
     evaluate(force_var[k], &values[(3 + k) * static_cast<size_t>(nlocal)]);
+  }
+  if (nv == NV_DUMP) {
+    evaluate(radius_var, &values[6 * static_cast<size_t>(nlocal)]);
+    evaluate(mass_var, &values[7 * static_cast<size_t>(nlocal)]);
   }
 
   int mine = 0;
   for (int i = 0; i < nlocal; i++)
     if (atom->mask[i] & groupbit) mine++;
-  send.resize(NV * static_cast<size_t>(std::max(mine, 1)));
+  send.resize(nv * static_cast<size_t>(std::max(mine, 1)));
   double *s = send.data();
   const tagint *tag = atom->tag;
   const int *type = atom->type;
@@ -378,15 +431,15 @@ void FixFibreNetOutput::write_frame()
     s[5] = static_cast<double>((image[i] & IMGMASK) - IMGMAX);
     s[6] = static_cast<double>((image[i] >> IMGBITS & IMGMASK) - IMGMAX);
     s[7] = static_cast<double>((image[i] >> IMG2BITS) - IMGMAX);
-    for (int k = 0; k < 6; k++) s[8 + k] = values[k * static_cast<size_t>(nlocal) + i];
-    s += NV;
+    for (int k = 0; k < nvar; k++) s[8 + k] = values[k * static_cast<size_t>(nlocal) + i];
+    s += nv;
   }
 
   // every rank's atoms to rank 0
   const int me = comm->me, nprocs = comm->nprocs;
-  if (static_cast<bigint>(mine) * NV > MAXSMALLINT)
+  if (static_cast<bigint>(mine) * nv > MAXSMALLINT)
     error->one(FLERR, "Fix fibrenet/output: too many atoms on one rank to gather");
-  int count = mine * NV;
+  int count = mine * nv;
   std::vector<int> counts(me == 0 ? nprocs : 1), displs(me == 0 ? nprocs : 1);
   MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, world);
   bigint total = 0;
@@ -405,8 +458,51 @@ void FixFibreNetOutput::write_frame()
 
   const bigint step = update->ntimestep;
   const bool restart_now = restart_due(step);
+  const bigint n = total / nv;
+  const int nr = nv + 6;
+  if (n * nr > MAXSMALLINT)
+    error->all(FLERR, "Fix fibrenet/output: too many atoms to gather on one rank");
+
+  // rank 0: the rows in id order, with their positions, cut into chunks; chunk c is formatted
+  // by rank c % nprocs, and the rows go to their ranks (rank 0's own chunks stay in place)
+  const bigint nchunks = (n + chunk_rows - 1) / chunk_rows;
+  bigint kept = 0;
+  std::vector<int> row_counts(me == 0 ? nprocs : 1), row_displs(me == 0 ? nprocs : 1);
+  if (me == 0) {
+    kept = sort_rows(n, step);
+    bigint at = 0;
+    for (int p = 0; p < nprocs; p++) {
+      row_displs[p] = static_cast<int>(at * nr);
+      for (bigint c = p; c < nchunks; c += nprocs) at += chunk_size(c, n);
+      row_counts[p] = static_cast<int>(at * nr) - row_displs[p];
+    }
+  }
+  bigint my_rows = 0;
+  for (bigint c = me; c < nchunks; c += nprocs) my_rows += chunk_size(c, n);
+  if (nprocs > 1) {
+    if (me == 0) {
+      MPI_Scatterv(rows.data(), row_counts.data(), row_displs.data(), MPI_DOUBLE, MPI_IN_PLACE, 0,
+                   MPI_DOUBLE, 0, world);
+    } else {
+      rows.resize(static_cast<size_t>(std::max<bigint>(my_rows * nr, 1)));
+      MPI_Scatterv(nullptr, nullptr, nullptr, MPI_DOUBLE, rows.data(),
+                   static_cast<int>(my_rows * nr), MPI_DOUBLE, 0, world);
+    }
+  }
+
   std::string failure;
-  if (me == 0) failure = write_files(recv, total / NV, step, restart_now);
+  if (me == 0) {
+    failure = write_files(n, kept, step, restart_now);
+  } else {
+    // this rank's chunks, formatted in order; each sent to rank 0 (which writes them in order)
+    const double *r = rows.data();
+    for (bigint c = me; c < nchunks; c += nprocs) {
+      const bigint size = chunk_size(c, n);
+      format_rows(r, size, restart_now, text);
+      send_text(text);
+      r += size * nr;
+    }
+  }
 
   // rank 0's outcome to every rank: a failure ends the run everywhere with its message
   int len = static_cast<int>(failure.size());
@@ -416,25 +512,44 @@ void FixFibreNetOutput::write_frame()
     MPI_Bcast(&failure[0], len, MPI_CHAR, 0, world);
     error->all(FLERR, failure);
   }
-  bigint outside[2] = {outside_step, outside_count};
-  MPI_Bcast(outside, 2, MPI_LMP_BIGINT, 0, world);
+  bigint outside[4] = {outside_step, outside_count, nonfinite_xyz, nonfinite_res};
+  MPI_Bcast(outside, 4, MPI_LMP_BIGINT, 0, world);
   outside_step = outside[0];
   outside_count = outside[1];
+  nonfinite_xyz = outside[2];
+  nonfinite_res = outside[3];
   frames_written++;
 }
 
-// rank 0: format and write the frame; the failure message, or "" on success
-std::string FixFibreNetOutput::write_files(const std::vector<double> &rec, bigint n, bigint step,
-                                           bool restart_now)
+// ids 1..n each once (FibreNet's beads; the usual case on several ranks): order[id - 1] = row,
+// in one pass instead of a sort; false (order unspecified) for any other set of ids
+bool FixFibreNetOutput::place_by_tag(std::vector<bigint> &order) const
 {
-  // atoms in id order, as the dump's "modify sort id"
+  const bigint n = static_cast<bigint>(order.size());
+  std::fill(order.begin(), order.end(), -1);
+  for (bigint k = 0; k < n; k++) {
+    const auto id = static_cast<bigint>(recv[k * nv]);
+    if (id < 1 || id > n || order[id - 1] >= 0) return false;
+    order[id - 1] = k;
+  }
+  return true;
+}
+
+// rank 0: the gathered atoms as rows in id order (as the dump's "modify sort id"), each the
+// gathered values and the wrapped and unwrapped position, stored chunk by chunk in the order
+// of the ranks that format them (rank 0's chunks first); the wall check; returns how many
+// rows the xyz files keep
+bigint FixFibreNetOutput::sort_rows(bigint n, bigint step)
+{
   std::vector<bigint> order(n);
   std::iota(order.begin(), order.end(), 0);
   bool sorted = true;
-  for (bigint k = 1; k < n && sorted; k++) sorted = rec[k * NV] > rec[(k - 1) * NV];
-  if (!sorted)
+  for (bigint k = 1; k < n && sorted; k++) sorted = recv[k * nv] > recv[(k - 1) * nv];
+  if (!sorted && !place_by_tag(order)) {
+    std::iota(order.begin(), order.end(), 0);
     std::sort(order.begin(), order.end(),
-              [&rec](bigint a, bigint b) { return rec[a * NV] < rec[b * NV]; });
+              [this](bigint a, bigint b) { return recv[a * nv] < recv[b * nv]; });
+  }
 
   // positions as the converter computes them from the dump's x and image flags
   double lo[3], len[3];
@@ -442,152 +557,251 @@ std::string FixFibreNetOutput::write_files(const std::vector<double> &rec, bigin
     lo[d] = domain->boxlo[d];
     len[d] = domain->boxhi[d] - domain->boxlo[d];
   }
-  std::vector<double> wrapped(3 * n), unwrapped(3 * n);
-  for (bigint k = 0; k < n; k++) {
-    const double *r = &rec[order[k] * NV];
-    for (int d = 0; d < 3; d++) {
-      const double u = r[2 + d] + r[5 + d] * len[d];
-      unwrapped[3 * k + d] = u;
-      wrapped[3 * k + d] = domain->periodicity[d] ? lo[d] + py_mod(u - lo[d], len[d]) : r[2 + d];
+  const int nr = nv + 6, nprocs = comm->nprocs;
+  const bigint nchunks = (n + chunk_rows - 1) / chunk_rows;
+  rows.resize(static_cast<size_t>(std::max<bigint>(n * nr, 1)));
+  bigint pos = 0, kept = 0, outside = 0;
+  for (int p = 0; p < nprocs; p++) {
+    for (bigint c = p; c < nchunks; c += nprocs) {
+      for (bigint k = c * chunk_rows; k < c * chunk_rows + chunk_size(c, n); k++) {
+        const double *r = &recv[order[k] * nv];
+        double *w = &rows[pos++ * nr];
+        std::copy(r, r + nv, w);
+        bool out = false;
+        for (int d = 0; d < 3; d++) {
+          const double u = r[2 + d] + r[5 + d] * len[d];
+          w[nv + 3 + d] = u;
+          w[nv + d] = domain->periodicity[d] ? lo[d] + py_mod(u - lo[d], len[d]) : r[2 + d];
+          if (!domain->periodicity[d] && (w[nv + d] < 0 || w[nv + d] >= box[d])) out = true;
+        }
+        outside += out;
+        kept += in_xyz[static_cast<int>(r[1])];
+      }
     }
   }
-
   // FibreNet drops beads outside [0, L) on a walled axis from its contact grid: the first
   // frame where that happens is reported (to_fibrenet.outside_finite_box)
-  if (outside_step < 0) {
-    bigint outside = 0;
-    for (bigint k = 0; k < n; k++) {
-      bool out = false;
-      for (int d = 0; d < 3; d++)
-        if (!domain->periodicity[d]) {
-          const double w = wrapped[3 * k + d];
-          if (w < 0 || w >= box[d]) out = true;
-        }
-      outside += out;
-    }
-    if (outside) {
-      outside_step = step;
-      outside_count = outside;
-    }
+  if (outside_step < 0 && outside) {
+    outside_step = step;
+    outside_count = outside;
   }
+  return kept;
+}
 
-  std::string body[3];
-  bool any = files[COORD] || files[VEL] || files[FORCE];
-  if (any) {
-    bigint kept = 0;
-    for (bigint k = 0; k < n; k++) kept += in_xyz[static_cast<int>(rec[order[k] * NV + 1])];
-    std::string head;
-    put_int(head, kept);
-    head += "\nFRAME\t";
-    put_int(head, step);
-    for (double v : {dt, box[0], box[1], box[2]}) {
-      head += '\t';
-      put_fixed5(head, v);
-    }
-    head += '\n';
-    for (int f = 0; f < 3; f++) {
-      if (!files[f]) continue;
-      std::string &out = body[f];
-      out.reserve(head.size() + static_cast<size_t>(kept) * 48);
-      out = head;
-      for (bigint k = 0; k < n; k++) {
-        const double *r = &rec[order[k] * NV];
-        const int t = static_cast<int>(r[1]);
-        if (!in_xyz[t]) continue;
-        const double *v = f == COORD ? &wrapped[3 * k] : (f == VEL ? r + 8 : r + 11);
-        out += type_names[t];
+// any rank: the lines of `count` rows in every file of the frame
+void FixFibreNetOutput::format_rows(const double *rows_, bigint count, bool restart_now,
+                                    FrameText &t) const
+{
+  const int nr = nv + 6;
+  for (auto &s : t.xyz) s.clear();
+  t.res.clear();
+  t.dump.clear();
+  t.bad_xyz = t.bad_res = 0;
+  for (int f = 0; f < 3; f++)
+    if (files[f]) t.xyz[f].reserve(static_cast<size_t>(count) * 48);
+  if (restart_now) t.res.reserve(static_cast<size_t>(count) * 160);
+  if (!dump_path.empty()) t.dump.reserve(static_cast<size_t>(count) * 330);
+  for (bigint k = 0; k < count; k++) {
+    const double *r = rows_ + k * nr;
+    const double *wrapped = r + nv, *unwrapped = r + nv + 3;
+    const int type = static_cast<int>(r[1]);
+    const std::string &name = type_names[type];
+    if (in_xyz[type]) {
+      for (int f = 0; f < 3; f++) {
+        if (!files[f]) continue;
+        const double *v = f == COORD ? wrapped : (f == VEL ? r + 8 : r + 11);
+        std::string &out = t.xyz[f];
+        out += name;
         for (int d = 0; d < 3; d++) {
           out += '\t';
           put_fixed5(out, v[d]);
+          t.bad_xyz += !std::isfinite(v[d]);
         }
         out += '\n';
       }
     }
-  }
-
-  std::string res;
-  if (restart_now) {
-    put_int(res, n);
-    res += "\nFRAME\t";
-    put_int(res, step);
-    for (double v : {dt, box[0], box[1], box[2]}) {
-      res += '\t';
-      put_g(res, v);
+    if (restart_now) {
+      t.res += '\t';
+      t.res += name;
+      for (const double *part : {wrapped, unwrapped, r + 8, r + 11}) {
+        for (int d = 0; d < 3; d++) {
+          t.res += '\t';
+          put_g(t.res, part[d]);
+          t.bad_res += !std::isfinite(part[d]);
+        }
+      }
+      t.res += '\n';
     }
-    res += '\n';
-    for (bigint k = 0; k < n; k++) {
-      const double *r = &rec[order[k] * NV];
-      res += '\t';
-      res += type_names[static_cast<int>(r[1])];
-      for (int d = 0; d < 3; d++) {
-        res += '\t';
-        put_g(res, wrapped[3 * k + d]);
+    if (!dump_path.empty()) {
+      put_int(t.dump, static_cast<bigint>(r[0]));    // id, type
+      t.dump += ' ';
+      put_int(t.dump, static_cast<bigint>(r[1]));
+      for (int j = 2; j < nv; j++) {
+        t.dump += ' ';
+        if (j >= 5 && j <= 7)
+          put_int(t.dump, static_cast<bigint>(r[j]));    // image flags
+        else
+          put_g17(t.dump, r[j]);
       }
-      for (int d = 0; d < 3; d++) {
-        res += '\t';
-        put_g(res, unwrapped[3 * k + d]);
-      }
-      for (int j = 8; j < 14; j++) {
-        res += '\t';
-        put_g(res, r[j]);
-      }
-      res += '\n';
+      t.dump += '\n';
     }
   }
+}
 
-  // ---- the files: xyz appended (truncated at this job's first frame), every write cut back
-  // when any part of the frame fails; the restart file through a temp file and a rename
+// a chunk's text to rank 0, and its receipt there (strings in pieces below 2^30 bytes)
+void FixFibreNetOutput::send_text(FrameText &t)
+{
+  std::string *parts[5] = {&t.xyz[0], &t.xyz[1], &t.xyz[2], &t.res, &t.dump};
+  bigint head[7];
+  for (int k = 0; k < 5; k++) head[k] = static_cast<bigint>(parts[k]->size());
+  head[5] = t.bad_xyz;
+  head[6] = t.bad_res;
+  MPI_Send(head, 7, MPI_LMP_BIGINT, 0, 0, world);
+  for (auto *s : parts)
+    for (size_t at = 0; at < s->size(); at += TEXT_PIECE)
+      MPI_Send(&(*s)[at], static_cast<int>(std::min(TEXT_PIECE, s->size() - at)), MPI_CHAR, 0, 0, world);
+}
+
+void FixFibreNetOutput::receive_text(int from, FrameText &t)
+{
+  std::string *parts[5] = {&t.xyz[0], &t.xyz[1], &t.xyz[2], &t.res, &t.dump};
+  bigint head[7];
+  MPI_Recv(head, 7, MPI_LMP_BIGINT, from, 0, world, MPI_STATUS_IGNORE);
+  for (int k = 0; k < 5; k++) {
+    std::string &s = *parts[k];
+    s.resize(static_cast<size_t>(head[k]));
+    for (size_t at = 0; at < s.size(); at += TEXT_PIECE)
+      MPI_Recv(&s[at], static_cast<int>(std::min(TEXT_PIECE, s.size() - at)), MPI_CHAR, from, 0,
+               world, MPI_STATUS_IGNORE);
+  }
+  t.bad_xyz = head[5];
+  t.bad_res = head[6];
+}
+
+// rank 0: the frame written chunk by chunk (its own chunks formatted here, the others'
+// received in order); xyz files and the work dump appended (truncated at this job's first
+// frame) and cut back if any write fails, the restart file through a temp file and a rename.
+// Every chunk is received even after a failure (the other ranks are sending).  Returns the
+// failure message, or "" on success.
+std::string FixFibreNetOutput::write_files(bigint n, bigint kept, bigint step, bool restart_now)
+{
   const bool first = frames_written == 0;
   const std::string restart_path = prefix + RESTART_SUFFIX;
   if (first && restart_steps >= 0) ::unlink(restart_path.c_str());    // not a stale run's
-  struct Written {
-    std::string path;
-    off_t size;
+  std::string failure;
+  auto fail = [&failure](const std::string &path, int err) {
+    if (failure.empty()) failure = fmt::format("Fix fibrenet/output: cannot write {}: {}", path, reason(err));
   };
-  std::vector<Written> done;
-  auto undo = [&done]() {
-    for (const auto &w : done) {
-      if (::truncate(w.path.c_str(), w.size) != 0) {
-        // nothing more to do: the error reported names the file that failed first
-      }
-    }
-  };
-  for (int f = 0; f < 3; f++) {
-    if (!files[f]) continue;
-    const std::string path = prefix + XYZ_SUFFIX[f];
-    const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | (first ? O_TRUNC : O_APPEND), 0666);
-    if (fd < 0) {
-      const int err = errno;
-      undo();
-      return fmt::format("Fix fibrenet/output: cannot write {}: {}", path, reason(err));
-    }
-    struct stat st;
-    off_t size = 0;
-    if (::fstat(fd, &st) == 0) size = st.st_size;
-    done.push_back({path, size});
-    int err = write_all(fd, body[f]);
-    if (::close(fd) != 0 && !err) err = errno;
-    if (err) {
-      undo();
-      return fmt::format("Fix fibrenet/output: cannot write {}: {}", path, reason(err));
-    }
+
+  // the files: 0-2 the xyz files, 3 the restart file's temp file, 4 the work dump
+  std::string paths[5], heads[5];
+  int fds[5] = {-1, -1, -1, -1, -1};
+  off_t sizes[5] = {0, 0, 0, 0, 0};
+  std::string xyz_head;
+  put_int(xyz_head, kept);
+  xyz_head += "\nFRAME\t";
+  put_int(xyz_head, step);
+  for (double v : {dt, box[0], box[1], box[2]}) {
+    xyz_head += '\t';
+    put_fixed5(xyz_head, v);
   }
+  xyz_head += '\n';
+  for (int f = 0; f < 3; f++)
+    if (files[f]) {
+      paths[f] = prefix + XYZ_SUFFIX[f];
+      heads[f] = xyz_head;
+    }
   if (restart_now) {
     const size_t slash = restart_path.rfind('/');
     const std::string folder = slash == std::string::npos ? "" : restart_path.substr(0, slash + 1);
     const std::string name = slash == std::string::npos ? restart_path : restart_path.substr(slash + 1);
-    const std::string tmp = fmt::format("{}.{}.tmp{}", folder, name, static_cast<long>(::getpid()));
-    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0666);
-    int err = fd < 0 ? errno : write_all(fd, res);
-    if (fd >= 0 && ::close(fd) != 0 && !err) err = errno;
-    if (!err && ::rename(tmp.c_str(), restart_path.c_str()) != 0) err = errno;
-    if (err) {
-      ::unlink(tmp.c_str());
-      undo();
-      return fmt::format("Fix fibrenet/output: cannot write {}: {}", restart_path, reason(err));
+    paths[3] = fmt::format("{}.{}.tmp{}", folder, name, static_cast<long>(::getpid()));
+    put_int(heads[3], n);
+    heads[3] += "\nFRAME\t";
+    put_int(heads[3], step);
+    for (double v : {dt, box[0], box[1], box[2]}) {
+      heads[3] += '\t';
+      put_g(heads[3], v);
     }
+    heads[3] += '\n';
   }
+  if (!dump_path.empty()) {
+    paths[4] = dump_path;
+    heads[4] = dump_head(n);
+  }
+  for (int k = 0; k < 5 && failure.empty(); k++) {
+    if (paths[k].empty()) continue;
+    const bool append = k != 3 && !first;
+    fds[k] = ::open(paths[k].c_str(), O_WRONLY | O_CREAT | (append ? O_APPEND : O_TRUNC), 0666);
+    if (fds[k] < 0) {
+      fail(k == 3 ? restart_path : paths[k], errno);
+      break;
+    }
+    struct stat st;
+    if (::fstat(fds[k], &st) == 0) sizes[k] = st.st_size;
+  }
+  auto put = [&](int k, const std::string &data) {
+    if (fds[k] < 0 || !failure.empty()) return;
+    const int err = write_all(fds[k], data);
+    if (err) fail(k == 3 ? restart_path : paths[k], err);
+  };
+  for (int k = 0; k < 5; k++) put(k, heads[k]);
+
+  const int nr = nv + 6, nprocs = comm->nprocs;
+  const bigint nchunks = (n + chunk_rows - 1) / chunk_rows;
+  const double *own = rows.data();
+  bigint bad_xyz = 0, bad_res = 0;
+  for (bigint c = 0; c < nchunks; c++) {
+    const int owner = static_cast<int>(c % nprocs);
+    if (owner == 0) {
+      format_rows(own, chunk_size(c, n), restart_now, text);
+      own += chunk_size(c, n) * nr;
+    } else {
+      receive_text(owner, text);
+    }
+    for (int f = 0; f < 3; f++) put(f, text.xyz[f]);
+    put(3, text.res);
+    put(4, text.dump);
+    bad_xyz += text.bad_xyz;
+    bad_res += text.bad_res;
+  }
+
+  for (int k = 0; k < 5; k++)
+    if (fds[k] >= 0 && ::close(fds[k]) != 0) fail(k == 3 ? restart_path : paths[k], errno);
+  if (failure.empty() && restart_now && ::rename(paths[3].c_str(), restart_path.c_str()) != 0)
+    fail(restart_path, errno);
+  if (!failure.empty()) {
+    if (restart_now) ::unlink(paths[3].c_str());
+    for (int k : {0, 1, 2, 4}) {
+      if (fds[k] >= 0 && ::truncate(paths[k].c_str(), sizes[k]) != 0) {
+        // nothing more to do: the error reported names the file that failed first
+      }
+    }
+    return failure;
+  }
+  nonfinite_xyz += bad_xyz;
+  if (restart_now) nonfinite_res = bad_res;    // the file holds this frame only
   return "";
+}
+
+// the work dump's frame header as write_dump custom writes it (Dump::header_item's formats)
+std::string FixFibreNetOutput::dump_head(bigint n) const
+{
+  // Domain::boundary_string's letters: p f s m per face, "xx yy zz"
+  std::string bounds;
+  for (int d = 0; d < 3; d++) {
+    if (d) bounds += ' ';
+    for (int side = 0; side < 2; side++) bounds += "pfsm"[domain->boundary[d][side] & 3];
+  }
+  const double time =
+      update->atime + static_cast<double>(update->ntimestep - update->atimestep) * update->dt;
+  std::string out = fmt::format("ITEM: TIME\n{:.16}\n", time);
+  out += fmt::format("ITEM: TIMESTEP\n{}\nITEM: NUMBER OF ATOMS\n{}\n", update->ntimestep, n);
+  out += fmt::format("ITEM: BOX BOUNDS {}\n{:>1.16e} {:>1.16e}\n{:>1.16e} {:>1.16e}\n{:>1.16e} {:>1.16e}\n",
+                     bounds, domain->boxlo[0], domain->boxhi[0], domain->boxlo[1], domain->boxhi[1],
+                     domain->boxlo[2], domain->boxhi[2]);
+  out += "ITEM: ATOMS id type x y z ix iy iz vx vy vz fx fy fz radius mass\n";
+  return out;
 }
 
 /* ---------------------------------------------------------------------- */

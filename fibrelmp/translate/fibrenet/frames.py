@@ -7,20 +7,22 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Iterator
 
 from fibrelmp.errors import wrong_frame
+from fibrelmp.runplan import FRAME_COMMANDS
 
 if TYPE_CHECKING:
     from fibrelmp.post.lammps_dump.reader import Frame
 
 
 class DumpFrames:
-    """The frames of the job's dump (``write_dump`` commands), read as LAMMPS writes them."""
+    """The frames of the job's dump (``write_dump``, or ``fibrenet/frame`` when fix
+    fibrenet/output writes the dump), read as LAMMPS writes them."""
 
     def __init__(self, path: Path):
         self.path = path
         self.frames: Iterator["Frame"] | None = None
 
     def is_frame(self, words: list[str]) -> bool:
-        return words[0] == "write_dump"
+        return words[0] in FRAME_COMMANDS
 
     def read(self, step: int) -> "Frame":
         from fibrelmp.post.lammps_dump.reader import iter_frames
@@ -38,11 +40,11 @@ class DumpFrames:
 
 
 class WrittenFrames:
-    """The frames of a job that writes FibreNet's files itself: every ``write_dump`` is
-    followed by ``fibrenet/frame``, so nothing is read back (the schedule is still checked)."""
+    """The frames of a job that writes FibreNet's files (and its work dump) itself with
+    ``fibrenet/frame``: nothing is read back (the schedule is still checked)."""
 
     def is_frame(self, words: list[str]) -> bool:
-        return words[0] == "write_dump"
+        return words[0] == "fibrenet/frame"
 
     def read(self, step: int) -> int:
         return step

@@ -32,7 +32,7 @@ def render(model: "Model"):
         if job.native is None:
             return Rendered(job, job.text, job.output_steps, [job.frames])
         return Rendered(job, job.text, job.output_steps, [job.frames, *job.native.xyz],
-                        finished=report_outside(model))
+                        finished=report_outside(model, job.native))
     return build
 
 
@@ -73,7 +73,13 @@ def _move_native(native, folder: Path, prefix: str, fields) -> Consumer:
                 raise RunError(f"{src}: the job did not write this FibreNet file (fix fibrenet/output)")
         from fibrelmp.finite import scan_text_files
 
-        scan_text_files(src for src, _ in moves)      # nan/inf: nothing moves into place
+        # nan/inf: nothing moves into place (the fix counted them as it wrote; the files are
+        # searched for the line to name only then, or when the count is unknown)
+        if native.nonfinite != 0:
+            scan_text_files(src for src, _ in moves)
+            if native.nonfinite:        # counted, yet the search named no line: still refused
+                raise RunError(f"{native.restart.parent}: the simulation produced {native.nonfinite} "
+                               "nan/inf values in FibreNet's files: no results written")
         for src, dst in moves:
             move_file(src, dst)
         return [dst for _, dst in moves]

@@ -295,13 +295,17 @@ def convert_frames(model: Model, job: Job, frames: Iterator[Frame], folder: Path
                           model.box.lengths, types, warn=model.warn)
 
 
-def report_outside(model: Model):
+def report_outside(model: Model, native=None):
     """After a run whose job wrote FibreNet's files itself: the fix's wall check (the
-    warning ``outside_message`` the converter gives when it reads the frames itself)."""
+    warning ``outside_message`` the converter gives when it reads the frames itself), and
+    how many nan/inf values it wrote into them (``native.nonfinite``: the files are searched
+    for their lines only when there are any)."""
     def finished(lmp) -> None:
         from fibrelmp.translate.lammps_job import OUTPUT_FIX
 
-        step, count = (int(lmp.extract_fix(OUTPUT_FIX, 0, 1, k)) for k in (0, 1))   # global vector
+        step, count, bad = (int(lmp.extract_fix(OUTPUT_FIX, 0, 1, k)) for k in (0, 1, 2))   # global vector
         if step >= 0:
             model.warn(OUTSIDE_KIND, outside_message(step, count, model.box.lengths))
+        if native is not None:
+            native.nonfinite = bad
     return finished

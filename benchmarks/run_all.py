@@ -71,8 +71,8 @@ BENCHES = [
     Bench("musen_models_cost", "per-contact cost of the 33 cmusen models: fibrelmp / cmusen -t=1 (worst model)",
           r"worst fibrelmp / cmusen per-contact ratio: ([0-9.]+)", "<= 1.0", ["--quick"],
           needs="FIBRELMP_CMUSEN"),
-    Bench("vs_real_codes", "real FibreNet, 2 PoCL threads / best fibrelmp 1|2 ranks (worst of 5k/50k/260k)",
-          r"worst FibreNet ratio, real / best fibrelmp: ([0-9.]+)", ">= 1.5", ["--quick", "--repeat", "1"],
+    Bench("vs_real_codes", "real FibreNet, 2 PoCL threads / best fibrelmp 1|2 ranks (worst of 5k/50k/260k/2.6M)",
+          r"worst FibreNet ratio, real / best fibrelmp: ([0-9.]+)", ">= 3", ["--quick", "--repeat", "1"],
           needs="FIBRELMP_FIBRENET"),
 ]
 

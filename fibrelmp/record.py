@@ -276,8 +276,15 @@ def largest_strain(ids: np.ndarray, x: np.ndarray, bonds: np.ndarray, rest: np.n
     strain (stretched > 0) and its beads' ids; None without springs."""
     if not len(bonds):
         return None
-    order = np.argsort(ids)
-    rows = order[np.searchsorted(ids[order], bonds[:, 1:])]
+    ids = np.asarray(ids)
+    if len(ids) and ids.min() == 1 and ids.max() == len(ids):
+        # LAMMPS's ids are unique: ids 1..n are a permutation, so each id's row is direct
+        row_of = np.empty(len(ids) + 1, dtype=np.int64)
+        row_of[ids] = np.arange(len(ids))
+        rows = row_of[bonds[:, 1:]]
+    else:
+        order = np.argsort(ids)
+        rows = order[np.searchsorted(ids[order], bonds[:, 1:])]
     d = _min_image_diff(x, lo, hi, periodic)(rows[:, 0], rows[:, 1])
     r0 = np.asarray(rest, float)[bonds[:, 0] - 1]
     strain = (np.sqrt((d * d).sum(1)) - r0) / r0

@@ -487,3 +487,27 @@ def test_hint_without_a_warning_and_none_for_other_errors():
     hint = blow_up_hint(model, "in.lammps:70: LAMMPS error: ERROR on proc 0: Lost atoms: original 128 current 127")
     assert hint is not None and "fibrelmp check" in hint and "spring period" in hint
     assert blow_up_hint(model, "in.lammps:3: LAMMPS error: Unknown pair style") is None
+
+
+@pytest.mark.parametrize("ids", [np.arange(1, 9), np.array([8, 3, 1, 7, 2, 6, 5, 4]),
+                                 np.array([40, 3, 11, 7, 2, 6, 5, 4])])
+def test_largest_strain_finds_the_beads_by_id_whatever_their_order(ids):
+    """Rows in any order of the ids (dense 1..n: direct lookup; sparse: a search) give the
+    strain a loop over the springs computes (periodic x: minimum image)."""
+    from fibrelmp.record import largest_strain
+
+    rng = np.random.default_rng(3)
+    x = rng.uniform(0, 10, (len(ids), 3))
+    lo, hi, periodic = np.zeros(3), np.full(3, 10.0), np.array([True, False, False])
+    pairs = [(ids[0], ids[1]), (ids[2], ids[5]), (ids[7], ids[4]), (ids[3], ids[6])]
+    bonds = np.array([[t + 1, a, b] for t, (a, b) in enumerate(pairs)])
+    rest = [1.0, 2.0, 0.5, 3.0]
+    expected = []
+    for (a, b), r0 in zip(pairs, rest):
+        d = x[list(ids).index(a)] - x[list(ids).index(b)]
+        d[0] -= 10.0 * round(d[0] / 10.0)
+        expected.append((math.sqrt(float(d @ d)) - r0) / r0)
+    k = int(np.argmax(np.abs(expected)))
+    got = largest_strain(ids, x, bonds, np.array(rest), lo, hi, periodic)
+    assert got["value"] == pytest.approx(expected[k], rel=1e-12)
+    assert got["ids"] == sorted(int(v) for v in pairs[k])

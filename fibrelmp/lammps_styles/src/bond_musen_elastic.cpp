@@ -363,10 +363,12 @@ void thermal_tangential_damping(const LawInput &in, const double *tangentialVelo
    plastic laws' normal force) at the current positions.  fresh (not advancing): a bond's
    first evaluation, which has no stored damping or plastic normal force: compute and store
    them from the current positions and velocities. */
-void musen_law(const LawInput &in, double *h, bool advance, bool fresh, LawOutput &out)
+template <int FORM>
+void musen_law_of(const LawInput &in, double *h, bool advance, bool fresh, LawOutput &out)
 {
   using B = BondMusenElastic;
-  const int form = in.law->form;
+  // FORM >= 0: compiled for that law alone (its branches folded away; the same operations)
+  const int form = FORM >= 0 ? FORM : in.law->form;
   const bool kelvin = form == B::KELVIN;
   // ModelSBThermal: the elastic bond with its rest length growing in time, MU-damped
   const bool thermal = form == B::THERMAL;
@@ -534,6 +536,15 @@ void musen_law(const LawInput &in, double *h, bool advance, bool fresh, LawOutpu
   out.normal_force_length = length(normalForce);
   out.normal_scalar = normal_scalar;
   out.tangential_force_length = length(tangentialForce);
+}
+
+// MUSEN's elastic bond (the common case) compiled on its own, every other law by the general code
+void musen_law(const LawInput &in, double *h, bool advance, bool fresh, LawOutput &out)
+{
+  if (in.law->form == BondMusenElastic::ELASTIC)
+    musen_law_of<BondMusenElastic::ELASTIC>(in, h, advance, fresh, out);
+  else
+    musen_law_of<-1>(in, h, advance, fresh, out);
 }
 
 // MUSEN's stress breakage test (ModelSBElastic: CONSIDER_BREAKAGE 1 and 2; ModelSBKelvin,

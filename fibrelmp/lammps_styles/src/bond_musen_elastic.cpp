@@ -20,6 +20,7 @@
 ------------------------------------------------------------------------- */
 
 #include "bond_musen_elastic.h"
+#include "lammps_time.h"
 #include "style_registry.h"
 #include "musen_startup.h"
 
@@ -710,7 +711,7 @@ bool BondMusenElastic::apply_laws(int i1, int i2, int type, double *h, bool adva
   in.wl = atom->omega[i1];
   in.wr = atom->omega[i2];
   in.dt = update->dt;
-  in.time = update->atime + static_cast<double>(update->ntimestep - update->atimestep) * update->dt;
+  in.time = simulation_time(update);
   in.E = youngs[type];
   in.G = shear[type];
   in.mu = viscosity[type];
@@ -884,7 +885,7 @@ void BondMusenElastic::process_breaks()
   atom->nbonds -= nbroken;
   if (comm->me == 0 && breaks_fp && timed_breaks) {
     // MUSEN's time of this evaluation (the fix keeps atime at it: atimestep is this step)
-    const double t = update->atime + (update->ntimestep - update->atimestep) * update->dt;
+    const double t = simulation_time(update);
     for (const auto &r : rec) utils::print(breaks_fp, "{} {} {} {:.17g}\n", r[0], r[1], r[2], t);
     fflush(breaks_fp);
   } else if (comm->me == 0 && breaks_fp) {

@@ -14,6 +14,7 @@
 ------------------------------------------------------------------------- */
 
 #include "fix_fibrenet_output.h"
+#include "lammps_time.h"
 #include "style_registry.h"
 
 #include "atom.h"
@@ -133,36 +134,34 @@ void put_fixed5(std::string &out, double x)
   out.append(d, 6);
 }
 
-// "%g" (6 significant digits, FibreNet's default ostream precision); nan as "nan"
-void put_g(std::string &out, double x)
+// printf's "%.<precision>g", byte for byte: std::to_chars in general format with a precision
+// is specified to give printf's output, ~4x faster than glibc's printf (which formats with
+// multi-precision arithmetic)
+void put_general(std::string &out, double x, int precision)
 {
-  if (std::isnan(x)) {
-    out += "nan";
-    return;
-  }
   char buf[32];
 #if defined(__cpp_lib_to_chars) && __cpp_lib_to_chars >= 201611L
-  // specified to give printf's %.6g (= %g), ~4x faster than glibc's printf
-  const auto r = std::to_chars(buf, buf + sizeof(buf), x, std::chars_format::general, 6);
+  const auto r = std::to_chars(buf, buf + sizeof(buf), x, std::chars_format::general, precision);
   out.append(buf, r.ptr - buf);
 #else
-  std::snprintf(buf, sizeof(buf), "%g", x);
-  out += buf;
+  const int n = std::snprintf(buf, sizeof(buf), "%.*g", precision, x);
+  out.append(buf, static_cast<size_t>(n));
 #endif
 }
 
-// "%.17g", byte for byte (dump custom's "format float %.17g"): std::to_chars with precision
-// 17 in general format is specified to give printf's output, ~4x faster than glibc's printf
+// "%g" (6 significant digits, FibreNet's default ostream precision); nan as "nan"
+void put_g(std::string &out, double x)
+{
+  if (std::isnan(x))
+    out += "nan";
+  else
+    put_general(out, x, 6);
+}
+
+// "%.17g" (dump custom's "format float %.17g": nan stays printf's, e.g. "-nan")
 void put_g17(std::string &out, double x)
 {
-  char buf[32];
-#if defined(__cpp_lib_to_chars) && __cpp_lib_to_chars >= 201611L
-  const auto r = std::to_chars(buf, buf + sizeof(buf), x, std::chars_format::general, 17);
-  out.append(buf, r.ptr - buf);
-#else
-  const int n = std::snprintf(buf, sizeof(buf), "%.17g", x);
-  out.append(buf, static_cast<size_t>(n));
-#endif
+  put_general(out, x, 17);
 }
 
 void put_int(std::string &out, bigint v)
@@ -173,6 +172,22 @@ void put_int(std::string &out, bigint v)
   } else {
     put_uint(out, static_cast<uint64_t>(v));
   }
+}
+
+// a FibreNet frame's first two lines: "count\nFRAME\tstep\tdt\tLx\tLy\tLz\n", the numbers by put
+std::string frame_head(bigint count, bigint step, double dt, const double *box,
+                       void (*put)(std::string &, double))
+{
+  std::string head;
+  put_int(head, count);
+  head += "\nFRAME\t";
+  put_int(head, step);
+  for (double v : {dt, box[0], box[1], box[2]}) {
+    head += '\t';
+    put(head, v);
+  }
+  head += '\n';
+  return head;
 }
 
 std::string reason(int err)
@@ -465,7 +480,7 @@ void FixFibreNetOutput::write_frame()
 
   // rank 0: the rows in id order, with their positions, cut into chunks; chunk c is formatted
   // by rank c % nprocs, and the rows go to their ranks (rank 0's own chunks stay in place)
-  const bigint nchunks = (n + chunk_rows - 1) / chunk_rows;
+  const bigint nchunks = chunk_count(n);
   bigint kept = 0;
   std::vector<int> row_counts(me == 0 ? nprocs : 1), row_displs(me == 0 ? nprocs : 1);
   if (me == 0) {
@@ -558,7 +573,7 @@ bigint FixFibreNetOutput::sort_rows(bigint n, bigint step)
     len[d] = domain->boxhi[d] - domain->boxlo[d];
   }
   const int nr = nv + 6, nprocs = comm->nprocs;
-  const bigint nchunks = (n + chunk_rows - 1) / chunk_rows;
+  const bigint nchunks = chunk_count(n);
   rows.resize(static_cast<size_t>(std::max<bigint>(n * nr, 1)));
   bigint pos = 0, kept = 0, outside = 0;
   for (int p = 0; p < nprocs; p++) {
@@ -697,15 +712,7 @@ std::string FixFibreNetOutput::write_files(bigint n, bigint kept, bigint step, b
   std::string paths[5], heads[5];
   int fds[5] = {-1, -1, -1, -1, -1};
   off_t sizes[5] = {0, 0, 0, 0, 0};
-  std::string xyz_head;
-  put_int(xyz_head, kept);
-  xyz_head += "\nFRAME\t";
-  put_int(xyz_head, step);
-  for (double v : {dt, box[0], box[1], box[2]}) {
-    xyz_head += '\t';
-    put_fixed5(xyz_head, v);
-  }
-  xyz_head += '\n';
+  const std::string xyz_head = frame_head(kept, step, dt, box, put_fixed5);
   for (int f = 0; f < 3; f++)
     if (files[f]) {
       paths[f] = prefix + XYZ_SUFFIX[f];
@@ -716,14 +723,7 @@ std::string FixFibreNetOutput::write_files(bigint n, bigint kept, bigint step, b
     const std::string folder = slash == std::string::npos ? "" : restart_path.substr(0, slash + 1);
     const std::string name = slash == std::string::npos ? restart_path : restart_path.substr(slash + 1);
     paths[3] = fmt::format("{}.{}.tmp{}", folder, name, static_cast<long>(::getpid()));
-    put_int(heads[3], n);
-    heads[3] += "\nFRAME\t";
-    put_int(heads[3], step);
-    for (double v : {dt, box[0], box[1], box[2]}) {
-      heads[3] += '\t';
-      put_g(heads[3], v);
-    }
-    heads[3] += '\n';
+    heads[3] = frame_head(n, step, dt, box, put_g);
   }
   if (!dump_path.empty()) {
     paths[4] = dump_path;
@@ -748,7 +748,7 @@ std::string FixFibreNetOutput::write_files(bigint n, bigint kept, bigint step, b
   for (int k = 0; k < 5; k++) put(k, heads[k]);
 
   const int nr = nv + 6, nprocs = comm->nprocs;
-  const bigint nchunks = (n + chunk_rows - 1) / chunk_rows;
+  const bigint nchunks = chunk_count(n);
   const double *own = rows.data();
   bigint bad_xyz = 0, bad_res = 0;
   for (bigint c = 0; c < nchunks; c++) {
@@ -793,9 +793,7 @@ std::string FixFibreNetOutput::dump_head(bigint n) const
     if (d) bounds += ' ';
     for (int side = 0; side < 2; side++) bounds += "pfsm"[domain->boundary[d][side] & 3];
   }
-  const double time =
-      update->atime + static_cast<double>(update->ntimestep - update->atimestep) * update->dt;
-  std::string out = fmt::format("ITEM: TIME\n{:.16}\n", time);
+  std::string out = fmt::format("ITEM: TIME\n{:.16}\n", simulation_time(update));
   out += fmt::format("ITEM: TIMESTEP\n{}\nITEM: NUMBER OF ATOMS\n{}\n", update->ntimestep, n);
   out += fmt::format("ITEM: BOX BOUNDS {}\n{:>1.16e} {:>1.16e}\n{:>1.16e} {:>1.16e}\n{:>1.16e} {:>1.16e}\n",
                      bounds, domain->boxlo[0], domain->boxhi[0], domain->boxlo[1], domain->boxhi[1],

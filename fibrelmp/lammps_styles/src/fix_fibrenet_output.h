@@ -91,6 +91,7 @@ class FixFibreNetOutput : public Fix {
   std::string dump_path, radius_var, mass_var;    // the work dump ("": none)
   int nv;                                 // values gathered per atom (14, 16 with the dump)
   bigint chunk_rows;                      // rows formatted per chunk (keyword chunk)
+  bigint chunk_count(bigint n) const { return (n + chunk_rows - 1) / chunk_rows; }
   bigint chunk_size(bigint c, bigint n) const { return std::min<bigint>(chunk_rows, n - c * chunk_rows); }
 
   // global state (restart files)

@@ -4,6 +4,7 @@
 ------------------------------------------------------------------------- */
 
 #include "fix_musen_field.h"
+#include "lammps_time.h"
 #include "style_registry.h"
 
 #include "atom.h"
@@ -169,7 +170,7 @@ void FixMusenField::heat()
   double *flux = static_cast<double *>(heat_fix->extract("flux", dim));
   const double *radius = atom->radius;
   const int *mask = atom->mask;
-  const double time = update->atime + static_cast<double>(update->ntimestep - update->atimestep) * update->dt;
+  const double time = simulation_time(update);
   double environment;
   if (time > heating_time)
     environment = air_t1;

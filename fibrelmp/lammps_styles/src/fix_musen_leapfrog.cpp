@@ -4,6 +4,7 @@
 ------------------------------------------------------------------------- */
 
 #include "fix_musen_leapfrog.h"
+#include "lammps_time.h"
 #include "style_registry.h"
 #include "musen_startup.h"
 
@@ -57,7 +58,7 @@ FixMusenLeapfrog::FixMusenLeapfrog(LAMMPS *lmp, int narg, char **arg) :
   }
   if (variable) {
     // MUSEN's clock starts at the time of this step; the restart file may replace it
-    t_now = t_last = t_before = update->atime + (update->ntimestep - update->atimestep) * update->dt;
+    t_now = t_last = t_before = simulation_time(update);
     dt_before = update->dt;
     vector_flag = 1;
     size_vector = 4;

@@ -4,6 +4,7 @@
 ------------------------------------------------------------------------- */
 
 #include "fix_musen_pbc_move.h"
+#include "lammps_time.h"
 #include "style_registry.h"
 
 #include "comm.h"
@@ -52,7 +53,7 @@ void FixMusenPbcMove::post_integrate()
 /* SPBC::UpdatePBC at the current time: coordBeg = initBeg - vVel t, coordEnd = initEnd + vVel t */
 void FixMusenPbcMove::set_box()
 {
-  const double t = update->atime + static_cast<double>(update->ntimestep - update->atimestep) * update->dt;
+  const double t = simulation_time(update);
   bool changed = false;
   for (int k = 0; k < 3; k++) {
     if (vel[k] == 0.0) continue;

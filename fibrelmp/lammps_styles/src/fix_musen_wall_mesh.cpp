@@ -9,6 +9,7 @@
 ------------------------------------------------------------------------- */
 
 #include "fix_musen_wall_mesh.h"
+#include "lammps_time.h"
 #include "style_registry.h"
 #include "fix_musen_history.h"
 #include "fix_musen_leapfrog.h"
@@ -643,7 +644,7 @@ void FixMusenWallMesh::setup(int vflag)
 
 double FixMusenWallMesh::current_time() const
 {
-  return update->atime + static_cast<double>(update->ntimestep - update->atimestep) * update->dt;
+  return simulation_time(update);
 }
 
 /* Triangle positions at time t: x = R(t) x0 + b(t) per moving geometry (the solution of

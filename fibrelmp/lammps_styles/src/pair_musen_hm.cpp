@@ -29,6 +29,7 @@
 ------------------------------------------------------------------------- */
 
 #include "pair_musen_hm.h"
+#include "lammps_time.h"
 #include "style_registry.h"
 #include "musen_startup.h"
 #include "musen_pp_hertz_mindlin.h"
@@ -221,8 +222,7 @@ template <bool LAW_VALUES, class Laws> void PairMusenHM::contacts(Laws apply)
   const int law_values = LAW_VALUES ? history_values - HISTORY_VALUES : 0;
   double *block = law_block.data();
   // MUSEN's time of this evaluation (its `_time == 0` rule)
-  const bool at_time_zero =
-      update->atime + static_cast<double>(update->ntimestep - update->atimestep) * dt == 0.0;
+  const bool at_time_zero = simulation_time(update) == 0.0;
 
   const int inum = list->inum;
   int *ilist = list->ilist;

@@ -25,7 +25,7 @@ from fibrelmp._lammps import new_lammps
 from fibrelmp.errors import RunError
 from fibrelmp.lammps_flow import condition_holds, execute, jump_target
 from fibrelmp.lammps_text import input_lines, read_script
-from fibrelmp.runplan import FRAME_COMMANDS
+from fibrelmp.runplan import DATA_COMMANDS, FRAME_COMMANDS
 
 if TYPE_CHECKING:
     from fibrelmp.checkpoint import Checkpointing  # noqa: F401
@@ -368,7 +368,7 @@ class _ScriptRun:
             return None
         if self.atomfiles and _uses_atomfile(words, self.atomfiles):
             return None
-        if words[0] == "read_data":
+        if words[0] in DATA_COMMANDS:
             return f"read_restart {self.resume['restart']}"
         return text
 
@@ -407,7 +407,7 @@ class _ScriptRun:
             counts = words[0] in ("run", "reset_timestep")
             before = _timestep(self.lmp) if counts else 0
             self.lmp.command(text)
-            if replaying and words[0] == "read_data":
+            if replaying and words[0] in DATA_COMMANDS:
                 for fix in self.deferred:
                     self.lmp.command(fix)
             if replaying and words[0] == "dump":     # keep what it wrote before

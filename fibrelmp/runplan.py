@@ -26,6 +26,9 @@ if TYPE_CHECKING:
 # the script commands that write a frame: LAMMPS's write_dump, and fibrenet/frame (fix
 # fibrenet/output writes FibreNet's files and the work dump)
 FRAME_COMMANDS = frozenset({"write_dump", "fibrenet/frame"})
+# the script commands that create the box and the atoms (a resumed run reads its restart there):
+# LAMMPS's read_data, and fibrenet/read_data (a FibreNet job's binary topology file)
+DATA_COMMANDS = frozenset({"read_data", "fibrenet/read_data"})
 
 
 @dataclass(frozen=True)

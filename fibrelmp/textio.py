@@ -256,17 +256,20 @@ def temp_name(path: str | os.PathLike) -> Path:
     return p.with_name(f".{p.name}.tmp{os.getpid()}")
 
 
-def atomic_write(path: str | os.PathLike, data: str | bytes) -> None:
-    """Write a file through a temp file + rename so no half-written output is left.
+def atomic_write(path: str | os.PathLike, data: str | bytes | list) -> None:
+    """Write a file through a temp file + rename so no half-written output is left; ``data``
+    may be a list of bytes-like parts (written in turn: no joined copy).
 
     On any failure the temp file is removed and the error names ``path`` (write_failure)."""
     p = Path(path)
     tmp = temp_name(p)
-    mode = "wb" if isinstance(data, bytes) else "w"
+    parts = data if isinstance(data, list) else [data]
+    mode = "w" if isinstance(data, str) else "wb"
     fh = None
     try:
         fh = open(tmp, mode)
-        fh.write(data)
+        for part in parts:
+            fh.write(part)
         fh.close()
         os.replace(tmp, p)
     except OSError as exc:

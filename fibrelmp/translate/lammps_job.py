@@ -23,6 +23,7 @@ from fibrelmp.textio import atomic_write
 from fibrelmp.translate.lammps_data import DataSection, write_data_file
 from fibrelmp.translate.lammps_format import atomfile_blocks, float_text
 from fibrelmp.translate.steps import MIN_PIECE_STEPS, SaveSteps, run_piece
+from fibrelmp.translate.topology_file import write_topology_file
 from fibrelmp.translate.work_facts import WorkFacts, write_facts
 
 # FibreNet's result file names (<prefix><suffix>): fix fibrenet/output writes them in the job
@@ -32,6 +33,7 @@ RESTART_SUFFIX = "_restart.res"
 
 SCRIPT_NAME = "in.lammps"
 DATA_NAME = "data.lammps"
+TOPOLOGY_NAME = "topology.bin"      # data.lammps's box and topology for fibrenet/read_data
 FRAMES_NAME = "frames.dump"
 # FibreNet's per-bead state (fix fn_state), read by LAMMPS as an atomfile variable: kept out of
 # the data file, whose custom section other readers (MDAnalysis, OVITO) cannot skip
@@ -65,11 +67,13 @@ class Job:
     native: NativeFiles | None = None     # FibreNet's files written by LAMMPS (the plugin)
     state: Path | None = None             # the per-bead state file (STATE_NAME)
     bond_lengths: np.ndarray | None = None   # rest length of each LAMMPS bond type (1-based: [type - 1])
+    topology: Path | None = None          # TOPOLOGY_NAME, when the script reads it instead of data
 
     @property
     def inputs(self) -> list[Path]:
         """The files the script reads (a checkpoint is refused when one changed)."""
-        return [self.data] + ([self.state] if self.state is not None else [])
+        read = self.topology if self.topology is not None else self.data
+        return [read] + ([self.state] if self.state is not None else [])
 
 
 def _factorize(col: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -288,6 +292,58 @@ def write_job(model: Model, folder: str | Path, write_files: bool = True) -> Job
     general_lambda = dyn.lambda_ != 0.5
     use_mvv = general_lambda and dyn.damping != 0 and bool(mobile_types)
 
+    skin, comm_cut = _skin_and_ghost_cutoff(model, bonds, max_cut)
+
+    acts, out_steps, total = _schedule(model, general_lambda)
+    type_names = [p.type_names[int(t)] for t in ltypes[:, 0]]
+    styles = lammps_styles.plugin()
+    native, native_files = _native_output(model, folder, type_names, styles.path is not None)
+    if model.angles.count and not styles.available:
+        model.warn(STOCK_ANGLES, stock_angle_warning(styles.how))
+
+    data_path = folder / DATA_NAME
+    state_path = folder / STATE_NAME if p.count else None
+    # the plugin's fibrenet/read_data loads atom_style angle jobs from a binary copy of the data
+    # file (read once on rank 0, not parsed twice on every rank); data.lammps stays for post
+    topology_path = folder / TOPOLOGY_NAME if styles.path is not None and not use_mvv and p.count else None
+    if write_files:
+        _write_data(model, bonds, data_path, ltypes, atype, btypes, btype, atypes, antype, use_mvv)
+        if topology_path is not None:
+            _write_topology(model, bonds, topology_path, ltypes, atype, btypes, btype, atypes, antype)
+        if state_path is not None:
+            _write_state(model, state_path)
+        write_facts(data_path, _facts(model, type_names))
+    script = template_environment().get_template("bead_spring.lammps.j2").render(
+        model=model, dyn=dyn, box=box, fmt=float_text, use_mvv=use_mvv,
+        frozen_types=frozen_types, mobile_types=mobile_types,
+        bond_types=btypes, angle_types=atypes, pair_lines=pair_lines, pair_styles=pair_styles,
+        max_cut=max(max_cut, 1e-6), skin=skin, comm_cut=comm_cut, acts=acts,
+        general_lambda=general_lambda, data_name=DATA_NAME, frames_name=FRAMES_NAME,
+        topology_name=TOPOLOGY_NAME if topology_path is not None else None,
+        state_name=STATE_NAME if state_path is not None else None, state_columns=STATE_COLUMNS,
+        wall_pad=float(box.lengths.max()), type_names=type_names,
+        radius_expression=_per_type_expression(ltypes[:, 2]), dump_names=DUMP_NAMES,
+        rad2deg=180.0 / math.pi, inf=float("inf"), angle_expression=angle_expression,
+        extra_packages=_extra_packages(pair_styles, btypes, use_mvv),
+        # the plugin is loaded only for a style of its own: angle_style fibrenet, fix
+        # fibrenet/output, fibrenet/read_data
+        plugin=lammps_path(styles.path, "plugin") if styles.path and (len(atypes) or native or topology_path) else None,
+        native=native,
+        thermo_every=min(out_steps.period or 0, 2 ** 31 - 1),     # thermo N is a C int
+    )
+    script_path = folder / SCRIPT_NAME
+    if write_files:
+        atomic_write(script_path, script)
+    type_of_ltype = np.r_[-1, ltypes[:, 0].astype(np.int64)]
+    return Job(folder, script_path, data_path, folder / FRAMES_NAME, total, type_of_ltype, out_steps,
+               text=script, native=native_files, state=state_path,
+               bond_lengths=btypes[:, 1].astype(float) if bonds.count else np.zeros(0),
+               topology=topology_path)
+
+
+def _skin_and_ghost_cutoff(model: Model, bonds, max_cut: float) -> tuple[float, float]:
+    """The neighbour skin and the ghost cutoff (comm_modify cutoff)."""
+    p = model.particles
     # communication must reach across bonds and angles (1-3 pairs) as well as pair cutoffs
     # ghosts must reach both legs of every angle and every bond, as well as the pair cutoffs
     legs = [bonds.atoms] + [model.angles.atoms[:, [0, 1]], model.angles.atoms[:, [2, 1]]]
@@ -301,44 +357,7 @@ def write_job(model: Model, folder: str | Path, write_files: bool = True) -> Job
     # step; measured 12 % (50k beads) and 9 % (260k) faster than a quarter (docs/performance.md)
     skin = max(0.05, 0.5 * max(max_cut, 1e-12)) if max_cut > 0 else 0.3
     comm_cut = max(max_cut + skin, 2.0 * leg_len + skin)
-
-    acts, out_steps, total = _schedule(model, general_lambda)
-    type_names = [p.type_names[int(t)] for t in ltypes[:, 0]]
-    styles = lammps_styles.plugin()
-    native, native_files = _native_output(model, folder, type_names, styles.path is not None)
-    if model.angles.count and not styles.available:
-        model.warn(STOCK_ANGLES, stock_angle_warning(styles.how))
-
-    data_path = folder / DATA_NAME
-    state_path = folder / STATE_NAME if p.count else None
-    if write_files:
-        _write_data(model, bonds, data_path, ltypes, atype, btypes, btype, atypes, antype, use_mvv)
-        if state_path is not None:
-            _write_state(model, state_path)
-        write_facts(data_path, _facts(model, type_names))
-    script = template_environment().get_template("bead_spring.lammps.j2").render(
-        model=model, dyn=dyn, box=box, fmt=float_text, use_mvv=use_mvv,
-        frozen_types=frozen_types, mobile_types=mobile_types,
-        bond_types=btypes, angle_types=atypes, pair_lines=pair_lines, pair_styles=pair_styles,
-        max_cut=max(max_cut, 1e-6), skin=skin, comm_cut=comm_cut, acts=acts,
-        general_lambda=general_lambda, data_name=DATA_NAME, frames_name=FRAMES_NAME,
-        state_name=STATE_NAME if state_path is not None else None, state_columns=STATE_COLUMNS,
-        wall_pad=float(box.lengths.max()), type_names=type_names,
-        radius_expression=_per_type_expression(ltypes[:, 2]), dump_names=DUMP_NAMES,
-        rad2deg=180.0 / math.pi, inf=float("inf"), angle_expression=angle_expression,
-        extra_packages=_extra_packages(pair_styles, btypes, use_mvv),
-        # the plugin is loaded only for a style of its own: angle_style fibrenet, fix fibrenet/output
-        plugin=lammps_path(styles.path, "plugin") if styles.path and (len(atypes) or native) else None,
-        native=native,
-        thermo_every=min(out_steps.period or 0, 2 ** 31 - 1),     # thermo N is a C int
-    )
-    script_path = folder / SCRIPT_NAME
-    if write_files:
-        atomic_write(script_path, script)
-    type_of_ltype = np.r_[-1, ltypes[:, 0].astype(np.int64)]
-    return Job(folder, script_path, data_path, folder / FRAMES_NAME, total, type_of_ltype, out_steps,
-               text=script, native=native_files, state=state_path,
-               bond_lengths=btypes[:, 1].astype(float) if bonds.count else np.zeros(0))
+    return skin, comm_cut
 
 
 def _per_type_expression(values: np.ndarray) -> str:
@@ -452,6 +471,33 @@ def _bonds_alive_at_first_step(model: Model):
     return Bonds(b.atoms[keep], b.k[keep], b.r0[keep], b.break_length[keep])
 
 
+def _data_box(model: Model) -> list[tuple[float, float]]:
+    """The box of the data file: on finite axes it must hold beads already pushed into a wall
+    (restarts); the walls themselves sit at box.lo / box.hi in the script."""
+    p, box = model.particles, model.box
+    x = p.unwrapped if any(box.periodic) else p.positions
+    bounds = []
+    for axis in range(3):
+        lo, hi = box.lo[axis], box.hi[axis]
+        if not box.periodic[axis] and p.count:
+            margin = 1e-6 * (hi - lo)
+            lo = min(lo, float(x[:, axis].min()) - margin)
+            hi = max(hi, float(x[:, axis].max()) + margin)
+        bounds.append((lo, hi))
+    return bounds
+
+
+def _write_topology(model: Model, bonds, path: Path, ltypes, atype, btypes, btype, atypes, antype) -> None:
+    """``topology.bin``: what ``_write_data`` writes for ``read_data``, for fibrenet/read_data."""
+    p = model.particles
+    v = p.velocities
+    write_topology_file(
+        path, _data_box(model), [row[1] if row[1] > 0 else 1.0 for row in ltypes], p.molecules, atype + 1,
+        p.unwrapped if any(model.box.periodic) else p.positions, v if (v.any() or np.signbit(v).any()) else None,
+        bonds.atoms + 1, btype + 1, len(btypes) if bonds.count else 0,
+        model.angles.atoms + 1, antype + 1, len(atypes) if model.angles.count else 0)
+
+
 def _write_data(model: Model, bonds, path: Path, ltypes, atype, btypes, btype, atypes, antype,
                 use_mvv: bool) -> None:
     p, box = model.particles, model.box
@@ -460,17 +506,8 @@ def _write_data(model: Model, bonds, path: Path, ltypes, atype, btypes, btype, a
     counts = [(n, "atoms"), (bonds.count, "bonds"), (model.angles.count, "angles"),
               (len(ltypes), "atom types"), (len(btypes) if bonds.count else 0, "bond types"),
               (len(atypes) if model.angles.count else 0, "angle types")]
-    # finite axes: the data-file box must hold beads already pushed into a wall (restarts);
-    # the walls themselves sit at box.lo / box.hi in the script
     x = p.unwrapped if any(box.periodic) else p.positions
-    bounds = []
-    for axis in range(3):
-        lo, hi = box.lo[axis], box.hi[axis]
-        if not box.periodic[axis] and n:
-            margin = 1e-6 * (hi - lo)
-            lo = min(lo, float(x[:, axis].min()) - margin)
-            hi = max(hi, float(x[:, axis].max()) + margin)
-        bounds.append((lo, hi))
+    bounds = _data_box(model)
     # mass-0 beads are not integrated: 1.0 is a placeholder
     masses = [float_text(row[1] if row[1] > 0 else 1.0) for row in ltypes]
     notes = [f"{comment_text(p.type_names[int(row[0])])} m={row[1]:g} R={row[2]:g}" for row in ltypes]

@@ -35,16 +35,21 @@ from _common import load_generator  # noqa: E402
 
 
 
-def setup_and_read_data(script: Path) -> tuple[list[str], list[str]]:
-    """The commands of in.lammps before ``read_data``, and the commands that load the job's
-    files: the read_data line and the per-bead state (atomfile) commands after it."""
+def setup_and_read_data(script: Path) -> tuple[list[str], list[str], list[str]]:
+    """The commands of in.lammps before the job's files are loaded, and the commands that load
+    them: LAMMPS's ``read_data data.lammps`` (the baseline), and the script's own line (with
+    the plugin, ``fibrenet/read_data topology.bin``), each with the per-bead state (atomfile)
+    commands after it."""
     from fibrelmp.lammps_text import input_lines, read_script
+    from fibrelmp.runplan import DATA_COMMANDS
+    from fibrelmp.translate.lammps_job import DATA_NAME
 
     lines = [ln.strip() for ln in input_lines(read_script(script), script)]
     lines = [ln for ln in lines if ln and not ln.startswith("#")]
-    k = next(i for i, ln in enumerate(lines) if ln.split()[0] == "read_data")
+    k = next(i for i, ln in enumerate(lines) if ln.split()[0] in DATA_COMMANDS)
     end = next((i for i, ln in enumerate(lines) if ln.split() == ["variable", "fn_state", "delete"]), k)
-    return lines[:k], lines[k:end + 1]
+    state = lines[k + 1:end + 1]
+    return lines[:k], [f"read_data {DATA_NAME}"] + state, lines[k:end + 1]
 
 
 def time_translate(input_path: Path, job_dir: Path) -> tuple[float, float, object]:
@@ -103,16 +108,18 @@ def main() -> int:
 
         # warm-up (imports, jinja template compilation, LAMMPS library load), untimed
         _, _, job = time_translate(input_path, job_dir)
-        setup, read_data = setup_and_read_data(job.script)
+        setup, read_data, load = setup_and_read_data(job.script)
         print(f"model.txt {(net_dir / 'model.txt').stat().st_size / 1e6:.1f} MB, "
               f"data.lammps {job.data.stat().st_size / 1e6:.1f} MB")
 
-        parse, write, rd = [], [], []
+        parse, write, rd, own = [], [], [], []
         for _ in range(args.repeat):       # interleaved, so machine-load drift hits both alike
             a, b, _ = time_translate(input_path, job_dir)
             parse.append(a)
             write.append(b)
             rd.append(time_read_data(job_dir, setup, read_data))
+            if load != read_data:
+                own.append(time_read_data(job_dir, setup, load))
         total = [a + b for a, b in zip(parse, write)]
         best = min(range(args.repeat), key=lambda i: total[i])
         t_tr, t_rd = total[best], min(rd)
@@ -121,6 +128,9 @@ def main() -> int:
               f"all: {', '.join(f'{t:.3f}' for t in total)}")
         print(f"LAMMPS read_data, best of {args.repeat}: {t_rd:.3f} s; "
               f"all: {', '.join(f'{t:.3f}' for t in rd)}")
+        if own:
+            print(f"the job's own loading ({load[0]}), best of {args.repeat}: {min(own):.3f} s "
+                  f"(read_data / it: {t_rd / min(own):.1f}x)")
 
         if args.profile:
             import cProfile

@@ -68,6 +68,34 @@ def test_random_numbers_bit_identical(seed):
 
 
 @needs_c
+def test_digit_runs_of_every_length_at_every_place():
+    """The digit runs are read eight bytes at a time where eight are readable: runs of 0-24
+    digits before and after the point, followed by every kind of byte that may end them
+    (separator, point, exponent, the buffer's end), one row per token so that each run also
+    meets the end of the buffer, against float()."""
+    rng = np.random.default_rng(3)
+    toks = []
+    for a in range(0, 25):
+        for b in [None, *range(0, 25)]:
+            if a == 0 and not b:
+                continue
+            whole = "".join(str(d) for d in rng.integers(0, 10, a))
+            frac = None if b is None else "".join(str(d) for d in rng.integers(0, 10, b))
+            tok = whole + ("" if frac is None else "." + frac)
+            toks += [tok, "-" + tok, tok + "e-3", tok + "E+2"]
+    for tok in toks:
+        for end in (b"", b"\n", b" \n", b"\t\n"):
+            block = tok.encode() + end
+            got = fastparse.parse_numbers(block, 1, 1)
+            want = float(tok)
+            assert got is not None and got[0, 0] == want and np.signbit(got[0, 0]) == np.signbit(want), tok
+    block = ("\n".join(toks) + "\n").encode()
+    got = fastparse.parse_numbers(block, len(toks), 1)
+    assert got is not None and got.ravel().view(np.int64).tolist() == \
+        np.array([float(t) for t in toks]).view(np.int64).tolist()
+
+
+@needs_c
 def test_split_across_threads_matches(monkeypatch):
     monkeypatch.setattr(fastparse, "SPLIT_BYTES", 64)
     rng = np.random.default_rng(9)

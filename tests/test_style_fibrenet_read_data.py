@@ -181,8 +181,13 @@ def test_whole_job_replayed_gives_read_datas_bytes(tmp_path, plugin, name, ranks
 def test_cut_or_foreign_file_is_a_lammps_error(tmp_path, plugin):
     _, job = _job(tmp_path, "walls")
     whole = job.topology.read_bytes()
+    last = len(whole) - 32               # the last angle: type, atom1, atom2, atom3 (int64)
+    no_atom = whole[:last + 8] + (0).to_bytes(8, "little") + whole[last + 16:]
+    far_atom = whole[:last + 24] + (10 ** 6).to_bytes(8, "little")
+    huge = whole[:8] + (2 ** 40).to_bytes(8, "little") + whole[16:]
     for bad, says in [(whole[:-5], "ends inside its angles"), (b"NOTMINE!" + whole[8:], "not a fibrelmp topology file"),
-                      (whole[:30], "ends inside its header")]:
+                      (whole[:30], "ends inside its header"), (no_atom, "angle [0-9]+ is invalid"),
+                      (far_atom, "angle [0-9]+ is invalid"), (huge, "more atoms or types than this LAMMPS holds")]:
         path = tmp_path / "bad.bin"
         path.write_bytes(bad)
         with pytest.raises(Exception, match=says):

@@ -84,6 +84,9 @@ void FibreNetReadData::command(int narg, char **arg)
     if (count < 0) error->all(FLERR, "fibrenet/read_data: {}: a negative count", path);
   if (head[NTYPES] < 1 || head[NTYPES] > 1 << 20)
     error->all(FLERR, "fibrenet/read_data: {}: {} atom types", path, head[NTYPES]);
+  if (head[NATOMS] > MAXTAGINT || head[NBONDTYPES] > MAXSMALLINT || head[NANGLETYPES] > MAXSMALLINT ||
+      head[BOND_PER_OFF] > MAXSMALLINT || head[ANGLE_PER_OFF] > MAXSMALLINT)
+    error->all(FLERR, "fibrenet/read_data: {}: more atoms or types than this LAMMPS holds", path);
   std::vector<double> mass(head[NTYPES]);
   read(mass.data(), mass.size() * sizeof(double), "masses");
 
@@ -223,13 +226,12 @@ void FibreNetReadData::add_angles(int64_t nangles)
     read(rec.data(), n * 4 * sizeof(int64_t), "angles");
     for (int64_t k = 0; k < n; k++) {
       const int64_t *r = &rec[4 * k];
-      if (r[0] < 1 || r[0] > atom->nangletypes)
+      if (r[0] < 1 || r[0] > atom->nangletypes || r[1] < 1 || r[1] > atom->natoms || r[2] < 1 ||
+          r[2] > atom->natoms || r[3] < 1 || r[3] > atom->natoms)
         error->all(FLERR, "fibrenet/read_data: {}: angle {} is invalid", path, first + k + 1);
       const int order[3] = {2, 1, 3};
       for (int j : order) {
         if (j != 2 && force->newton_bond) continue;
-        if (r[j] < 1 || r[j] > atom->natoms)
-          error->all(FLERR, "fibrenet/read_data: {}: angle {} is invalid", path, first + k + 1);
         const int m = atom->map((tagint) r[j]);
         if (m < 0 || m >= nlocal) continue;
         if (atom->num_angle[m] == atom->angle_per_atom)

@@ -35,22 +35,46 @@ enum {
 
 /* ---------------------------------------------------------------------- */
 
+FibreNetReadData::~FibreNetReadData()
+{
+  if (fp) fclose(fp);
+}
+
+/* ---------------------------------------------------------------------- */
+
 void FibreNetReadData::read(void *buf, size_t bytes, const char *what)
 {
   // rank 0 reads, every rank learns whether it worked, then gets the bytes
   int ok = 1;
   if (comm->me == 0) ok = fread(buf, 1, bytes, fp) == bytes;
   MPI_Bcast(&ok, 1, MPI_INT, 0, world);
-  if (!ok) {
-    if (comm->me == 0) fclose(fp);
-    error->all(FLERR, "fibrenet/read_data: {} ends inside its {} (cut short?)", path, what);
-  }
+  if (!ok) error->all(FLERR, "fibrenet/read_data: {} ends inside its {} (cut short?)", path, what);
   // MPI counts are ints: broadcast in pieces below 1 GiB
   for (size_t done = 0; done < bytes;) {
     const size_t n = std::min<size_t>(bytes - done, size_t(1) << 30);
     MPI_Bcast(static_cast<char *>(buf) + done, (int) n, MPI_CHAR, 0, world);
     done += n;
   }
+}
+
+template <class Body>
+void FibreNetReadData::each_chunk(int64_t count, int64_t width, const char *what, Body body)
+{
+  std::vector<int64_t> rec(std::min(count, CHUNK) * width);
+  for (int64_t first = 0; first < count; first += CHUNK) {
+    const int64_t n = std::min(CHUNK, count - first);
+    read(rec.data(), n * width * sizeof(int64_t), what);
+    body(first, n, rec.data());
+  }
+}
+
+// the records stored on all ranks together are the expected number (read_data's check)
+void FibreNetReadData::check_stored(bigint stored, bigint expected, const char *what)
+{
+  bigint total = 0;
+  MPI_Allreduce(&stored, &total, 1, MPI_LMP_BIGINT, MPI_SUM, world);
+  if (total != expected)
+    error->all(FLERR, "fibrenet/read_data: {}: {} assigned incorrectly", path, what);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -72,10 +96,8 @@ void FibreNetReadData::command(int narg, char **arg)
 
   char magic[8];
   read(magic, sizeof(magic), "header");
-  if (memcmp(magic, MAGIC, sizeof(MAGIC)) != 0) {
-    if (comm->me == 0) fclose(fp);
+  if (memcmp(magic, MAGIC, sizeof(MAGIC)) != 0)
     error->all(FLERR, "fibrenet/read_data: {} is not a fibrelmp topology file", path);
-  }
   int64_t head[HEAD];
   double box[6];
   read(head, sizeof(head), "header");
@@ -94,7 +116,7 @@ void FibreNetReadData::command(int narg, char **arg)
   create_atoms(head[NATOMS], head[VELOCITIES] != 0);
   add_bonds(head[NBONDS]);
   add_angles(head[NANGLES]);
-  if (comm->me == 0) fclose(fp);
+  if (fp) fclose(fp);
   fp = nullptr;
   if (comm->me == 0)
     utils::logmesg(lmp, "  {} atoms, {} bonds, {} angles from {}\n", atom->natoms, atom->nbonds,
@@ -129,15 +151,12 @@ void FibreNetReadData::create_atoms(int64_t natoms, bool velocities)
 {
   // per record: id molecule type (int64), x y z [vx vy vz] (double)
   const int64_t width = velocities ? 9 : 6;
-  std::vector<int64_t> rec(std::min(natoms, CHUNK) * width);
   std::vector<tagint> ids;
   std::vector<int> types;
   std::vector<imageint> image;
   std::vector<double> x, v;
   const imageint centre = ((imageint) IMGMAX << IMG2BITS) | ((imageint) IMGMAX << IMGBITS) | IMGMAX;
-  for (int64_t first = 0; first < natoms; first += CHUNK) {
-    const int64_t n = std::min(CHUNK, natoms - first);
-    read(rec.data(), n * width * sizeof(int64_t), "atoms");
+  each_chunk(natoms, width, "atoms", [&](int64_t first, int64_t n, const int64_t *rec) {
     ids.resize(n);
     types.resize(n);
     image.assign(n, centre);
@@ -166,7 +185,7 @@ void FibreNetReadData::create_atoms(int64_t natoms, bool velocities)
       const int64_t k = atom->tag[i] - 1 - first;
       atom->molecule[i] = (tagint) rec[k * width + 1];
     }
-  }
+  });
   if (atom->natoms != natoms)
     error->all(FLERR, "fibrenet/read_data: {}: {} of {} atoms are inside the box", path,
                atom->natoms, natoms);
@@ -179,7 +198,6 @@ void FibreNetReadData::create_atoms(int64_t natoms, bool velocities)
 void FibreNetReadData::add_bonds(int64_t nbonds)
 {
   // Atom::data_bonds: with the first atom, and with newton_bond off also with the second
-  std::vector<int64_t> rec(std::min(nbonds, CHUNK) * 3);
   const int nlocal = atom->nlocal;
   bigint stored = 0;
   auto put = [&](int m, int type, tagint other) {
@@ -190,9 +208,7 @@ void FibreNetReadData::add_bonds(int64_t nbonds)
     atom->bond_atom[m][atom->num_bond[m]++] = other;
     stored++;
   };
-  for (int64_t first = 0; first < nbonds; first += CHUNK) {
-    const int64_t n = std::min(CHUNK, nbonds - first);
-    read(rec.data(), n * 3 * sizeof(int64_t), "bonds");
+  each_chunk(nbonds, 3, "bonds", [&](int64_t first, int64_t n, const int64_t *rec) {
     for (int64_t k = 0; k < n; k++) {
       const int64_t *r = &rec[3 * k];
       if (r[0] < 1 || r[0] > atom->nbondtypes || r[1] < 1 || r[1] > atom->natoms || r[2] < 1 ||
@@ -205,11 +221,8 @@ void FibreNetReadData::add_bonds(int64_t nbonds)
         if (m >= 0 && m < nlocal) put(m, (int) r[0], (tagint) r[1]);
       }
     }
-  }
-  bigint total = 0;
-  MPI_Allreduce(&stored, &total, 1, MPI_LMP_BIGINT, MPI_SUM, world);
-  if (total != (force->newton_bond ? 1 : 2) * nbonds)
-    error->all(FLERR, "fibrenet/read_data: {}: bonds assigned incorrectly", path);
+  });
+  check_stored(stored, (force->newton_bond ? 1 : 2) * nbonds, "bonds");
   atom->nbonds = nbonds;
 }
 
@@ -218,12 +231,9 @@ void FibreNetReadData::add_bonds(int64_t nbonds)
 void FibreNetReadData::add_angles(int64_t nangles)
 {
   // Atom::data_angles: with the middle atom, and with newton_bond off also with the others
-  std::vector<int64_t> rec(std::min(nangles, CHUNK) * 4);
   const int nlocal = atom->nlocal;
   bigint stored = 0;
-  for (int64_t first = 0; first < nangles; first += CHUNK) {
-    const int64_t n = std::min(CHUNK, nangles - first);
-    read(rec.data(), n * 4 * sizeof(int64_t), "angles");
+  each_chunk(nangles, 4, "angles", [&](int64_t first, int64_t n, const int64_t *rec) {
     for (int64_t k = 0; k < n; k++) {
       const int64_t *r = &rec[4 * k];
       if (r[0] < 1 || r[0] > atom->nangletypes || r[1] < 1 || r[1] > atom->natoms || r[2] < 1 ||
@@ -245,11 +255,8 @@ void FibreNetReadData::add_angles(int64_t nangles)
         stored++;
       }
     }
-  }
-  bigint total = 0;
-  MPI_Allreduce(&stored, &total, 1, MPI_LMP_BIGINT, MPI_SUM, world);
-  if (total != (force->newton_bond ? 1 : 3) * nangles)
-    error->all(FLERR, "fibrenet/read_data: {}: angles assigned incorrectly", path);
+  });
+  check_stored(stored, (force->newton_bond ? 1 : 3) * nangles, "angles");
   atom->nangles = nangles;
 }
 

@@ -17,22 +17,14 @@
    that follows in fibrelmp's script changes the weights and so builds them (as it rebuilds
    them after read_data).
 
-   File (little-endian; written by fibrelmp/translate/lammps_job.py, which documents it):
-     char[8] "FLMPTOP1"
-     int64   natoms nbonds nangles ntypes nbondtypes nangletypes has_velocities
-             bond_per_atom angle_per_atom bond_per_atom_off angle_per_atom_off
-     double  xlo xhi ylo yhi zlo zhi
-     double  mass[ntypes]
-     natoms  x {int64 id molecule type; double x y z; (has_velocities) double vx vy vz}
-     nbonds  x {int64 type atom1 atom2}
-     nangles x {int64 type atom1 atom2 atom3}
-   Atom ids are 1..natoms in file order.
+   The file's layout is documented once, where it is written: fibrelmp/translate/topology_file.py.
 ------------------------------------------------------------------------- */
 
 #ifndef FIBRELMP_FIBRENET_READ_DATA_H
 #define FIBRELMP_FIBRENET_READ_DATA_H
 
 #include "command.h"
+#include "lmptype.h"
 
 #include <cstdint>
 #include <cstdio>
@@ -44,6 +36,7 @@ namespace LAMMPS_NS {
 class FibreNetReadData : public Command {
  public:
   FibreNetReadData(class LAMMPS *lmp) : Command(lmp) {}
+  ~FibreNetReadData() override;    // closes the file, also when an error ends the command
   void command(int, char **) override;
 
  private:
@@ -51,6 +44,10 @@ class FibreNetReadData : public Command {
   std::string path;
 
   void read(void *buf, size_t bytes, const char *what);     // every rank gets rank 0's bytes
+  // the `count` records of `width` int64/double words that follow, CHUNK records at a time:
+  // body(first, n, records) on every rank
+  template <class Body> void each_chunk(int64_t count, int64_t width, const char *what, Body body);
+  void check_stored(bigint stored, bigint expected, const char *what);
   void make_box(const int64_t *head, const double *box, const std::vector<double> &mass);
   void create_atoms(int64_t natoms, bool velocities);
   void add_bonds(int64_t nbonds);

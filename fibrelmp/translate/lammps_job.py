@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 from pathlib import Path
 
 import numpy as np
@@ -307,9 +308,10 @@ def write_job(model: Model, folder: str | Path, write_files: bool = True) -> Job
     # file (read once on rank 0, not parsed twice on every rank); data.lammps stays for post
     topology_path = folder / TOPOLOGY_NAME if styles.path is not None and not use_mvv and p.count else None
     if write_files:
-        _write_data(model, bonds, data_path, ltypes, atype, btypes, btype, atypes, antype, use_mvv)
+        atoms = _data_atoms(model, ltypes)
+        _write_data(model, bonds, data_path, atoms, ltypes, atype, btypes, btype, atypes, antype, use_mvv)
         if topology_path is not None:
-            _write_topology(model, bonds, topology_path, ltypes, atype, btypes, btype, atypes, antype)
+            _write_topology(model, bonds, topology_path, atoms, atype, btypes, btype, atypes, antype)
         if state_path is not None:
             _write_state(model, state_path)
         write_facts(data_path, _facts(model, type_names))
@@ -471,11 +473,19 @@ def _bonds_alive_at_first_step(model: Model):
     return Bonds(b.atoms[keep], b.k[keep], b.r0[keep], b.break_length[keep])
 
 
-def _data_box(model: Model) -> list[tuple[float, float]]:
-    """The box of the data file: on finite axes it must hold beads already pushed into a wall
-    (restarts); the walls themselves sit at box.lo / box.hi in the script."""
+class _DataAtoms(NamedTuple):
+    """What data.lammps and topology.bin both hold of the atoms, decided once for both."""
+    bounds: list[tuple[float, float]]     # the box: on finite axes it holds every bead
+    masses: list[float]                   # per LAMMPS type
+    x: np.ndarray                         # unwrapped (read_data wraps them and sets image flags)
+    v: np.ndarray | None                  # None: every bead at rest (+0.0, LAMMPS's start)
+
+
+def _data_atoms(model: Model, ltypes: np.ndarray) -> _DataAtoms:
     p, box = model.particles, model.box
     x = p.unwrapped if any(box.periodic) else p.positions
+    # finite axes: the box must hold beads already pushed into a wall (restarts); the walls
+    # themselves sit at box.lo / box.hi in the script
     bounds = []
     for axis in range(3):
         lo, hi = box.lo[axis], box.hi[axis]
@@ -484,32 +494,32 @@ def _data_box(model: Model) -> list[tuple[float, float]]:
             lo = min(lo, float(x[:, axis].min()) - margin)
             hi = max(hi, float(x[:, axis].max()) + margin)
         bounds.append((lo, hi))
-    return bounds
-
-
-def _write_topology(model: Model, bonds, path: Path, ltypes, atype, btypes, btype, atypes, antype) -> None:
-    """``topology.bin``: what ``_write_data`` writes for ``read_data``, for fibrenet/read_data."""
-    p = model.particles
+    # mass-0 beads are not integrated: 1.0 is a placeholder
+    masses = [float(row[1]) if row[1] > 0 else 1.0 for row in ltypes]
     v = p.velocities
+    # a network at rest (e.g. 2.6M beads) has no velocities to write and for LAMMPS to read
+    return _DataAtoms(bounds, masses, x, v if (v.any() or np.signbit(v).any()) else None)
+
+
+def _write_topology(model: Model, bonds, path: Path, atoms: _DataAtoms, atype, btypes, btype, atypes,
+                    antype) -> None:
+    """``topology.bin``: what ``_write_data`` writes for ``read_data``, for fibrenet/read_data."""
     write_topology_file(
-        path, _data_box(model), [row[1] if row[1] > 0 else 1.0 for row in ltypes], p.molecules, atype + 1,
-        p.unwrapped if any(model.box.periodic) else p.positions, v if (v.any() or np.signbit(v).any()) else None,
+        path, atoms.bounds, atoms.masses, model.particles.molecules, atype + 1, atoms.x, atoms.v,
         bonds.atoms + 1, btype + 1, len(btypes) if bonds.count else 0,
         model.angles.atoms + 1, antype + 1, len(atypes) if model.angles.count else 0)
 
 
-def _write_data(model: Model, bonds, path: Path, ltypes, atype, btypes, btype, atypes, antype,
-                use_mvv: bool) -> None:
-    p, box = model.particles, model.box
+def _write_data(model: Model, bonds, path: Path, atoms: _DataAtoms, ltypes, atype, btypes, btype, atypes,
+                antype, use_mvv: bool) -> None:
+    p = model.particles
     n = p.count
     ids = np.arange(1, n + 1)
     counts = [(n, "atoms"), (bonds.count, "bonds"), (model.angles.count, "angles"),
               (len(ltypes), "atom types"), (len(btypes) if bonds.count else 0, "bond types"),
               (len(atypes) if model.angles.count else 0, "angle types")]
-    x = p.unwrapped if any(box.periodic) else p.positions
-    bounds = _data_box(model)
-    # mass-0 beads are not integrated: 1.0 is a placeholder
-    masses = [float_text(row[1] if row[1] > 0 else 1.0) for row in ltypes]
+    x = atoms.x
+    masses = [float_text(m) for m in atoms.masses]
     notes = [f"{comment_text(p.type_names[int(row[0])])} m={row[1]:g} R={row[2]:g}" for row in ltypes]
     sections = [DataSection("Masses", "%d %s  # %s\n", [np.arange(1, len(ltypes) + 1), masses, notes])]
     # unwrapped coordinates: read_data wraps them into periodic boxes and sets image flags
@@ -519,10 +529,8 @@ def _write_data(model: Model, bonds, path: Path, ltypes, atype, btypes, btype, a
     else:
         sections.append(DataSection("Atoms # angle", "%d %d %d %.17g %.17g %.17g\n",
                                     [ids, p.molecules, atype + 1, x[:, 0], x[:, 1], x[:, 2]]))
-    v = p.velocities
-    # LAMMPS starts every atom at rest (+0.0): the section only when a velocity differs (a
-    # network at rest, e.g. 2.6M beads: 2.6M lines fewer to write and for read_data to parse)
-    if v.any() or np.signbit(v).any():
+    if atoms.v is not None:
+        v = atoms.v
         sections.append(DataSection("Velocities", "%d %.17g %.17g %.17g\n", [ids, v[:, 0], v[:, 1], v[:, 2]]))
     if bonds.count:
         b = bonds.atoms + 1
@@ -533,4 +541,4 @@ def _write_data(model: Model, bonds, path: Path, ltypes, atype, btypes, btype, a
         sections.append(DataSection("Angles", "%d %d %d %d %d\n",
                                     [np.arange(1, len(a) + 1), antype + 1, a[:, 0], a[:, 1], a[:, 2]]))
     write_data_file(path, f"LAMMPS data file written by fibrelmp from {comment_text(model.source.name)}",
-                    counts, bounds, sections)
+                    counts, atoms.bounds, sections)

@@ -19,26 +19,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from fibrelmp import lammps_styles
 from fibrelmp._lammps import lmp_executable_env, new_lammps
 from fibrelmp.translate.fibrenet.reader import read as read_fibrenet
 from fibrelmp.translate.lammps_job import DATA_NAME, TOPOLOGY_NAME, write_job
 
 from . import fibrenet_reference as ref
+from .test_mpi import MPIEXEC
 from .conftest import data_path
 
 BIN = Path(sys.executable).parent
-MPIEXEC = str(BIN / "mpiexec") if (BIN / "mpiexec").exists() else shutil.which("mpiexec")
 LMP = [str(BIN / "lmp")] if (BIN / "lmp").exists() else \
     [sys.executable, "-c", "import sys; from lammps.executable import lmp; sys.argv[0]='lmp'; sys.exit(lmp())"]
-
-
-@pytest.fixture(scope="module")
-def plugin() -> Path:
-    found = lammps_styles.plugin()
-    if not found.available:
-        pytest.skip(f"fibrelmp's LAMMPS styles are unavailable here: {found.how}")
-    return found.path
 
 
 def _walls_net() -> ref.Net:
@@ -92,7 +83,7 @@ def _job(tmp_path: Path, name: str):
     return model, job
 
 
-def _loaded(job, plugin: Path, command: str, newton_bond: str = "on") -> dict[str, np.ndarray]:
+def _loaded(job, command: str, newton_bond: str = "on") -> dict[str, np.ndarray]:
     """The atoms and topology LAMMPS holds after the script's lines up to ``command``."""
     lmp = new_lammps(["-log", "none", "-screen", "none", "-nocite"])
     try:
@@ -121,10 +112,10 @@ def _loaded(job, plugin: Path, command: str, newton_bond: str = "on") -> dict[st
 
 @pytest.mark.parametrize("newton_bond", ["on", "off"])
 @pytest.mark.parametrize("name", sorted(NETS) + REAL)
-def test_loads_what_the_model_says_and_what_read_data_loads(tmp_path, plugin, name, newton_bond):
+def test_loads_what_the_model_says_and_what_read_data_loads(tmp_path, plugin_path, name, newton_bond):
     model, job = _job(tmp_path, name)
-    ours = _loaded(job, plugin, f"fibrenet/read_data {job.topology}", newton_bond)
-    theirs = _loaded(job, plugin, f"read_data {job.data}", newton_bond)
+    ours = _loaded(job, f"fibrenet/read_data {job.topology}", newton_bond)
+    theirs = _loaded(job, f"read_data {job.data}", newton_bond)
     for key in ours:
         np.testing.assert_array_equal(ours[key], theirs[key], err_msg=key)
 
@@ -157,7 +148,7 @@ def test_loads_what_the_model_says_and_what_read_data_loads(tmp_path, plugin, na
 
 @pytest.mark.parametrize("ranks", [1, 3])
 @pytest.mark.parametrize("name", sorted(NETS) + REAL[:1])
-def test_whole_job_replayed_gives_read_datas_bytes(tmp_path, plugin, name, ranks):
+def test_whole_job_replayed_gives_read_datas_bytes(tmp_path, plugin_path, name, ranks):
     if ranks > 1 and not MPIEXEC:
         pytest.skip("mpiexec not found (pip install mpich)")
     _, job = _job(tmp_path, name)
@@ -178,7 +169,7 @@ def test_whole_job_replayed_gives_read_datas_bytes(tmp_path, plugin, name, ranks
     assert len(files["binary"]) >= 4 and files["binary"] == files["text"]
 
 
-def test_cut_or_foreign_file_is_a_lammps_error(tmp_path, plugin):
+def test_cut_or_foreign_file_is_a_lammps_error(tmp_path, plugin_path):
     _, job = _job(tmp_path, "walls")
     whole = job.topology.read_bytes()
     last = len(whole) - 32               # the last angle: type, atom1, atom2, atom3 (int64)
@@ -191,4 +182,4 @@ def test_cut_or_foreign_file_is_a_lammps_error(tmp_path, plugin):
         path = tmp_path / "bad.bin"
         path.write_bytes(bad)
         with pytest.raises(Exception, match=says):
-            _loaded(job, plugin, f"fibrenet/read_data {path}")
+            _loaded(job, f"fibrenet/read_data {path}")

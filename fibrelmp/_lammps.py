@@ -112,7 +112,9 @@ def mpi_barrier() -> None:
 def mpi_wait_for_all(poll: float = 0.05) -> None:
     """A barrier that sleeps between tests (MPI_Ibarrier + MPI_Test): MPICH's blocking
     barrier spins, which would keep a core busy on every waiting rank for as long as rank 0
-    works alone (``fibrelmp post``).  Every rank must call it; a no-op without MPI."""
+    works alone (converting frames, exporting, ``fibrelmp post``), the core rank 0's second
+    thread needs.  The sleeps grow from 1 ms to ``poll``, so a short wait stays short.  Every
+    rank must call it (an MPI_Ibarrier does not match an MPI_Barrier); a no-op without MPI."""
     import time
 
     lib = _libmpi()
@@ -120,11 +122,13 @@ def mpi_wait_for_all(poll: float = 0.05) -> None:
         return
     request, flag = ctypes.c_int(0), ctypes.c_int(0)      # MPI_Request is an int (MPICH ABI)
     lib.MPI_Ibarrier(ctypes.c_int(_COMM_WORLD), ctypes.byref(request))
+    nap = 0.001
     while True:
         lib.MPI_Test(ctypes.byref(request), ctypes.byref(flag), ctypes.c_void_p(1))  # MPI_STATUS_IGNORE
         if flag.value:
             return
-        time.sleep(poll)
+        time.sleep(nap)
+        nap = min(poll, 2 * nap)
 
 
 def mpi_finalize() -> None:
@@ -139,5 +143,5 @@ def mpi_finalize() -> None:
         return
     sys.stdout.flush()
     sys.stderr.flush()
-    lib.MPI_Barrier(ctypes.c_int(_COMM_WORLD))
+    mpi_wait_for_all()          # sleeping: rank 0 may still be exporting on both cores
     lib.MPI_Finalize()

@@ -360,3 +360,41 @@ def test_a_scene_of_millions_of_empty_descriptors_is_refused_before_allocating(t
     assert path.stat().st_size < 100_000
     with pytest.raises(InputError, match="lists more than 10.* objects and other entries"):
         MdemFile(path)
+
+
+def test_blocks_compressed_beside_the_caller_give_the_same_file(tmp_path, monkeypatch):
+    """MdemWriter compresses a large time point on the helper thread while the next one is
+    prepared: the file is byte-identical to compressing each in turn, and reads back."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from fibrelmp.numtext import fast
+
+    rng = np.random.default_rng(2)
+    points = [rng.standard_normal((40000, tp.NCOLS)) for _ in range(3)]   # ~10 MB each: split size
+
+    def write(path: Path) -> bytes:
+        with open(path, "w+b") as fh:
+            out = MdemWriter(fh)
+            for k, values in enumerate(points):
+                out.add((k + 1) * 1e-3, values, np.full(len(values), tp.bit("coord", "vel"), np.uint32))
+            storage = new("ProtoSimulationStorage")
+            for _ in range(len(points[0])):
+                storage.info.particles.add(type=1, encoded_properties=b"\0" * 16)
+            out.finish(storage)
+        return path.read_bytes()
+    monkeypatch.setattr(fast, "helper_pool", lambda: None)
+    alone = write(tmp_path / "alone.mdem")
+    submitted = []
+
+    class Pool(ThreadPoolExecutor):
+        def submit(self, *args, **kwargs):
+            submitted.append(args[0])
+            return super().submit(*args, **kwargs)
+    with Pool(1) as pool:
+        monkeypatch.setattr(fast, "helper_pool", lambda: pool)
+        beside = write(tmp_path / "beside.mdem")
+    assert beside == alone and len(submitted) == 3
+    with MdemFile(tmp_path / "beside.mdem") as mdem:
+        assert mdem.count() == 3
+        t, values, _ = mdem.time_point(2)
+        assert t == 3e-3 and np.array_equal(values[:, :3], points[2][:, :3])

@@ -407,3 +407,23 @@ def test_overrides_and_defaults(tmp_path):
     out = write(m, tmp_path / "r.txt", frames_from(m, [0.0]))
     assert "32 KF6843H84OPHH3017U3D Glass 0 3000 " in out.read_text()
     assert "33 KF6843H84OPHH3017U3D KYDX71DJATPLUTAHNBZX 200 0.5 " in out.read_text()
+
+
+def test_text_scan_reused_only_while_the_file_is_unchanged(tmp_path, monkeypatch):
+    """A job script reads its scene up to three times: the scan of an unchanged small file is
+    shared; a changed file, the other mode or a file above the size limit is scanned again."""
+    from fibrelmp.translate.musen import text
+
+    path = tmp_path / "scene.txt"
+    line = "0 {} 1 1 5 0.0004 0.0004 23 KEY 24 0 1e+300 2 0 12 {} 0 0\n"
+    path.write_text(line.format(0, 0.0) + line.format(1, 0.001))
+    first = text.scan_text(path)
+    assert text.scan_text(path) is first and first.ids == [0, 1]
+    assert text.scan_text(path, objects_only=True) is not first
+    path.write_text(line.format(0, 0.0) + line.format(1, 0.001) + line.format(2, 0.002))
+    again = text.scan_text(path)
+    assert again is not first and again.ids == [0, 1, 2]
+    monkeypatch.setattr(text, "_REUSE_BYTES", 10)
+    path.write_text(line.format(5, 0.0))
+    big = text.scan_text(path)
+    assert big.ids == [5] and text.scan_text(path) is not big

@@ -34,3 +34,63 @@ def test_selectors_leave_out_parts_and_fields():
 def test_scene_line_puts_a_space_after_every_value():
     assert scene_line(27, 0, "") == "27 0  \n"
     assert scene_line(29, 1) == "29 1 \n"
+
+
+def test_time_points_c_and_python_formatting_agree(monkeypatch):
+    """precision 6 goes through the C formatter (fast.format_g_template), other precisions
+    and a missing library through Python's %: the same lines, for values across 60 decades,
+    signed zeros and exact binary ties at the 6th digit, split over two threads or not."""
+    from fibrelmp.numtext import fast
+
+    if fast.library() is None:
+        import pytest
+        pytest.skip(f"no C helper: {fast.active_path()}")
+    rng = np.random.default_rng(5)
+    objects, saves = 2000, 7            # 70,000 values: large enough to split
+    spool = rng.standard_normal((objects, saves, 4)) * 10.0 ** rng.integers(-30, 30, (objects, saves, 4))
+    spool[:20, :, 0] = (rng.integers(100000, 1000000, (20, saves)) + 0.5) * 2.0 ** -3   # ties
+    spool[20:40] = -0.0
+    heads = [f"0 {k} " for k in range(objects)]
+    times = np.linspace(0.0, 1e-5, saves)
+    flags = {"coord": True, "forceAmpl": True}
+
+    def lines():
+        return time_point_lines(heads, FIELDS, flags, times, 6, lambda cols: spool[:, :, cols])
+    template = "2 %g 12 %g %g %g 18 %g "
+    want = [h + "".join(template % (t, *spool[k, j]) for j, t in enumerate(times)) + "\n"
+            for k, h in enumerate(heads)]
+    monkeypatch.setattr(fast, "_helper", lambda: None)
+    assert lines() == want
+    monkeypatch.undo()
+    from concurrent.futures import ThreadPoolExecutor
+    with ThreadPoolExecutor(1) as pool:                       # the two-thread path
+        monkeypatch.setattr(fast, "_helper", lambda: pool)
+        assert lines() == want
+    monkeypatch.setattr(fast, "library", lambda: None)       # Python's % alone
+    assert lines() == want
+
+
+def test_c_time_point_formatter_declines_non_finite_values():
+    from fibrelmp.numtext import fast
+
+    if fast.library() is None:
+        import pytest
+        pytest.skip(f"no C helper: {fast.active_path()}")
+    assert fast.format_g_template(np.array([[1.0, 2.5]]), ["2 ", "18 "], 1) == b"2 1 18 2.5 \n"
+    for bad in (np.nan, np.inf, -np.inf):
+        assert fast.format_g_template(np.array([[1.0, bad]]), ["2 ", ""], 1) is None
+    # Python's % writes them as MUSEN's ostream does not; the caller falls back to it
+    lines = time_point_lines(["h "], FIELDS[1:], {"forceAmpl": True}, [0.0], 6,
+                             lambda cols: np.array([[[np.inf]]]))
+    assert lines == ["h 2 0 18 inf \n"]
+
+
+def test_headers_formatted_in_bulk_keep_one_entry_per_object():
+    """writer._bulk: one % for all rows, row by row when a value (a material key read from a
+    .mdem) holds a newline, which would shift every later object's header."""
+    from fibrelmp.translate.musen.writer import _bulk
+
+    assert _bulk("%d %.16g %s", np.array([1, 2]), np.array([0.1, 1e300]), ["a", "b"]) == \
+        ["1 0.1 a", "2 1e+300 b"]
+    assert _bulk("%d %s", np.array([1, 2]), ["a\nx", "b"]) == ["1 a\nx", "2 b"]
+    assert _bulk("%g", np.array([])) == []

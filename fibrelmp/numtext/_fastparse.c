@@ -578,6 +578,32 @@ int64_t fp_format_g_rows(const int64_t *codes, const double *vals, int64_t n, in
     return (int64_t)(o - out);
 }
 
+/* Rows of ncols values, each value its prefix (prefixes + k * w, NUL-padded to w bytes), then
+   printf("%g"), then a space; a '\n' after every per_line rows (MUSEN's text export: "2 t 12 x y
+   z ..." per time point, a line per object).  Returns the bytes written, or -1 (a non-finite
+   value, or out too small). */
+int64_t fp_format_g_template(const double *vals, int64_t nrows, int64_t ncols, const char *prefixes,
+                             int64_t w, int64_t per_line, char *out, int64_t cap)
+{
+    char *o = out, *end = out + cap;
+    if (FP_EXCESS_PRECISION || per_line < 1) return -1;
+    for (int64_t i = 0; i < nrows; i++) {
+        if (end - o < ncols * (w + 33) + 1) return -1;
+        for (int64_t k = 0; k < ncols; k++) {
+            const char *pre = prefixes + k * w;
+            for (int64_t j = 0; j < w && pre[j]; j++) *o++ = pre[j];
+            double x = vals[i * ncols + k];
+            if (!isfinite(x)) return -1;
+            int m = format_g6(x, o);
+            if (m < 0 || m >= 31) return -1;
+            o += m;
+            *o++ = ' ';
+        }
+        if ((i + 1) % per_line == 0) *o++ = '\n';
+    }
+    return (int64_t)(o - out);
+}
+
 /* ---- MUSEN .mdem time points (protobuf wire format of ProtoTimePoint) -------------------
    A time point is "1: double time" and "2: repeated ProtoTimeDependentProperties", one per
    object.  An object's fields go to 34 columns (absent = 0, as protobuf reads them):

@@ -137,6 +137,8 @@ def _open(lib: Path) -> ctypes.CDLL:
         dll.fp_format_fixed_rows.restype = i64
         dll.fp_format_g_rows.argtypes = [ptr, ptr, i64, i64, ctypes.c_char_p, i64, i64, ptr, i64]
         dll.fp_format_g_rows.restype = i64
+        dll.fp_format_g_template.argtypes = [ptr, i64, i64, ctypes.c_char_p, i64, i64, ptr, i64]
+        dll.fp_format_g_template.restype = i64
         dll.fp_count_lines.argtypes = [ptr, i64]
         dll.fp_count_lines.restype = i64
         dll.fp_nth_newline.argtypes = [ptr, i64, i64, ctypes.POINTER(i64)]
@@ -249,6 +251,12 @@ def _helper():
                 _pool = ThreadPoolExecutor(1, thread_name_prefix="fibrelmp-fast") if _cores() > 1 else False
                 _pool_pid = os.getpid()
     return _pool or None
+
+
+def helper_pool():
+    """The one-thread pool that takes the second half of large calls (ctypes, zlib and file
+    I/O release the GIL), or None when no core is free (one core, or LAMMPS running beside)."""
+    return _helper()
 
 
 def nth_newline(buf: bytearray, start: int, stop: int, need: int) -> tuple[int, int] | None:
@@ -386,6 +394,40 @@ def format_g_rows(codes: np.ndarray, table: list[str], values: np.ndarray) -> by
         parts = [part(0, n // 2), job.result()]
     else:
         parts = [part(0, n)]
+    if any(p is None for p in parts):
+        return None
+    return b"".join(p.tobytes() for p in parts)
+
+
+def format_g_template(values: np.ndarray, prefixes: list[str], per_line: int) -> bytes | None:
+    """Rows of ``values`` (nrows, len(prefixes)): each value ``prefixes[k]`` + ``%g`` + a space,
+    a newline after every ``per_line`` rows (printf-identical to Python's % formatting); None
+    without the C library or for non-finite values."""
+    lib = library()
+    if lib is None or values.ndim != 2 or values.shape[1] != len(prefixes) or per_line < 1 \
+            or len(values) % per_line or not len(values):
+        return None
+    enc = [t.encode() for t in prefixes]
+    if any(b"\0" in e for e in enc):
+        return None
+    w = max(1, max(len(e) for e in enc))
+    table = b"".join(e.ljust(w, b"\0") for e in enc)
+    values = np.ascontiguousarray(values, np.float64)
+    ncols = values.shape[1]
+    lines = len(values) // per_line
+
+    def part(a: int, b: int) -> np.ndarray | None:          # lines a..b
+        rows = (b - a) * per_line
+        buf = np.empty(rows * ncols * (w + 33) + (b - a) + 1, np.uint8)
+        got = lib.fp_format_g_template(values[a * per_line:].ctypes.data, rows, ncols, table, w,
+                                       per_line, buf.ctypes.data, len(buf))
+        return None if got < 0 else buf[:got]
+    pool = _helper() if values.size >= 1 << 16 and lines >= 2 else None
+    if pool is not None:
+        job = pool.submit(part, lines // 2, lines)
+        parts = [part(0, lines // 2), job.result()]
+    else:
+        parts = [part(0, lines)]
     if any(p is None for p in parts):
         return None
     return b"".join(p.tobytes() for p in parts)

@@ -96,7 +96,7 @@ def simulate(request: RunRequest, options: RunOptions, rank: int = 0, size: int 
     names the simulation in progress lines."""
     import time
 
-    from fibrelmp._lammps import mpi_barrier
+    from fibrelmp._lammps import mpi_barrier, mpi_wait_for_all
     from fibrelmp.checkpoint import STATE
     from fibrelmp.record import SUMMARY_NAME, Recorder, write_summary
     from fibrelmp.runner import run_script
@@ -120,7 +120,7 @@ def simulate(request: RunRequest, options: RunOptions, rank: int = 0, size: int 
         with _hint(request.model):
             run_script(rendered.script, rendered.total_steps, progress=False, text=rendered.text,
                        checkpoints=checkpoints, record=record)
-        mpi_barrier()
+        mpi_wait_for_all()   # asleep while rank 0 converts the frames (with both cores)
         return rendered, [], None
     more = dict(record=record, log_every=options.log_every, label=label)
 
@@ -158,7 +158,7 @@ def simulate(request: RunRequest, options: RunOptions, rank: int = 0, size: int 
         summary["frames"] = schedule.given                   # variable step): not scheduled
     write_summary(rendered.folder, summary)
     if size > 1:
-        mpi_barrier()
+        mpi_wait_for_all()
     return rendered, list(written), summary
 
 

@@ -233,10 +233,33 @@ def _check_binary(path: Path) -> None:
                          "export it as text with cmusen COMPONENT EXPORT_TO_TEXT")
 
 
+# The last scan of a file up to this size, reused while the file is unchanged: a job script
+# reads its scene up to three times (planning, IMPORT_FROM_TEXT, the result's scene message).
+# Larger files are scanned each time, so a big scene is not held through the run.
+_REUSE_BYTES = 16 << 20
+_last_scan: tuple[tuple, TextScan] | None = None
+
+
 def scan_text(path: Path, objects_only: bool = False) -> TextScan:
     """The one MUSEN text reader (scenes, results, ``.mdem`` text import): every line of
     ``path`` tokenised, malformed lines an InputError at their line; ``objects_only`` skips the
-    scene lines."""
+    scene lines.  The result is shared with later calls on the unchanged file: read it only."""
+    global _last_scan
+    try:
+        st = Path(path).stat()
+        key = (str(Path(path).resolve()), st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, objects_only)
+    except OSError:
+        key = None                          # _scan_text reports it
+    last = _last_scan
+    if key is not None and last is not None and last[0] == key:
+        return last[1]
+    scan = _scan_text(path, objects_only)
+    if key is not None and key[3] <= _REUSE_BYTES:
+        _last_scan = (key, scan)
+    return scan
+
+
+def _scan_text(path: Path, objects_only: bool) -> TextScan:
     _check_binary(path)
     text = read_text(path, "MUSEN text file")
     if "\r" in text:                       # MUSEN's safeGetLine accepts \n, \r\n and \r

@@ -17,6 +17,8 @@ from typing import IO, Any
 
 import numpy as np
 
+from fibrelmp.numtext.fast import format_g_template
+
 # MUSEN's export selector groups and flags, in ExportAsText.h order (cmusen TEXT_EXPORT_*).
 EXPORT_FLAGS: dict[str, tuple[str, ...]] = {
     "objectTypes": ("particles", "bonds", "walls"),
@@ -102,9 +104,23 @@ def time_point_lines(heads: Sequence[str], fields: Sequence[Field], flags: dict[
     values[:, :, 0] = times
     if cols:
         values[:, :, 1:] = values_of(cols)
-    # one C-level % for the whole chunk of objects
-    text = ((tpl * nt + "\n") * len(heads)) % tuple(values.ravel().tolist())
+    raw = None
+    if precision == 6:                  # the C formatter's %g (printf-identical), else Python's %
+        raw = format_g_template(values.reshape(-1, 1 + len(cols)), _prefixes(fields, flags), nt)
+    if raw is not None:
+        text = raw.decode("ascii")
+    else:                               # one C-level % for the whole chunk of objects
+        text = ((tpl * nt + "\n") * len(heads)) % tuple(values.ravel().tolist())
     return [h + body + "\n" for h, body in zip(heads, text.split("\n"))]
+
+
+def _prefixes(fields: Sequence[Field], flags: dict[str, bool]) -> list[str]:
+    """What precedes each value of a time point: ``2 `` the time, ``TAG `` a field's first."""
+    out = ["2 "]
+    for flag, tag, width in fields:
+        if flags[flag]:
+            out += [f"{tag} "] + [""] * (width - 1)
+    return out
 
 
 def _time_point_template(fields: Sequence[Field], flags: dict[str, bool],

@@ -383,21 +383,38 @@ class MdemWriter:
         # per block: time, offset, stored size, raw size
         self.times, self.offsets, self.sizes, self.raw_sizes = (array("d"), array("q"), array("q"),
                                                                  array("q"))
+        self.pending = None                # (time, raw size, future of the compressed block)
 
     def add(self, time: float, values: np.ndarray, masks: np.ndarray) -> None:
-        """One time point (one block, as MUSEN's simulator saves)."""
+        """One time point (one block, as MUSEN's simulator saves).  A large block is
+        compressed on the second core while the caller prepares the next one (memory: two
+        time points)."""
         block = _field2(timepoints.encode(time, values, masks))   # ProtoBlockOfTimePoints
-        packed = zlib.compress(block, _LEVEL)
+        self._drain()
+        pool = fast.helper_pool() if len(block) >= fast.SPLIT_BYTES else None
+        if pool is None:
+            self._store(float(time), len(block), zlib.compress(block, _LEVEL))
+        else:
+            self.pending = (float(time), len(block), pool.submit(zlib.compress, block, _LEVEL))
+
+    def _drain(self) -> None:
+        if self.pending is not None:
+            time, raw, job = self.pending
+            self.pending = None
+            self._store(time, raw, job.result())
+
+    def _store(self, time: float, raw: int, packed: bytes) -> None:
         self.out.write(1, self.end, packed)
-        self.times.append(float(time))
+        self.times.append(time)
         self.offsets.append(self.end)
         self.sizes.append(len(packed))
-        self.raw_sizes.append(len(block))
+        self.raw_sizes.append(raw)
         self.end += len(packed)
 
     def finish(self, storage: Any) -> None:
         """Write ``storage`` (its block descriptors, saved times and begin/end time are set
         to what ``add`` wrote) and the headers."""
+        self._drain()
         if not self.times:                                 # MUSEN files always have a block
             self.add(0.0, np.zeros((0, timepoints.NCOLS)), np.zeros(0, np.uint32))
         times = np.frombuffer(self.times, float)

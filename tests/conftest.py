@@ -59,12 +59,17 @@ def copy_example(folder: str | Path, dest: Path) -> Path:
     return dest
 
 
-@pytest.fixture(scope="module")
-def plugin_path() -> str:
+def styles_or_skip() -> Path:
     """fibrelmp's compiled LAMMPS styles (the plugin library), else the test is skipped."""
     from fibrelmp import lammps_styles
 
     found = lammps_styles.plugin()
     if not found.available:
         pytest.skip(f"fibrelmp's LAMMPS styles are not available: {found.how}")
-    return str(found.path)
+    return found.path
+
+
+@pytest.fixture(scope="module")
+def plugin_path() -> str:
+    """styles_or_skip() as a fixture (a str)."""
+    return str(styles_or_skip())

@@ -26,6 +26,8 @@ import numpy as np
 import pytest
 
 from fibrelmp import lammps_styles
+from tests.conftest import styles_or_skip
+from tests.test_mpi import MPIEXEC
 from fibrelmp._lammps import lmp_executable_env, new_lammps
 from fibrelmp.translate.lammps_job import angle_expression
 
@@ -37,11 +39,8 @@ F32_PI = float(np.float32(math.pi))        # FibreNet reads theta0 with stof: pi
 
 
 @pytest.fixture(scope="module")
-def plugin_path() -> Path:
-    found = lammps_styles.plugin()
-    if not found.available:
-        pytest.skip(f"fibrelmp's LAMMPS styles are unavailable here: {found.how}")
-    return found.path
+def plugin_path() -> Path:        # conftest's, as a Path
+    return styles_or_skip()
 
 
 # ------------------------------------------------------------------------------------------
@@ -432,7 +431,6 @@ def test_restart_and_data_file_keep_the_coefficients(tmp_path, plugin_path):
 # ------------------------------------------------------------------------------------------
 # a network: serial vs 2 MPI ranks, and the translated job
 BIN = Path(sys.executable).parent
-MPIEXEC = str(BIN / "mpiexec") if (BIN / "mpiexec").exists() else shutil.which("mpiexec")
 LMP = str(BIN / "lmp") if (BIN / "lmp").exists() else shutil.which("lmp")
 
 

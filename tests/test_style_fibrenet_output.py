@@ -25,6 +25,8 @@ import numpy as np
 import pytest
 
 from fibrelmp import lammps_styles
+from tests.conftest import styles_or_skip
+from tests.test_mpi import MPIEXEC
 from fibrelmp._lammps import new_lammps
 from fibrelmp.pipeline.run_model import run_fibrenet
 from fibrelmp.post.lammps_dump.reader import iter_frames
@@ -44,10 +46,7 @@ CASES = ["network_pbc_hs", "lambda_07_damped", "st_pairs_network", "lj_two_types
 
 @pytest.fixture(scope="module")
 def plugin() -> Path:
-    found = lammps_styles.plugin()
-    if not found.available:
-        pytest.skip(f"fibrelmp's LAMMPS styles are unavailable here: {found.how}")
-    return found.path
+    return styles_or_skip()
 
 
 def _env() -> dict[str, str]:
@@ -394,7 +393,6 @@ def test_resume_cuts_the_fix_files_back_to_the_checkpoint(tmp_path, plugin, monk
 
 
 # ------------------------------------------------------------------------------------------
-MPIEXEC = str(BIN / "mpiexec") if (BIN / "mpiexec").exists() else shutil.which("mpiexec")
 needs_mpi = pytest.mark.skipif(not MPIEXEC, reason="mpiexec not found (pip install mpich)")
 
 

@@ -34,17 +34,12 @@ import numpy as np
 import pytest
 
 from fibrelmp import lammps_styles
+from tests.conftest import styles_or_skip
+from tests.test_mpi import MPIEXEC
 from fibrelmp.granmodel import SolidBondLaw
 from fibrelmp._lammps import new_lammps
 
 MUSEN_PI = 3.14159265358979323846
-
-
-def plugin_or_skip() -> Path:
-    found = lammps_styles.plugin()
-    if not found.available:
-        pytest.skip(f"fibrelmp's LAMMPS styles are unavailable here: {found.how}")
-    return found.path
 
 
 # --------------------------------------------------------------------------------------------
@@ -208,7 +203,7 @@ class Lmp:
         cwd = os.getcwd()
         os.chdir(folder)
         try:
-            for c in [f"plugin load {plugin_or_skip()}", "units si", "atom_style bpm/sphere",
+            for c in [f"plugin load {styles_or_skip()}", "units si", "atom_style bpm/sphere",
                       "atom_modify map array sort 0 0.0", f"newton on {newton_bond}",
                       "comm_modify vel yes" if comm_vel else "comm_modify vel no", *pre,
                       f"read_data {data.name} {read_data_extra}",
@@ -691,7 +686,7 @@ def test_restart_and_split_runs_continue_exactly(tmp_path, style, dt):
                     lmp = Lmp.__new__(Lmp)
                     lmp.lmp = new_lammps(["-log", "none", "-screen", "none", "-nocite"])
                     lmp.folder, lmp.first = folder, True
-                    for c in [f"plugin load {plugin_or_skip()}", "read_restart half.restart",
+                    for c in [f"plugin load {styles_or_skip()}", "read_restart half.restart",
                               "pair_style zero 0.003", "pair_coeff * *", f"bond_style {style}",
                               f"bond_coeff {CLUSTER_COEFF}", "fix integ all nve/bpm/sphere",
                               "thermo_style custom step", "thermo 0", *_pull_commands(len(x))]:
@@ -745,7 +740,6 @@ def test_bad_settings_are_errors(tmp_path, case, message):
 # serial vs mpiexec -n 2
 
 BIN = Path(sys.executable).parent
-MPIEXEC = str(BIN / "mpiexec") if (BIN / "mpiexec").exists() else shutil.which("mpiexec")
 
 
 
@@ -801,7 +795,7 @@ def test_serial_and_two_ranks_agree(tmp_path):
         write_data(folder / "data.bonds", x, [RADIUS] * n, pairs, v, w, box=box)
         text = (folder / "data.bonds").read_text().replace(f"{-box} {box} ylo yhi", "-0.004 0.006 ylo yhi")
         (folder / "data.bonds").write_text(text.replace(f"{-box} {box} zlo zhi", "-0.004 0.006 zlo zhi"))
-        commands = [f"plugin load {plugin_or_skip()}", "units si", "atom_style bpm/sphere",
+        commands = [f"plugin load {styles_or_skip()}", "units si", "atom_style bpm/sphere",
                     "boundary p f f", "newton on on", "comm_modify vel yes cutoff 0.003",
                     "read_data data.bonds", "pair_style zero 0.0012", "pair_coeff * *",
                     "special_bonds lj/coul 1 1 1", f"bond_style {CLUSTER_STYLE}",
@@ -854,7 +848,7 @@ def test_job_keeps_each_bonds_geometry_exactly(tmp_path):
     """With the plugin: bond_style musen/elastic, one bond type per material (E G sigma tau
     mu), and every bond's own d, L0 and initial overlap, as doubles that read back exactly,
     on its first sphere; no 'approximate' bond warning."""
-    plugin_or_skip()
+    styles_or_skip()
     from fibrelmp.translate.granular_job import write_granular_job
 
     x = np.array([[0, 0, 0], [0.0008, 0, 0], [0.0016, 0, 0], [0.0024, 0, 0.0001]])
@@ -931,7 +925,7 @@ def test_pipeline_break_time_is_musens(tmp_path, model_name, criterion):
     positions its force stage used), computed here with the numpy model on the same motion
     (heavy spheres: constant velocity).  Kelvin (glass's viscosity 1e40, capped at the elastic
     force) breaks on the elastic stresses alone, at the same step."""
-    plugin_or_skip()
+    styles_or_skip()
     from tests.granular_models import run
 
     dt, v, L0, d = 1e-8, 0.1037, 0.0008, 0.0006      # breaks after ~770 steps
@@ -970,7 +964,7 @@ def test_broken_bond_lets_contact_act(tmp_path, bonded_contacts):
     musen/verlet), which never comes here: nothing moves (MUSEN updates when a sphere has
     moved half its Verlet distance, 2 x 0.4 mm).  The set-ups and neighbour-list builds LAMMPS
     makes do not let it in.  (Updates mid-run: tests/test_musen_verlet_schedule.py.)"""
-    plugin_or_skip()
+    styles_or_skip()
     from tests.granular_models import run
 
     r, delta = 0.0004, 2e-6
@@ -1037,7 +1031,7 @@ def test_sigterm_and_resume_continue_the_bonds_exactly(tmp_path):
     import signal
     import time
 
-    plugin_or_skip()
+    styles_or_skip()
     repo = str(Path(__file__).resolve().parents[1])
     env = dict(os.environ, OMP_NUM_THREADS="1")
 
@@ -1093,7 +1087,7 @@ def test_agglomerate_impact_scenario(tmp_path):
     1.34 m/s rebound (2.51)."""
     import gzip
 
-    plugin_or_skip()
+    styles_or_skip()
     sys.path.insert(0, str(Path(__file__).resolve().parent / "scenarios"))
     import agglomerate_metrics as am
     from .conftest import data_path

@@ -31,14 +31,14 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from fibrelmp import lammps_styles
+from tests.conftest import styles_or_skip
+from tests.test_mpi import MPIEXEC
 from fibrelmp._lammps import new_lammps
 
 from .conftest import data_path
 
 ROOT = Path(__file__).resolve().parents[1]
 BIN = Path(sys.executable).parent
-MPIEXEC = str(BIN / "mpiexec") if (BIN / "mpiexec").exists() else shutil.which("mpiexec")
 
 # ---------------------------------------------------------------- MUSEN, re-written in Python
 
@@ -198,13 +198,6 @@ def calculate_pp(src: Sphere, dst: Sphere, p: Interaction, c: Contact, dt: float
 GLASS = Material(5e10, 0.22)          # the oblique scenario's materials
 STEEL = Material(2.1e11, 0.29)
 RHO = {"glass": 2500.0, "steel": 7800.0}
-
-
-def plugin_or_skip() -> Path:
-    found = lammps_styles.plugin()
-    if not found.available:
-        pytest.skip(f"fibrelmp's LAMMPS styles are unavailable here: {found.how}")
-    return found.path
 
 
 def coeff_line(i: int, j: int, p: Interaction) -> str:
@@ -374,7 +367,7 @@ CASES = {
 
 @pytest.mark.parametrize("case", sorted(CASES))
 def test_forces_and_torques_equal_musen(case):
-    plugin = plugin_or_skip()
+    plugin = styles_or_skip()
     rec, _ = collide(plugin, CASES[case], nsteps=500)
     assert rec.contact_steps > 100, f"the spheres must collide ({rec.contact_steps} contact steps)"
     assert rec.worst <= 1e-12, f"largest relative difference {rec.worst:.3g}"
@@ -385,7 +378,7 @@ def test_forces_and_torques_equal_musen(case):
 def test_both_atom_orders_give_the_same_trajectory():
     """MUSEN's law is antisymmetric in IEEE arithmetic: swapping which sphere is atom 1 gives
     the same trajectory bit for bit."""
-    plugin = plugin_or_skip()
+    plugin = styles_or_skip()
     bodies = CASES["oblique_spinning"]
     _, (x1, v1, w1) = collide(plugin, bodies, nsteps=500)
     rec, (x2, v2, w2) = collide(plugin, bodies[::-1], nsteps=500)
@@ -399,7 +392,7 @@ def test_contact_across_a_periodic_boundary_is_computed_from_both_sides():
     """Across a periodic boundary each sphere meets a ghost image of the other: the pair is
     computed once from each side, each keeping its own history entry; both must agree with
     MUSEN and with the same collision inside the box."""
-    plugin = plugin_or_skip()
+    plugin = styles_or_skip()
     box = 0.004
     inside = CASES["oblique_spinning"]
     shift = np.array([box - 0.8e-3, 0.0, 0.0])
@@ -415,7 +408,7 @@ def test_contact_across_a_periodic_boundary_is_computed_from_both_sides():
 def test_history_survives_many_runs_and_setups():
     """A collision cut into 10 runs: LAMMPS recomputes forces at each run's setup, which must
     not advance the tangential overlap (the reference does not either)."""
-    plugin = plugin_or_skip()
+    plugin = styles_or_skip()
     laws = default_laws()
     lmp = setup_lammps(plugin, CASES["oblique_spinning"], laws, 5e-8)
     rec = Recorder(lmp, laws, 5e-8)
@@ -467,7 +460,7 @@ def test_scenario_pairs_as_in_cmusen(tmp_path, case):
     Measured: omega within 4e-8 rad/s of cmusen's; velocities within 2.5e-7 m/s, which is
     g dt / 2 (MUSEN saves the half-step velocity of its leapfrog, LAMMPS the full step), the
     other components within 1e-11 m/s."""
-    plugin = plugin_or_skip()
+    plugin = styles_or_skip()
     ids, bodies = SCENARIO_PAIRS[case]
     # the scene's own coordinates: 10/11 start exactly 1000 steps before touching, so a
     # shifted origin changes by round-off the step the contact starts at (0.003 rad/s after)
@@ -562,7 +555,7 @@ def test_history_migrates_with_atoms_serial():
     """Serial run with atom sorting and periodic wrapping: the pair forces of every step equal
     MUSEN's (the reference keeps its own history), while the pressed contact is computed
     from the glass sphere's side, from the steel sphere's side, and across the boundary."""
-    plugin = plugin_or_skip()
+    plugin = styles_or_skip()
     laws = default_laws()
     lmp = persistent_lammps(plugin, record=True)
     rec = Recorder(lmp, laws, PERSISTENT_DT, [hi - lo for lo, hi in BOX])
@@ -608,7 +601,7 @@ def _run_case(plugin, ranks, steps, tmp_path, style="pair_style musen/hm"):
 def test_serial_and_two_ranks_bitwise(tmp_path, style):
     """The contacts above under mpiexec -n 2 (each contact crosses the processor boundary;
     pairs with a ghost are computed on both ranks from each side): bit-identical to serial."""
-    plugin = plugin_or_skip()
+    plugin = styles_or_skip()
     serial = _run_case(plugin, None, STEPS, tmp_path, style)
     two = _run_case(plugin, 2, STEPS, tmp_path, style)
     for name in ("x", "v", "omega"):
@@ -628,7 +621,7 @@ def check_restart_round_trip(tmp_path: Path, style: str) -> None:
     half-way: a new LAMMPS reading it (the fixes defined again, the pair style and its laws
     from the file) ends with the positions, velocities and spins of the run not stopped, bit
     for bit."""
-    plugin = plugin_or_skip()
+    plugin = styles_or_skip()
     restart = tmp_path / "mid.restart"
     lmp = persistent_lammps(plugin, style=style)
     try:
@@ -669,7 +662,7 @@ def check_restart_round_trip(tmp_path: Path, style: str) -> None:
     (("pair_style", "pair_style musen/hm then nosuch"), "unknown particle-particle law nosuch"),
 ])
 def test_bad_input_is_a_clear_error(change, message):
-    plugin = plugin_or_skip()
+    plugin = styles_or_skip()
     laws = default_laws()
     lmp = new_lammps(["-log", "none", "-screen", "none", "-nocite"])
     cmds = [f"plugin load {plugin}", "units si", "atom_style sphere", "boundary f f f",
@@ -689,7 +682,7 @@ def test_bad_input_is_a_clear_error(change, message):
 
 
 def test_partial_special_weights_are_refused():
-    plugin = plugin_or_skip()
+    plugin = styles_or_skip()
     lmp = new_lammps(["-log", "none", "-screen", "none", "-nocite"])
     cmds = [f"plugin load {plugin}", "units si", "atom_style bpm/sphere", "boundary f f f",
             "comm_modify vel yes", "region box block -0.01 0.01 -0.01 0.01 -0.01 0.01",
@@ -726,7 +719,7 @@ def _oblique_job(folder: Path, end_time: float | None = None) -> Path:
 def test_musen_job_uses_musen_hm_with_line_33_coefficients(tmp_path):
     """With the plugin: newton off, pair_style musen/hm and, per type pair, the E*/G* MUSEN
     mixes from the materials and e/mu/mu_r of the scene's `33` line."""
-    plugin_or_skip()
+    styles_or_skip()
     proc = _translate(_oblique_job(tmp_path / "in"), tmp_path / "job")
     assert proc.returncode == 0, proc.stderr
     script = (tmp_path / "job" / "in.lammps").read_text()
@@ -768,7 +761,7 @@ def test_wall_particles_with_musen_hm(tmp_path):
     contact is the flat wall's (R* = R_p); mu_r stays (musen/hm's rolling torque uses the
     sphere's own radius).  (Spheres on moving tiled walls with musen/hm:
     tests/test_granular_walls.py, which runs with the plugin when it is there.)"""
-    plugin_or_skip()
+    styles_or_skip()
     from fibrelmp.granmodel import ContactLaw
     from fibrelmp.translate.granular.contacts import pair_coeff_lines
 
@@ -798,7 +791,7 @@ def test_oblique_scenario_sphere_sphere_metrics(tmp_path):
     metric script tests/scenarios/oblique_metrics.py.  README tolerances: |v| 0.01 m/s,
     omega 20 rad/s; measured |v| within 1.5e-7 m/s, omega within 1.5e-9 rad/s.  (The plate
     impacts depend on the wall law, not asserted here.)"""
-    plugin_or_skip()
+    styles_or_skip()
     from tests.scenarios.oblique_metrics import compare, sphere_sphere
 
     job = _oblique_job(tmp_path / "run", end_time=0.0012)
@@ -815,7 +808,7 @@ def test_oblique_scenario_sphere_sphere_metrics(tmp_path):
 def test_newton_on_gives_the_same_trajectory():
     """The style asks for a newton-off list whatever `newton` says: `newton on` (e.g. a
     hand-written script) gives the same collision bit for bit, across a periodic boundary too."""
-    plugin = plugin_or_skip()
+    plugin = styles_or_skip()
     box = 0.004
     shift = np.array([box - 0.8e-3, 0.0, 0.0])
     across = [Body(b.kind, b.r, tuple(float(c) for c in np.add(b.x, shift)), b.v, b.w)

@@ -20,15 +20,13 @@ import pytest
 from fibrelmp import lammps_styles, python_api
 from fibrelmp.errors import InputError
 from fibrelmp.translate.musen.text import TimePoints, read_time_points
+from tests.conftest import styles_or_skip  # noqa: F401  (the model tests import it from here)
 
 CMUSEN = os.environ.get("FIBRELMP_CMUSEN")
 needs_cmusen = pytest.mark.skipif(not CMUSEN, reason="set FIBRELMP_CMUSEN to the real cmusen")
 VEL, ANGVEL, COORD = 15, 16, 12                # MUSEN text tags
 
 
-def styles_or_skip() -> None:
-    if not lammps_styles.plugin().available:
-        pytest.skip("fibrelmp's LAMMPS styles are not available")
 
 
 def model_job(tmp_path: Path, data: Path, prefix: str, params: str, new_params: str | None = None) -> Path:

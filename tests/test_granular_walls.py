@@ -25,7 +25,7 @@ from fibrelmp.translate.granular.kinematics import geometry_kinematics
 
 from . import granular_models as gm
 from .granular_models import run
-from .conftest import REPO, data_path
+from .conftest import REPO, data_path, styles_or_skip
 
 R = 0.0005
 G = 9.81
@@ -43,9 +43,7 @@ def stock_styles():
 def mesh_styles() -> None:
     """Use fibrelmp's styles (MUSEN geometries become fix musen/wall/mesh triangles)."""
     lammps_styles.request_stock(False)
-    found = lammps_styles.plugin()
-    if not found.available:
-        pytest.skip(f"fibrelmp's LAMMPS styles are not available: {found.how}")
+    styles_or_skip()
 
 
 

@@ -14,17 +14,11 @@ from fibrelmp import lammps_styles
 from fibrelmp._lammps import new_lammps
 from fibrelmp.errors import RunError
 from fibrelmp.lammps_styles import build
+from tests.conftest import styles_or_skip
 from fibrelmp.lammps_text import lammps_path
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE_JOB = ROOT / "examples" / "musen" / "single_particle_job.txt"
-
-
-def plugin_or_skip() -> Path:
-    found = lammps_styles.plugin()
-    if not found.available:
-        pytest.skip(f"fibrelmp's LAMMPS styles are unavailable here: {found.how}")
-    return found.path
 
 
 def _lammps(log: Path):
@@ -32,7 +26,7 @@ def _lammps(log: Path):
 
 
 def test_plugin_registers_its_styles(tmp_path):
-    path = plugin_or_skip()
+    path = styles_or_skip()
     lmp = _lammps(tmp_path / "screen.txt")
     try:
         lmp.command(f"plugin load {path}")
@@ -56,7 +50,7 @@ def test_self_registered_styles_load_in_a_fixed_order(tmp_path):
     """Each style registers itself from its own .cpp (src/style_registry.h); the plugin hands
     them to LAMMPS sorted by their order number, so log.lammps's "Loading plugin" lines keep
     the order they had when plugin.cpp listed the styles by hand (a new style may add a line)."""
-    path = plugin_or_skip()
+    path = styles_or_skip()
     log = tmp_path / "screen.txt"
     # a fresh process: a plugin already loaded in this one would not print its lines again
     code = f"""
@@ -99,7 +93,7 @@ def test_every_style_class_registers_itself_and_plugin_cpp_names_none():
 def test_plugin_refuses_another_lammps_version(tmp_path):
     """A plugin compiled for another LAMMPS registers nothing and says why; using one of its
     styles then fails with LAMMPS's own 'unrecognized style' error."""
-    plugin_or_skip()            # needs a working compiler and the headers, as the real build
+    styles_or_skip()            # needs a working compiler and the headers, as the real build
     wrong = build.build(tmp_path, num_ver=20000101, core_only=True)
     log = tmp_path / "screen.txt"
     # a fresh process: plugins loaded by other tests stay registered in this one
@@ -168,7 +162,7 @@ def test_stock_styles_job_has_no_plugin_and_warns(tmp_path, how):
 
 
 def test_job_loads_the_plugin(tmp_path):
-    path = plugin_or_skip()
+    path = styles_or_skip()
     proc = _translate(tmp_path / "job")
     assert proc.returncode == 0, proc.stderr
     script = (tmp_path / "job" / "in.lammps").read_text()

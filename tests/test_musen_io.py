@@ -1,5 +1,6 @@
 """MUSEN text reader, result writer and cmusen script parser, against MUSEN's own files."""
 
+import os
 import gzip
 import math
 import shutil
@@ -410,8 +411,9 @@ def test_overrides_and_defaults(tmp_path):
 
 
 def test_text_scan_reused_only_while_the_file_is_unchanged(tmp_path, monkeypatch):
-    """A job script reads its scene up to three times: the scan of an unchanged small file is
-    shared; a changed file, the other mode or a file above the size limit is scanned again."""
+    """A job script reads its scene up to three times: the scan of the same small text is
+    shared; a changed text (also one of the same size with its old mtime put back), the other
+    mode or a text above the size limit is scanned again."""
     from fibrelmp.translate.musen import text
 
     path = tmp_path / "scene.txt"
@@ -423,6 +425,11 @@ def test_text_scan_reused_only_while_the_file_is_unchanged(tmp_path, monkeypatch
     path.write_text(line.format(0, 0.0) + line.format(1, 0.001) + line.format(2, 0.002))
     again = text.scan_text(path)
     assert again is not first and again.ids == [0, 1, 2]
+    same_size = line.format(0, 0.0) + line.format(1, 0.001) + line.format(3, 0.002)
+    stat = path.stat()
+    path.write_text(same_size)                      # same size, the old mtime put back (cp -p)
+    os.utime(path, ns=(stat.st_atime_ns, stat.st_mtime_ns))
+    assert path.stat().st_size == stat.st_size and text.scan_text(path).ids == [0, 1, 3]
     monkeypatch.setattr(text, "_REUSE_BYTES", 10)
     path.write_text(line.format(5, 0.0))
     big = text.scan_text(path)

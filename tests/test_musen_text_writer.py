@@ -39,7 +39,10 @@ def test_scene_line_puts_a_space_after_every_value():
 def test_time_points_c_and_python_formatting_agree(monkeypatch):
     """precision 6 goes through the C formatter (fast.format_g_template), other precisions
     and a missing library through Python's %: the same lines, for values across 60 decades,
-    signed zeros and exact binary ties at the 6th digit, split over two threads or not."""
+    signed zeros and exact binary ties at the 6th digit, with a field switched off between two
+    that are on, split over two threads or not."""
+    from concurrent.futures import ThreadPoolExecutor
+
     from fibrelmp.numtext import fast
 
     if fast.library() is None:
@@ -47,27 +50,41 @@ def test_time_points_c_and_python_formatting_agree(monkeypatch):
         pytest.skip(f"no C helper: {fast.active_path()}")
     rng = np.random.default_rng(5)
     objects, saves = 2000, 7            # 70,000 values: large enough to split
-    spool = rng.standard_normal((objects, saves, 4)) * 10.0 ** rng.integers(-30, 30, (objects, saves, 4))
-    spool[:20, :, 0] = (rng.integers(100000, 1000000, (20, saves)) + 0.5) * 2.0 ** -3   # ties
+    fields = (("coord", 12, 3), ("force", 20, 3), ("forceAmpl", 18, 1))
+    flags = {"coord": True, "force": False, "forceAmpl": True}
+    spool = rng.standard_normal((objects, saves, 7)) * 10.0 ** rng.integers(-30, 30, (objects, saves, 7))
+    spool[:20, :, 0] = rng.integers(100000, 1000000, (20, saves)) + 0.5      # exact ties: 123456.5
     spool[20:40] = -0.0
     heads = [f"0 {k} " for k in range(objects)]
     times = np.linspace(0.0, 1e-5, saves)
-    flags = {"coord": True, "forceAmpl": True}
 
     def lines():
-        return time_point_lines(heads, FIELDS, flags, times, 6, lambda cols: spool[:, :, cols])
+        return time_point_lines(heads, fields, flags, times, 6, lambda cols: spool[:, :, cols])
     template = "2 %g 12 %g %g %g 18 %g "
-    want = [h + "".join(template % (t, *spool[k, j]) for j, t in enumerate(times)) + "\n"
+    want = [h + "".join(template % (t, *spool[k, j, [0, 1, 2, 6]]) for j, t in enumerate(times)) + "\n"
             for k, h in enumerate(heads)]
+    assert (spool[:20, :, 0] % 1 == 0.5).all()                                # ties, rounded to even
+    used = []
+    real = fast.format_g_template
+
+    def counted(*args):
+        got = real(*args)
+        used.append(got is not None)
+        return got
+    monkeypatch.setattr("fibrelmp.translate.musen.text_writer.format_g_template", counted)
     monkeypatch.setattr(fast, "_helper", lambda: None)
-    assert lines() == want
-    monkeypatch.undo()
-    from concurrent.futures import ThreadPoolExecutor
-    with ThreadPoolExecutor(1) as pool:                       # the two-thread path
+    assert lines() == want and used == [True]
+    submitted = []
+
+    class Pool(ThreadPoolExecutor):
+        def submit(self, *args, **kwargs):
+            submitted.append(args[0])
+            return super().submit(*args, **kwargs)
+    with Pool(1) as pool:                                      # the two-thread path
         monkeypatch.setattr(fast, "_helper", lambda: pool)
-        assert lines() == want
+        assert lines() == want and used == [True, True] and len(submitted) == 1
     monkeypatch.setattr(fast, "library", lambda: None)       # Python's % alone
-    assert lines() == want
+    assert lines() == want and used == [True, True, False]
 
 
 def test_c_time_point_formatter_declines_non_finite_values():

@@ -10,9 +10,9 @@ from pathlib import Path
 
 import pytest
 
-from fibrelmp import lammps_styles
 from fibrelmp._lammps import new_lammps
 from fibrelmp.lammps_styles import build
+from tests.conftest import styles_or_skip
 
 CMAKE = build.HERE / "CMakeLists.txt"
 
@@ -38,12 +38,10 @@ def test_every_source_is_compiled_without_a_list():
 
 
 def _unknown_law_message(command: str, tmp_path: Path) -> str:
-    found = lammps_styles.plugin()
-    if not found.available:
-        pytest.skip(f"fibrelmp's LAMMPS styles are unavailable here: {found.how}")
+    plugin = styles_or_skip()
     lmp = new_lammps(["-log", "none", "-screen", str(tmp_path / "screen.txt"), "-nocite"])
     try:
-        for c in [f"plugin load {found.path}", "units si", "atom_style sphere",
+        for c in [f"plugin load {plugin}", "units si", "atom_style sphere",
                   "region box block 0 1 0 1 0 1", "create_box 1 box"]:
             lmp.command(c)
         with pytest.raises(Exception) as raised:

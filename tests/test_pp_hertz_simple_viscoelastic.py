@@ -28,7 +28,8 @@ from .conftest import data_path
 from .musen_model_checks import (ANGVEL, COORD, VEL, check_reference_is_cmusens_output,
                                  check_refused_without_styles, check_result_is_cmusens, model_job,
                                  needs_cmusen, styles_or_skip)
-from .test_style_musen_pair import check_restart_round_trip, persistent_lammps, plugin_or_skip
+
+from .test_style_musen_pair import check_restart_round_trip, persistent_lammps
 
 HERTZ = data_path("real-outputs/musen/models/pp_hertz")
 SVE = data_path("real-outputs/musen/models/pp_simple_viscoelastic")
@@ -118,7 +119,7 @@ def _single_contact(style: str, overlap: float, v2: tuple, w1=(0.0, 0.0, 0.0)):
     a new contact, stored tangential state zero, one step's vt dt), sphere 2 at +x."""
     lmp = new_lammps(["-log", "none", "-screen", "none", "-nocite"])
     try:
-        for c in [f"plugin load {plugin_or_skip()}", "units si", "atom_style sphere",
+        for c in [f"plugin load {styles_or_skip()}", "units si", "atom_style sphere",
                   "boundary f f f", "comm_modify vel yes", "atom_modify map array",
                   "region box block -0.01 0.01 -0.01 0.01 -0.01 0.01", "create_box 1 box",
                   "create_atoms 1 single 0 0 0", f"create_atoms 1 single {2 * R - overlap!r} 0 0",
@@ -203,7 +204,7 @@ def test_restart_keeps_the_first_law(tmp_path, style):
 
 def test_cost_per_contact_vs_hertz_mindlin(tmp_path):
     """Rough cost of the persistent contacts per law (printed, not asserted)."""
-    plugin = plugin_or_skip()
+    plugin = styles_or_skip()
     for style in ("pair_style musen/hm", "pair_style musen/pp hertz",
                   "pair_style musen/pp simple/viscoelastic 3e4 0.01", "pair_style musen/pp jkr 1.0",
                   "pair_style musen/pp popov/jkr 0.7"):

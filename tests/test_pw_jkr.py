@@ -24,7 +24,6 @@ from .musen_model_checks import (ANGVEL, CMUSEN, COORD, VEL, check_reference_is_
                                  check_refused_without_styles, check_run_is_cmusens, model_job,
                                  needs_cmusen, styles_or_skip)
 from .test_pp_jkr import _with_property
-from .test_style_musen_pair import plugin_or_skip
 
 JKR = data_path("real-outputs/musen/models/pw_jkr")
 POPOV = data_path("real-outputs/musen/models/pw_popov_jkr")
@@ -131,7 +130,7 @@ def _wall_force(tmp_path, law: str, overlap: float) -> tuple[float, float]:
     cwd = os.getcwd()
     os.chdir(tmp_path)
     try:
-        for c in [f"plugin load {plugin_or_skip()}", "units si", "atom_style sphere",
+        for c in [f"plugin load {styles_or_skip()}", "units si", "atom_style sphere",
                   "boundary f f f", "comm_modify vel yes",
                   "region box block -0.01 0.01 -0.01 0.01 -0.01 0.01", "create_box 1 box",
                   f"create_atoms 1 single 0 0 {z!r}", f"set type 1 diameter {2 * R!r} density 2500",

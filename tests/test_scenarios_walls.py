@@ -16,7 +16,7 @@ import sys
 
 import pytest
 
-from fibrelmp import lammps_styles
+from tests.conftest import styles_or_skip
 
 from .conftest import data_path
 
@@ -25,9 +25,7 @@ pytestmark = pytest.mark.skipif(os.environ.get("FIBRELMP_SLOW", "") in ("", "0")
 
 
 def _run(folder, job: str) -> None:
-    found = lammps_styles.plugin()
-    if not found.available:
-        pytest.skip(f"fibrelmp's LAMMPS styles are not available: {found.how}")
+    styles_or_skip()
     proc = subprocess.run([sys.executable, "-m", "fibrelmp.cli", "-q", "run", job, "-o", "out",
                            "--work", "work"], cwd=folder, capture_output=True,
                           text=True, timeout=7200, env=dict(os.environ, OMP_NUM_THREADS="1"))

@@ -405,7 +405,7 @@ def format_g_template(values: np.ndarray, prefixes: list[str], per_line: int) ->
     without the C library or for non-finite values."""
     lib = library()
     if lib is None or values.ndim != 2 or values.shape[1] != len(prefixes) or per_line < 1 \
-            or len(values) % per_line or not len(values):
+            or len(values) % per_line or not len(values) or not prefixes:
         return None
     enc = [t.encode() for t in prefixes]
     if any(b"\0" in e for e in enc):

@@ -233,35 +233,36 @@ def _check_binary(path: Path) -> None:
                          "export it as text with cmusen COMPONENT EXPORT_TO_TEXT")
 
 
-# The last scan of a file up to this size, reused while the file is unchanged: a job script
+# The last scan of a text up to this size, reused while the text is the same: a job script
 # reads its scene up to three times (planning, IMPORT_FROM_TEXT, the result's scene message).
-# Larger files are scanned each time, so a big scene is not held through the run.
-_REUSE_BYTES = 16 << 20
-_last_scan: tuple[tuple, TextScan] | None = None
+# Keyed on the text itself (what read_text returns: `fibrelmp check` substitutes failing
+# lines), not on the file's times.  A scan takes ~5x its text, so at most ~25 MB is held
+# (through the run); larger texts are scanned each time.
+_REUSE_BYTES = 4 << 20
+_last_scan: tuple[tuple, str, TextScan] | None = None
 
 
 def scan_text(path: Path, objects_only: bool = False) -> TextScan:
     """The one MUSEN text reader (scenes, results, ``.mdem`` text import): every line of
     ``path`` tokenised, malformed lines an InputError at their line; ``objects_only`` skips the
-    scene lines.  The result is shared with later calls on the unchanged file: read it only."""
+    scene lines.  The result is shared with later calls on the same text: read it only (its
+    arrays are read-only)."""
     global _last_scan
-    try:
-        st = Path(path).stat()
-        key = (str(Path(path).resolve()), st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, objects_only)
-    except OSError:
-        key = None                          # _scan_text reports it
+    _check_binary(path)
+    text = read_text(path, "MUSEN text file")
+    key = (str(path), objects_only)
     last = _last_scan
-    if key is not None and last is not None and last[0] == key:
-        return last[1]
-    scan = _scan_text(path, objects_only)
-    if key is not None and key[3] <= _REUSE_BYTES:
-        _last_scan = (key, scan)
+    if last is not None and last[0] == key and last[1] == text:
+        return last[2]
+    scan = _scan_text(path, objects_only, text)
+    if len(text) <= _REUSE_BYTES:
+        for vals in scan.vals:
+            vals.setflags(write=False)
+        _last_scan = (key, text, scan)
     return scan
 
 
-def _scan_text(path: Path, objects_only: bool) -> TextScan:
-    _check_binary(path)
-    text = read_text(path, "MUSEN text file")
+def _scan_text(path: Path, objects_only: bool, text: str) -> TextScan:
     if "\r" in text:                       # MUSEN's safeGetLine accepts \n, \r\n and \r
         text = text.replace("\r\n", "\n").replace("\r", "\n")
     scan = TextScan(path)

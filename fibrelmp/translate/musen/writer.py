@@ -30,7 +30,8 @@ from fibrelmp.translate.musen.scene import (ACTIVE_INTERACTIONS, ACTIVE_PROPERTI
                                PROPERTY_DEFAULTS)
 from fibrelmp.translate.musen.liquid_bonds import LiquidBondActivity
 from fibrelmp.translate.musen.scene_record import scene_record
-from fibrelmp.translate.musen.text_writer import (export_selectors, gather_spool, long_lines, scene_line, time_point_lines, write_long_line)
+from fibrelmp.translate.musen.text_writer import (export_selectors, gather_spool, long_lines, scene_line,
+                                                  time_point_lines, write_long_line)
 
 # per type: (flag, tag, width) in the exporter's order, and the spooled column block.
 # Spheres: principal stresses (42) and the stress tensor (36) are never written (fibrelmp

@@ -8,7 +8,8 @@ that index.  ``copy_to`` writes the file back unchanged (same layout, same bytes
 
 ``MdemWriter`` writes a new file: time points are compressed and written as they come (one
 block each, as MUSEN saves them), the scene message at the end, with the descriptors, saved
-times and begin/end time of what was written.  Memory holds one time point at a time.
+times and begin/end time of what was written.  Memory holds two time points (the one being
+compressed on the helper thread and the next).
 """
 
 from __future__ import annotations
@@ -373,8 +374,9 @@ class MdemFile:
 
 class MdemWriter:
     """Writes a new ``.mdem`` to an open binary file: ``add`` time points (each compressed
-    and written at once), then ``finish(storage)`` with the scene message.  Memory holds one
-    time point and 32 bytes per time point written (its block descriptor, in arrays)."""
+    and written in turn), then ``finish(storage)`` with the scene message.  Memory holds two
+    time points (one being compressed) and 32 bytes per time point written (its block
+    descriptor, in arrays)."""
 
     def __init__(self, fh: BinaryIO):
         self.out = ContainerWriter(fh)

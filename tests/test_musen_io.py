@@ -434,3 +434,45 @@ def test_text_scan_reused_only_while_the_file_is_unchanged(tmp_path, monkeypatch
     path.write_text(line.format(5, 0.0))
     big = text.scan_text(path)
     assert big.ids == [5] and text.scan_text(path) is not big
+
+
+@pytest.mark.parametrize("scene", [SINGLE, AGGLO], ids=["walls", "spheres-and-bonds"])
+def test_bulk_object_headers_equal_the_line_by_line_ones_under_every_selector(tmp_path, scene):
+    """MusenResultWriter._headers (one % for all objects) against object_header called per
+    object, as the writer did before: every one of the 32 constProps selections, spheres,
+    solid bonds and walls (inactive ends written as MUSEN's 1e+300)."""
+    from itertools import product
+
+    from fibrelmp.translate.musen.text_writer import export_selectors, object_header
+    from fibrelmp.translate.musen.writer import _g
+
+    m = musen.read(scene)
+    w = MusenResultWriter(m, tmp_path / "r.txt")
+    ids, types, rows = w._objects()
+    flags = ("id", "type", "geometry", "material", "activityInterval")
+    seen = set()
+    for mask in product([True, False], repeat=5):
+        w.sel = export_selectors({"constProps": dict(zip(flags, mask))})
+        const = w.sel["constProps"]
+        for otype in (1, 9, 14):
+            pick = np.flatnonzero(types == otype)[:60]
+            if not len(pick):
+                continue
+            got = w._headers(otype, ids[pick], rows[pick])
+            start, end = w._activity(np.full(len(pick), otype), rows[pick])
+            obj = {1: m.spheres, 9: m.bonds, 14: m.triangles}[otype]
+            want = []
+            for j, r in enumerate(rows[pick]):
+                if otype == 1:
+                    geom = "%.16g %.16g" % (obj.radius[r], obj.contact_radius[r])
+                elif otype == 9:
+                    pair = m.spheres.ids[obj.pair[r]]
+                    geom = "%d %d %.25g %.25g" % (pair[0], pair[1], obj.diameter[r], obj.length0[r])
+                else:
+                    geom = ""
+                key = w._key(obj, otype, r) if const["material"] else ""
+                want.append(object_header(const, ids[pick][j], otype, geom, key, _g(start[j]), _g(end[j])))
+            assert got == want, (mask, otype)
+            seen.add(otype)
+    assert seen == ({1, 14} if scene == SINGLE else {1, 9})
+    w.abort()

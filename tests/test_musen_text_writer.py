@@ -103,9 +103,9 @@ def test_c_time_point_formatter_declines_non_finite_values():
 
 
 def test_headers_formatted_in_bulk_keep_one_entry_per_object():
-    """writer._bulk: one % for all rows, row by row when a value (a material key read from a
+    """text_writer.bulk_format: one % for all rows, row by row when a value (a material key read from a
     .mdem) holds a newline, which would shift every later object's header."""
-    from fibrelmp.translate.musen.writer import _bulk
+    from fibrelmp.translate.musen.text_writer import bulk_format as _bulk
 
     assert _bulk("%d %.16g %s", np.array([1, 2]), np.array([0.1, 1e300]), ["a", "b"]) == \
         ["1 0.1 a", "2 1e+300 b"]

@@ -32,6 +32,7 @@ import sys
 import sysconfig
 import tempfile
 import threading
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -366,6 +367,20 @@ def format_fixed_rows(values: np.ndarray, decimals: np.ndarray, widths: np.ndarr
     return buf.tobytes() if ok else None
 
 
+def _joined_halves(part: Callable[[int, int], np.ndarray | None], n: int, large: bool) -> bytes | None:
+    """``part(0, n)`` as bytes; when ``large`` and a core is free, ``part(n // 2, n)`` on the
+    helper thread beside ``part(0, n // 2)``, joined in order.  None if a part is None."""
+    pool = _helper() if large else None
+    if pool is not None:
+        job = pool.submit(part, n // 2, n)
+        parts = [part(0, n // 2), job.result()]
+    else:
+        parts = [part(0, n)]
+    if any(p is None for p in parts):
+        return None
+    return b"".join(p.tobytes() for p in parts)
+
+
 def format_g_rows(codes: np.ndarray, table: list[str], values: np.ndarray) -> bytes | None:
     """Rows ``\t table[codes[i]]`` + ``\t%g`` per value + ``\n`` (printf-identical to
     Python's % formatting), or None without the C library or for non-finite values."""
@@ -388,15 +403,7 @@ def format_g_rows(codes: np.ndarray, table: list[str], values: np.ndarray) -> by
         got = lib.fp_format_g_rows(codes[a:].ctypes.data, values[a:].ctypes.data, b - a, ncols,
                                    names, len(enc), w, buf.ctypes.data, len(buf))
         return None if got < 0 else buf[:got]
-    pool = _helper() if n >= 4096 else None
-    if pool is not None:
-        job = pool.submit(part, n // 2, n)
-        parts = [part(0, n // 2), job.result()]
-    else:
-        parts = [part(0, n)]
-    if any(p is None for p in parts):
-        return None
-    return b"".join(p.tobytes() for p in parts)
+    return _joined_halves(part, n, n >= 4096)
 
 
 def format_g_template(values: np.ndarray, prefixes: list[str], per_line: int) -> bytes | None:
@@ -422,15 +429,7 @@ def format_g_template(values: np.ndarray, prefixes: list[str], per_line: int) ->
         got = lib.fp_format_g_template(values[a * per_line:].ctypes.data, rows, ncols, table, w,
                                        per_line, buf.ctypes.data, len(buf))
         return None if got < 0 else buf[:got]
-    pool = _helper() if values.size >= 1 << 16 and lines >= 2 else None
-    if pool is not None:
-        job = pool.submit(part, lines // 2, lines)
-        parts = [part(0, lines // 2), job.result()]
-    else:
-        parts = [part(0, lines)]
-    if any(p is None for p in parts):
-        return None
-    return b"".join(p.tobytes() for p in parts)
+    return _joined_halves(part, lines, values.size >= 1 << 16 and lines >= 2)
 
 
 def _format_rows(lib, codes, values, n, names, nnames, w, decimals) -> np.ndarray | None:

@@ -28,8 +28,9 @@ from fibrelmp.translate.musen.mdem import timepoints as tp
 from fibrelmp.translate.musen.mdem.document import MdemFile
 from fibrelmp.translate.musen.mdem.objects import (LIQUID_BOND, SOLID_BOND, SPHERE, WALL, Objects,
                                                    read_objects)
-from fibrelmp.translate.musen.text_writer import (export_selectors, gather_spool, long_lines, object_header,
-                                                  scene_line, time_point_lines, write_long_line)
+from fibrelmp.translate.musen.text_writer import (bulk_format, export_selectors, gather_spool, long_lines,
+                                                  object_headers, scene_line, time_point_lines,
+                                                  write_long_line)
 from fibrelmp.translate.musen.text_writer import number_text as g
 
 # material property ids MUSEN exports (DefinesMDB.h _MUSEN_ACTIVE_PROPERTIES/_INTERACTIONS)
@@ -275,10 +276,9 @@ def _write_objects(out, obj: Objects, index, keep, spools, times, precision: int
 
 
 def _headers(obj: Objects, rows: np.ndarray, kind: int, compounds, const: dict) -> list[str]:
-    geom = geometry_text(obj, rows, compounds)
-    return [object_header(const, obj.ids[r], kind, geom[j], obj.compound[r] or "Undefined",
-                          g(obj.start[r]), g(obj.end[r]))
-            for j, r in enumerate(rows.tolist())]
+    return object_headers(const, obj.ids[rows].tolist(), kind, geometry_text(obj, rows, compounds),
+                          [obj.compound[r] or "Undefined" for r in rows.tolist()],
+                          bulk_format("%g", obj.start[rows]), bulk_format("%g", obj.end[rows]))
 
 
 # ------------------------------------------------------------------------- scene lines

@@ -538,5 +538,7 @@ class GranularFrame:
     triangle_velocity: np.ndarray | None = None # (k,3)
     triangle_force: np.ndarray | None = None    # (k,3) force the particles exert on each triangle
     temperature: np.ndarray | None = None      # (n',) K, when a heat model changes it
+    stress_tensor: np.ndarray | None = None    # (n',9) MUSEN's stress tensor, row-major
+                                               # (granular_run.stress), when the job computes it
     saved_force: np.ndarray | None = None      # (n',3) the force cmusen saves now (MUSEN's
                                                # integrator: the previous evaluation's)

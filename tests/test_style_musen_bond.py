@@ -253,7 +253,7 @@ class Lmp:
 def breaks_in(path: Path) -> list[tuple[int, int, int]]:
     if not path.exists():
         return []
-    return [tuple(int(w) for w in ln.split()) for ln in path.read_text().split("\n") if ln.strip()]
+    return [tuple(int(w) for w in ln.split()[:3]) for ln in path.read_text().split("\n") if ln.strip()]
 
 
 # --------------------------------------------------------------------------------------------

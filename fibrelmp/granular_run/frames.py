@@ -17,6 +17,7 @@ import numpy as np
 
 from fibrelmp.errors import RunError, wrong_frame
 from fibrelmp.granmodel import GranularFrame, GranularModel, quat_multiply
+from fibrelmp.granular_run.stress import stress_tensors
 from fibrelmp.post.lammps_dump.reader import iter_frames
 from fibrelmp.translate.granular_job import GranularJob
 from fibrelmp.translate.granular.geometry import nearest_triangle
@@ -25,8 +26,9 @@ from fibrelmp.translate.granular.schedule import UNKNOWN_STEP
 
 
 class _BreakLog:
-    """Reads the per-step broken-bond dump (``step id1 id2`` lines, and the time as a 4th
-    column with a variable time step) as LAMMPS appends it."""
+    """Reads the per-step broken-bond dump as LAMMPS appends it: ``step id1 id2 fx fy fz``
+    lines (bond_style musen/elastic: the force on id1 as it broke), ``step id1 id2 time fx fy
+    fz`` with a variable time step, ``step id1 id2`` from other bond styles."""
 
     def __init__(self, path: Path | None):
         self.path = path
@@ -34,6 +36,8 @@ class _BreakLog:
         self.pending = b""
         self.rows: list[tuple[float, float, float]] = []
         self.times: dict[tuple[int, int, int], float] = {}    # a variable step's break times
+        # (step, id1, id2, fx, fy, fz) of breaks not yet counted in a stress tensor
+        self.forces: list[tuple[int, int, int, float, float, float]] = []
 
     def time(self, step: int, id1: int, id2: int) -> float:
         """The time logged with a break (variable time step)."""
@@ -52,11 +56,19 @@ class _BreakLog:
             w = ln.split()
             if len(w) >= 3:
                 self.rows.append((float(w[0]), float(w[1]), float(w[2])))
-            if len(w) >= 4:
+            if len(w) in (4, 7):
                 self.times[(int(w[0]), int(w[1]), int(w[2]))] = float(w[3])
+            if len(w) >= 6:
+                self.forces.append((int(w[0]), int(w[1]), int(w[2]), *map(float, w[-3:])))
         out = [(int(s), int(a), int(b)) for s, a, b in self.rows if s <= step]
         self.rows = [r for r in self.rows if r[0] > step]
         return out
+
+    def broken_between(self, first: int, last: int) -> list[tuple[int, int, int, float, float, float]]:
+        """The breaks read so far at steps ``first`` .. ``last`` with their forces; those
+        before ``first`` are forgotten."""
+        self.forces = [r for r in self.forces if r[0] >= first]
+        return [r for r in self.forces if r[0] <= last]
 
     def close(self) -> None:
         if self.fh is not None:
@@ -75,6 +87,11 @@ class FrameBuilder:
         self.tiles = iter_frames(job.tile_dump) if job.tile_dump is not None else None
         self.mesh = iter_frames(job.wall_forces) if job.wall_forces is not None else None
         self.breaks = _BreakLog(job.breaks)
+        # MUSEN's stress tensor: the previous evaluation's bonds and contacts, one block per frame
+        self.stress_bonds = iter_frames(job.stress_bonds) if job.stress_bonds is not None else None
+        self.stress_contacts = iter_frames(job.stress_contacts) if job.stress_contacts is not None else None
+        self.first_frame = True
+        self.prev_frame_step = 0
         self.sphere_end = np.full(sp.count, np.inf)
         self.present = np.zeros(sp.count, bool)
         self.present[job.sphere_rows] = True
@@ -199,6 +216,8 @@ class FrameBuilder:
             self._bonds(frame, step)
         if self.v0 is not None:
             self._triangles(frame, t, c)
+        if self.stress_contacts is not None:
+            self._stress(frame, step)
         self.prev_t, self.prev_x[rows], self.prev_v[rows] = t, pos, vel
         return frame
 
@@ -328,6 +347,40 @@ class FrameBuilder:
             frame.bond_tangential_overlap = overlap
             frame.bond_torque = torque
 
+    def _stress(self, frame: GranularFrame, step: int) -> None:
+        """MUSEN's stress tensor of the frame's spheres (granular_run.stress) from the presave
+        dumps written one step before it; 0 at the first frame (cmusen saves it before any
+        evaluation, with no contact listed and no bond force yet).  A bond broken since the
+        previous frame still counts, with the force it broke with: MUSEN marks its object
+        inactive only at the save after the break."""
+        job = self.job
+        blocks = [(job.stress_bonds, self.stress_bonds), (job.stress_contacts, self.stress_contacts)]
+        got = [(path, next(it, None)) for path, it in blocks if it is not None]
+        first, self.first_frame = self.first_frame, False
+        for path, block in got:
+            if block is None or (not first and block.step != step - 1):
+                raise wrong_frame(path, step - 1, None if block is None else block.step)
+        prev, self.prev_frame_step = self.prev_frame_step, step
+        if first:
+            frame.stress_tensor = np.zeros((len(frame.sphere_rows), 9))
+            return
+        pairs = []
+        for path, block in got:
+            cols = block.columns
+            ids = np.column_stack([cols.get("id1", []), cols.get("id2", [])]).astype(np.int64)
+            force = np.column_stack([cols.get(c, []) for c in ("fx", "fy", "fz")]).reshape(-1, 3)
+            if "ftx" in cols:            # a contact: its normal and tangential force on id1
+                force = force + np.column_stack([cols["ftx"], cols["fty"], cols["ftz"]])
+                order = np.lexsort((ids.max(1), ids.min(1)))          # by sphere pair
+            else:                        # bonds, broken ones included, in MUSEN's bond order
+                gone = np.array(self.breaks.broken_between(prev, step - 1), np.float64).reshape(-1, 6)
+                ids = np.r_[ids, gone[:, 1:3].astype(np.int64)]
+                force = np.r_[force, gone[:, 3:6]]
+                order = np.argsort(self._bond_lookup(ids[:, 0], ids[:, 1]), kind="stable")
+            pairs.append((ids[order, 0] - 1, ids[order, 1] - 1, force[order]))
+        frame.stress_tensor = stress_tensors(np.asarray(frame.sphere_rows, np.int64), frame.position,
+                                             np.asarray(self.model.spheres.radius, np.float64), pairs)
+
     def _exit_time(self, r: int, t: float) -> float:
         """Ballistic estimate of when sphere r crossed the domain, from the previous frame."""
         job = self.job
@@ -389,7 +442,7 @@ class FrameBuilder:
         self.breaks.close()
         if self.variable_clock is not None:
             self.variable_clock.close()
-        for dump in (self.frames, self.bonds, self.tiles, self.mesh):
+        for dump in (self.frames, self.bonds, self.tiles, self.mesh, self.stress_bonds, self.stress_contacts):
             if dump is not None:
                 dump.close()
 

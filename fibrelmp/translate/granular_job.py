@@ -31,7 +31,7 @@ from fibrelmp.translate.granular.reach import Travel, speed_bound
 from fibrelmp.translate.granular.musen_clock import MusenClock
 from fibrelmp.translate.granular.schedule import (STOP_LABEL, RunTime, compress_ids, run_time, save_steps,
                                                   schedule, variable_schedule, variable_step_refusals,
-                                                  with_stop_criterion)
+                                                  with_presaves, with_stop_criterion)
 from fibrelmp.translate.granular.fields import TEMPERATURE, field_commands, uses_temperature
 from fibrelmp.translate.granular.inlets import LOG_NAME as INLET_LOG
 from fibrelmp.translate.granular.inlets import inlet_bond_capacity, inlet_bond_reach, inlet_commands
@@ -57,6 +57,8 @@ BONDS_NAME = "bonds.dump"
 TILES_NAME = "walls.dump"
 BREAKS_NAME = "breaks.dump"
 CONTACTS_NAME = "contacts.dump"
+STRESS_BONDS_NAME = "stress_bonds.dump"          # MUSEN's stress tensor: the previous evaluation's
+STRESS_CONTACTS_NAME = "stress_contacts.dump"    # bond and contact forces (schedule.with_presaves)
 CLOCK_NAME = VARIABLE_CLOCK      # variable time step: "step time dt" of every frame (fix musen/leapfrog)
 
 
@@ -95,6 +97,9 @@ class GranularJob:
     inlet_bond_rows: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     type_materials: dict[int, int] | None = None   # LAMMPS sphere type -> material
     variable_clock: Path | None = None   # variable time step: each frame's step, time and dt
+    # MUSEN's stress tensor: bonds and contacts one step before each frame (granular_run.stress)
+    stress_bonds: Path | None = None
+    stress_contacts: Path | None = None
 
     @property
     def inputs(self) -> list[Path]:
@@ -204,7 +209,9 @@ def build_granular_job(model: GranularModel, folder: str | Path):
         inlet_log=folder / INLET_LOG if model.plan.inlets else None,
         inlet_bond_rows=_inlet_bond_rows(model),
         type_materials={t: m for m, t in spheres.type_of_mat.items()},
-        variable_clock=folder / CLOCK_NAME if model.plan.variable_step is not None else None)
+        variable_clock=folder / CLOCK_NAME if model.plan.variable_step is not None else None,
+        stress_bonds=folder / STRESS_BONDS_NAME if parts.stress and has_bonds else None,
+        stress_contacts=folder / STRESS_CONTACTS_NAME if parts.stress else None)
     return job, script, write_data_file
 
 
@@ -240,6 +247,7 @@ class _JobParts:
     frame_columns: list[str]
     geometry: BondGeometry | None
     verlet: VerletSchedule | None    # fix musen/verlet's settings (None: not needed)
+    stress: bool = False             # MUSEN's stress tensor computed (presave dumps)
 
 
 def _plan_parts(model: GranularModel) -> _JobParts:
@@ -308,9 +316,33 @@ def _plan_parts(model: GranularModel) -> _JobParts:
             warnings.append(("musen-verlet-schedule", f"MUSEN's contact-list updates, which let "
                              f"broken bonds' spheres touch, may come at other steps: "
                              f"{verlet.approximate}"))
+    why_not = _no_stress(model, musen_hm, geometry, len(bonds.rows) > 0 or stored > 0)
+    if why_not is not None and model.kind == "musen":
+        warnings.append(("musen-no-stress", f"the stress tensor and principal stresses (MUSEN's "
+                         f"36 and 42) are left out of the results: {why_not}"))
     return _JobParts(run, warnings, dom_lo, dom_hi, spheres, wall_plans, mesh, tiles, ntypes, axes,
                      styles, bonds, musen_hm, pair_lines, sb_model, box_cmds + wall_cmds, var_cmds,
-                     frame_columns, geometry, verlet)
+                     frame_columns, geometry, verlet, why_not is None)
+
+
+def _no_stress(model: GranularModel, musen_hm: bool, geometry, has_bonds: bool) -> str | None:
+    """Why fibrelmp does not compute MUSEN's stress tensor for this job (None: it does,
+    granular_run.stress)."""
+    if model.kind != "musen":
+        return "not a MUSEN job"
+    if not musen_hm:
+        return "it needs fibrelmp's LAMMPS styles"
+    if model.plan.variable_step is not None:
+        return "not with MUSEN's variable time step (the step before a save is not known in advance)"
+    if has_bonds and geometry is None:
+        return "it needs bond style musen/elastic"
+    if len(physics.chosen_all(model, "PP")) > 1:
+        return "with several particle-particle models (MUSEN takes the last one's force alone)"
+    if has_bonds and len(physics.chosen_all(model, "SB")) > 1:
+        return "with several solid-bond models (MUSEN takes the last one's force alone)"
+    if model.triangles is not None and model.triangles.count:
+        return "not with walls yet (their contacts' points and forces are not dumped)"
+    return None
 
 
 def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> str:
@@ -324,6 +356,8 @@ def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> 
         acts = schedule(run.total, saves, spheres.deletions, predict=parts.musen_hm)
         # cmusen's save of the step reaching END_TIME (FinalizeSimulation) checks no criterion
         acts = _stop_criterion(model, parts, acts, last_unchecked=acts[-1] == ("frame", run.total))
+        if parts.stress:
+            acts = with_presaves(acts)
     skin = 0.5 * tiles.largest_radius(spheres.r_max)
     pair_cut = 2.0 * tiles.largest_radius(spheres.r_max)
     comm_cut = max(pair_cut, 1.5 * bonds.max_length) + skin
@@ -372,7 +406,8 @@ def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> 
         lost=bool(parts.axes.removal_axes.any()),
         walls=[(wp.name, wp.description) for wp in parts.wall_plans],
         mesh_fix=MESH_FIX if len(parts.mesh) else None, mesh_forces_name=MESH_FORCES_NAME,
-        contacts_name=CONTACTS_NAME, velocity_limit=plan.velocity_limit, pbc_velocity=pbc_velocity,
+        contacts_name=CONTACTS_NAME, stress_bonds_name=STRESS_BONDS_NAME,
+        stress_contacts_name=STRESS_CONTACTS_NAME, velocity_limit=plan.velocity_limit, pbc_velocity=pbc_velocity,
         musen_integrator=parts.musen_hm, verlet=parts.verlet,
         fields=field_commands(model, spheres.rows, spheres.type_of_mat, parts.ntypes),
         variable_step=None if plan.variable_step is None else " ".join(float_text(v) for v in (

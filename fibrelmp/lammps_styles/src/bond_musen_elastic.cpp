@@ -663,8 +663,8 @@ void BondMusenElastic::compute(int eflag, int vflag)
       h = init_entry(i1, i2, type);
       fresh = true;
     }
-    double total[3] = {0.0, 0.0, 0.0};
-    const bool broke = apply_laws(i1, i2, type, h, advance, fresh, total);
+    double total[3] = {0.0, 0.0, 0.0}, broke_force[3] = {0.0, 0.0, 0.0};
+    const bool broke = apply_laws(i1, i2, type, h, advance, fresh, total, broke_force);
     if (broke) {
       // MUSEN: Active = false, EndActivity = time; an inactive bond is not consolidated
       bondlist[n][2] = 0;
@@ -677,6 +677,7 @@ void BondMusenElastic::compute(int eflag, int vflag)
       broken.push_back(update->ntimestep);
       broken.push_back(tag[i1]);
       broken.push_back(tag[i2]);
+      broken_force.insert(broken_force.end(), broke_force, broke_force + 3);
     }
     if (evflag) {
       double del[3];
@@ -699,7 +700,7 @@ void BondMusenElastic::compute(int eflag, int vflag)
 ------------------------------------------------------------------------- */
 
 bool BondMusenElastic::apply_laws(int i1, int i2, int type, double *h, bool advance, bool fresh,
-                                  double *total)
+                                  double *total, double *broke_force)
 {
   double **f = atom->f;
   double **torque = atom->torque;
@@ -744,8 +745,10 @@ bool BondMusenElastic::apply_laws(int i1, int i2, int type, double *h, bool adva
         aerogel_breaks(law, out, h[H_DIAMETER], in.E) ||
         musen_breaks(law.form == WEAKENING || law.form == CONCRETE ? 0 : law.breakage, state,
                      out, sigma_n[type],
-                     tau_s[type]))
+                     tau_s[type])) {
+      for (int c = 0; c < 3; c++) broke_force[c] = out.total[c];    // MUSEN's TotalForce
       return true;
+    }
     for (int c = 0; c < 3; c++) {
       f[i1][c] += out.total[c];
       torque[i1][c] += out.mleft[c];
@@ -865,6 +868,7 @@ void BondMusenElastic::process_breaks()
   if (total == 0) return;
 
   std::vector<bigint> all;
+  std::vector<double> all_force;
   if (comm->nprocs > 1) {
     std::vector<int> counts(comm->nprocs), displs(comm->nprocs, 0);
     MPI_Allgather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, world);
@@ -872,33 +876,46 @@ void BondMusenElastic::process_breaks()
     all.resize(total);
     MPI_Allgatherv(broken.data(), mine, MPI_LMP_BIGINT, all.data(), counts.data(), displs.data(),
                    MPI_LMP_BIGINT, world);
+    all_force.resize(total);    // 3 doubles per break, as 3 bigints per break
+    MPI_Allgatherv(broken_force.data(), mine, MPI_DOUBLE, all_force.data(), counts.data(),
+                   displs.data(), MPI_DOUBLE, world);
   } else {
     all.swap(broken);
+    all_force.swap(broken_force);
   }
   broken.clear();
+  broken_force.clear();
 
   const int nbroken = total / 3;
   std::vector<std::array<bigint, 3>> rec(nbroken);
-  for (int r = 0; r < nbroken; r++) rec[r] = {all[3 * r], all[3 * r + 1], all[3 * r + 2]};
-  std::sort(rec.begin(), rec.end());
+  std::vector<int> order(nbroken);
+  for (int r = 0; r < nbroken; r++) {
+    rec[r] = {all[3 * r], all[3 * r + 1], all[3 * r + 2]};
+    order[r] = r;
+  }
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return rec[a] < rec[b]; });
 
   atom->nbonds -= nbroken;
   if (comm->me == 0 && breaks_fp && timed_breaks) {
     // MUSEN's time of this evaluation (the fix keeps atime at it: atimestep is this step)
     const double t = simulation_time(update);
-    for (const auto &r : rec) utils::print(breaks_fp, "{} {} {} {:.17g}\n", r[0], r[1], r[2], t);
+    for (int k : order)
+      utils::print(breaks_fp, "{} {} {} {:.17g} {:.17g} {:.17g} {:.17g}\n", rec[k][0], rec[k][1],
+                   rec[k][2], t, all_force[3 * k], all_force[3 * k + 1], all_force[3 * k + 2]);
     fflush(breaks_fp);
   } else if (comm->me == 0 && breaks_fp) {
-    for (const auto &r : rec) utils::print(breaks_fp, "{} {} {}\n", r[0], r[1], r[2]);
+    for (int k : order)
+      utils::print(breaks_fp, "{} {} {} {:.17g} {:.17g} {:.17g}\n", rec[k][0], rec[k][1],
+                   rec[k][2], all_force[3 * k], all_force[3 * k + 1], all_force[3 * k + 2]);
     fflush(breaks_fp);
   }
   if (update_special && verlet) {
     // the pair waits for MUSEN's next contact-list update (fix musen/verlet)
     std::vector<std::pair<tagint, tagint>> pairs;
-    for (const auto &r : rec) pairs.emplace_back((tagint) r[1], (tagint) r[2]);
+    for (int k : order) pairs.emplace_back((tagint) rec[k][1], (tagint) rec[k][2]);
     verlet->add_broken(pairs);
   } else if (update_special) {
-    for (const auto &r : rec) forget_special((tagint) r[1], (tagint) r[2]);
+    for (int k : order) forget_special((tagint) rec[k][1], (tagint) rec[k][2]);
     pairs_waiting += nbroken;
   }
 }

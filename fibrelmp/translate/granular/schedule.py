@@ -248,6 +248,33 @@ def compress_ids(ids: np.ndarray) -> str:
     return " ".join(str(a) if a == b else f"{a}:{b}" for a, b in zip(starts, ends))
 
 
+def with_presaves(acts: list[tuple]) -> list[tuple]:
+    """A ``("presave",)`` before every frame, one step before it: MUSEN's stress tensor of a
+    saved time point sums the contact and bond forces of the previous evaluation (cmusen saves
+    before the step's force evaluation), which LAMMPS has at the step before the frame.  The
+    run reaching a frame is split into its steps but the last, the presave, and that last step;
+    the first frame (step 0: no evaluation before it) gets a presave too, so every frame has
+    one, in order."""
+    out: list[tuple] = []
+    first = True
+    for act in acts:
+        if act[0] == "frame":
+            if first:
+                out.append(("presave",))
+                first = False
+            else:
+                j = len(out) - 1
+                while out[j][0] == "delete":          # deletions come after the step
+                    j -= 1
+                if out[j][0] != "run":
+                    raise RuntimeError(f"a frame after {out[j]!r}, not after a run")
+                _, n, pre = out[j]
+                split = ([("run", n - 1, pre)] if n > 1 else []) + [("presave",), ("run", 1, pre and n == 1)]
+                out[j:j + 1] = split
+        out.append(act)
+    return out
+
+
 STOP_LABEL, END_LABEL = "fl_stopped", "fl_finish"
 
 

@@ -25,6 +25,7 @@ import numpy as np
 
 from fibrelmp.formatbase import Writer
 from fibrelmp.granmodel import GranularFrame, GranularModel
+from fibrelmp.granular_run.stress import principal_stresses
 from fibrelmp.textio import temp_name, write_failure
 from fibrelmp.translate.musen.scene import (ACTIVE_INTERACTIONS, ACTIVE_PROPERTIES, DEFAULT_ACTIVITY_END,
                                PROPERTY_DEFAULTS)
@@ -35,11 +36,13 @@ from fibrelmp.translate.musen.text_writer import (bulk_format, export_selectors,
                                                   write_long_line)
 
 # per type: (flag, tag, width) in the exporter's order, and the spooled column block.
-# Spheres: principal stresses (42) and the stress tensor (36) are never written (fibrelmp
-# does not compute them); temperature (37) is 0, as MUSEN writes without a thermal model
-# (the frame's, when ModelEFHeatTransfer runs).
-_SPHERE = (("angVel", 16, 3), ("coord", 12, 3), ("force", 20, 3), ("forceAmpl", 18, 1),
-           ("orient", 31, 4), ("temperature", 37, 1), ("velocity", 15, 3))
+# Spheres: principal stresses (42) and the stress tensor (36) when the job computes them
+# (granular_run.stress; else left out: the warning musen-no-stress says why); temperature (37)
+# is 0, as MUSEN writes without a thermal model (the frame's, when a heat model runs).
+_SPHERE_STRESS = (("angVel", 16, 3), ("coord", 12, 3), ("force", 20, 3), ("forceAmpl", 18, 1),
+                  ("orient", 31, 4), ("princStress", 42, 3), ("stressTensor", 36, 9),
+                  ("temperature", 37, 1), ("velocity", 15, 3))
+_SPHERE = tuple(f for f in _SPHERE_STRESS if f[0] not in ("princStress", "stressTensor"))
 _BOND = (("coord", 12, 3), ("force", 20, 3), ("forceAmpl", 18, 1), ("tangOverlap", 45, 3),
          ("temperature", 37, 1), ("totTorque", 43, 1), ("velocity", 15, 3))
 _WALL = (("coord", 44, 9), ("force", 20, 3), ("forceAmpl", 18, 1), ("velocity", 15, 3))
@@ -80,6 +83,7 @@ class MusenResultWriter(Writer):
         self.time_interval = time_interval
         self.sel = export_selectors(selectors)
         self.times: list[float] = []
+        self.sphere_spec = _SPHERE          # _SPHERE_STRESS once a frame brings the stress tensor
         sp = model.spheres
         self.sphere_end = sp.active_end.copy()
         self.bond_end = model.bonds.active_end.copy() if model.bonds is not None else None
@@ -130,6 +134,8 @@ class MusenResultWriter(Writer):
         rows = np.asarray(frame.sphere_rows, np.int64)
         if not self.track_activity(frame):
             return
+        if not self.times and frame.stress_tensor is not None:
+            self.sphere_spec = _SPHERE_STRESS
         blocks = {"s": self._sphere_block(frame, rows)}
         if m.bonds is not None:
             blocks["b"] = self._bond_block(frame, blocks["s"])
@@ -143,7 +149,8 @@ class MusenResultWriter(Writer):
     def _sphere_block(self, f: GranularFrame, rows: np.ndarray) -> np.ndarray:
         # spheres not in the frame are written as zeros, as MUSEN stores nothing for them
         n = self.model.spheres.count
-        b = np.zeros((n, 18))
+        stress = self.sphere_spec is _SPHERE_STRESS
+        b = np.zeros((n, sum(w for _, _, w in self.sphere_spec)))
         # MUSEN saves the previous evaluation's force (docs/musen.md, saved time points)
         saved = f.force if f.saved_force is None else f.saved_force
         force = np.asarray(saved, np.float64).reshape(-1, 3)
@@ -152,9 +159,15 @@ class MusenResultWriter(Writer):
         b[rows, 6:9] = force
         b[rows, 9] = np.linalg.norm(force, axis=1)
         b[rows, 10:14] = f.quaternion
-        b[rows, 15:18] = f.velocity
-        if f.temperature is not None:        # column 14: temperature (0 without a heat model)
-            b[rows, 14] = f.temperature
+        at = 14
+        if stress:                            # 42 principal stresses, 36 the tensor
+            tensor = np.asarray(f.stress_tensor, np.float64).reshape(-1, 9)
+            b[rows, 14:17] = principal_stresses(tensor)
+            b[rows, 17:26] = tensor
+            at = 26
+        if f.temperature is not None:        # temperature (0 without a heat model)
+            b[rows, at] = f.temperature
+        b[rows, at + 1:at + 4] = f.velocity
         return b
 
     def _bond_block(self, f: GranularFrame, s: np.ndarray) -> np.ndarray:
@@ -162,8 +175,9 @@ class MusenResultWriter(Writer):
         pair = bonds.pair
         b = np.zeros((bonds.count, 15))
         # midpoint / mean velocity of the two spheres as the frame has them (0 when absent)
+        v = sum(w for _, _, w in self.sphere_spec) - 3        # the velocity is the last field
         b[:, 0:3] = 0.5 * (s[pair[:, 0], 3:6] + s[pair[:, 1], 3:6])
-        b[:, 12:15] = 0.5 * (s[pair[:, 0], 15:18] + s[pair[:, 1], 15:18])
+        b[:, 12:15] = 0.5 * (s[pair[:, 0], v:v + 3] + s[pair[:, 1], v:v + 3])
         alive = (np.ones(bonds.count, bool) if f.bond_alive is None
                  else np.asarray(f.bond_alive, bool))
         if f.bond_force is not None:
@@ -261,18 +275,19 @@ class MusenResultWriter(Writer):
         nt = len(self.times)
         maps = {}
         m = self.model
-        for name, count, width in (("s", m.spheres.count, 18),
+        for name, count, width in (("s", m.spheres.count, sum(w for _, _, w in self.sphere_spec)),
                                    ("b", 0 if m.bonds is None else m.bonds.count, 15),
                                    ("w", 0 if m.triangles is None else m.triangles.count, 16)):
             if nt and count:
                 maps[name] = (self.spool / f"{name}.bin", count, width)
-        piece = long_lines(nt, 19, _VALUES_PER_CHUNK)
+        most = 1 + max(sum(w for _, _, w in spec) for spec in (self.sphere_spec, _BOND, _WALL))
+        piece = long_lines(nt, most, _VALUES_PER_CHUNK)
         if piece is not None:               # many saves: one line at a time, in pieces
             for i in range(len(ids)):
                 self._long_line(out, int(types[i]), ids[i:i + 1], rows[i:i + 1], maps, piece)
             return
         # objects per chunk: about _VALUES_PER_CHUNK numbers in memory whatever the saves
-        chunk = max(16, min(_CHUNK, _VALUES_PER_CHUNK // max(1, nt * 19)))
+        chunk = max(16, min(_CHUNK, _VALUES_PER_CHUNK // max(1, nt * most)))
         for lo in range(0, len(ids), chunk):
             cid, ctype, crow = ids[lo:lo + chunk], types[lo:lo + chunk], rows[lo:lo + chunk]
             lines = np.empty(len(cid), dtype=object)
@@ -283,7 +298,7 @@ class MusenResultWriter(Writer):
             out.write("".join(lines.tolist()))
 
     def _lines(self, otype: int, ids: np.ndarray, rows: np.ndarray, maps) -> list[str]:
-        spec, group, name = {1: (_SPHERE, "tdPropsPart", "s"), 9: (_BOND, "tdPropsBond", "b"),
+        spec, group, name = {1: (self.sphere_spec, "tdPropsPart", "s"), 9: (_BOND, "tdPropsBond", "b"),
                              14: (_WALL, "tdPropsWall", "w"), 13: ((), "", "")}[otype]
         nt = len(self.times)
 
@@ -296,7 +311,7 @@ class MusenResultWriter(Writer):
                                 self.times, self.precision, values_of)
 
     def _long_line(self, out, otype: int, ids: np.ndarray, rows: np.ndarray, maps, piece: int) -> None:
-        spec, group, name = {1: (_SPHERE, "tdPropsPart", "s"), 9: (_BOND, "tdPropsBond", "b"),
+        spec, group, name = {1: (self.sphere_spec, "tdPropsPart", "s"), 9: (_BOND, "tdPropsBond", "b"),
                              14: (_WALL, "tdPropsWall", "w"), 13: ((), "", "")}[otype]
 
         def values_of(cols: list[int], steps: slice) -> np.ndarray:

@@ -90,6 +90,9 @@ class MdemResultWriter(MusenResultWriter):
         if frame.temperature is not None:      # a heat model ran (MUSEN saves it then)
             values[ids, _T] = frame.temperature
             masks[ids] |= tp.bit("temperature")
+        if frame.stress_tensor is not None:    # MUSEN's stress tensor (granular_run.stress)
+            values[ids, tp.columns("stress_tensor")] = frame.stress_tensor
+            masks[ids] |= tp.bit("stress_tensor")
         if self.bond_ids is not None:
             alive = (np.ones(len(self.bond_ids), bool) if frame.bond_alive is None
                      else np.asarray(frame.bond_alive, bool))

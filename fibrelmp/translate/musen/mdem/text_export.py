@@ -24,6 +24,7 @@ from typing import IO, Any
 
 import numpy as np
 
+from fibrelmp.granular_run.stress import principal_stresses
 from fibrelmp.translate.musen.mdem import timepoints as tp
 from fibrelmp.translate.musen.mdem.document import MdemFile
 from fibrelmp.translate.musen.mdem.objects import (LIQUID_BOND, SOLID_BOND, SPHERE, WALL, Objects,
@@ -68,29 +69,6 @@ _WIDTH = {SPHERE: _SPHERE_COLS, SOLID_BOND: _BOND_COLS, WALL: _WALL_COLS, LIQUID
 def _length(v: np.ndarray) -> np.ndarray:
     """CVector3::Length: sqrt(x*x + y*y + z*z), in that order."""
     return np.sqrt(v[:, 0] * v[:, 0] + v[:, 1] * v[:, 1] + v[:, 2] * v[:, 2])
-
-
-def principal_stresses(s: np.ndarray) -> np.ndarray:
-    """CMatrix3::GetPrincipalStresses of each row (9 values, row-major), with the C math
-    library's functions (Python's math module) so that the digits are MUSEN's."""
-    out = np.zeros((len(s), 3))
-    for i in np.flatnonzero(np.any(s != 0, axis=1)):
-        m = s[i].tolist()
-        a, b, c, d, e, f = m[0], m[4], m[8], m[1], m[2], m[5]
-        i1 = a + b + c
-        i2 = a * b + b * c + c * a - math.pow(d, 2.) - math.pow(e, 2.) - math.pow(f, 2.)
-        i3 = (a * b * c - a * math.pow(f, 2.) - b * math.pow(e, 2.) - c * math.pow(d, 2.)
-              + 2 * d * e * f)
-        q = min((3 * i2 - math.pow(i1, 2.)) / 9.0, 0.0)
-        r = (2 * math.pow(i1, 3.) - 9 * i1 * i2 + 27 * i3) / 54
-        root = math.sqrt(math.pow(-q, 3.))
-        ratio = r / root if root != 0 else (math.nan if r == 0 else math.copysign(math.inf, r))
-        gg = min(max(ratio, -1.0) if ratio == ratio else -1.0, 1.0)     # fmax(nan, -1) = -1
-        te = math.acos(gg)
-        sq = 2 * math.sqrt(-q)
-        out[i] = (sq * math.cos(te / 3) + i1 / 3., sq * math.cos((te + 2 * math.pi) / 3) + i1 / 3.,
-                  sq * math.cos((te + 4 * math.pi) / 3) + i1 / 3.)
-    return out
 
 
 def _rows(values: np.ndarray, n: int) -> np.ndarray:

@@ -1,0 +1,118 @@
+"""MUSEN's stress tensor (36) and principal stresses (42) in fibrelmp's MUSEN results, against
+the real cmusen's 17-digit exports stored in tests/data (each case's README gives how cmusen
+1.74.2 made it): every sphere at every saved time.
+
+- models/pp_hertz: two spheres in an oblique Hertz impact (contacts only): within 4 ulp of
+  the scale (the sum of two terms per sphere, in MUSEN's order).
+- stop_criterion: five spheres joined by four bonds, two of which break; a bond broken since
+  the previous save still counts there with the force it broke with (MUSEN marks its object
+  inactive only at that save): bit for bit.
+
+Independently of cmusen, ``granular_run.stress.stress_tensors`` is checked against the formula
+written out per pair (numpy loops) and ``schedule.with_presaves`` against the steps it must
+dump at.
+"""
+
+from __future__ import annotations
+
+import math
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from fibrelmp.granular_run.stress import principal_stresses, stress_tensors
+from fibrelmp.translate.granular.schedule import with_presaves
+from fibrelmp.translate.musen.scene import read_time_points
+
+from .conftest import data_path, styles_or_skip
+
+MUSEN = data_path("real-outputs", "musen")
+
+
+def _run(case, job: str, tmp_path):
+    styles_or_skip()
+    for f in case.iterdir():
+        if f.suffix == ".txt" and not f.name.startswith("cmusen"):
+            shutil.copy(f, tmp_path)
+    done = subprocess.run([sys.executable, "-m", "fibrelmp.cli", "-q", "run", job], cwd=tmp_path,
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    return done
+
+
+@pytest.mark.parametrize("case, job, ours, theirs, ulps", [
+    (MUSEN / "models" / "pp_hertz", "job_hertz.txt", "hertz_result_prec17.txt",
+     "cmusen_hertz_result_prec17.txt", 4),
+    (MUSEN / "stop_criterion", "job_stop.txt", "stop_result_prec17.txt",
+     "cmusen_stop_result_prec17.txt", 0),
+])
+def test_stress_tensor_is_cmusens(tmp_path, case, job, ours, theirs, ulps):
+    done = _run(case, job, tmp_path)
+    assert "musen-no-stress" not in done.stderr
+    real = read_time_points(case / theirs, tags=(36, 42))
+    mine = read_time_points(tmp_path / ours, tags=(36, 42))
+    assert mine.times.tolist() == real.times.tolist()
+    spheres = real.types == 1
+    for tag in (36, 42):
+        r, o = real.fields[tag][:, spheres], mine.fields[tag][:, spheres]
+        scale = np.abs(r).max()
+        assert scale > 1e3                                  # the cases do load their spheres
+        assert np.abs(o - r).max() <= ulps * np.spacing(scale), tag
+    # the zero tensor of the first save (no evaluation before it) is written too
+    assert not np.any(mine.fields[36][0][spheres])
+
+
+def test_stress_formula_per_pair():
+    rng = np.random.default_rng(3)
+    radius = rng.uniform(0.5, 1.5, 6)
+    rows = np.array([0, 2, 3, 4, 5])                    # sphere 1 is not in the frame
+    pos = rng.normal(size=(5, 3)) * 3
+    r1, r2 = np.array([0, 2, 1, 3]), np.array([2, 3, 4, 5])
+    force = rng.normal(size=(4, 3))
+    got = stress_tensors(rows, pos, radius, [(r1, r2, force)])
+    want = np.zeros((5, 9))
+    where = {r: k for k, r in enumerate(rows)}
+    for a, b, f in zip(r1, r2, force):
+        if a not in where or b not in where:
+            continue                                    # a pair with a sphere not in the frame
+        xa, xb = pos[where[a]], pos[where[b]]
+        for me, other, fm in ((a, xb, f), (b, xa, -f)):
+            x = pos[where[me]]
+            arm = (other - x) / np.linalg.norm(other - x) * radius[me]
+            volume = math.pi * (2 * radius[me]) ** 3 / 6
+            want[where[me]] += np.outer(arm, fm).ravel() / volume
+    np.testing.assert_allclose(got, want, rtol=1e-13, atol=1e-13 * np.abs(want).max())
+    # principal stresses of a symmetric tensor are its eigenvalues (MUSEN's closed form)
+    sym = got.reshape(-1, 3, 3)
+    sym = 0.5 * (sym + sym.transpose(0, 2, 1))
+    p = principal_stresses(sym.reshape(-1, 9))
+    np.testing.assert_allclose(np.sort(p, axis=1), np.linalg.eigvalsh(sym), rtol=1e-9,
+                               atol=1e-9 * np.abs(sym).max())
+
+
+def test_presave_one_step_before_every_frame():
+    acts = [("run0",), ("frame", 0), ("predict",), ("run", 5, False), ("frame", 5),
+            ("loop", "fl_loop1", 3), ("run", 2, False), ("run", 3, False), ("frame", None),
+            ("end", "fl_loop1"), ("run", 1, True), ("delete", 21, [0]), ("frame", 21)]
+    out = with_presaves(acts)
+    assert out == [("run0",), ("presave",), ("frame", 0), ("predict",), ("run", 4, False),
+                   ("presave",), ("run", 1, False), ("frame", 5), ("loop", "fl_loop1", 3),
+                   ("run", 2, False), ("run", 2, False), ("presave",), ("run", 1, False),
+                   ("frame", None), ("end", "fl_loop1"), ("presave",), ("run", 1, True),
+                   ("delete", 21, [0]), ("frame", 21)]
+    # the steps: a presave is always followed by exactly one step before its frame
+    for k, act in enumerate(out):
+        if act == ("presave",) and k > 1:
+            assert out[k + 1][:2] == ("run", 1)
+
+
+def test_no_stress_says_why(tmp_path):
+    """A job fibrelmp does not compute the stress for says so (warning musen-no-stress) and
+    leaves 36/42 out, as before: here MUSEN's variable time step."""
+    styles_or_skip()
+    case = MUSEN / "variable_time_step"
+    done = _run(case, "job_vardt.txt", tmp_path)
+    assert "musen-no-stress" in done.stderr and "variable time step" in done.stderr

@@ -351,8 +351,9 @@ class _ScriptRun:
         """What replaying executes for a command done before the checkpoint (None: nothing)."""
         from fibrelmp.checkpoint import ACTIONS
 
-        # fix_modify ID write FILE: a frame of fix musen/wall/mesh's triangle forces
-        if words[0] in ACTIONS or (words[0] == "fix_modify" and words[2:3] == ["write"]):
+        # fix_modify ID write|contacts FILE: a frame of fix musen/wall/mesh's triangle forces
+        # or its contacts (or of fix musen/leapfrog's clock)
+        if words[0] in ACTIONS or (words[0] == "fix_modify" and words[2:3] in (["write"], ["contacts"])):
             if words[0] in FRAME_COMMANDS:
                 self.frames += 1
                 if self.on_command is not None:

@@ -49,27 +49,15 @@ def test_cmusen_exports_fibrelmps_result_as_fibrelmp_does(tmp_path):
     # every field, the stress tensor (36) fibrelmp stores and its principal stresses (42) that
     # cmusen's export computes from it included
     assert set(theirs.fields) == set(ours.fields) and {36, 42} <= set(ours.fields)
-    for tag in set(ours.fields) - {42}:
+    for tag in ours.fields:
         assert np.array_equal(ours.fields[tag], theirs.fields[tag], equal_nan=True), tag
-    scale = np.nanmax(np.abs(ours.fields[36]))
-    assert scale > 1e4
-    # principal stresses: MUSEN's closed form cancels for the smallest one, where fibrelmp's
-    # and cmusen's last bits may differ (measured: 55 of 102,528 values, up to 1.4e-12 of the
-    # value, 2e-16 of the stress scale)
-    np.testing.assert_allclose(ours.fields[42], theirs.fields[42], rtol=0, atol=1e-15 * scale)
+    assert np.nanmax(np.abs(ours.fields[36])) > 1e4
     lines = [(tmp_path / n).read_text().splitlines() for n in ("agglomerate_short_result.txt", "cmusen.txt")]
     assert [[ln.split(" 2 ")[0] for ln in f if ln.startswith("0 ")] for f in lines][0] == \
            [[ln.split(" 2 ")[0] for ln in f if ln.startswith("0 ")] for f in lines][1]
     assert [ln for ln in lines[0] if not ln.startswith("0 ")] == [ln for ln in lines[1] if not ln.startswith("0 ")]
     python_api.convert_file(tmp_path / "agglomerate_short_result.mdem", tmp_path / "ours.txt", precision=17)
-    converted = read_time_points(tmp_path / "ours.txt")
-    for tag in set(converted.fields) - {42}:
-        assert np.array_equal(converted.fields[tag], theirs.fields[tag], equal_nan=True), tag
-    np.testing.assert_allclose(converted.fields[42], theirs.fields[42], rtol=0, atol=1e-15 * scale)
-    mine = (tmp_path / "ours.txt").read_text().splitlines()
-    assert [ln for ln in mine if not ln.startswith("0 ")] == [ln for ln in lines[1] if not ln.startswith("0 ")]
-    assert [ln.split(" 2 ")[0] for ln in mine if ln.startswith("0 ")] == \
-           [ln.split(" 2 ")[0] for ln in lines[1] if ln.startswith("0 ")]
+    assert (tmp_path / "ours.txt").read_bytes() == (tmp_path / "cmusen.txt").read_bytes()
 
 
 def test_cmusen_simulates_fibrelmps_import_as_its_own(tmp_path):

@@ -7,6 +7,9 @@ the real cmusen's 17-digit exports stored in tests/data (each case's README give
 - stop_criterion: five spheres joined by four bonds, two of which break; a bond broken since
   the previous save still counts there with the force it broke with (MUSEN marks its object
   inactive only at that save): bit for bit.
+- force_walls press and rot: three spheres between a plate and a force-driven (and, in rot,
+  rotating) plate: sphere-wall contacts (fix musen/wall/mesh's contact points and forces)
+  and sphere-sphere ones: bit for bit.
 
 Independently of cmusen, ``granular_run.stress.stress_tensors`` is checked against the formula
 written out per pair (numpy loops) and ``schedule.with_presaves`` against the steps it must
@@ -48,6 +51,10 @@ def _run(case, job: str, tmp_path):
      "cmusen_hertz_result_prec17.txt", 4),
     (MUSEN / "stop_criterion", "job_stop.txt", "stop_result_prec17.txt",
      "cmusen_stop_result_prec17.txt", 0),
+    (MUSEN / "force_walls", "job_press.txt", "press_result_prec17.txt",
+     "cmusen_press_result_prec17.txt", 0),
+    (MUSEN / "force_walls", "job_rot.txt", "rot_result_prec17.txt",
+     "cmusen_rot_result_prec17.txt", 0),
 ])
 def test_stress_tensor_is_cmusens(tmp_path, case, job, ours, theirs, ulps):
     done = _run(case, job, tmp_path)
@@ -116,3 +123,24 @@ def test_no_stress_says_why(tmp_path):
     case = MUSEN / "variable_time_step"
     done = _run(case, "job_vardt.txt", tmp_path)
     assert "musen-no-stress" in done.stderr and "variable time step" in done.stderr
+
+
+def test_principal_stresses_c_and_python_agree(monkeypatch):
+    """The C helper (numtext) and the Python fallback give the same bits (both are MUSEN's
+    closed form; cmusen's export of fibrelmp's agglomerate result equals them:
+    tests/test_mdem_cmusen.py), zero and degenerate tensors included."""
+    from fibrelmp.numtext import fast
+
+    if fast.library() is None:
+        pytest.skip("no C helper here")
+    rng = np.random.default_rng(5)
+    s = rng.normal(size=(5000, 9)) * 10.0 ** rng.uniform(-3, 8, (5000, 1))
+    s[::9] = 0.0
+    s[1] = [1, 0, 0, 0, 1, 0, 0, 0, 1]                  # three equal principal stresses
+    s[2] = [2, 1, 0, 1, 2, 0, 0, 0, 3]
+    c = principal_stresses(s)
+    monkeypatch.setattr(fast, "principal_stresses", lambda tensors: None)
+    p = principal_stresses(s)
+    assert c.tobytes() == p.tobytes()
+    assert not c[::9].any() and np.isfinite(c).all()
+

@@ -90,6 +90,7 @@ class FrameBuilder:
         # MUSEN's stress tensor: the previous evaluation's bonds and contacts, one block per frame
         self.stress_bonds = iter_frames(job.stress_bonds) if job.stress_bonds is not None else None
         self.stress_contacts = iter_frames(job.stress_contacts) if job.stress_contacts is not None else None
+        self.stress_walls = iter_frames(job.stress_walls) if job.stress_walls is not None else None
         self.first_frame = True
         self.prev_frame_step = 0
         self.sphere_end = np.full(sp.count, np.inf)
@@ -354,7 +355,8 @@ class FrameBuilder:
         previous frame still counts, with the force it broke with: MUSEN marks its object
         inactive only at the save after the break."""
         job = self.job
-        blocks = [(job.stress_bonds, self.stress_bonds), (job.stress_contacts, self.stress_contacts)]
+        blocks = [(job.stress_bonds, self.stress_bonds), (job.stress_contacts, self.stress_contacts),
+                  (job.stress_walls, self.stress_walls)]
         got = [(path, next(it, None)) for path, it in blocks if it is not None]
         first, self.first_frame = self.first_frame, False
         for path, block in got:
@@ -364,9 +366,16 @@ class FrameBuilder:
         if first:
             frame.stress_tensor = np.zeros((len(frame.sphere_rows), 9))
             return
-        pairs = []
+        pairs, walls = [], None
         for path, block in got:
             cols = block.columns
+            if "cpx" in cols:            # sphere-wall contacts: after the pairs, by sphere
+                r = cols["id"].astype(np.int64) - 1
+                order = np.lexsort((cols["tri"], r))
+                point = np.column_stack([cols["cpx"], cols["cpy"], cols["cpz"]])
+                force = np.column_stack([cols["fx"], cols["fy"], cols["fz"]])
+                walls = (r[order], point[order], force[order])
+                continue
             ids = np.column_stack([cols.get("id1", []), cols.get("id2", [])]).astype(np.int64)
             force = np.column_stack([cols.get(c, []) for c in ("fx", "fy", "fz")]).reshape(-1, 3)
             if "ftx" in cols:            # a contact: its normal and tangential force on id1
@@ -379,7 +388,8 @@ class FrameBuilder:
                 order = np.argsort(self._bond_lookup(ids[:, 0], ids[:, 1]), kind="stable")
             pairs.append((ids[order, 0] - 1, ids[order, 1] - 1, force[order]))
         frame.stress_tensor = stress_tensors(np.asarray(frame.sphere_rows, np.int64), frame.position,
-                                             np.asarray(self.model.spheres.radius, np.float64), pairs)
+                                             np.asarray(self.model.spheres.radius, np.float64), pairs,
+                                             walls)
 
     def _exit_time(self, r: int, t: float) -> float:
         """Ballistic estimate of when sphere r crossed the domain, from the previous frame."""
@@ -442,7 +452,8 @@ class FrameBuilder:
         self.breaks.close()
         if self.variable_clock is not None:
             self.variable_clock.close()
-        for dump in (self.frames, self.bonds, self.tiles, self.mesh, self.stress_bonds, self.stress_contacts):
+        for dump in (self.frames, self.bonds, self.tiles, self.mesh, self.stress_bonds, self.stress_contacts,
+                     self.stress_walls):
             if dump is not None:
                 dump.close()
 

@@ -1,6 +1,7 @@
 """MUSEN's stress tensor of a sphere at a saved time point (``36``; its principal stresses are
 ``42``), from ``CCPUSimulator::PrepareAdditionalSavingData`` (e0ff360): for every solid bond and
-every sphere-sphere contact of the last force evaluation, each of its two spheres adds
+every sphere-sphere contact of the last force evaluation, each of its two spheres adds (and a
+sphere touching a wall adds unit(contact point - x) R with the wall's force on it)
 
     sigma[a][b] += r_c[a] * F[b] / V,   r_c = unit(x_other - x_self) * R,  V = pi (2 R)^3 / 6
 
@@ -17,13 +18,18 @@ import math
 
 import numpy as np
 
+from fibrelmp.numtext import fast as numtext_fast
+
 
 def stress_tensors(rows: np.ndarray, position: np.ndarray, radius: np.ndarray,
-                   pairs: list[tuple[np.ndarray, np.ndarray, np.ndarray]]) -> np.ndarray:
+                   pairs: list[tuple[np.ndarray, np.ndarray, np.ndarray]],
+                   walls: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None) -> np.ndarray:
     """(len(rows), 9) row-major tensors of the frame's spheres.  ``rows``/``position``: the
     frame's sphere rows and positions; ``radius``: every model row's radius; ``pairs``: per
-    kind (bonds, then contacts), (row1, row2, force on row1) in the order MUSEN adds them.
-    Pairs with a sphere not in the frame add nothing."""
+    kind (bonds, then contacts), (row1, row2, force on row1) in the order MUSEN adds them;
+    ``walls``: the sphere-wall contacts after them, (row, contact point, force on the
+    sphere), each adding unit(point - x) R with its force.  Pairs and contacts with a sphere
+    not in the frame add nothing."""
     count = len(radius)
     where = np.full(count, -1, np.int64)
     where[rows] = np.arange(len(rows))
@@ -41,6 +47,13 @@ def stress_tensors(rows: np.ndarray, position: np.ndarray, radius: np.ndarray,
         c[0::2], f[0::2], v[0::2], k[0::2] = (-1 * conn) * radius[r1[ok], None], force, volume[r1[ok]], k1
         c[1::2], f[1::2], v[1::2], k[1::2] = conn * radius[r2[ok], None], -1 * force, volume[r2[ok]], k2
         np.add.at(sigma, k, (c[:, :, None] * f[:, None, :] / v[:, None, None]).reshape(-1, 9))
+    if walls is not None:
+        r, point, force = walls
+        k = where[r]
+        ok = k >= 0
+        r, k, point, force = r[ok], k[ok], point[ok], force[ok]
+        c = _normalized(point - position[k]) * radius[r, None]
+        np.add.at(sigma, k, (c[:, :, None] * force[:, None, :] / volume[r, None, None]).reshape(-1, 9))
     return sigma
 
 
@@ -53,16 +66,21 @@ def _normalized(v: np.ndarray) -> np.ndarray:
 
 def principal_stresses(s: np.ndarray) -> np.ndarray:
     """CMatrix3::GetPrincipalStresses of each row (9 values, row-major), with the C math
-    library's functions (Python's math module) so that the digits are MUSEN's."""
+    library's functions (numtext's C helper, else Python's math module, ~3 µs a row) so that
+    the digits are MUSEN's."""
+    fast = numtext_fast.principal_stresses(s)
+    if fast is not None:
+        return fast
     out = np.zeros((len(s), 3))
     for i in np.flatnonzero(np.any(s != 0, axis=1)):
         m = s[i].tolist()
         a, b, c, d, e, f = m[0], m[4], m[8], m[1], m[2], m[5]
         i1 = a + b + c
-        i2 = a * b + b * c + c * a - math.pow(d, 2.) - math.pow(e, 2.) - math.pow(f, 2.)
-        i3 = (a * b * c - a * math.pow(f, 2.) - b * math.pow(e, 2.) - c * math.pow(d, 2.)
-              + 2 * d * e * f)
-        q = min((3 * i2 - math.pow(i1, 2.)) / 9.0, 0.0)
+        # MUSEN's pow(x, 2.) is x * x as GCC compiles it (math.pow differs in the last bit for
+        # some x: cmusen's digits are x * x's)
+        i2 = a * b + b * c + c * a - d * d - e * e - f * f
+        i3 = a * b * c - a * (f * f) - b * (e * e) - c * (d * d) + 2 * d * e * f
+        q = min((3 * i2 - i1 * i1) / 9.0, 0.0)
         r = (2 * math.pow(i1, 3.) - 9 * i1 * i2 + 27 * i3) / 54
         root = math.sqrt(math.pow(-q, 3.))
         ratio = r / root if root != 0 else (math.nan if r == 0 else math.copysign(math.inf, r))

@@ -986,3 +986,36 @@ int64_t fp_mdem_put_blocks(const double *start, const int64_t *offset, const int
     }
     return (int64_t)(o - out);
 }
+
+/* ------------------------------------------------------------------------------------------
+   MUSEN's CMatrix3::GetPrincipalStresses (Matrix3.h, e0ff360) of n row-major 3x3 tensors into
+   n x 3 values: the closed trigonometric form on the upper triangle, operation for operation
+   (pow(x, 3.), sqrt, fmin/fmax, acos, cos of the C library), as fibrelmp.granular_run.stress's
+   Python fallback computes it.  An all-zero row gives 0 0 0 without evaluating the form. */
+void fp_principal_stresses(const double *s, int64_t n, double *out)
+{
+    const double pi = 3.14159265358979323846;
+    for (int64_t r = 0; r < n; r++) {
+        const double *m = s + 9 * r;
+        double *o = out + 3 * r;
+        int any = 0;
+        for (int k = 0; k < 9; k++) any |= m[k] != 0;
+        if (!any) {
+            o[0] = o[1] = o[2] = 0.0;
+            continue;
+        }
+        const double a = m[0], b = m[4], c = m[8], d = m[1], e = m[2], f = m[5];
+        const double i1 = a + b + c;
+        /* pow(x, 2.) as x * x: what GCC compiles MUSEN's pow(x, 2.) to (cmusen's digits; the
+           C library's pow differs in the last bit for some x) */
+        const double i2 = a * b + b * c + c * a - d * d - e * e - f * f;
+        const double i3 = a * b * c - a * (f * f) - b * (e * e) - c * (d * d) + 2 * d * e * f;
+        const double q = fmin((3 * i2 - i1 * i1) / 9.0, 0.0);
+        const double rr = (2 * pow(i1, 3.) - 9 * i1 * i2 + 27 * i3) / 54;
+        const double g = fmin(fmax(rr / sqrt(pow(-q, 3.)), -1.), 1.);
+        const double te = acos(g);
+        o[0] = 2 * sqrt(-q) * cos(te / 3) + i1 / 3.;
+        o[1] = 2 * sqrt(-q) * cos((te + 2 * pi) / 3) + i1 / 3.;
+        o[2] = 2 * sqrt(-q) * cos((te + 4 * pi) / 3) + i1 / 3.;
+    }
+}

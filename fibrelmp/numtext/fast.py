@@ -154,6 +154,8 @@ def _open(lib: Path) -> ctypes.CDLL:
         dll.fp_mdem_blocks.restype = i64
         dll.fp_mdem_put_blocks.argtypes = [ptr, ptr, ptr, ptr, i64, i64, ptr, i64]
         dll.fp_mdem_put_blocks.restype = i64
+        dll.fp_principal_stresses.argtypes = [ptr, i64, ptr]
+        dll.fp_principal_stresses.restype = None
     except (OSError, AttributeError) as exc:
         raise _Unavailable(f"cannot load: {exc}") from exc
     # self-check against Python's correctly rounded conversions before trusting it
@@ -404,6 +406,19 @@ def format_g_rows(codes: np.ndarray, table: list[str], values: np.ndarray) -> by
                                    names, len(enc), w, buf.ctypes.data, len(buf))
         return None if got < 0 else buf[:got]
     return _joined_halves(part, n, n >= 4096)
+
+
+def principal_stresses(tensors: np.ndarray) -> np.ndarray | None:
+    """MUSEN's principal stresses of (n, 9) row-major tensors (``fp_principal_stresses``), or
+    None without the C library."""
+    lib = library()
+    if lib is None:
+        return None
+    tensors = np.ascontiguousarray(tensors, np.float64).reshape(-1, 9)
+    out = np.empty((len(tensors), 3))
+    if len(tensors):
+        lib.fp_principal_stresses(tensors.ctypes.data, len(tensors), out.ctypes.data)
+    return out
 
 
 def format_g_template(values: np.ndarray, prefixes: list[str], per_line: int) -> bytes | None:

@@ -59,6 +59,7 @@ BREAKS_NAME = "breaks.dump"
 CONTACTS_NAME = "contacts.dump"
 STRESS_BONDS_NAME = "stress_bonds.dump"          # MUSEN's stress tensor: the previous evaluation's
 STRESS_CONTACTS_NAME = "stress_contacts.dump"    # bond and contact forces (schedule.with_presaves)
+STRESS_WALLS_NAME = "stress_walls.dump"          # and sphere-wall contacts (fix musen/wall/mesh)
 CLOCK_NAME = VARIABLE_CLOCK      # variable time step: "step time dt" of every frame (fix musen/leapfrog)
 
 
@@ -100,6 +101,7 @@ class GranularJob:
     # MUSEN's stress tensor: bonds and contacts one step before each frame (granular_run.stress)
     stress_bonds: Path | None = None
     stress_contacts: Path | None = None
+    stress_walls: Path | None = None
 
     @property
     def inputs(self) -> list[Path]:
@@ -211,7 +213,8 @@ def build_granular_job(model: GranularModel, folder: str | Path):
         type_materials={t: m for m, t in spheres.type_of_mat.items()},
         variable_clock=folder / CLOCK_NAME if model.plan.variable_step is not None else None,
         stress_bonds=folder / STRESS_BONDS_NAME if parts.stress and has_bonds else None,
-        stress_contacts=folder / STRESS_CONTACTS_NAME if parts.stress else None)
+        stress_contacts=folder / STRESS_CONTACTS_NAME if parts.stress else None,
+        stress_walls=folder / STRESS_WALLS_NAME if parts.stress and has_mesh else None)
     return job, script, write_data_file
 
 
@@ -316,7 +319,7 @@ def _plan_parts(model: GranularModel) -> _JobParts:
             warnings.append(("musen-verlet-schedule", f"MUSEN's contact-list updates, which let "
                              f"broken bonds' spheres touch, may come at other steps: "
                              f"{verlet.approximate}"))
-    why_not = _no_stress(model, musen_hm, geometry, len(bonds.rows) > 0 or stored > 0)
+    why_not = _no_stress(model, musen_hm, geometry, len(bonds.rows) > 0 or stored > 0, len(mesh))
     if why_not is not None and model.kind == "musen":
         warnings.append(("musen-no-stress", f"the stress tensor and principal stresses (MUSEN's "
                          f"36 and 42) are left out of the results: {why_not}"))
@@ -325,7 +328,7 @@ def _plan_parts(model: GranularModel) -> _JobParts:
                      frame_columns, geometry, verlet, why_not is None)
 
 
-def _no_stress(model: GranularModel, musen_hm: bool, geometry, has_bonds: bool) -> str | None:
+def _no_stress(model: GranularModel, musen_hm: bool, geometry, has_bonds: bool, meshed: int) -> str | None:
     """Why fibrelmp does not compute MUSEN's stress tensor for this job (None: it does,
     granular_run.stress)."""
     if model.kind != "musen":
@@ -340,8 +343,11 @@ def _no_stress(model: GranularModel, musen_hm: bool, geometry, has_bonds: bool) 
         return "with several particle-particle models (MUSEN takes the last one's force alone)"
     if has_bonds and len(physics.chosen_all(model, "SB")) > 1:
         return "with several solid-bond models (MUSEN takes the last one's force alone)"
-    if model.triangles is not None and model.triangles.count:
-        return "not with walls yet (their contacts' points and forces are not dumped)"
+    walls = model.triangles.count if model.triangles is not None else 0
+    if walls and meshed < walls:
+        return "with walls outside fix musen/wall/mesh"
+    if walls and len(physics.chosen_all(model, "PW")) > 1:
+        return "with several particle-wall models (MUSEN takes the last one's force alone)"
     return None
 
 
@@ -407,7 +413,7 @@ def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> 
         walls=[(wp.name, wp.description) for wp in parts.wall_plans],
         mesh_fix=MESH_FIX if len(parts.mesh) else None, mesh_forces_name=MESH_FORCES_NAME,
         contacts_name=CONTACTS_NAME, stress_bonds_name=STRESS_BONDS_NAME,
-        stress_contacts_name=STRESS_CONTACTS_NAME, velocity_limit=plan.velocity_limit, pbc_velocity=pbc_velocity,
+        stress_contacts_name=STRESS_CONTACTS_NAME, stress_walls_name=STRESS_WALLS_NAME, velocity_limit=plan.velocity_limit, pbc_velocity=pbc_velocity,
         musen_integrator=parts.musen_hm, verlet=parts.verlet,
         fields=field_commands(model, spheres.rows, spheres.type_of_mat, parts.ntypes),
         variable_step=None if plan.variable_step is None else " ".join(float_text(v) for v in (

@@ -958,6 +958,7 @@ void FixMusenWallMesh::post_force(int /*vflag*/)
     pending = false;
   }
   at_start = false;
+  contact_rec.clear();
   const double t = current_time();
   const bool placing = any_moving || !placed;
   if (placing) place(t);
@@ -1125,6 +1126,9 @@ void FixMusenWallMesh::post_force(int /*vflag*/)
         torque[i][k] += to[k];
         ftri[3 * (size_t) cd.tri + k] -= fo[k];
       }
+      const double rec[8] = {(double) atom->tag[i], (double) cd.tri + 1, cd.cp[0], cd.cp[1],
+                             cd.cp[2], fo[0], fo[1], fo[2]};
+      contact_rec.insert(contact_rec.end(), rec, rec + 8);
     }
     // a set-up force evaluation (run, run 0) leaves the contacts as they were: only time
     // steps advance them (as LAMMPS's own granular styles do)
@@ -1249,9 +1253,56 @@ double FixMusenWallMesh::compute_vector(int i)
   return fgeom_all[i];
 }
 
+/* fix_modify ID contacts FILE [append yes|no]: the last evaluation's sphere-wall contacts as
+   one local-dump frame (id tri cpx cpy cpz fx fy fz: the sphere, the triangle, the contact
+   point, the force on the sphere), gathered on rank 0 (MUSEN's stress tensor) */
+int FixMusenWallMesh::write_contacts(int narg, char **arg)
+{
+  if (narg < 2) error->all(FLERR, "Illegal fix_modify {} contacts command: contacts FILE [append yes|no]", id);
+  bool append = false;
+  int used = 2;
+  if (narg >= 4 && strcmp(arg[2], "append") == 0) {
+    append = utils::logical(FLERR, arg[3], false, lmp) != 0;
+    used = 4;
+  }
+  int mine = static_cast<int>(contact_rec.size());
+  std::vector<int> counts(comm->nprocs), displs(comm->nprocs, 0);
+  MPI_Gather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, world);
+  std::vector<double> all;
+  if (comm->me == 0) {
+    for (int p = 1; p < comm->nprocs; p++) displs[p] = displs[p - 1] + counts[p - 1];
+    all.resize((size_t) displs[comm->nprocs - 1] + counts[comm->nprocs - 1]);
+  }
+  MPI_Gatherv(contact_rec.data(), mine, MPI_DOUBLE, all.data(), counts.data(), displs.data(),
+              MPI_DOUBLE, 0, world);
+  int ok = 1;
+  if (comm->me == 0) {
+    FILE *fp = fopen(arg[1], append ? "a" : "w");
+    if (!fp) {
+      ok = 0;
+    } else {
+      const size_t n = all.size() / 8;
+      fmt::print(fp, "ITEM: TIMESTEP\n{}\nITEM: NUMBER OF ENTRIES\n{}\nITEM: BOX BOUNDS ff ff ff\n",
+                 update->ntimestep, n);
+      for (int k = 0; k < 3; k++) fmt::print(fp, "{:.17g} {:.17g}\n", domain->boxlo[k], domain->boxhi[k]);
+      fputs("ITEM: ENTRIES id tri cpx cpy cpz fx fy fz\n", fp);
+      for (size_t r = 0; r < n; r++) {
+        const double *v = &all[8 * r];
+        fprintf(fp, "%.0f %.0f %.17g %.17g %.17g %.17g %.17g %.17g\n", v[0], v[1], v[2], v[3], v[4],
+                v[5], v[6], v[7]);
+      }
+      if (fclose(fp) != 0) ok = 0;
+    }
+  }
+  MPI_Bcast(&ok, 1, MPI_INT, 0, world);
+  if (!ok) error->all(FLERR, "Fix musen/wall/mesh: cannot write {}", arg[1]);
+  return used;
+}
+
 /* fix_modify ID write FILE [append yes|no]: one dump frame of the per-triangle forces */
 int FixMusenWallMesh::modify_param(int narg, char **arg)
 {
+  if (strcmp(arg[0], "contacts") == 0) return write_contacts(narg, arg);
   if (strcmp(arg[0], "write") != 0) return 0;
   if (narg < 2) error->all(FLERR, "Illegal fix_modify {} write command: write FILE [append yes|no]", id);
   bool append = false;

@@ -115,6 +115,7 @@ class FixMusenWallMesh : public Fix {
   void post_force(int) override;
   double compute_array(int, int) override;
   double compute_vector(int) override;
+  int write_contacts(int, char **);
   int modify_param(int, char **) override;
   void write_restart(FILE *) override;
   void restart(char *) override;
@@ -203,6 +204,9 @@ class FixMusenWallMesh : public Fix {
 
   // per-triangle force on the walls (local sums; reduced on demand)
   std::vector<double> ftri, ftri_all, fgeom_all;
+  // the last evaluation's contacts on this rank: (tag, triangle id, contact point, force on the
+  // sphere) each, for MUSEN's stress tensor (fix_modify ID contacts FILE)
+  std::vector<double> contact_rec;
   bigint reduced_step;
   bool reduced_valid;
   bigint ftri_step = -1;    // the time step whose contacts made ftri (-1: a set-up evaluation)

@@ -29,7 +29,8 @@ _GRANULAR = [("position", "position", "sphere"), ("velocity", "velocity", "spher
              ("bond_force", "force", "bond"), ("bond_torque", "torque", "bond"),
              ("bond_tangential_overlap", "tangential overlap", "bond"),
              ("triangle_vertices", "vertices", "triangle"),
-             ("triangle_velocity", "velocity", "triangle"), ("triangle_force", "force", "triangle")]
+             ("triangle_velocity", "velocity", "triangle"), ("triangle_force", "force", "triangle"),
+             ("stress_tensor", "stress tensor", "sphere"), ("saved_triangle_force", "force", "triangle")]
 _SPH = [("positions", "position"), ("velocities", "velocity"), ("density", "density"),
         ("pressure", "pressure")]
 _BLOCK = 1 << 20

@@ -532,11 +532,16 @@ class GranularFrame:
     bond_alive: np.ndarray | None = None       # (m,) bool
     bond_end_time: np.ndarray | None = None    # (m,) break / removal time, inf if alive
     bond_force: np.ndarray | None = None       # (m,3) force on the bond's first sphere
+    bond_saved: np.ndarray | None = None       # (m,) bool: bonds whose values the save holds
+                                               # (MUSEN: alive, or broken since the previous
+                                               # save, as they broke); None: bond_alive
     bond_torque: np.ndarray | None = None      # (m,) |total torque| if known
     bond_tangential_overlap: np.ndarray | None = None   # (m,3) if known
     triangle_vertices: np.ndarray | None = None # (k,3,3)
     triangle_velocity: np.ndarray | None = None # (k,3)
     triangle_force: np.ndarray | None = None    # (k,3) force the particles exert on each triangle
+    saved_triangle_force: np.ndarray | None = None   # (k,3) what cmusen saves now (MUSEN jobs
+                                                     # with presaves: the previous evaluation's)
     temperature: np.ndarray | None = None      # (n',) K, when a heat model changes it
     stress_tensor: np.ndarray | None = None    # (n',9) MUSEN's stress tensor, row-major
                                                # (granular_run.stress), when the job computes it

@@ -32,7 +32,7 @@ from fibrelmp.formatbase import replacing
 
 # what a run writes into its work folder (translate.lammps_job / granular_job, checkpoint)
 WORK_FILES = frozenset({"in.lammps", "data.lammps", "frames.dump", "bonds.dump", "walls.dump",
-                        "breaks.dump", "stress_bonds.dump", "stress_contacts.dump", "stress_walls.dump",
+                        "breaks.dump", "stress_contacts.dump", "stress_walls.dump",
                         "checkpoint.json",
                         "log.lammps", "data.fibrelmp.json",
                         "fibrenet_state.txt", "bond_geometry.txt", "summary.json"})

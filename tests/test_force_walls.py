@@ -141,15 +141,16 @@ def test_reference_is_cmusens_output(tmp_path, prefix):
 
 @needs_cmusen
 def test_saved_wall_force_is_the_previous_steps(tmp_path):
-    """Saving every step (7 s): cmusen's wall force at each saved time equals fibrelmp's
-    force one step earlier (to 1e-12 of its scale)."""
+    """Saving every step (7 s): at each of cmusen's saved times fibrelmp's saved wall force is
+    cmusen's, bit for bit: the previous evaluation's, from the contacts dumped one step before
+    the frame (here the previous frame's step: with_presaves splits no run)."""
     styles_or_skip()
     ours, _ = _run(tmp_path, "press", **{"SAVING_STEP          1e-5": f"SAVING_STEP {DT}"})
     theirs = read_time_points(DATA / "cmusen_press_result_prec17.txt")
     force = theirs.fields[FORCE][:, 6, 2]
     steps = np.rint(theirs.times / DT).astype(int)[1:len(theirs.times) - 1]
-    np.testing.assert_allclose(ours.fields[FORCE][steps - 1, 6, 2], force[1:len(steps) + 1],
-                               rtol=0, atol=1e-12 * np.max(np.abs(force)))
+    assert np.abs(force).max() > 1.0
+    np.testing.assert_array_equal(ours.fields[FORCE][steps, 6, 2], force[1:len(steps) + 1])
 
 
 def test_checkpoint_and_resume_give_the_uninterrupted_run(tmp_path, monkeypatch):

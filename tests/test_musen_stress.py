@@ -7,9 +7,12 @@ the real cmusen's 17-digit exports stored in tests/data (each case's README give
 - stop_criterion: five spheres joined by four bonds, two of which break; a bond broken since
   the previous save still counts there with the force it broke with (MUSEN marks its object
   inactive only at that save): bit for bit.
-- force_walls press and rot: three spheres between a plate and a force-driven (and, in rot,
-  rotating) plate: sphere-wall contacts (fix musen/wall/mesh's contact points and forces)
-  and sphere-sphere ones: bit for bit.
+- force_walls press, rot and const: three spheres between a plate and a force-driven (in rot
+  also rotating; in const constant-force) plate: sphere-wall contacts (fix musen/wall/mesh's
+  contact points and forces) and sphere-sphere ones: bit for bit.
+
+In the bit-for-bit cases every other field of the export equals cmusen's too (the bonds' and
+walls' forces are the previous evaluation's, as cmusen saves them).
 
 Independently of cmusen, ``granular_run.stress.stress_tensors`` is checked against the formula
 written out per pair (numpy loops) and ``schedule.with_presaves`` against the steps it must
@@ -55,6 +58,8 @@ def _run(case, job: str, tmp_path):
      "cmusen_press_result_prec17.txt", 0),
     (MUSEN / "force_walls", "job_rot.txt", "rot_result_prec17.txt",
      "cmusen_rot_result_prec17.txt", 0),
+    (MUSEN / "force_walls", "job_const.txt", "const_result_prec17.txt",
+     "cmusen_const_result_prec17.txt", 0),
 ])
 def test_stress_tensor_is_cmusens(tmp_path, case, job, ours, theirs, ulps):
     done = _run(case, job, tmp_path)
@@ -70,6 +75,14 @@ def test_stress_tensor_is_cmusens(tmp_path, case, job, ours, theirs, ulps):
         assert np.abs(o - r).max() <= ulps * np.spacing(scale), tag
     # the zero tensor of the first save (no evaluation before it) is written too
     assert not np.any(mine.fields[36][0][spheres])
+    if ulps == 0:
+        # and every other field of every object too: the bonds' force, overlap and torque (a
+        # bond broken since the previous save as it broke) and the walls' forces are the
+        # previous evaluation's, as cmusen saves them
+        real, mine = read_time_points(case / theirs), read_time_points(tmp_path / ours)
+        assert set(real.fields) == set(mine.fields)
+        for tag in real.fields:
+            assert np.array_equal(real.fields[tag], mine.fields[tag], equal_nan=True), tag
 
 
 def test_stress_formula_per_pair():

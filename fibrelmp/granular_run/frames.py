@@ -26,9 +26,10 @@ from fibrelmp.translate.granular.schedule import UNKNOWN_STEP
 
 
 class _BreakLog:
-    """Reads the per-step broken-bond dump as LAMMPS appends it: ``step id1 id2 fx fy fz``
-    lines (bond_style musen/elastic: the force on id1 as it broke), ``step id1 id2 time fx fy
-    fz`` with a variable time step, ``step id1 id2`` from other bond styles."""
+    """Reads the per-step broken-bond dump as LAMMPS appends it: ``step id1 id2 fx fy fz ox oy
+    oz m`` lines (bond_style musen/elastic: the force on id1, the tangential overlap and
+    |M_n + M_t| as it broke), with MUSEN's time 4th with a variable time step, ``step id1
+    id2`` from other bond styles."""
 
     def __init__(self, path: Path | None):
         self.path = path
@@ -36,8 +37,8 @@ class _BreakLog:
         self.pending = b""
         self.rows: list[tuple[float, float, float]] = []
         self.times: dict[tuple[int, int, int], float] = {}    # a variable step's break times
-        # (step, id1, id2, fx, fy, fz) of breaks not yet counted in a stress tensor
-        self.forces: list[tuple[int, int, int, float, float, float]] = []
+        # (step, id1, id2, fx, fy, fz, ox, oy, oz, m) of breaks a frame may still need
+        self.forces: list[tuple] = []
 
     def time(self, step: int, id1: int, id2: int) -> float:
         """The time logged with a break (variable time step)."""
@@ -56,19 +57,19 @@ class _BreakLog:
             w = ln.split()
             if len(w) >= 3:
                 self.rows.append((float(w[0]), float(w[1]), float(w[2])))
-            if len(w) in (4, 7):
+            if len(w) in (4, 11):
                 self.times[(int(w[0]), int(w[1]), int(w[2]))] = float(w[3])
-            if len(w) >= 6:
-                self.forces.append((int(w[0]), int(w[1]), int(w[2]), *map(float, w[-3:])))
+            if len(w) >= 10:
+                self.forces.append((int(w[0]), int(w[1]), int(w[2]), *map(float, w[-7:])))
         out = [(int(s), int(a), int(b)) for s, a, b in self.rows if s <= step]
         self.rows = [r for r in self.rows if r[0] > step]
         return out
 
-    def broken_between(self, first: int, last: int) -> list[tuple[int, int, int, float, float, float]]:
-        """The breaks read so far at steps ``first`` .. ``last`` with their forces; those
-        before ``first`` are forgotten."""
+    def broken_between(self, first: int, last: int) -> np.ndarray:
+        """(k, 10) rows of the breaks read so far at steps ``first`` .. ``last`` with their
+        state (step, id1, id2, force, overlap, |moment|); those before ``first`` are forgotten."""
         self.forces = [r for r in self.forces if r[0] >= first]
-        return [r for r in self.forces if r[0] <= last]
+        return np.array([r for r in self.forces if r[0] <= last], np.float64).reshape(-1, 10)
 
     def close(self) -> None:
         if self.fh is not None:
@@ -88,10 +89,11 @@ class FrameBuilder:
         self.mesh = iter_frames(job.wall_forces) if job.wall_forces is not None else None
         self.breaks = _BreakLog(job.breaks)
         # MUSEN's stress tensor: the previous evaluation's bonds and contacts, one block per frame
-        self.stress_bonds = iter_frames(job.stress_bonds) if job.stress_bonds is not None else None
         self.stress_contacts = iter_frames(job.stress_contacts) if job.stress_contacts is not None else None
         self.stress_walls = iter_frames(job.stress_walls) if job.stress_walls is not None else None
         self.first_frame = True
+        self.bond_block = None           # the bond dump's block of the frame being read
+        self.presave: list = []          # (path, block) of the presave dumps of that frame
         self.prev_frame_step = 0
         self.sphere_end = np.full(sp.count, np.inf)
         self.present = np.zeros(sp.count, bool)
@@ -213,6 +215,10 @@ class FrameBuilder:
             self.temperatures.append(_temperature_figures(t, step, frame.temperature))
         if "sfx" in c:      # fix musen/leapfrog: the force cmusen saves (the previous evaluation's)
             frame.saved_force = np.column_stack([c["sfx"], c["sfy"], c["sfz"]])
+        # the presave's contacts and wall contacts (MUSEN's stress tensor, its wall forces)
+        self.presave = [(path, next(it, None)) for path, it in ((job.stress_contacts, self.stress_contacts),
+                                                                 (job.stress_walls, self.stress_walls))
+                        if it is not None]
         if self.nb:
             self._bonds(frame, step)
         if self.v0 is not None:
@@ -320,31 +326,51 @@ class FrameBuilder:
         frame.bond_alive = self.bond_alive.copy()
         frame.bond_end_time = self.bond_end.copy()
         bf = np.full((self.nb, 3), np.nan)
-        # no bond dump when no bond survives the start (e.g. all left the domain at t = 0)
-        cols = next(self.bonds).columns if self.bonds is not None else {}
+        # no bond dump when no bond survives the start (e.g. all left the domain at t = 0);
+        # with presaves (MUSEN's stress tensor) it is the previous evaluation's, as cmusen saves
+        self.bond_block = next(self.bonds, None) if self.bonds is not None else None
+        cols = self.bond_block.columns if self.bond_block is not None else {}
         # musen/elastic also dumps the tangential overlap and |M_n + M_t| (MUSEN's TotalTorque)
         extra = "c_fl_bforce[7]" in cols
         overlap = np.full((self.nb, 3), np.nan) if extra else None
         torque = np.full(self.nb, np.nan) if extra else None
+        dumped = np.zeros(self.nb, bool)          # the bonds the dump lists
         if len(cols.get("c_fl_bpair[1]", [])):
             i1 = cols["c_fl_bpair[1]"].astype(np.int64)
             i2 = cols["c_fl_bpair[2]"].astype(np.int64)
             fb = np.column_stack([cols[f"c_fl_bforce[{k}]"] for k in range(1, 4)])
+            if self.job.stress_contacts is not None and self.first_frame:
+                fb = np.zeros_like(fb)   # cmusen's first save: no evaluation yet, TotalForce 0
             br = self._bond_lookup(i1, i2)
             ok = br >= 0
             # the force on batom1 (and the overlap seen from it): report them for the bond's
             # first sphere
             sign = np.where(i1[ok] == self.first_id[br[ok]], 1.0, -1.0)
             bf[br[ok]] = fb[ok] * sign[:, None]
+            dumped[br[ok]] = True
             if extra:
                 ov = np.column_stack([cols[f"c_fl_bforce[{k}]"] for k in range(4, 7)])
                 overlap[br[ok]] = ov[ok] * sign[:, None]
                 torque[br[ok]] = cols["c_fl_bforce[7]"][ok]
-        bf[~self.bond_alive] = 0.0
+        held = self.bond_alive
+        if self.job.stress_contacts is not None and extra:
+            # cmusen's save holds the bonds alive before its step's evaluation (the presave's)
+            # and, once more, those broken since the previous save, as they broke
+            held = dumped
+            gone = (self.breaks.broken_between(self.prev_frame_step, step - 1) if not self.first_frame
+                    else np.zeros((0, 10)))
+            rows = self._bond_lookup(gone[:, 1].astype(np.int64), gone[:, 2].astype(np.int64))
+            gone, rows = gone[rows >= 0], rows[rows >= 0]
+            sign = np.where(gone[:, 1] == self.first_id[rows], 1.0, -1.0)
+            bf[rows], overlap[rows] = gone[:, 3:6] * sign[:, None], gone[:, 6:9] * sign[:, None]
+            torque[rows] = gone[:, 9]
+            held[rows] = True
+            frame.bond_saved = held
+        bf[~held] = 0.0
         frame.bond_force = bf
         if extra:
-            overlap[~self.bond_alive] = 0.0
-            torque[~self.bond_alive] = 0.0
+            overlap[~held] = 0.0
+            torque[~held] = 0.0
             frame.bond_tangential_overlap = overlap
             frame.bond_torque = torque
 
@@ -355,9 +381,9 @@ class FrameBuilder:
         previous frame still counts, with the force it broke with: MUSEN marks its object
         inactive only at the save after the break."""
         job = self.job
-        blocks = [(job.stress_bonds, self.stress_bonds), (job.stress_contacts, self.stress_contacts),
-                  (job.stress_walls, self.stress_walls)]
-        got = [(path, next(it, None)) for path, it in blocks if it is not None]
+        # bonds (the bond dump _bonds read: the same presave), contacts, walls: MUSEN's order
+        got = [(job.bond_dump, self.bond_block)] if self.bonds is not None else []
+        got += self.presave
         first, self.first_frame = self.first_frame, False
         for path, block in got:
             if block is None or (not first and block.step != step - 1):
@@ -376,13 +402,16 @@ class FrameBuilder:
                 force = np.column_stack([cols["fx"], cols["fy"], cols["fz"]])
                 walls = (r[order], point[order], force[order])
                 continue
+            if "c_fl_bpair[1]" in cols:   # the bond dump's columns
+                cols = {"id1": cols["c_fl_bpair[1]"], "id2": cols["c_fl_bpair[2]"],
+                        **{c: cols[f"c_fl_bforce[{k}]"] for k, c in ((1, "fx"), (2, "fy"), (3, "fz"))}}
             ids = np.column_stack([cols.get("id1", []), cols.get("id2", [])]).astype(np.int64)
             force = np.column_stack([cols.get(c, []) for c in ("fx", "fy", "fz")]).reshape(-1, 3)
             if "ftx" in cols:            # a contact: its normal and tangential force on id1
                 force = force + np.column_stack([cols["ftx"], cols["fty"], cols["ftz"]])
                 order = np.lexsort((ids.max(1), ids.min(1)))          # by sphere pair
             else:                        # bonds, broken ones included, in MUSEN's bond order
-                gone = np.array(self.breaks.broken_between(prev, step - 1), np.float64).reshape(-1, 6)
+                gone = self.breaks.broken_between(prev, step - 1)
                 ids = np.r_[ids, gone[:, 1:3].astype(np.int64)]
                 force = np.r_[force, gone[:, 3:6]]
                 order = np.argsort(self._bond_lookup(ids[:, 0], ids[:, 1]), kind="stable")
@@ -431,6 +460,14 @@ class FrameBuilder:
             fm = next(self.mesh).columns
             k = fm["id"].astype(np.int64) - 1
             tforce[self.job.mesh_rows[k]] = np.column_stack([fm["fx"], fm["fy"], fm["fz"]])
+            walls = [block for path, block in self.presave if path == self.job.stress_walls]
+            if walls and walls[0] is not None:
+                # with presaves, what cmusen saves: the previous evaluation's (0 before any)
+                saved = tforce.copy()
+                saved[self.job.mesh_rows] = 0.0
+                if not self.first_frame:
+                    _presave_wall_forces(saved, self.job.mesh_rows, walls[0].columns)
+                frame.saved_triangle_force = saved
             if "x1" in fm:
                 # geometries the fix moves step by step: where it moved them, their velocity
                 _stepped_walls(self.job, fm, k, verts, tvel)
@@ -452,8 +489,7 @@ class FrameBuilder:
         self.breaks.close()
         if self.variable_clock is not None:
             self.variable_clock.close()
-        for dump in (self.frames, self.bonds, self.tiles, self.mesh, self.stress_bonds, self.stress_contacts,
-                     self.stress_walls):
+        for dump in (self.frames, self.bonds, self.tiles, self.mesh, self.stress_contacts, self.stress_walls):
             if dump is not None:
                 dump.close()
 
@@ -506,6 +542,17 @@ def _stepped_walls(job, fm: dict, k: np.ndarray, verts: np.ndarray, tvel: np.nda
     cols = [fm[f"{c}{a}"] for a in (1, 2, 3) for c in "xyz"]
     verts[rows[sel]] = np.column_stack(cols)[sel].reshape(-1, 3, 3)
     tvel[rows[sel]] = np.column_stack([fm["vx"], fm["vy"], fm["vz"]])[sel]
+
+
+def _presave_wall_forces(tforce: np.ndarray, mesh_rows: np.ndarray, cols: dict) -> None:
+    """Each mesh triangle's force from the presave's sphere-wall contacts: minus the force on
+    each sphere (MUSEN's ConsolidateWall), added sphere by sphere (its collision order)."""
+    if not len(cols.get("id", [])):
+        return
+    order = np.lexsort((cols["tri"], cols["id"]))
+    tri = cols["tri"].astype(np.int64)[order] - 1
+    force = np.column_stack([cols["fx"], cols["fy"], cols["fz"]])[order]
+    np.add.at(tforce, mesh_rows[tri], -1 * force)
 
 
 def _clock(job) -> Callable[[int], float]:

@@ -34,7 +34,7 @@ def stress_tensors(rows: np.ndarray, position: np.ndarray, radius: np.ndarray,
     where = np.full(count, -1, np.int64)
     where[rows] = np.arange(len(rows))
     volume = math.pi * np.power(2 * np.asarray(radius, np.float64), 3.0) / 6
-    sigma = np.zeros((len(rows), 9))
+    arms, forces, vols, targets = [], [], [], []
     for r1, r2, force in pairs:
         k1, k2 = where[r1], where[r2]
         ok = (k1 >= 0) & (k2 >= 0)
@@ -46,14 +46,23 @@ def stress_tensors(rows: np.ndarray, position: np.ndarray, radius: np.ndarray,
         c, f, v, k = np.empty((2 * n, 3)), np.empty((2 * n, 3)), np.empty(2 * n), np.empty(2 * n, np.int64)
         c[0::2], f[0::2], v[0::2], k[0::2] = (-1 * conn) * radius[r1[ok], None], force, volume[r1[ok]], k1
         c[1::2], f[1::2], v[1::2], k[1::2] = conn * radius[r2[ok], None], -1 * force, volume[r2[ok]], k2
-        np.add.at(sigma, k, (c[:, :, None] * f[:, None, :] / v[:, None, None]).reshape(-1, 9))
+        arms.append(c), forces.append(f), vols.append(v), targets.append(k)
     if walls is not None:
         r, point, force = walls
         k = where[r]
         ok = k >= 0
-        r, k, point, force = r[ok], k[ok], point[ok], force[ok]
-        c = _normalized(point - position[k]) * radius[r, None]
-        np.add.at(sigma, k, (c[:, :, None] * force[:, None, :] / volume[r, None, None]).reshape(-1, 9))
+        r, k = r[ok], k[ok]
+        arms.append(_normalized(point[ok] - position[k]) * radius[r, None])
+        forces.append(np.asarray(force, np.float64)[ok]), vols.append(volume[r]), targets.append(k)
+    sigma = np.zeros((len(rows), 9))
+    if not targets:
+        return sigma
+    c, f, v, k = (np.concatenate(a) for a in (arms, forces, vols, targets))
+    terms = (c[:, :, None] * f[:, None, :] / v[:, None, None]).reshape(-1, 9)
+    # every sphere's terms added one after the other in the order given (bincount sums in
+    # index order, as MUSEN's += do), each of the 9 components
+    for col in range(9):
+        sigma[:, col] = np.bincount(k, weights=terms[:, col], minlength=len(rows))
     return sigma
 
 

@@ -140,12 +140,13 @@ def granular_frame(frame: Frame, time: float, model: GranularModel,
 def spheres_only(work: Path, frame: Frame) -> str:
     """What a MUSEN result from a work folder's dump lacks against the run's own result."""
     from fibrelmp.translate.granular.mesh import MESH_NAME
-    from fibrelmp.translate.granular_job import BONDS_NAME, TILES_NAME
+    from fibrelmp.translate.granular_job import BONDS_NAME, STRESS_CONTACTS_NAME, TILES_NAME
 
     walls = (work / MESH_NAME).exists() or (work / TILES_NAME).exists() or \
         any(name.startswith("v_w") for name in frame.columns)
     missing = (["its walls (triangles, geometries)"] if walls else []) + \
-        (["its bonds"] if (work / BONDS_NAME).exists() else [])
+        (["its bonds"] if (work / BONDS_NAME).exists() else []) + \
+        (["the stress tensors (36, 42: from the contacts)"] if (work / STRESS_CONTACTS_NAME).exists() else [])
     return (f"the result has the run's spheres only: {', '.join(missing + [''])}material properties "
             "other than the density and the interactions are not in a dump, and the PBC line comes from "
             "the dump's box; `fibrelmp run` writes the complete result (docs/post.md, fibrelmp's own "

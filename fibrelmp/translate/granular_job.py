@@ -57,9 +57,11 @@ BONDS_NAME = "bonds.dump"
 TILES_NAME = "walls.dump"
 BREAKS_NAME = "breaks.dump"
 CONTACTS_NAME = "contacts.dump"
-STRESS_BONDS_NAME = "stress_bonds.dump"          # MUSEN's stress tensor: the previous evaluation's
-STRESS_CONTACTS_NAME = "stress_contacts.dump"    # bond and contact forces (schedule.with_presaves)
-STRESS_WALLS_NAME = "stress_walls.dump"          # and sphere-wall contacts (fix musen/wall/mesh)
+# MUSEN's stress tensor: the previous evaluation's contacts and sphere-wall contacts (fix
+# musen/wall/mesh), one step before each frame (schedule.with_presaves); its bonds are the
+# frame's bonds.dump, written there too
+STRESS_CONTACTS_NAME = "stress_contacts.dump"
+STRESS_WALLS_NAME = "stress_walls.dump"
 CLOCK_NAME = VARIABLE_CLOCK      # variable time step: "step time dt" of every frame (fix musen/leapfrog)
 
 
@@ -98,8 +100,8 @@ class GranularJob:
     inlet_bond_rows: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     type_materials: dict[int, int] | None = None   # LAMMPS sphere type -> material
     variable_clock: Path | None = None   # variable time step: each frame's step, time and dt
-    # MUSEN's stress tensor: bonds and contacts one step before each frame (granular_run.stress)
-    stress_bonds: Path | None = None
+    # MUSEN's stress tensor: contacts one step before each frame (granular_run.stress), where
+    # bond_dump is written then too (stress_contacts set: presaves)
     stress_contacts: Path | None = None
     stress_walls: Path | None = None
 
@@ -212,7 +214,6 @@ def build_granular_job(model: GranularModel, folder: str | Path):
         inlet_bond_rows=_inlet_bond_rows(model),
         type_materials={t: m for m, t in spheres.type_of_mat.items()},
         variable_clock=folder / CLOCK_NAME if model.plan.variable_step is not None else None,
-        stress_bonds=folder / STRESS_BONDS_NAME if parts.stress and has_bonds else None,
         stress_contacts=folder / STRESS_CONTACTS_NAME if parts.stress else None,
         stress_walls=folder / STRESS_WALLS_NAME if parts.stress and has_mesh else None)
     return job, script, write_data_file
@@ -412,7 +413,7 @@ def _render_script(model: GranularModel, parts: _JobParts, saves: SaveSteps) -> 
         lost=bool(parts.axes.removal_axes.any()),
         walls=[(wp.name, wp.description) for wp in parts.wall_plans],
         mesh_fix=MESH_FIX if len(parts.mesh) else None, mesh_forces_name=MESH_FORCES_NAME,
-        contacts_name=CONTACTS_NAME, stress_bonds_name=STRESS_BONDS_NAME,
+        contacts_name=CONTACTS_NAME, presaves=parts.stress,
         stress_contacts_name=STRESS_CONTACTS_NAME, stress_walls_name=STRESS_WALLS_NAME, velocity_limit=plan.velocity_limit, pbc_velocity=pbc_velocity,
         musen_integrator=parts.musen_hm, verlet=parts.verlet,
         fields=field_commands(model, spheres.rows, spheres.type_of_mat, parts.ntypes),

@@ -663,8 +663,8 @@ void BondMusenElastic::compute(int eflag, int vflag)
       h = init_entry(i1, i2, type);
       fresh = true;
     }
-    double total[3] = {0.0, 0.0, 0.0}, broke_force[3] = {0.0, 0.0, 0.0};
-    const bool broke = apply_laws(i1, i2, type, h, advance, fresh, total, broke_force);
+    double total[3] = {0.0, 0.0, 0.0}, broke_state[7] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+    const bool broke = apply_laws(i1, i2, type, h, advance, fresh, total, broke_state);
     if (broke) {
       // MUSEN: Active = false, EndActivity = time; an inactive bond is not consolidated
       bondlist[n][2] = 0;
@@ -677,7 +677,7 @@ void BondMusenElastic::compute(int eflag, int vflag)
       broken.push_back(update->ntimestep);
       broken.push_back(tag[i1]);
       broken.push_back(tag[i2]);
-      broken_force.insert(broken_force.end(), broke_force, broke_force + 3);
+      broken_force.insert(broken_force.end(), broke_state, broke_state + 7);
     }
     if (evflag) {
       double del[3];
@@ -700,7 +700,7 @@ void BondMusenElastic::compute(int eflag, int vflag)
 ------------------------------------------------------------------------- */
 
 bool BondMusenElastic::apply_laws(int i1, int i2, int type, double *h, bool advance, bool fresh,
-                                  double *total, double *broke_force)
+                                  double *total, double *broke_state)
 {
   double **f = atom->f;
   double **torque = atom->torque;
@@ -746,7 +746,14 @@ bool BondMusenElastic::apply_laws(int i1, int i2, int type, double *h, bool adva
         musen_breaks(law.form == WEAKENING || law.form == CONCRETE ? 0 : law.breakage, state,
                      out, sigma_n[type],
                      tau_s[type])) {
-      for (int c = 0; c < 3; c++) broke_force[c] = out.total[c];    // MUSEN's TotalForce
+      // what MUSEN's bond still holds: TotalForce, TangentialOverlap, |M_n + M_t|
+      double msum[3];
+      add(state + H_NMOMENT, state + H_TMOMENT, msum);
+      for (int c = 0; c < 3; c++) {
+        broke_state[c] = out.total[c];
+        broke_state[3 + c] = state[H_OVERLAP + c];
+      }
+      broke_state[6] = length(msum);
       return true;
     }
     for (int c = 0; c < 3; c++) {
@@ -876,9 +883,15 @@ void BondMusenElastic::process_breaks()
     all.resize(total);
     MPI_Allgatherv(broken.data(), mine, MPI_LMP_BIGINT, all.data(), counts.data(), displs.data(),
                    MPI_LMP_BIGINT, world);
-    all_force.resize(total);    // 3 doubles per break, as 3 bigints per break
-    MPI_Allgatherv(broken_force.data(), mine, MPI_DOUBLE, all_force.data(), counts.data(),
-                   displs.data(), MPI_DOUBLE, world);
+    // 7 doubles per break where there are 3 bigints
+    std::vector<int> dcounts(comm->nprocs), ddispls(comm->nprocs);
+    for (int p = 0; p < comm->nprocs; p++) {
+      dcounts[p] = counts[p] / 3 * 7;
+      ddispls[p] = displs[p] / 3 * 7;
+    }
+    all_force.resize((size_t) total / 3 * 7);
+    MPI_Allgatherv(broken_force.data(), mine / 3 * 7, MPI_DOUBLE, all_force.data(), dcounts.data(),
+                   ddispls.data(), MPI_DOUBLE, world);
   } else {
     all.swap(broken);
     all_force.swap(broken_force);
@@ -899,14 +912,18 @@ void BondMusenElastic::process_breaks()
   if (comm->me == 0 && breaks_fp && timed_breaks) {
     // MUSEN's time of this evaluation (the fix keeps atime at it: atimestep is this step)
     const double t = simulation_time(update);
-    for (int k : order)
-      utils::print(breaks_fp, "{} {} {} {:.17g} {:.17g} {:.17g} {:.17g}\n", rec[k][0], rec[k][1],
-                   rec[k][2], t, all_force[3 * k], all_force[3 * k + 1], all_force[3 * k + 2]);
+    for (int k : order) {
+      utils::print(breaks_fp, "{} {} {} {:.17g}", rec[k][0], rec[k][1], rec[k][2], t);
+      for (int c = 0; c < 7; c++) utils::print(breaks_fp, " {:.17g}", all_force[7 * (size_t) k + c]);
+      fputc('\n', breaks_fp);
+    }
     fflush(breaks_fp);
   } else if (comm->me == 0 && breaks_fp) {
-    for (int k : order)
-      utils::print(breaks_fp, "{} {} {} {:.17g} {:.17g} {:.17g}\n", rec[k][0], rec[k][1],
-                   rec[k][2], all_force[3 * k], all_force[3 * k + 1], all_force[3 * k + 2]);
+    for (int k : order) {
+      utils::print(breaks_fp, "{} {} {}", rec[k][0], rec[k][1], rec[k][2]);
+      for (int c = 0; c < 7; c++) utils::print(breaks_fp, " {:.17g}", all_force[7 * (size_t) k + c]);
+      fputc('\n', breaks_fp);
+    }
     fflush(breaks_fp);
   }
   if (update_special && verlet) {

@@ -11,10 +11,11 @@
 
      bond_style musen/elastic [breakage B] [LAW]  [then FORM B PARAMETERS] ...
                               [geometry PARTNER VALUES K] [breaks FILE]
-       (FILE: "step id1 id2 fx fy fz" per broken bond, the force on id1 its law computed as it
-       broke (MUSEN's TotalForce, which its stress tensor of the next save still counts); with
-       fix musen/leapfrog's variable time step MUSEN's time of that step, %.17g, which a step
-       number no longer gives, comes before the force: "step id1 id2 time fx fy fz")
+       (FILE: "step id1 id2 fx fy fz ox oy oz m" per broken bond: the force on id1 its law
+       computed as it broke (MUSEN's TotalForce), the tangential overlap and |M_n + M_t|, what
+       cmusen's next save still holds for it; with fix musen/leapfrog's variable time step
+       MUSEN's time of that step, %.17g, which a step number no longer gives, comes 4th:
+       "step id1 id2 time fx fy fz ox oy oz m")
        LAW = FORM PARAMETERS: kelvin MAX_DAMP_RATIO | plastic FT FC TY RC |
             linear/plastic KL KU | creep FT FC TY RC A m | weakening CB BS WF |
             aerogel PSC PST SRC SRT BST HRC HRT | concrete (then elastic B, then concrete B:
@@ -145,11 +146,12 @@ class BondMusenElastic : public Bond {
   class FixMusenVerlet *verlet;    // MUSEN's contact-list schedule for broken pairs (or none)
 
   std::vector<bigint> broken;    // (step, tag left, tag right) found on this rank this call
-  std::vector<double> broken_force;    // each one's force on the left sphere when it broke
+  // each one's force on the left sphere, tangential overlap and |M_n + M_t| when it broke (7)
+  std::vector<double> broken_force;
 
   int entry_size() const { return H_SIZE + H_LAWSTATE * (int) then_laws.size(); }
   bool apply_laws(int i1, int i2, int type, double *h, bool advance, bool fresh, double *total,
-                  double *broke_force);
+                  double *broke_state);
   bool any_breakage() const;
   bool uses_yield() const;
   int parse_law(const std::string &form, int narg, char **arg, Law &law);

@@ -180,14 +180,15 @@ class MusenResultWriter(Writer):
         b[:, 12:15] = 0.5 * (s[pair[:, 0], v:v + 3] + s[pair[:, 1], v:v + 3])
         alive = (np.ones(bonds.count, bool) if f.bond_alive is None
                  else np.asarray(f.bond_alive, bool))
+        held = alive if f.bond_saved is None else np.asarray(f.bond_saved, bool)   # values saved
         if f.bond_force is not None:
-            force = np.where(alive[:, None], np.asarray(f.bond_force, np.float64), 0.0)
+            force = np.where(held[:, None], np.asarray(f.bond_force, np.float64), 0.0)
             b[:, 3:6] = force
             b[:, 6] = np.linalg.norm(force, axis=1)
         if f.bond_tangential_overlap is not None:
-            b[:, 7:10] = np.where(alive[:, None], f.bond_tangential_overlap, 0.0)
+            b[:, 7:10] = np.where(held[:, None], f.bond_tangential_overlap, 0.0)
         if f.bond_torque is not None:                 # column 10: temperature 0
-            b[:, 11] = np.where(alive, f.bond_torque, 0.0)
+            b[:, 11] = np.where(held, f.bond_torque, 0.0)
         return b
 
     def _wall_block(self, f: GranularFrame) -> np.ndarray:
@@ -195,9 +196,10 @@ class MusenResultWriter(Writer):
         b = np.zeros((tri.count, 16))
         vert = tri.vertices if f.triangle_vertices is None else f.triangle_vertices
         b[:, 0:9] = np.asarray(vert, np.float64).reshape(-1, 9)
-        if f.triangle_force is not None:
-            b[:, 9:12] = f.triangle_force
-            b[:, 12] = np.linalg.norm(np.asarray(f.triangle_force, np.float64), axis=1)
+        force = f.triangle_force if f.saved_triangle_force is None else f.saved_triangle_force
+        if force is not None:                 # what cmusen saves, when the frame has it
+            b[:, 9:12] = force
+            b[:, 12] = np.linalg.norm(np.asarray(force, np.float64), axis=1)
         b[:, 13:16] = tri.velocity if f.triangle_velocity is None else f.triangle_velocity
         return b
 

@@ -76,8 +76,9 @@ class MdemResultWriter(MusenResultWriter):
         rows = np.asarray(frame.sphere_rows, np.int64)
         ids = self.sphere_ids[rows]
         self.n = max(self.n, 1 + int(ids.max()) if len(ids) else 0)
-        if self.bond_ids is not None and frame.bond_alive is not None and np.any(frame.bond_alive):
-            self.n = max(self.n, 1 + int(self.bond_ids[np.asarray(frame.bond_alive, bool)].max()))
+        kept = frame.bond_alive if frame.bond_saved is None else frame.bond_saved
+        if self.bond_ids is not None and kept is not None and np.any(kept):
+            self.n = max(self.n, 1 + int(self.bond_ids[np.asarray(kept, bool)].max()))
         values = np.zeros((self.n, tp.NCOLS))
         masks = np.zeros(self.n, np.uint32)
         values[ids, 0:3] = frame.position
@@ -96,6 +97,8 @@ class MdemResultWriter(MusenResultWriter):
         if self.bond_ids is not None:
             alive = (np.ones(len(self.bond_ids), bool) if frame.bond_alive is None
                      else np.asarray(frame.bond_alive, bool))
+            if frame.bond_saved is not None:      # MUSEN's save holds these bonds' values
+                alive = np.asarray(frame.bond_saved, bool)
             ids = self.bond_ids[alive]
             if frame.bond_force is not None:
                 values[ids, 18:21] = np.asarray(frame.bond_force, np.float64)[alive]
@@ -113,8 +116,9 @@ class MdemResultWriter(MusenResultWriter):
             values[ids, _Q:_Q + 3] = vert[:, 3:6]
             values[ids, 9:12] = vert[:, 6:9]
             values[ids, 6:9] = tri.velocity if frame.triangle_velocity is None else frame.triangle_velocity
-            if frame.triangle_force is not None:
-                values[ids, 18:21] = frame.triangle_force
+            force = frame.triangle_force if frame.saved_triangle_force is None else frame.saved_triangle_force
+            if force is not None:               # what cmusen saves, when the frame has it
+                values[ids, 18:21] = force
             masks[ids] = WALL_FIELDS
         try:
             self.mdem.add(float(frame.time), values, masks)

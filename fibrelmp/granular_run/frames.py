@@ -31,8 +31,9 @@ class _BreakLog:
     |M_n + M_t| as it broke), with MUSEN's time 4th with a variable time step, ``step id1
     id2`` from other bond styles."""
 
-    def __init__(self, path: Path | None):
+    def __init__(self, path: Path | None, keep_states: bool = False):
         self.path = path
+        self.keep_states = keep_states       # keep what each bond held as it broke (presaves)
         self.fh = None
         self.pending = b""
         self.rows: list[tuple[float, float, float]] = []
@@ -59,7 +60,7 @@ class _BreakLog:
                 self.rows.append((float(w[0]), float(w[1]), float(w[2])))
             if len(w) in (4, 11):
                 self.times[(int(w[0]), int(w[1]), int(w[2]))] = float(w[3])
-            if len(w) >= 10:
+            if len(w) >= 10 and self.keep_states:
                 self.forces.append((int(w[0]), int(w[1]), int(w[2]), *map(float, w[-7:])))
         out = [(int(s), int(a), int(b)) for s, a, b in self.rows if s <= step]
         self.rows = [r for r in self.rows if r[0] > step]
@@ -87,7 +88,7 @@ class FrameBuilder:
         self.bonds = iter_frames(job.bond_dump) if job.bond_dump is not None else None
         self.tiles = iter_frames(job.tile_dump) if job.tile_dump is not None else None
         self.mesh = iter_frames(job.wall_forces) if job.wall_forces is not None else None
-        self.breaks = _BreakLog(job.breaks)
+        self.breaks = _BreakLog(job.breaks, keep_states=job.stress_contacts is not None)
         # MUSEN's stress tensor: the previous evaluation's bonds and contacts, one block per frame
         self.stress_contacts = iter_frames(job.stress_contacts) if job.stress_contacts is not None else None
         self.stress_walls = iter_frames(job.stress_walls) if job.stress_walls is not None else None
@@ -365,6 +366,11 @@ class FrameBuilder:
             bf[rows], overlap[rows] = gone[:, 3:6] * sign[:, None], gone[:, 6:9] * sign[:, None]
             torque[rows] = gone[:, 9]
             held[rows] = True
+            # a bond alive but not in the presave (an inlet made it in the frame's last step):
+            # new in cmusen's save, its values 0
+            new = self.bond_alive & ~held
+            bf[new], overlap[new], torque[new] = 0.0, 0.0, 0.0
+            held |= new
             frame.bond_saved = held
         bf[~held] = 0.0
         frame.bond_force = bf
@@ -397,7 +403,7 @@ class FrameBuilder:
             cols = block.columns
             if "cpx" in cols:            # sphere-wall contacts: after the pairs, by sphere
                 r = cols["id"].astype(np.int64) - 1
-                order = np.lexsort((cols["tri"], r))
+                order = np.argsort(r, kind="stable")       # each sphere's in its collision order
                 point = np.column_stack([cols["cpx"], cols["cpy"], cols["cpz"]])
                 force = np.column_stack([cols["fx"], cols["fy"], cols["fz"]])
                 walls = (r[order], point[order], force[order])
@@ -412,6 +418,7 @@ class FrameBuilder:
                 order = np.lexsort((ids.max(1), ids.min(1)))          # by sphere pair
             else:                        # bonds, broken ones included, in MUSEN's bond order
                 gone = self.breaks.broken_between(prev, step - 1)
+                gone = gone[self._bond_lookup(gone[:, 1].astype(np.int64), gone[:, 2].astype(np.int64)) >= 0]
                 ids = np.r_[ids, gone[:, 1:3].astype(np.int64)]
                 force = np.r_[force, gone[:, 3:6]]
                 order = np.argsort(self._bond_lookup(ids[:, 0], ids[:, 1]), kind="stable")
@@ -549,7 +556,7 @@ def _presave_wall_forces(tforce: np.ndarray, mesh_rows: np.ndarray, cols: dict) 
     each sphere (MUSEN's ConsolidateWall), added sphere by sphere (its collision order)."""
     if not len(cols.get("id", [])):
         return
-    order = np.lexsort((cols["tri"], cols["id"]))
+    order = np.argsort(cols["id"], kind="stable")      # each sphere's in its collision order
     tri = cols["tri"].astype(np.int64)[order] - 1
     force = np.column_stack([cols["fx"], cols["fy"], cols["fz"]])[order]
     np.add.at(tforce, mesh_rows[tri], -1 * force)

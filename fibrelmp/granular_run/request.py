@@ -24,7 +24,8 @@ def render(model: "GranularModel"):
         else:
             job, text, _ = build_granular_job(model, folder)
         dumps = [p for p in (job.frames, job.bond_dump, job.tile_dump, job.breaks, job.wall_forces,
-                             job.contacts, job.variable_clock) if p is not None]
+                             job.contacts, job.variable_clock, job.stress_contacts, job.stress_walls)
+                 if p is not None]
         return Rendered(job, text, job.save_steps, dumps)
     return build
 

@@ -269,8 +269,15 @@ def with_presaves(acts: list[tuple]) -> list[tuple]:
                 if out[j][0] != "run":
                     raise RuntimeError(f"a frame after {out[j]!r}, not after a run")
                 _, n, pre = out[j]
-                split = ([("run", n - 1, pre)] if n > 1 else []) + [("presave",), ("run", 1, pre and n == 1)]
-                out[j:j + 1] = split
+                if n > 1:
+                    out[j:j + 1] = [("run", n - 1, pre), ("presave",), ("run", 1, False)]
+                else:
+                    # a one-step run after deletions: the presave goes before them (delete_atoms
+                    # drops the ghost atoms until the next set-up, and the pairs with them)
+                    k = j
+                    while k > 0 and out[k - 1][0] == "delete":
+                        k -= 1
+                    out.insert(k, ("presave",))
         out.append(act)
     return out
 

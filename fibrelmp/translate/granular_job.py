@@ -342,8 +342,6 @@ def _no_stress(model: GranularModel, musen_hm: bool, geometry, has_bonds: bool, 
         return "it needs bond style musen/elastic"
     if len(physics.chosen_all(model, "PP")) > 1:
         return "with several particle-particle models (MUSEN takes the last one's force alone)"
-    if has_bonds and len(physics.chosen_all(model, "SB")) > 1:
-        return "with several solid-bond models (MUSEN takes the last one's force alone)"
     walls = model.triangles.count if model.triangles is not None else 0
     if walls and meshed < walls:
         return "with walls outside fix musen/wall/mesh"

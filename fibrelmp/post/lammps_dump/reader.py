@@ -375,11 +375,19 @@ def _read_header(st: _Stream, path: Path, first: bytes, warnings: list | None,
     time = units = tilt = None
     box = None
     line = first
+    seen: set[str] = set()
     while True:
         text = _decode(line)
         if not text.startswith("ITEM:"):
             raise InputError(path, st.line, _not_an_item(text, line is first, prev))
         item = text[5:].strip()
+        # an item twice in one header: a frame cut before its atom block (else the next
+        # frame's items would silently replace this one's)
+        key = item.split()[0] if not item.startswith("NUMBER OF") else "NUMBER OF"
+        if key in seen:
+            raise InputError(path, st.line, f"ITEM: {key} again before an ITEM: ATOMS (or ENTRIES) "
+                             f"block: the frame starting at line {start} has none")
+        seen.add(key)
         if item.startswith(("ATOMS", "ENTRIES")):
             kind = "ATOMS" if item.startswith("ATOMS") else "ENTRIES"
             missing = [w for w, v in (("TIMESTEP", step), ("NUMBER OF " + kind, count)) if v is None]

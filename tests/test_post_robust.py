@@ -114,6 +114,8 @@ def test_dump_local_entries(tmp_path):
     (frame(0, ROWS).replace("NUMBER OF ATOMS\n3", "NUMBER OF ATOMS\n4") + frame(1, ROWS), 13,
      "frame has 3 atom lines but NUMBER OF ATOMS says 4"),
     (frame(0, ROWS).replace("ITEM: BOX BOUNDS", "ITEM: WHATEVER"), 5, "unknown dump item"),
+    # an empty item (hypothesis found it raising IndexError once)
+    ("ITEM:\r\n TIMESTEP\n0\n" + frame(0, ROWS), 1, "unknown dump item"),
     # a frame cut after its header's NUMBER OF ATOMS, another frame after it: not merged
     ("ITEM: TIMESTEP\n7\nITEM: NUMBER OF ATOMS\n0\n" + frame(0, ROWS), 5,
      "ITEM: TIMESTEP again before an ITEM: ATOMS (or ENTRIES) block: the frame starting at line 1"),

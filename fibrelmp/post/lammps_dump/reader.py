@@ -383,7 +383,7 @@ def _read_header(st: _Stream, path: Path, first: bytes, warnings: list | None,
         item = text[5:].strip()
         # an item twice in one header: a frame cut before its atom block (else the next
         # frame's items would silently replace this one's)
-        key = item.split()[0] if not item.startswith("NUMBER OF") else "NUMBER OF"
+        key = "NUMBER OF" if item.startswith("NUMBER OF") else (item.split() or [""])[0]
         if key in seen:
             raise InputError(path, st.line, f"ITEM: {key} again before an ITEM: ATOMS (or ENTRIES) "
                              f"block: the frame starting at line {start} has none")

@@ -88,13 +88,16 @@ class FrameBuilder:
         self.bonds = iter_frames(job.bond_dump) if job.bond_dump is not None else None
         self.tiles = iter_frames(job.tile_dump) if job.tile_dump is not None else None
         self.mesh = iter_frames(job.wall_forces) if job.wall_forces is not None else None
-        self.breaks = _BreakLog(job.breaks, keep_states=job.stress_contacts is not None)
-        # MUSEN's stress tensor: the previous evaluation's bonds and contacts, one block per frame
-        self.stress_contacts = iter_frames(job.stress_contacts) if job.stress_contacts is not None else None
+        # presaves (MUSEN's stress tensor, its saved bonds and wall forces): the previous
+        # evaluation's bonds, contacts and wall contacts, one block per frame
+        self.presaves = job.stress_contacts is not None
+        self.breaks = _BreakLog(job.breaks, keep_states=self.presaves)
+        self.stress_contacts = iter_frames(job.stress_contacts) if self.presaves else None
         self.stress_walls = iter_frames(job.stress_walls) if job.stress_walls is not None else None
         self.first_frame = True
-        self.bond_block = None           # the bond dump's block of the frame being read
-        self.presave: list = []          # (path, block) of the presave dumps of that frame
+        # the blocks of the frame being read: the bond dump's (read by _bonds), the contacts',
+        # the wall contacts'
+        self.bond_block = self.contact_block = self.wall_block = None
         self.prev_frame_step = 0
         self.sphere_end = np.full(sp.count, np.inf)
         self.present = np.zeros(sp.count, bool)
@@ -216,15 +219,16 @@ class FrameBuilder:
             self.temperatures.append(_temperature_figures(t, step, frame.temperature))
         if "sfx" in c:      # fix musen/leapfrog: the force cmusen saves (the previous evaluation's)
             frame.saved_force = np.column_stack([c["sfx"], c["sfy"], c["sfz"]])
-        # the presave's contacts and wall contacts (MUSEN's stress tensor, its wall forces)
-        self.presave = [(path, next(it, None)) for path, it in ((job.stress_contacts, self.stress_contacts),
-                                                                 (job.stress_walls, self.stress_walls))
-                        if it is not None]
+        if self.presaves:
+            self.contact_block = next(self.stress_contacts, None)
+            self.wall_block = next(self.stress_walls, None) if self.stress_walls is not None else None
         if self.nb:
             self._bonds(frame, step)
+        if self.presaves:
+            self._check_presaves(step)
         if self.v0 is not None:
             self._triangles(frame, t, c)
-        if self.stress_contacts is not None:
+        if self.presaves:
             self._stress(frame, step)
         self.prev_t, self.prev_x[rows], self.prev_v[rows] = t, pos, vel
         return frame
@@ -340,7 +344,7 @@ class FrameBuilder:
             i1 = cols["c_fl_bpair[1]"].astype(np.int64)
             i2 = cols["c_fl_bpair[2]"].astype(np.int64)
             fb = np.column_stack([cols[f"c_fl_bforce[{k}]"] for k in range(1, 4)])
-            if self.job.stress_contacts is not None and self.first_frame:
+            if self.presaves and self.first_frame:
                 fb = np.zeros_like(fb)   # cmusen's first save: no evaluation yet, TotalForce 0
             br = self._bond_lookup(i1, i2)
             ok = br >= 0
@@ -354,7 +358,7 @@ class FrameBuilder:
                 overlap[br[ok]] = ov[ok] * sign[:, None]
                 torque[br[ok]] = cols["c_fl_bforce[7]"][ok]
         held = self.bond_alive
-        if self.job.stress_contacts is not None and extra:
+        if self.presaves and extra:
             # cmusen's save holds the bonds alive before its step's evaluation (the presave's)
             # and, once more, those broken since the previous save, as they broke
             held = dumped
@@ -380,49 +384,45 @@ class FrameBuilder:
             frame.bond_tangential_overlap = overlap
             frame.bond_torque = torque
 
+    def _check_presaves(self, step: int) -> None:
+        """Every presave block of the frame at ``step`` is there, written one step before it
+        (the first frame's at its own step)."""
+        job = self.job
+        blocks = [(job.bond_dump, self.bond_block)] if self.bonds is not None else []
+        blocks += [(job.stress_contacts, self.contact_block)]
+        blocks += [(job.stress_walls, self.wall_block)] if self.stress_walls is not None else []
+        for path, block in blocks:
+            if block is None or (not self.first_frame and block.step != step - 1):
+                raise wrong_frame(path, step - 1, None if block is None else block.step)
+
     def _stress(self, frame: GranularFrame, step: int) -> None:
         """MUSEN's stress tensor of the frame's spheres (granular_run.stress) from the presave
         dumps written one step before it; 0 at the first frame (cmusen saves it before any
-        evaluation, with no contact listed and no bond force yet).  A bond broken since the
-        previous frame still counts, with the force it broke with: MUSEN marks its object
-        inactive only at the save after the break."""
-        job = self.job
-        # bonds (the bond dump _bonds read: the same presave), contacts, walls: MUSEN's order
-        got = [(job.bond_dump, self.bond_block)] if self.bonds is not None else []
-        got += self.presave
+        evaluation, with no contact listed and no bond force yet).  The bonds are those the
+        save holds, with their saved force (``_bonds``): a bond broken since the previous
+        frame still counts, with the force it broke with, as MUSEN marks its object inactive
+        only at the save after the break."""
         first, self.first_frame = self.first_frame, False
-        for path, block in got:
-            if block is None or (not first and block.step != step - 1):
-                raise wrong_frame(path, step - 1, None if block is None else block.step)
-        prev, self.prev_frame_step = self.prev_frame_step, step
+        self.prev_frame_step = step
         if first:
             frame.stress_tensor = np.zeros((len(frame.sphere_rows), 9))
             return
-        pairs, walls = [], None
-        for path, block in got:
-            cols = block.columns
-            if "cpx" in cols:            # sphere-wall contacts: after the pairs, by sphere
-                r = cols["id"].astype(np.int64) - 1
-                order = np.argsort(r, kind="stable")       # each sphere's in its collision order
-                point = np.column_stack([cols["cpx"], cols["cpy"], cols["cpz"]])
-                force = np.column_stack([cols["fx"], cols["fy"], cols["fz"]])
-                walls = (r[order], point[order], force[order])
-                continue
-            if "c_fl_bpair[1]" in cols:   # the bond dump's columns
-                cols = {"id1": cols["c_fl_bpair[1]"], "id2": cols["c_fl_bpair[2]"],
-                        **{c: cols[f"c_fl_bforce[{k}]"] for k, c in ((1, "fx"), (2, "fy"), (3, "fz"))}}
-            ids = np.column_stack([cols.get("id1", []), cols.get("id2", [])]).astype(np.int64)
-            force = np.column_stack([cols.get(c, []) for c in ("fx", "fy", "fz")]).reshape(-1, 3)
-            if "ftx" in cols:            # a contact: its normal and tangential force on id1
-                force = force + np.column_stack([cols["ftx"], cols["fty"], cols["ftz"]])
-                order = np.lexsort((ids.max(1), ids.min(1)))          # by sphere pair
-            else:                        # bonds, broken ones included, in MUSEN's bond order
-                gone = self.breaks.broken_between(prev, step - 1)
-                gone = gone[self._bond_lookup(gone[:, 1].astype(np.int64), gone[:, 2].astype(np.int64)) >= 0]
-                ids = np.r_[ids, gone[:, 1:3].astype(np.int64)]
-                force = np.r_[force, gone[:, 3:6]]
-                order = np.argsort(self._bond_lookup(ids[:, 0], ids[:, 1]), kind="stable")
+        pairs = []
+        if frame.bond_saved is not None:       # in MUSEN's bond order, force on the first sphere
+            held = np.flatnonzero(frame.bond_saved)
+            pair = self.model.bonds.pair[held]
+            pairs.append((pair[:, 0], pair[:, 1], frame.bond_force[held]))
+        cols = self.contact_block.columns      # contacts: normal and tangential force on id1
+        if len(cols.get("id1", [])):
+            ids = np.column_stack([cols["id1"], cols["id2"]]).astype(np.int64)
+            force = (np.column_stack([cols["fx"], cols["fy"], cols["fz"]])
+                     + np.column_stack([cols["ftx"], cols["fty"], cols["ftz"]]))
+            order = np.lexsort((ids.max(1), ids.min(1)))          # by sphere pair
             pairs.append((ids[order, 0] - 1, ids[order, 1] - 1, force[order]))
+        walls = None
+        if self.wall_block is not None:
+            rows, _, point, force = _wall_contacts(self.wall_block.columns)
+            walls = (rows, point, force)
         frame.stress_tensor = stress_tensors(np.asarray(frame.sphere_rows, np.int64), frame.position,
                                              np.asarray(self.model.spheres.radius, np.float64), pairs,
                                              walls)
@@ -467,13 +467,14 @@ class FrameBuilder:
             fm = next(self.mesh).columns
             k = fm["id"].astype(np.int64) - 1
             tforce[self.job.mesh_rows[k]] = np.column_stack([fm["fx"], fm["fy"], fm["fz"]])
-            walls = [block for path, block in self.presave if path == self.job.stress_walls]
-            if walls and walls[0] is not None:
-                # with presaves, what cmusen saves: the previous evaluation's (0 before any)
+            if self.wall_block is not None:
+                # with presaves, what cmusen saves: minus the previous evaluation's contact
+                # forces, sphere by sphere (MUSEN's ConsolidateWall; 0 before any evaluation)
                 saved = tforce.copy()
                 saved[self.job.mesh_rows] = 0.0
                 if not self.first_frame:
-                    _presave_wall_forces(saved, self.job.mesh_rows, walls[0].columns)
+                    rows, tri, _, force = _wall_contacts(self.wall_block.columns)
+                    np.add.at(saved, self.job.mesh_rows[tri], -1 * force)
                 frame.saved_triangle_force = saved
             if "x1" in fm:
                 # geometries the fix moves step by step: where it moved them, their velocity
@@ -551,15 +552,15 @@ def _stepped_walls(job, fm: dict, k: np.ndarray, verts: np.ndarray, tvel: np.nda
     tvel[rows[sel]] = np.column_stack([fm["vx"], fm["vy"], fm["vz"]])[sel]
 
 
-def _presave_wall_forces(tforce: np.ndarray, mesh_rows: np.ndarray, cols: dict) -> None:
-    """Each mesh triangle's force from the presave's sphere-wall contacts: minus the force on
-    each sphere (MUSEN's ConsolidateWall), added sphere by sphere (its collision order)."""
-    if not len(cols.get("id", [])):
-        return
-    order = np.argsort(cols["id"], kind="stable")      # each sphere's in its collision order
-    tri = cols["tri"].astype(np.int64)[order] - 1
-    force = np.column_stack([cols["fx"], cols["fy"], cols["fz"]])[order]
-    np.add.at(tforce, mesh_rows[tri], -1 * force)
+def _wall_contacts(cols: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(sphere rows, triangle rows in the mesh, contact points, forces on the spheres) of a
+    presave block of fix musen/wall/mesh's contacts, each sphere's in its collision order."""
+    rows = np.asarray(cols.get("id", []), np.float64).astype(np.int64) - 1
+    order = np.argsort(rows, kind="stable")
+    tri = np.asarray(cols.get("tri", []), np.float64).astype(np.int64)[order] - 1
+    point = np.column_stack([cols.get(c, []) for c in ("cpx", "cpy", "cpz")]).reshape(-1, 3)[order]
+    force = np.column_stack([cols.get(c, []) for c in ("fx", "fy", "fz")]).reshape(-1, 3)[order]
+    return rows[order], tri, point, force
 
 
 def _clock(job) -> Callable[[int], float]:

@@ -547,3 +547,19 @@ class GranularFrame:
                                                # (granular_run.stress), when the job computes it
     saved_force: np.ndarray | None = None      # (n',3) the force cmusen saves now (MUSEN's
                                                # integrator: the previous evaluation's)
+
+    # what a MUSEN result saves (cmusen's values where the frame has them, else the frame's)
+    def sphere_force_as_saved(self) -> np.ndarray:
+        """(n',3) the sphere forces a MUSEN result saves."""
+        return np.asarray(self.force if self.saved_force is None else self.saved_force,
+                          np.float64).reshape(-1, 3)
+
+    def triangle_force_as_saved(self) -> np.ndarray | None:
+        """(k,3) the wall triangles' forces a MUSEN result saves (None: not known)."""
+        return self.triangle_force if self.saved_triangle_force is None else self.saved_triangle_force
+
+    def bonds_as_saved(self, count: int) -> np.ndarray:
+        """(count,) bool: the bonds whose values a MUSEN result saves (``bond_saved``, else
+        the alive ones, else all)."""
+        held = self.bond_alive if self.bond_saved is None else self.bond_saved
+        return np.ones(count, bool) if held is None else np.asarray(held, bool)

@@ -50,6 +50,11 @@ _CHUNK = 4096
 _VALUES_PER_CHUNK = 1_000_000         # ~8 MB of floats (+ their text) per formatting chunk
 
 
+def _width(spec) -> int:
+    """Spool columns of one object's time point: the fields' values, in the spec's order."""
+    return sum(w for _, _, w in spec)
+
+
 def _property(mat, pid: int) -> float:
     """A material property as simulated: the Material fields win over ``props``."""
     fields = {0: mat.density, 7: mat.youngs, 8: mat.normal_strength, 9: mat.shear_strength,
@@ -150,10 +155,9 @@ class MusenResultWriter(Writer):
         # spheres not in the frame are written as zeros, as MUSEN stores nothing for them
         n = self.model.spheres.count
         stress = self.sphere_spec is _SPHERE_STRESS
-        b = np.zeros((n, sum(w for _, _, w in self.sphere_spec)))
+        b = np.zeros((n, _width(self.sphere_spec)))
         # MUSEN saves the previous evaluation's force (docs/musen.md, saved time points)
-        saved = f.force if f.saved_force is None else f.saved_force
-        force = np.asarray(saved, np.float64).reshape(-1, 3)
+        force = f.sphere_force_as_saved()
         b[rows, 0:3] = f.omega
         b[rows, 3:6] = f.position
         b[rows, 6:9] = force
@@ -173,14 +177,12 @@ class MusenResultWriter(Writer):
     def _bond_block(self, f: GranularFrame, s: np.ndarray) -> np.ndarray:
         bonds = self.model.bonds
         pair = bonds.pair
-        b = np.zeros((bonds.count, 15))
+        b = np.zeros((bonds.count, _width(_BOND)))
         # midpoint / mean velocity of the two spheres as the frame has them (0 when absent)
-        v = sum(w for _, _, w in self.sphere_spec) - 3        # the velocity is the last field
+        v = _width(self.sphere_spec) - 3        # the velocity is the last field
         b[:, 0:3] = 0.5 * (s[pair[:, 0], 3:6] + s[pair[:, 1], 3:6])
         b[:, 12:15] = 0.5 * (s[pair[:, 0], v:v + 3] + s[pair[:, 1], v:v + 3])
-        alive = (np.ones(bonds.count, bool) if f.bond_alive is None
-                 else np.asarray(f.bond_alive, bool))
-        held = alive if f.bond_saved is None else np.asarray(f.bond_saved, bool)   # values saved
+        held = f.bonds_as_saved(bonds.count)
         if f.bond_force is not None:
             force = np.where(held[:, None], np.asarray(f.bond_force, np.float64), 0.0)
             b[:, 3:6] = force
@@ -193,11 +195,11 @@ class MusenResultWriter(Writer):
 
     def _wall_block(self, f: GranularFrame) -> np.ndarray:
         tri = self.model.triangles
-        b = np.zeros((tri.count, 16))
+        b = np.zeros((tri.count, _width(_WALL)))
         vert = tri.vertices if f.triangle_vertices is None else f.triangle_vertices
         b[:, 0:9] = np.asarray(vert, np.float64).reshape(-1, 9)
-        force = f.triangle_force if f.saved_triangle_force is None else f.saved_triangle_force
-        if force is not None:                 # what cmusen saves, when the frame has it
+        force = f.triangle_force_as_saved()
+        if force is not None:
             b[:, 9:12] = force
             b[:, 12] = np.linalg.norm(np.asarray(force, np.float64), axis=1)
         b[:, 13:16] = tri.velocity if f.triangle_velocity is None else f.triangle_velocity
@@ -277,12 +279,12 @@ class MusenResultWriter(Writer):
         nt = len(self.times)
         maps = {}
         m = self.model
-        for name, count, width in (("s", m.spheres.count, sum(w for _, _, w in self.sphere_spec)),
-                                   ("b", 0 if m.bonds is None else m.bonds.count, 15),
-                                   ("w", 0 if m.triangles is None else m.triangles.count, 16)):
+        for name, count, width in (("s", m.spheres.count, _width(self.sphere_spec)),
+                                   ("b", 0 if m.bonds is None else m.bonds.count, _width(_BOND)),
+                                   ("w", 0 if m.triangles is None else m.triangles.count, _width(_WALL))):
             if nt and count:
                 maps[name] = (self.spool / f"{name}.bin", count, width)
-        most = 1 + max(sum(w for _, _, w in spec) for spec in (self.sphere_spec, _BOND, _WALL))
+        most = 1 + max(_width(spec) for spec in (self.sphere_spec, _BOND, _WALL))
         piece = long_lines(nt, most, _VALUES_PER_CHUNK)
         if piece is not None:               # many saves: one line at a time, in pieces
             for i in range(len(ids)):

@@ -76,16 +76,16 @@ class MdemResultWriter(MusenResultWriter):
         rows = np.asarray(frame.sphere_rows, np.int64)
         ids = self.sphere_ids[rows]
         self.n = max(self.n, 1 + int(ids.max()) if len(ids) else 0)
-        kept = frame.bond_alive if frame.bond_saved is None else frame.bond_saved
-        if self.bond_ids is not None and kept is not None and np.any(kept):
-            self.n = max(self.n, 1 + int(self.bond_ids[np.asarray(kept, bool)].max()))
+        if self.bond_ids is not None:            # the bonds this time point holds values of
+            kept = frame.bonds_as_saved(len(self.bond_ids))
+            if np.any(kept):
+                self.n = max(self.n, 1 + int(self.bond_ids[kept].max()))
         values = np.zeros((self.n, tp.NCOLS))
         masks = np.zeros(self.n, np.uint32)
         values[ids, 0:3] = frame.position
         values[ids, 6:9] = frame.velocity
         values[ids, 9:12] = frame.omega
-        saved = frame.force if frame.saved_force is None else frame.saved_force    # MUSEN's saved force
-        values[ids, 18:21] = np.asarray(saved, np.float64).reshape(-1, 3)
+        values[ids, 18:21] = frame.sphere_force_as_saved()
         values[ids, _Q:_Q + 4] = frame.quaternion
         masks[ids] = SPHERE_FIELDS
         if frame.temperature is not None:      # a heat model ran (MUSEN saves it then)
@@ -95,10 +95,7 @@ class MdemResultWriter(MusenResultWriter):
             values[ids, tp.columns("stress_tensor")] = frame.stress_tensor
             masks[ids] |= tp.bit("stress_tensor")
         if self.bond_ids is not None:
-            alive = (np.ones(len(self.bond_ids), bool) if frame.bond_alive is None
-                     else np.asarray(frame.bond_alive, bool))
-            if frame.bond_saved is not None:      # MUSEN's save holds these bonds' values
-                alive = np.asarray(frame.bond_saved, bool)
+            alive = frame.bonds_as_saved(len(self.bond_ids))
             ids = self.bond_ids[alive]
             if frame.bond_force is not None:
                 values[ids, 18:21] = np.asarray(frame.bond_force, np.float64)[alive]
@@ -116,8 +113,8 @@ class MdemResultWriter(MusenResultWriter):
             values[ids, _Q:_Q + 3] = vert[:, 3:6]
             values[ids, 9:12] = vert[:, 6:9]
             values[ids, 6:9] = tri.velocity if frame.triangle_velocity is None else frame.triangle_velocity
-            force = frame.triangle_force if frame.saved_triangle_force is None else frame.saved_triangle_force
-            if force is not None:               # what cmusen saves, when the frame has it
+            force = frame.triangle_force_as_saved()
+            if force is not None:
                 values[ids, 18:21] = force
             masks[ids] = WALL_FIELDS
         try:

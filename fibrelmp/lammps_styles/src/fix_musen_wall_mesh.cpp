@@ -26,6 +26,7 @@
 #include "utils.h"
 
 #include <algorithm>
+#include <functional>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -1253,18 +1254,48 @@ double FixMusenWallMesh::compute_vector(int i)
   return fgeom_all[i];
 }
 
-/* fix_modify ID contacts FILE [append yes|no]: the last evaluation's sphere-wall contacts as
-   one local-dump frame (id tri cpx cpy cpz fx fy fz: the sphere, the triangle, the contact
-   point, the force on the sphere), gathered on rank 0 (MUSEN's stress tensor) */
-int FixMusenWallMesh::write_contacts(int narg, char **arg)
+/* fix_modify ID KEYWORD FILE [append yes|no]: rank 0 opens FILE (for appending with append
+   yes) and write_body writes one dump frame into it; every rank learns whether that worked.
+   Returns the words used. */
+int FixMusenWallMesh::write_dump_frame(int narg, char **arg,
+                                       const std::function<void(FILE *)> &write_body)
 {
-  if (narg < 2) error->all(FLERR, "Illegal fix_modify {} contacts command: contacts FILE [append yes|no]", id);
+  if (narg < 2)
+    error->all(FLERR, "Illegal fix_modify {} {} command: {} FILE [append yes|no]", id, arg[0], arg[0]);
   bool append = false;
   int used = 2;
   if (narg >= 4 && strcmp(arg[2], "append") == 0) {
     append = utils::logical(FLERR, arg[3], false, lmp) != 0;
     used = 4;
   }
+  int ok = 1;
+  if (comm->me == 0) {
+    FILE *fp = fopen(arg[1], append ? "a" : "w");
+    if (!fp) {
+      ok = 0;
+    } else {
+      write_body(fp);
+      if (fclose(fp) != 0) ok = 0;
+    }
+  }
+  MPI_Bcast(&ok, 1, MPI_INT, 0, world);
+  if (!ok) error->all(FLERR, "Fix musen/wall/mesh: cannot write {}", arg[1]);
+  return used;
+}
+
+/* a dump frame's items up to its ATOMS (or ENTRIES: KIND) line: this step, N rows, the box */
+void FixMusenWallMesh::dump_header(FILE *fp, const char *kind, size_t n) const
+{
+  fmt::print(fp, "ITEM: TIMESTEP\n{}\nITEM: NUMBER OF {}\n{}\nITEM: BOX BOUNDS ff ff ff\n",
+             update->ntimestep, kind, n);
+  for (int k = 0; k < 3; k++) fmt::print(fp, "{:.17g} {:.17g}\n", domain->boxlo[k], domain->boxhi[k]);
+}
+
+/* fix_modify ID contacts FILE [append yes|no]: the last evaluation's sphere-wall contacts as
+   one local-dump frame (id tri cpx cpy cpz fx fy fz: the sphere, the triangle, the contact
+   point, the force on the sphere), gathered on rank 0 (MUSEN's stress tensor) */
+int FixMusenWallMesh::write_contacts(int narg, char **arg)
+{
   int mine = static_cast<int>(contact_rec.size());
   std::vector<int> counts(comm->nprocs), displs(comm->nprocs, 0);
   MPI_Gather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, world);
@@ -1275,28 +1306,16 @@ int FixMusenWallMesh::write_contacts(int narg, char **arg)
   }
   MPI_Gatherv(contact_rec.data(), mine, MPI_DOUBLE, all.data(), counts.data(), displs.data(),
               MPI_DOUBLE, 0, world);
-  int ok = 1;
-  if (comm->me == 0) {
-    FILE *fp = fopen(arg[1], append ? "a" : "w");
-    if (!fp) {
-      ok = 0;
-    } else {
-      const size_t n = all.size() / 8;
-      fmt::print(fp, "ITEM: TIMESTEP\n{}\nITEM: NUMBER OF ENTRIES\n{}\nITEM: BOX BOUNDS ff ff ff\n",
-                 update->ntimestep, n);
-      for (int k = 0; k < 3; k++) fmt::print(fp, "{:.17g} {:.17g}\n", domain->boxlo[k], domain->boxhi[k]);
-      fputs("ITEM: ENTRIES id tri cpx cpy cpz fx fy fz\n", fp);
-      for (size_t r = 0; r < n; r++) {
-        const double *v = &all[8 * r];
-        fprintf(fp, "%.0f %.0f %.17g %.17g %.17g %.17g %.17g %.17g\n", v[0], v[1], v[2], v[3], v[4],
-                v[5], v[6], v[7]);
-      }
-      if (fclose(fp) != 0) ok = 0;
+  return write_dump_frame(narg, arg, [&](FILE *fp) {
+    const size_t n = all.size() / 8;
+    dump_header(fp, "ENTRIES", n);
+    fputs("ITEM: ENTRIES id tri cpx cpy cpz fx fy fz\n", fp);
+    for (size_t r = 0; r < n; r++) {
+      const double *v = &all[8 * r];
+      fprintf(fp, "%.0f %.0f %.17g %.17g %.17g %.17g %.17g %.17g\n", v[0], v[1], v[2], v[3], v[4],
+              v[5], v[6], v[7]);
     }
-  }
-  MPI_Bcast(&ok, 1, MPI_INT, 0, world);
-  if (!ok) error->all(FLERR, "Fix musen/wall/mesh: cannot write {}", arg[1]);
-  return used;
+  });
 }
 
 /* fix_modify ID write FILE [append yes|no]: one dump frame of the per-triangle forces */
@@ -1304,45 +1323,26 @@ int FixMusenWallMesh::modify_param(int narg, char **arg)
 {
   if (strcmp(arg[0], "contacts") == 0) return write_contacts(narg, arg);
   if (strcmp(arg[0], "write") != 0) return 0;
-  if (narg < 2) error->all(FLERR, "Illegal fix_modify {} write command: write FILE [append yes|no]", id);
-  bool append = false;
-  int used = 2;
-  if (narg >= 4 && strcmp(arg[2], "append") == 0) {
-    append = utils::logical(FLERR, arg[3], false, lmp) != 0;
-    used = 4;
-  }
   reduce_forces();
-  int ok = 1;
-  if (comm->me == 0) {
-    FILE *fp = fopen(arg[1], append ? "a" : "w");
-    if (!fp) {
-      ok = 0;
-    } else {
-      fmt::print(fp, "ITEM: TIMESTEP\n{}\nITEM: NUMBER OF ATOMS\n{}\nITEM: BOX BOUNDS ff ff ff\n",
-                 update->ntimestep, ntri);
-      for (int k = 0; k < 3; k++) fmt::print(fp, "{:.17g} {:.17g}\n", domain->boxlo[k], domain->boxhi[k]);
-      fputs(any_stepped ? "ITEM: ATOMS id fx fy fz vx vy vz x1 y1 z1 x2 y2 z2 x3 y3 z3\n"
-                        : "ITEM: ATOMS id fx fy fz\n", fp);
-      for (int t = 0; t < ntri; t++) {
-        fprintf(fp, "%d %.17g %.17g %.17g", t + 1, ftri_all[3 * (size_t) t],
-                ftri_all[3 * (size_t) t + 1], ftri_all[3 * (size_t) t + 2]);
-        if (any_stepped) {
-          // before the first time step MUSEN's frame precedes its prediction update: the
-          // walls where and as they started
-          const bool first = at_start && !start_vert.empty();
-          const double *gv = first ? geoms[tgeom[t]].start_vel : geoms[tgeom[t]].vel;
-          const double *p = first ? &start_vert[9 * (size_t) t] : &vert[9 * (size_t) t];
-          fprintf(fp, " %.17g %.17g %.17g", gv[0], gv[1], gv[2]);
-          for (int k = 0; k < 9; k++) fprintf(fp, " %.17g", p[k]);
-        }
-        fputc('\n', fp);
+  return write_dump_frame(narg, arg, [&](FILE *fp) {
+    dump_header(fp, "ATOMS", (size_t) ntri);
+    fputs(any_stepped ? "ITEM: ATOMS id fx fy fz vx vy vz x1 y1 z1 x2 y2 z2 x3 y3 z3\n"
+                      : "ITEM: ATOMS id fx fy fz\n", fp);
+    for (int t = 0; t < ntri; t++) {
+      fprintf(fp, "%d %.17g %.17g %.17g", t + 1, ftri_all[3 * (size_t) t],
+              ftri_all[3 * (size_t) t + 1], ftri_all[3 * (size_t) t + 2]);
+      if (any_stepped) {
+        // before the first time step MUSEN's frame precedes its prediction update: the
+        // walls where and as they started
+        const bool first = at_start && !start_vert.empty();
+        const double *gv = first ? geoms[tgeom[t]].start_vel : geoms[tgeom[t]].vel;
+        const double *p = first ? &start_vert[9 * (size_t) t] : &vert[9 * (size_t) t];
+        fprintf(fp, " %.17g %.17g %.17g", gv[0], gv[1], gv[2]);
+        for (int k = 0; k < 9; k++) fprintf(fp, " %.17g", p[k]);
       }
-      if (fclose(fp) != 0) ok = 0;
+      fputc('\n', fp);
     }
-  }
-  MPI_Bcast(&ok, 1, MPI_INT, 0, world);
-  if (!ok) error->all(FLERR, "Fix musen/wall/mesh: cannot write {}", arg[1]);
-  return used;
+  });
 }
 
 /* the triangle forces of the last time step (restart files: a resumed run writes them in a

@@ -98,6 +98,8 @@ FixStyle(musen/wall/mesh,FixMusenWallMesh);
 #include "fix.h"
 #include "musen_pw_law.h"
 
+#include <cstdio>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -115,7 +117,6 @@ class FixMusenWallMesh : public Fix {
   void post_force(int) override;
   double compute_array(int, int) override;
   double compute_vector(int) override;
-  int write_contacts(int, char **);
   int modify_param(int, char **) override;
   void write_restart(FILE *) override;
   void restart(char *) override;
@@ -127,6 +128,9 @@ class FixMusenWallMesh : public Fix {
   enum { NO_CONTACT = 0, FACE_CONTACT = 1, EDGE_CONTACT = 2, VERTEX_CONTACT = 3 };
 
  private:
+  int write_contacts(int, char **);
+  int write_dump_frame(int, char **, const std::function<void(FILE *)> &);
+  void dump_header(FILE *, const char *, size_t) const;
   struct Segment {
     double t0, t1, w;
     double kr[4][3][3];

@@ -103,9 +103,9 @@ def check_other_contact_radius_is_refused(job: Path, scene: Path, line: int, con
     assert str(err.value).startswith(f"{job}:{line}: ")
 
 
-def run_cut_and_resumed(monkeypatch: pytest.MonkeyPatch, job: Path, work: Path, every: int) -> None:
+def run_to_first_checkpoint(monkeypatch: pytest.MonkeyPatch, job: Path, work: Path, every: int) -> None:
     """Run ``job`` with a checkpoint every ``every`` steps, stopped after its first checkpoint
-    (as if SIGTERM came), then resumed to the end."""
+    (as if SIGTERM came); ``--resume`` continues it."""
     import signal
 
     from fibrelmp import checkpoint
@@ -115,10 +115,16 @@ def run_cut_and_resumed(monkeypatch: pytest.MonkeyPatch, job: Path, work: Path, 
     def write_then_stop(self, *args, **kwargs):
         write(self, *args, **kwargs)
         self._stop = signal.SIGTERM
-    monkeypatch.setattr(checkpoint.Checkpointing, "write", write_then_stop)
-    with pytest.raises(checkpoint.CheckpointStop):
-        python_api.run(job, work=work, checkpoint_every=every)
-    monkeypatch.setattr(checkpoint.Checkpointing, "write", write)
+    with monkeypatch.context() as patch:
+        patch.setattr(checkpoint.Checkpointing, "write", write_then_stop)
+        with pytest.raises(checkpoint.CheckpointStop):
+            python_api.run(job, work=work, checkpoint_every=every)
+
+
+def run_cut_and_resumed(monkeypatch: pytest.MonkeyPatch, job: Path, work: Path, every: int) -> None:
+    """Run ``job`` with a checkpoint every ``every`` steps, stopped after its first checkpoint
+    (as if SIGTERM came), then resumed to the end."""
+    run_to_first_checkpoint(monkeypatch, job, work, every)
     python_api.run(job, work=work, resume=True)
 
 

@@ -184,29 +184,21 @@ def test_resume_cuts_the_presave_dumps_back(tmp_path, monkeypatch):
     """A run that died after its checkpoint may have appended presave blocks past it: a
     resumed run cuts stress_contacts.dump and stress_walls.dump back to the checkpoint (as
     every dump the script appends to) and writes the uninterrupted run's result."""
-    import signal
+    from fibrelmp import python_api
 
-    from fibrelmp import checkpoint, python_api
+    from .musen_model_checks import run_to_first_checkpoint
 
     case = MUSEN / "force_walls"
     whole, cut = tmp_path / "whole", tmp_path / "cut"
-    for folder in (whole, cut):
-        folder.mkdir()
-        _run(case, "job_press.txt", folder) if folder is whole else [
-            shutil.copy(case / n, folder) for n in ("job_press.txt", "press_scene.txt")]
-    write = checkpoint.Checkpointing.write
-
-    def write_then_stop(self, *args, **kwargs):
-        write(self, *args, **kwargs)
-        self._stop = signal.SIGTERM
-    monkeypatch.setattr(checkpoint.Checkpointing, "write", write_then_stop)
-    with pytest.raises(checkpoint.CheckpointStop):
-        python_api.run(cut / "job_press.txt", work=cut / "work", checkpoint_every=2290)
-    monkeypatch.setattr(checkpoint.Checkpointing, "write", write)
+    whole.mkdir()
+    cut.mkdir()
+    _run(case, "job_press.txt", whole)
+    for name in ("job_press.txt", "press_scene.txt"):
+        shutil.copy(case / name, cut)
+    run_to_first_checkpoint(monkeypatch, cut / "job_press.txt", cut / "work", 2290)
     for name in ("stress_contacts.dump", "stress_walls.dump"):    # as a crashed run leaves them:
         path = cut / "work" / "job2" / name                         # one more block, complete
         text = path.read_text()
         path.write_text(text + text[text.rindex("ITEM: TIMESTEP"):])
     python_api.run(cut / "job_press.txt", work=cut / "work", resume=True)
     assert (cut / "press_result_prec17.txt").read_bytes() == (whole / "press_result_prec17.txt").read_bytes()
-
